@@ -1,0 +1,157 @@
+//! Global characteristics: cell counts, components, boundary, Euler characteristic,
+//! orientability.
+
+use super::{AlphaMask, DartId, DartSet, GMap};
+
+/// Number of i-cells for each i in 0..=n.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
+pub struct CellCounts(pub Vec<usize>);
+
+impl CellCounts {
+    /// Σ (−1)^i · #i-cells.
+    pub fn euler_characteristic(&self) -> i64 {
+        self.0.iter().enumerate().map(|(i, &c)| if i % 2 == 0 { c as i64 } else { -(c as i64) }).sum()
+    }
+}
+
+/// The characteristics printed by `topomech info`.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
+pub struct MapSummary {
+    /// Live darts.
+    pub darts: usize,
+    /// i-cells per dimension.
+    pub cells: CellCounts,
+    /// (n−1)-cells on the boundary (made of αn-free darts).
+    pub boundary_faces: usize,
+    /// Connected components.
+    pub components: usize,
+    /// Σ (−1)^i · #i-cells.
+    pub euler_characteristic: i64,
+    /// Whether every component is orientable.
+    pub orientable: bool,
+    /// Whether `validate()` passed.
+    pub valid: bool,
+}
+
+impl<const N: usize> GMap<N> {
+    /// Number of i-cells for every i, read from the id allocators. O(n).
+    pub fn count_cells(&self) -> CellCounts {
+        CellCounts(self.ids.iter().map(|a| a.live()).collect())
+    }
+
+    /// Number of i-cells for every i, found by walking orbits (independent of cell ids).
+    /// O(darts · n²).
+    pub fn count_cells_by_traversal(&self) -> CellCounts {
+        CellCounts((0..=N).map(|i| self.count_orbits(AlphaMask::cell(N, i))).collect())
+    }
+
+    /// Number of distinct orbits ⟨mask⟩ over all live darts. O(darts · n).
+    pub fn count_orbits(&self, mask: AlphaMask) -> usize {
+        let mut seen = DartSet::with_capacity(self.capacity());
+        let mut stack = Vec::new();
+        let mut count = 0;
+        for d in self.darts() {
+            if seen.insert(d) {
+                count += 1;
+                self.flood(d, mask, &mut seen, &mut stack);
+            }
+        }
+        count
+    }
+
+    /// One dart per connected component (orbit of all involutions), smallest first. O(darts · n).
+    pub fn components(&self) -> Vec<DartId> {
+        let mut seen = DartSet::with_capacity(self.capacity());
+        let mut stack = Vec::new();
+        let mut roots = Vec::new();
+        for d in self.darts() {
+            if seen.insert(d) {
+                roots.push(d);
+                self.flood(d, AlphaMask::all(N), &mut seen, &mut stack);
+            }
+        }
+        roots
+    }
+
+    /// Component index of every dart slot (`u32::MAX` for dead slots), and the count.
+    /// O(darts · n).
+    pub fn component_labels(&self) -> (Vec<u32>, usize) {
+        let mut label = vec![u32::MAX; self.capacity()];
+        let roots = self.components();
+        for (k, &r) in roots.iter().enumerate() {
+            for d in self.orbit(r, AlphaMask::all(N)) {
+                label[d.index()] = k as u32;
+            }
+        }
+        (label, roots.len())
+    }
+
+    /// The αn-free darts: the boundary. O(capacity).
+    pub fn boundary_darts(&self) -> impl Iterator<Item = DartId> + '_ {
+        self.darts().filter(|&d| self.is_free(N, d))
+    }
+
+    /// Number of (n−1)-cells on the boundary (distinct (n−1)-cell ids among αn-free darts).
+    /// O(capacity).
+    pub fn boundary_cell_count(&self) -> usize {
+        let mut seen = DartSet::with_capacity(self.cell_id_bound(N - 1));
+        self.boundary_darts().filter(|&d| seen.insert(DartId(self.cell_id(N - 1, d).0))).count()
+    }
+
+    /// Σ (−1)^i · #i-cells. O(n).
+    pub fn euler_characteristic(&self) -> i64 {
+        self.count_cells().euler_characteristic()
+    }
+
+    /// A 2-colouring of the darts such that every non-free αi link joins two colours, if one
+    /// exists (colour `u8::MAX` on dead slots). The map is orientable iff it exists. O(darts · n).
+    pub fn orientation(&self) -> Option<Vec<u8>> {
+        let mut colour = vec![u8::MAX; self.capacity()];
+        let mut stack = Vec::new();
+        for d in self.darts() {
+            if colour[d.index()] != u8::MAX {
+                continue;
+            }
+            colour[d.index()] = 0;
+            stack.push(d);
+            while let Some(x) = stack.pop() {
+                let c = colour[x.index()];
+                for i in 0..=N {
+                    let y = self.alpha_dyn(i, x);
+                    if y == x {
+                        continue;
+                    }
+                    match colour[y.index()] {
+                        u8::MAX => {
+                            colour[y.index()] = 1 - c;
+                            stack.push(y);
+                        }
+                        cy if cy == c => return None,
+                        _ => {}
+                    }
+                }
+            }
+        }
+        Some(colour)
+    }
+
+    /// Whether every component is orientable. O(darts · n).
+    pub fn is_orientable(&self) -> bool {
+        self.orientation().is_some()
+    }
+
+    /// Darts, cells, boundary, components, Euler characteristic, orientability and validity.
+    /// O(darts · n²).
+    pub fn summary(&self) -> MapSummary {
+        let cells = self.count_cells();
+        MapSummary {
+            darts: self.dart_count(),
+            euler_characteristic: cells.euler_characteristic(),
+            cells,
+            boundary_faces: self.boundary_cell_count(),
+            components: self.components().len(),
+            orientable: self.is_orientable(),
+            valid: self.validate().is_ok(),
+        }
+    }
+}

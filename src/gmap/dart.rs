@@ -1,0 +1,59 @@
+//! Dart and cell identifiers: small `u32` newtypes.
+//!
+//! A dart is the single abstract element of an n-G-map (seed 000, §2.1): in 3D, roughly "a vertex
+//! on an edge of a face of a volume". Darts are indices into the map's flat arrays, so a `DartId`
+//! is only meaningful together with the map that issued it.
+
+use std::fmt;
+
+/// Index of a dart in a [`GMap`](crate::gmap::GMap). Four bytes; `u32::MAX` is never a valid dart.
+#[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Default)]
+pub struct DartId(pub u32);
+
+impl DartId {
+    /// The index as `usize`, for indexing flat arrays.
+    #[inline(always)]
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+}
+
+impl fmt::Debug for DartId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "d{}", self.0)
+    }
+}
+
+impl fmt::Display for DartId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "dart {}", self.0)
+    }
+}
+
+/// Identifier of an i-cell (the dimension is carried separately). Ids of one dimension are dense
+/// in `0..capacity` and reused after a cell disappears; embeddings are stored in arrays keyed by it.
+#[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Default)]
+pub struct CellId(pub u32);
+
+impl CellId {
+    /// The index as `usize`, for indexing embedding arrays.
+    #[inline(always)]
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+}
+
+impl fmt::Debug for CellId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "c{}", self.0)
+    }
+}
+
+impl fmt::Display for CellId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "cell {}", self.0)
+    }
+}
+
+/// Sentinel for "no id" inside flat arrays (dead darts, unassigned cells during a build).
+pub(crate) const NONE: u32 = u32::MAX;

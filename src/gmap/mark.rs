@@ -1,0 +1,135 @@
+//! Marks: one bit per dart, reusable, that must be cleaned before release.
+
+use super::{DartId, GMap};
+
+/// A set of darts as a bit set with a count. Grows on demand. Insert, remove and test are O(1).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct DartSet {
+    bits: Vec<u64>,
+    count: usize,
+}
+
+impl DartSet {
+    /// An empty set able to hold darts below `capacity` without growing.
+    pub fn with_capacity(capacity: usize) -> Self {
+        DartSet { bits: vec![0; capacity.div_ceil(64)], count: 0 }
+    }
+
+    /// Whether d is in the set. O(1).
+    #[inline(always)]
+    pub fn contains(&self, d: DartId) -> bool {
+        let i = d.index();
+        self.bits.get(i / 64).is_some_and(|w| w & (1u64 << (i % 64)) != 0)
+    }
+
+    /// Adds d; returns whether it was absent. O(1) amortized.
+    #[inline(always)]
+    pub fn insert(&mut self, d: DartId) -> bool {
+        let i = d.index();
+        if i / 64 >= self.bits.len() {
+            self.bits.resize(i / 64 + 1, 0);
+        }
+        let w = &mut self.bits[i / 64];
+        let bit = 1u64 << (i % 64);
+        let absent = *w & bit == 0;
+        *w |= bit;
+        self.count += absent as usize;
+        absent
+    }
+
+    /// Removes d; returns whether it was present. O(1).
+    #[inline(always)]
+    pub fn remove(&mut self, d: DartId) -> bool {
+        let i = d.index();
+        let Some(w) = self.bits.get_mut(i / 64) else { return false };
+        let bit = 1u64 << (i % 64);
+        let present = *w & bit != 0;
+        *w &= !bit;
+        self.count -= present as usize;
+        present
+    }
+
+    /// Number of darts in the set. O(1).
+    pub fn len(&self) -> usize {
+        self.count
+    }
+
+    /// Whether the set is empty. O(1).
+    pub fn is_empty(&self) -> bool {
+        self.count == 0
+    }
+
+    /// Empties the set. O(capacity / 64).
+    pub fn clear(&mut self) {
+        self.bits.iter_mut().for_each(|w| *w = 0);
+        self.count = 0;
+    }
+}
+
+/// A reserved mark of a map (CGAL's "reserve_mark"): a [`DartSet`] taken from the map's pool.
+///
+/// Give it back with [`GMap::free_mark`] once every dart is unmarked again; a mark released or
+/// dropped while darts are still marked is a bug in the caller's algorithm and asserts.
+#[derive(Debug)]
+pub struct Mark {
+    set: DartSet,
+}
+
+impl Mark {
+    /// Marks d; returns whether it was unmarked. O(1).
+    pub fn mark(&mut self, d: DartId) -> bool {
+        self.set.insert(d)
+    }
+
+    /// Unmarks d; returns whether it was marked. O(1).
+    pub fn unmark(&mut self, d: DartId) -> bool {
+        self.set.remove(d)
+    }
+
+    /// Whether d is marked. O(1).
+    pub fn is_marked(&self, d: DartId) -> bool {
+        self.set.contains(d)
+    }
+
+    /// Number of marked darts. O(1).
+    pub fn count(&self) -> usize {
+        self.set.len()
+    }
+}
+
+impl Drop for Mark {
+    fn drop(&mut self) {
+        if !std::thread::panicking() {
+            assert!(self.set.is_empty(), "a mark was dropped with {} darts still marked", self.set.len());
+        }
+    }
+}
+
+impl<const N: usize> GMap<N> {
+    /// Reserves a mark with no dart marked, reusing a released one if any. O(1) amortized.
+    pub fn reserve_mark(&mut self) -> Mark {
+        let set = self.mark_pool.pop().unwrap_or_else(|| DartSet::with_capacity(self.capacity()));
+        debug_assert!(set.is_empty());
+        Mark { set }
+    }
+
+    /// Returns a mark to the pool. Panics if some dart is still marked (a bug in the caller).
+    pub fn free_mark(&mut self, mut mark: Mark) {
+        assert!(mark.set.is_empty(), "free_mark: {} darts are still marked", mark.set.len());
+        self.mark_pool.push(std::mem::take(&mut mark.set));
+    }
+
+    /// Marks every dart of the orbit ⟨mask⟩(d). O(orbit).
+    pub fn mark_orbit(&self, mark: &mut Mark, d: DartId, mask: super::AlphaMask) {
+        for e in self.orbit(d, mask) {
+            mark.mark(e);
+        }
+    }
+
+    /// Unmarks every dart of the orbit ⟨mask⟩(d). O(orbit).
+    pub fn unmark_orbit(&self, mark: &mut Mark, d: DartId, mask: super::AlphaMask) {
+        for e in self.orbit(d, mask) {
+            mark.unmark(e);
+        }
+    }
+}

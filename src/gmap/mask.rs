@@ -1,0 +1,75 @@
+//! Sets of involutions {αi}, used to name orbits.
+
+/// A subset of {α0, …, α7} as a bit set; bit i stands for αi.
+///
+/// The i-cell orbit of an n-G-map is `⟨⟩N−{i}`: [`AlphaMask::cell`]. The involutions that commute
+/// with αi by the quasi-manifold law (|i − j| ≥ 2) form [`AlphaMask::commuting_with`]; an i-sew
+/// links exactly the darts of that orbit.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug, Default)]
+pub struct AlphaMask(pub u8);
+
+impl AlphaMask {
+    /// The empty set.
+    pub const EMPTY: AlphaMask = AlphaMask(0);
+
+    /// All involutions α0..=αn of an n-map.
+    pub const fn all(n: usize) -> AlphaMask {
+        AlphaMask(((1u16 << (n + 1)) - 1) as u8)
+    }
+
+    /// The set {αj : j in `indices`}.
+    pub const fn of(indices: &[usize]) -> AlphaMask {
+        let mut bits = 0u8;
+        let mut k = 0;
+        while k < indices.len() {
+            bits |= 1 << indices[k];
+            k += 1;
+        }
+        AlphaMask(bits)
+    }
+
+    /// The generators of the i-cell orbit of an n-map: every αj but αi.
+    pub const fn cell(n: usize, i: usize) -> AlphaMask {
+        AlphaMask(Self::all(n).0 & !(1 << i))
+    }
+
+    /// The involutions that must commute with αi in an n-map: αj with |i − j| ≥ 2.
+    pub const fn commuting_with(n: usize, i: usize) -> AlphaMask {
+        let mut bits = 0u8;
+        let mut j = 0;
+        while j <= n {
+            if j + 2 <= i || i + 2 <= j {
+                bits |= 1 << j;
+            }
+            j += 1;
+        }
+        AlphaMask(bits)
+    }
+
+    /// Whether αi is in the set.
+    #[inline(always)]
+    pub const fn contains(self, i: usize) -> bool {
+        self.0 & (1 << i) != 0
+    }
+
+    /// The indices in the set, in increasing order.
+    pub fn indices(self) -> impl Iterator<Item = usize> {
+        (0..8).filter(move |&i| self.contains(i))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cell_and_commuting_masks() {
+        assert_eq!(AlphaMask::cell(3, 0), AlphaMask::of(&[1, 2, 3]));
+        assert_eq!(AlphaMask::cell(2, 1), AlphaMask::of(&[0, 2]));
+        assert_eq!(AlphaMask::commuting_with(3, 3), AlphaMask::of(&[0, 1]));
+        assert_eq!(AlphaMask::commuting_with(3, 1), AlphaMask::of(&[3]));
+        assert_eq!(AlphaMask::commuting_with(3, 0), AlphaMask::of(&[2, 3]));
+        assert_eq!(AlphaMask::commuting_with(1, 0), AlphaMask::EMPTY);
+        assert_eq!(AlphaMask::all(3).indices().collect::<Vec<_>>(), vec![0, 1, 2, 3]);
+    }
+}

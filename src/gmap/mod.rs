@@ -1,0 +1,347 @@
+//! The n-dimensional generalized map (seed 000, §2.1).
+//!
+//! An n-G-map is G = (B, α0, …, αn) where B is a finite set of darts, every αi is an involution on
+//! B, and αi∘αj is an involution whenever 0 ≤ i < i + 2 ≤ j ≤ n (the quasi-manifold law). A dart
+//! with αi(d) = d is *i-free*; the αn-free darts form the boundary.
+//!
+//! # Layout
+//! One generic implementation for every dimension `N` (1, 2 and 3 are tested). State lives in flat
+//! arrays keyed by [`DartId`]: `alpha[d·(N+1) + i]` and `cell[d·(N+1) + i]`, the id of the i-cell
+//! of d. For N = 3 that is 32 bytes per dart (topology and all four cell ids), plus one bit of
+//! liveness. Freed dart slots are reused.
+//!
+//! # Layers of mutators
+//! 1. crate-private raw links ([`GMap::link_raw`]) that may break validity;
+//! 2. topological [`GMap::sew`] / [`GMap::unsew`] that sew whole orbits so the quasi-manifold law
+//!    holds and keep cell ids exact, returning the [`CellChanges`] they made;
+//! 3. (in `embedding`) the version that also splits and merges attributes.
+//!
+//! Every public mutator leaves the map valid. In debug builds a cheap local check runs on the
+//! darts it touched; with the `expensive-checks` feature the full [`GMap::validate`] runs.
+
+mod cells;
+mod cmap;
+mod dart;
+mod iso;
+mod mark;
+mod mask;
+mod orbit;
+mod sew;
+mod validate;
+
+pub use cells::{CellCounts, MapSummary};
+pub use cmap::CombinatorialMap;
+pub use dart::{CellId, DartId};
+pub use mark::{DartSet, Mark};
+pub use mask::AlphaMask;
+pub use sew::{CellChange, CellChanges, SewError};
+pub use validate::{InvariantViolation, Law};
+
+use dart::NONE;
+
+/// Allocator of the ids of one cell dimension: dense ids, a free list, and a count of live ids.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub(crate) struct IdAlloc {
+    pub(crate) next: u32,
+    pub(crate) free: Vec<u32>,
+}
+
+impl IdAlloc {
+    fn alloc(&mut self) -> u32 {
+        match self.free.pop() {
+            Some(id) => id,
+            None => {
+                self.next += 1;
+                self.next - 1
+            }
+        }
+    }
+
+    fn release(&mut self, id: u32) {
+        debug_assert!(id < self.next, "releasing an id never allocated");
+        self.free.push(id);
+    }
+
+    /// Number of live ids. O(1).
+    pub(crate) fn live(&self) -> usize {
+        self.next as usize - self.free.len()
+    }
+}
+
+/// Errors of dart creation and deletion.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum DartError {
+    /// The id is past the end of the map or names a deleted dart.
+    #[error("{0} does not exist in this map")]
+    NoSuchDart(DartId),
+    /// Only isolated darts (free for every αi) may be deleted.
+    #[error("{dart} is not isolated: it is {i}-sewn to {other}; unsew it first")]
+    NotIsolated {
+        /// The dart to delete.
+        dart: DartId,
+        /// An involution for which it is not free.
+        i: usize,
+        /// Its αi image.
+        other: DartId,
+    },
+    /// The map has 2^32 − 1 darts already.
+    #[error("the map is full: {0} darts")]
+    Full(usize),
+}
+
+/// An n-dimensional generalized map with exact cell ids. See the [module docs](self).
+#[derive(Clone, Debug)]
+pub struct GMap<const N: usize> {
+    alpha: Vec<u32>,
+    cell: Vec<u32>,
+    alive: Vec<u64>,
+    free_darts: Vec<u32>,
+    n_alive: usize,
+    ids: Vec<IdAlloc>,
+    mark_pool: Vec<DartSet>,
+}
+
+impl<const N: usize> Default for GMap<N> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const N: usize> GMap<N> {
+    /// Number of involutions, n + 1.
+    pub const ALPHAS: usize = N + 1;
+
+    /// An empty map. O(1).
+    pub fn new() -> Self {
+        const { assert!(N >= 1 && N <= 7, "dimension must be in 1..=7") };
+        GMap {
+            alpha: Vec::new(),
+            cell: Vec::new(),
+            alive: Vec::new(),
+            free_darts: Vec::new(),
+            n_alive: 0,
+            ids: vec![IdAlloc::default(); N + 1],
+            mark_pool: Vec::new(),
+        }
+    }
+
+    /// The dimension n.
+    pub const fn dimension(&self) -> usize {
+        N
+    }
+
+    /// Number of live darts. O(1).
+    pub fn dart_count(&self) -> usize {
+        self.n_alive
+    }
+
+    /// One past the largest dart index ever used: the length flat per-dart arrays need. O(1).
+    pub fn capacity(&self) -> usize {
+        self.alpha.len() / (N + 1)
+    }
+
+    /// Whether `d` names a live dart of this map. O(1).
+    #[inline]
+    pub fn contains(&self, d: DartId) -> bool {
+        let i = d.index();
+        i < self.capacity() && self.alive[i / 64] & (1u64 << (i % 64)) != 0
+    }
+
+    /// The live darts in increasing order. O(capacity).
+    pub fn darts(&self) -> impl Iterator<Item = DartId> + '_ {
+        (0..self.capacity() as u32).map(DartId).filter(|&d| self.contains(d))
+    }
+
+    /// αi(d) with i checked at compile time. O(1). `d` must be live (debug-asserted).
+    #[inline(always)]
+    pub fn alpha<const I: usize>(&self, d: DartId) -> DartId {
+        const { assert!(I <= N, "alpha index out of range for this dimension") };
+        self.alpha_dyn(I, d)
+    }
+
+    /// αi(d) with i given at run time. O(1). Panics if i > n.
+    #[inline(always)]
+    pub fn alpha_dyn(&self, i: usize, d: DartId) -> DartId {
+        assert!(i <= N, "alpha index {i} out of range for a {N}-map");
+        debug_assert!(self.contains(d), "{d:?} is not a live dart");
+        DartId(self.alpha[d.index() * (N + 1) + i])
+    }
+
+    /// αi(d), or an error if `d` is not a live dart or i > n. O(1).
+    pub fn try_alpha(&self, i: usize, d: DartId) -> Result<DartId, DartError> {
+        if i > N || !self.contains(d) {
+            return Err(DartError::NoSuchDart(d));
+        }
+        Ok(self.alpha_dyn(i, d))
+    }
+
+    /// Whether d is i-free (αi(d) = d). O(1).
+    #[inline]
+    pub fn is_free(&self, i: usize, d: DartId) -> bool {
+        self.alpha_dyn(i, d) == d
+    }
+
+    /// Whether d is free for every αi. O(n).
+    pub fn is_isolated(&self, d: DartId) -> bool {
+        (0..=N).all(|i| self.is_free(i, d))
+    }
+
+    /// The i-sewn pairs {d, αi(d)} with d < αi(d), each once. O(capacity).
+    pub fn sewn_pairs(&self, i: usize) -> impl Iterator<Item = (DartId, DartId)> + '_ {
+        self.darts().filter_map(move |d| {
+            let e = self.alpha_dyn(i, d);
+            (d < e).then_some((d, e))
+        })
+    }
+
+    /// The id of the i-cell that contains d. O(1).
+    #[inline(always)]
+    pub fn cell_id(&self, i: usize, d: DartId) -> CellId {
+        assert!(i <= N, "cell dimension {i} out of range for a {N}-map");
+        CellId(self.cell[d.index() * (N + 1) + i])
+    }
+
+    /// The vertex (0-cell) id of d. O(1).
+    #[inline(always)]
+    pub fn vertex_id(&self, d: DartId) -> CellId {
+        self.cell_id(0, d)
+    }
+
+    /// One past the largest live i-cell id: the length an array keyed by i-cell id needs. O(1).
+    pub fn cell_id_bound(&self, i: usize) -> usize {
+        self.ids[i].next as usize
+    }
+
+    /// Whether `id` is a live i-cell id. O(free ids of dimension i).
+    pub fn is_live_cell(&self, i: usize, id: CellId) -> bool {
+        id.0 < self.ids[i].next && !self.ids[i].free.contains(&id.0)
+    }
+
+    /// Creates an isolated dart (free for every αi), reusing a freed slot if any. It is its own
+    /// i-cell for every i and gets a fresh id in each dimension. Amortized O(n).
+    pub fn create_dart(&mut self) -> Result<DartId, DartError> {
+        let d = match self.free_darts.pop() {
+            Some(d) => d,
+            None => {
+                let d = self.capacity();
+                if d >= NONE as usize - 1 {
+                    return Err(DartError::Full(d));
+                }
+                self.alpha.extend(std::iter::repeat_n(d as u32, N + 1));
+                self.cell.extend(std::iter::repeat_n(NONE, N + 1));
+                if d / 64 >= self.alive.len() {
+                    self.alive.push(0);
+                }
+                d as u32
+            }
+        };
+        let base = d as usize * (N + 1);
+        for i in 0..=N {
+            self.alpha[base + i] = d;
+            self.cell[base + i] = self.ids[i].alloc();
+        }
+        self.alive[d as usize / 64] |= 1u64 << (d % 64);
+        self.n_alive += 1;
+        self.after_mutation(&[DartId(d)]);
+        Ok(DartId(d))
+    }
+
+    /// Deletes an isolated dart and frees its slot and cell ids. O(n).
+    ///
+    /// Errors: [`DartError::NoSuchDart`], [`DartError::NotIsolated`]; the map is unchanged then.
+    pub fn delete_dart(&mut self, d: DartId) -> Result<(), DartError> {
+        if !self.contains(d) {
+            return Err(DartError::NoSuchDart(d));
+        }
+        if let Some(i) = (0..=N).find(|&i| !self.is_free(i, d)) {
+            let other = self.alpha_dyn(i, d);
+            return Err(DartError::NotIsolated { dart: d, i, other });
+        }
+        let base = d.index() * (N + 1);
+        for i in 0..=N {
+            let id = self.cell[base + i];
+            self.ids[i].release(id);
+            self.cell[base + i] = NONE;
+        }
+        self.alive[d.index() / 64] &= !(1u64 << (d.0 % 64));
+        self.n_alive -= 1;
+        self.free_darts.push(d.0);
+        self.after_mutation(&[]);
+        Ok(())
+    }
+
+    /// Raw link αi(a) = b and αi(b) = a, with no check and no cell-id update. May break every
+    /// law: only the crate's sew and builders use it, and they restore validity before returning.
+    #[inline(always)]
+    pub(crate) fn link_raw(&mut self, i: usize, a: DartId, b: DartId) {
+        self.alpha[a.index() * (N + 1) + i] = b.0;
+        self.alpha[b.index() * (N + 1) + i] = a.0;
+    }
+
+    /// Raw unlink: d and αi(d) become i-free. No check, no cell-id update.
+    #[inline(always)]
+    pub(crate) fn unlink_raw(&mut self, i: usize, d: DartId) {
+        let e = self.alpha_dyn(i, d);
+        self.alpha[d.index() * (N + 1) + i] = d.0;
+        self.alpha[e.index() * (N + 1) + i] = e.0;
+    }
+
+    /// Raw write of the i-cell id of d.
+    #[inline(always)]
+    pub(crate) fn set_cell_raw(&mut self, i: usize, d: DartId, id: u32) {
+        self.cell[d.index() * (N + 1) + i] = id;
+    }
+
+    /// Allocates `count` darts at once with every link free and every cell id unset: the start of
+    /// a bulk build. Returns the first index. The caller must link and label them all.
+    pub(crate) fn alloc_darts_raw(&mut self, count: usize) -> u32 {
+        let first = self.capacity();
+        let total = first + count;
+        self.alpha.reserve_exact(count * (N + 1));
+        self.cell.reserve_exact(count * (N + 1));
+        for d in first..total {
+            self.alpha.extend(std::iter::repeat_n(d as u32, N + 1));
+        }
+        self.cell.resize(total * (N + 1), NONE);
+        self.alive.resize(total.div_ceil(64), 0);
+        for d in first..total {
+            self.alive[d / 64] |= 1u64 << (d % 64);
+        }
+        self.n_alive += count;
+        first as u32
+    }
+
+    /// Sets the id allocator of dimension i to "ids 0..next are used but those in `free`".
+    pub(crate) fn set_id_alloc_raw(&mut self, i: usize, next: u32, free: Vec<u32>) {
+        self.ids[i] = IdAlloc { next, free };
+    }
+
+    pub(crate) fn alloc_cell_id(&mut self, i: usize) -> u32 {
+        self.ids[i].alloc()
+    }
+
+    pub(crate) fn release_cell_id(&mut self, i: usize, id: u32) {
+        self.ids[i].release(id)
+    }
+
+    /// Checks run after every public mutation: local ones in debug builds, the full `validate()`
+    /// under the `expensive-checks` feature. A failure is a bug in this library and panics.
+    #[inline]
+    pub(crate) fn after_mutation(&self, touched: &[DartId]) {
+        #[cfg(debug_assertions)]
+        if let Err(e) = self.validate_local(touched) {
+            panic!("topomech bug: local invariant broken after a mutation: {e}");
+        }
+        let _ = touched;
+        #[cfg(feature = "expensive-checks")]
+        if let Err(e) = self.validate() {
+            panic!("topomech bug: invariant broken after a mutation: {e}");
+        }
+    }
+
+    /// Bytes used per live dart by topology and cell ids (not counting the mark pool). O(1).
+    pub fn bytes_per_dart(&self) -> f64 {
+        let bytes = (self.alpha.capacity() + self.cell.capacity()) * 4 + self.alive.capacity() * 8;
+        bytes as f64 / self.n_alive.max(1) as f64
+    }
+}

@@ -1,0 +1,333 @@
+//! Topological i-sew and i-unsew (layer 2 of the mutators).
+//!
+//! To i-sew d1 and d2 is to set αi(x) = f(x) for every x of the orbit O1 = ⟨αj : |i − j| ≥ 2⟩(d1),
+//! where f: O1 → O2 = ⟨αj : |i − j| ≥ 2⟩(d2) is the isomorphism with f(d1) = d2 and
+//! f(αj(x)) = αj(f(x)). Sewing the whole orbit is exactly what keeps αi∘αj an involution for
+//! every j ≥ i + 2 (and j ≤ i − 2). The sew is possible iff f exists, is a fixed-point-free
+//! involution on O1 ∪ O2, and every dart of O1 ∪ O2 is i-free: [`GMap::is_sewable`].
+//!
+//! An i-sew merges, for every j ≠ i, the j-cells on both sides (the cell of d1's side keeps its
+//! id); an i-unsew may split them (the side found smaller gets a fresh id). Both report what they
+//! did as [`CellChanges`], which the embedding layer turns into attribute merges and splits.
+//!
+//! Cost: O(|O1| · n) for the links plus the size of the relabelled cells; an unsew also walks,
+//! for each cell it might split, both sides in lockstep until they meet or the smaller one ends.
+
+use rustc_hash::FxHashMap;
+
+use super::{AlphaMask, CellId, DartId, GMap};
+
+/// Why a sew or unsew was refused. The map is unchanged when one is returned.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum SewError {
+    /// A dart id that is not live in this map.
+    #[error("{0} does not exist in this map")]
+    NoSuchDart(DartId),
+    /// αi with i > n.
+    #[error("alpha index {i} is out of range for a {n}-map")]
+    BadIndex {
+        /// The index asked for.
+        i: usize,
+        /// The map's dimension.
+        n: usize,
+    },
+    /// A dart of the orbit to sew is already i-sewn.
+    #[error("{dart} is already {i}-sewn to {partner}")]
+    NotFree {
+        /// The dart.
+        dart: DartId,
+        /// The involution.
+        i: usize,
+        /// Its current αi image.
+        partner: DartId,
+    },
+    /// The sew would make a dart its own αi image, or the two orbits overlap inconsistently.
+    #[error("{i}-sewing {d1} with {d2} would link {dart} inconsistently (to itself or to two darts)")]
+    NotInvolution {
+        /// First dart given.
+        d1: DartId,
+        /// Second dart given.
+        d2: DartId,
+        /// Index of the sew.
+        i: usize,
+        /// Where the correspondence breaks.
+        dart: DartId,
+    },
+    /// The orbits of the two darts are not isomorphic: following αj breaks the correspondence.
+    #[error("{i}-sew of {d1} and {d2}: orbits differ at {at} along alpha{j} (the quasi-manifold law would break)")]
+    OrbitsDiffer {
+        /// First dart given.
+        d1: DartId,
+        /// Second dart given.
+        d2: DartId,
+        /// Index of the sew.
+        i: usize,
+        /// The dart of d1's orbit where the walks disagree.
+        at: DartId,
+        /// The involution followed.
+        j: usize,
+    },
+    /// Unsewing a dart that is i-free.
+    #[error("{dart} is {i}-free: nothing to unsew")]
+    AlreadyFree {
+        /// The dart.
+        dart: DartId,
+        /// The involution.
+        i: usize,
+    },
+}
+
+/// One change of cell identity made by a sew or an unsew.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CellChange {
+    /// Two `dim`-cells became one: `absorbed` no longer exists, its darts now carry `kept`.
+    Merged {
+        /// Dimension of the cells.
+        dim: usize,
+        /// The surviving id.
+        kept: CellId,
+        /// The id released.
+        absorbed: CellId,
+    },
+    /// One `dim`-cell became two: the darts of one side (`dart_new` among them) now carry the
+    /// fresh id `new`; the other side (`dart_kept` among them) keeps `kept`.
+    Split {
+        /// Dimension of the cells.
+        dim: usize,
+        /// The id that stays with one side.
+        kept: CellId,
+        /// The fresh id of the other side.
+        new: CellId,
+        /// A dart of the side that kept the id.
+        dart_kept: DartId,
+        /// A dart of the side with the new id.
+        dart_new: DartId,
+    },
+}
+
+/// Everything a sew or unsew changed in cell identities, in the order it happened.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct CellChanges {
+    /// The changes.
+    pub changes: Vec<CellChange>,
+    /// The pairs of darts linked or unlinked by αi.
+    pub pairs: Vec<(DartId, DartId)>,
+}
+
+impl CellChanges {
+    /// The splits of `dim`-cells, as (kept, new, dart_kept, dart_new).
+    pub fn splits(&self, dim: usize) -> impl Iterator<Item = (CellId, CellId, DartId, DartId)> + '_ {
+        self.changes.iter().filter_map(move |c| match *c {
+            CellChange::Split { dim: k, kept, new, dart_kept, dart_new } if k == dim => Some((kept, new, dart_kept, dart_new)),
+            _ => None,
+        })
+    }
+
+    /// The merges of `dim`-cells, as (kept, absorbed).
+    pub fn merges(&self, dim: usize) -> impl Iterator<Item = (CellId, CellId)> + '_ {
+        self.changes.iter().filter_map(move |c| match *c {
+            CellChange::Merged { dim: k, kept, absorbed } if k == dim => Some((kept, absorbed)),
+            _ => None,
+        })
+    }
+}
+
+/// A partial involution being built: dart → partner.
+struct Pairing {
+    small: Vec<(u32, u32)>,
+    large: Option<FxHashMap<u32, u32>>,
+}
+
+impl Pairing {
+    fn new() -> Self {
+        Pairing { small: Vec::new(), large: None }
+    }
+
+    fn get(&self, x: DartId) -> Option<DartId> {
+        match &self.large {
+            Some(m) => m.get(&x.0).map(|&y| DartId(y)),
+            None => self.small.iter().find(|p| p.0 == x.0).map(|p| DartId(p.1)),
+        }
+    }
+
+    fn put(&mut self, x: DartId, y: DartId) {
+        match &mut self.large {
+            Some(m) => {
+                m.insert(x.0, y.0);
+            }
+            None => {
+                self.small.push((x.0, y.0));
+                if self.small.len() > 32 {
+                    self.large = Some(self.small.drain(..).collect());
+                }
+            }
+        }
+    }
+}
+
+impl<const N: usize> GMap<N> {
+    fn check_index(i: usize) -> Result<(), SewError> {
+        if i > N {
+            return Err(SewError::BadIndex { i, n: N });
+        }
+        Ok(())
+    }
+
+    fn check_dart(&self, d: DartId) -> Result<(), SewError> {
+        if !self.contains(d) {
+            return Err(SewError::NoSuchDart(d));
+        }
+        Ok(())
+    }
+
+    /// The pairs an i-sew of d1 and d2 would link, or why it may not. O(|O1| · n).
+    fn sew_pairs(&self, i: usize, d1: DartId, d2: DartId) -> Result<Vec<(DartId, DartId)>, SewError> {
+        Self::check_index(i)?;
+        self.check_dart(d1)?;
+        self.check_dart(d2)?;
+        let mask = AlphaMask::commuting_with(N, i);
+        let mut pairing = Pairing::new();
+        let mut pairs = Vec::new();
+        self.pair_up(i, (d1, d2), (d1, d2), &mut pairing, &mut pairs)?;
+        let mut head = 0;
+        while head < pairs.len() {
+            let (x, y) = pairs[head];
+            head += 1;
+            for j in mask.indices().filter(|&j| j <= N) {
+                let (xj, yj) = (self.alpha_dyn(j, x), self.alpha_dyn(j, y));
+                self.pair_up(i, (d1, d2), (xj, yj), &mut pairing, &mut pairs)
+                    .map_err(|_| SewError::OrbitsDiffer { d1, d2, i, at: x, j })?;
+            }
+        }
+        Ok(pairs)
+    }
+
+    /// Adds the pair (x, y) to the pairing if new, checking that both are i-free and that the
+    /// pairing stays a fixed-point-free involution.
+    fn pair_up(
+        &self,
+        i: usize,
+        (d1, d2): (DartId, DartId),
+        (x, y): (DartId, DartId),
+        pairing: &mut Pairing,
+        pairs: &mut Vec<(DartId, DartId)>,
+    ) -> Result<(), SewError> {
+        match (pairing.get(x), pairing.get(y)) {
+            (Some(px), _) if px == y => return Ok(()),
+            (Some(_), _) | (_, Some(_)) => return Err(SewError::NotInvolution { d1, d2, i, dart: x }),
+            (None, None) => {}
+        }
+        if x == y {
+            return Err(SewError::NotInvolution { d1, d2, i, dart: x });
+        }
+        for z in [x, y] {
+            let partner = self.alpha_dyn(i, z);
+            if partner != z {
+                return Err(SewError::NotFree { dart: z, i, partner });
+            }
+        }
+        pairing.put(x, y);
+        pairing.put(y, x);
+        pairs.push((x, y));
+        Ok(())
+    }
+
+    /// Whether `sew::<I>(d1, d2)` would succeed. O(|O1| · n).
+    pub fn is_sewable<const I: usize>(&self, d1: DartId, d2: DartId) -> bool {
+        const { assert!(I <= N) };
+        self.sew_pairs(I, d1, d2).is_ok()
+    }
+
+    /// Run-time-index version of [`GMap::is_sewable`]; false for i > n.
+    pub fn is_sewable_dyn(&self, i: usize, d1: DartId, d2: DartId) -> bool {
+        self.sew_pairs(i, d1, d2).is_ok()
+    }
+
+    /// I-sews d1 with d2 (see the [module docs](self)). Errors leave the map unchanged.
+    pub fn sew<const I: usize>(&mut self, d1: DartId, d2: DartId) -> Result<CellChanges, SewError> {
+        const { assert!(I <= N) };
+        self.sew_dyn(I, d1, d2)
+    }
+
+    /// Run-time-index version of [`GMap::sew`].
+    pub fn sew_dyn(&mut self, i: usize, d1: DartId, d2: DartId) -> Result<CellChanges, SewError> {
+        let pairs = self.sew_pairs(i, d1, d2)?;
+        for &(x, y) in &pairs {
+            self.link_raw(i, x, y);
+        }
+        let mut report = CellChanges { changes: Vec::new(), pairs };
+        for k in 0..report.pairs.len() {
+            let (x, y) = report.pairs[k];
+            for dim in (0..=N).filter(|&dim| dim != i) {
+                self.merge_cells(dim, x, y, &mut report.changes);
+            }
+        }
+        self.after_mutation(&touched(&report.pairs));
+        Ok(report)
+    }
+
+    /// After a link, gives y's dim-cell the id of x's if they differ.
+    fn merge_cells(&mut self, dim: usize, x: DartId, y: DartId, changes: &mut Vec<CellChange>) {
+        let (kx, ky) = (self.cell_id(dim, x).0, self.cell_id(dim, y).0);
+        if kx == ky {
+            return;
+        }
+        self.relabel(dim, y, AlphaMask::cell(N, dim), ky, kx);
+        self.release_cell_id(dim, ky);
+        changes.push(CellChange::Merged { dim, kept: CellId(kx), absorbed: CellId(ky) });
+    }
+
+    /// I-unsews d from αi(d), with the whole orbit ⟨αj : |i − j| ≥ 2⟩(d). Errors leave the map
+    /// unchanged: [`SewError::AlreadyFree`] if d is i-free.
+    pub fn unsew<const I: usize>(&mut self, d: DartId) -> Result<CellChanges, SewError> {
+        const { assert!(I <= N) };
+        self.unsew_dyn(I, d)
+    }
+
+    /// Run-time-index version of [`GMap::unsew`].
+    pub fn unsew_dyn(&mut self, i: usize, d: DartId) -> Result<CellChanges, SewError> {
+        Self::check_index(i)?;
+        self.check_dart(d)?;
+        if self.is_free(i, d) {
+            return Err(SewError::AlreadyFree { dart: d, i });
+        }
+        let pairs: Vec<(DartId, DartId)> = self
+            .orbit(d, AlphaMask::commuting_with(N, i))
+            .into_iter()
+            .map(|x| (x, self.alpha_dyn(i, x)))
+            .filter(|&(x, y)| x < y)
+            .collect();
+        for &(x, _) in &pairs {
+            self.unlink_raw(i, x);
+        }
+        let mut report = CellChanges { changes: Vec::new(), pairs };
+        for k in 0..report.pairs.len() {
+            let (x, y) = report.pairs[k];
+            for dim in (0..=N).filter(|&dim| dim != i) {
+                self.split_cells(dim, x, y, &mut report.changes);
+            }
+        }
+        self.after_mutation(&touched(&report.pairs));
+        Ok(report)
+    }
+
+    /// After an unlink, gives a fresh id to the smaller side if x and y no longer share a cell.
+    fn split_cells(&mut self, dim: usize, x: DartId, y: DartId, changes: &mut Vec<CellChange>) {
+        let old = self.cell_id(dim, x).0;
+        if old != self.cell_id(dim, y).0 {
+            return;
+        }
+        let Some((side, is_y)) = self.split_side(x, y, AlphaMask::cell(N, dim)) else { return };
+        let new = self.alloc_cell_id(dim);
+        for &z in &side {
+            self.set_cell_raw(dim, z, new);
+        }
+        let (dart_kept, dart_new) = if is_y { (x, y) } else { (y, x) };
+        changes.push(CellChange::Split { dim, kept: CellId(old), new: CellId(new), dart_kept, dart_new });
+    }
+}
+
+/// The darts of the pairs, for the local checks.
+fn touched(pairs: &[(DartId, DartId)]) -> Vec<DartId> {
+    pairs.iter().flat_map(|&(x, y)| [x, y]).collect()
+}

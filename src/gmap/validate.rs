@@ -1,0 +1,244 @@
+//! The laws of an n-G-map with cell ids, and `validate()`, which checks all of them.
+//!
+//! | law | statement | checked by |
+//! |---|---|---|
+//! | [`Law::Involution`] | αi(αi(d)) = d for every live d and i ≤ n, and αi(d) is live | [`GMap::validate`], local checks |
+//! | [`Law::QuasiManifold`] | αi(αj(d)) = αj(αi(d)) for 0 ≤ i, i + 2 ≤ j ≤ n | same |
+//! | [`Law::CellIdConstant`] | the i-cell id is constant on every orbit ⟨⟩N−{i} and is a live id | same |
+//! | [`Law::CellIdUnique`] | two different i-cells never share an id, and every live id has a cell | `validate` |
+//!
+//! `validate()` costs O(darts · n²): one sequential pass for the first three laws and one
+//! flood-fill per dimension for the last. The local check costs O(touched · n²).
+
+use super::{AlphaMask, CellId, DartId, DartSet, GMap};
+
+/// The law a violation breaks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Law {
+    /// Each αi is an involution on the live darts.
+    Involution,
+    /// αi∘αj is an involution for j ≥ i + 2.
+    QuasiManifold,
+    /// Cell ids are constant on cells and live.
+    CellIdConstant,
+    /// Distinct cells have distinct ids; every live id names a cell.
+    CellIdUnique,
+}
+
+/// A broken law, naming the dart(s), the indices and the law.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum InvariantViolation {
+    /// αi(d) is not a live dart.
+    #[error("involution law: alpha{i}({dart}) = {target:?}, which is not a live dart")]
+    DanglingLink {
+        /// The dart.
+        dart: DartId,
+        /// The involution.
+        i: usize,
+        /// Where it points.
+        target: DartId,
+    },
+    /// αi(αi(d)) ≠ d.
+    #[error("involution law: alpha{i}({dart}) = {image:?} but alpha{i}({image:?}) = {back:?}")]
+    NotInvolution {
+        /// The dart.
+        dart: DartId,
+        /// The involution.
+        i: usize,
+        /// αi(d).
+        image: DartId,
+        /// αi(αi(d)).
+        back: DartId,
+    },
+    /// αi(αj(d)) ≠ αj(αi(d)) with j ≥ i + 2.
+    #[error("quasi-manifold law: alpha{i}·alpha{j} is not an involution at {dart}: alpha{i}(alpha{j}) = {ij:?}, alpha{j}(alpha{i}) = {ji:?}")]
+    QuasiManifold {
+        /// The dart.
+        dart: DartId,
+        /// Lower index.
+        i: usize,
+        /// Higher index (≥ i + 2).
+        j: usize,
+        /// αi(αj(d)).
+        ij: DartId,
+        /// αj(αi(d)).
+        ji: DartId,
+    },
+    /// The dim-cell id differs between d and αj(d) (j ≠ dim): one cell, two ids.
+    #[error("cell-id law: {dart} has {dim}-cell {id:?} but alpha{j}({dart}) = {other:?} has {other_id:?}")]
+    CellIdDiffers {
+        /// The dart.
+        dart: DartId,
+        /// The cell dimension.
+        dim: usize,
+        /// The involution followed.
+        j: usize,
+        /// The dart's id.
+        id: CellId,
+        /// The neighbour.
+        other: DartId,
+        /// The neighbour's id.
+        other_id: CellId,
+    },
+    /// A dart carries an id that is not live.
+    #[error("cell-id law: {dart} carries {dim}-cell id {id:?}, which is not live")]
+    CellIdNotLive {
+        /// The dart.
+        dart: DartId,
+        /// The cell dimension.
+        dim: usize,
+        /// The id.
+        id: CellId,
+    },
+    /// Two different orbits carry one id.
+    #[error("cell-id law: {dim}-cells of {first} and {second} are different orbits but share id {id:?}")]
+    CellIdShared {
+        /// The cell dimension.
+        dim: usize,
+        /// The shared id.
+        id: CellId,
+        /// A dart of the first orbit.
+        first: DartId,
+        /// A dart of the second orbit.
+        second: DartId,
+    },
+    /// A live id is carried by no dart.
+    #[error("cell-id law: {dim}-cell id {id:?} is live but no dart carries it")]
+    CellIdOrphan {
+        /// The cell dimension.
+        dim: usize,
+        /// The id.
+        id: CellId,
+    },
+}
+
+impl InvariantViolation {
+    /// The law broken.
+    pub fn law(&self) -> Law {
+        use InvariantViolation::*;
+        match self {
+            DanglingLink { .. } | NotInvolution { .. } => Law::Involution,
+            QuasiManifold { .. } => Law::QuasiManifold,
+            CellIdDiffers { .. } | CellIdNotLive { .. } => Law::CellIdConstant,
+            CellIdShared { .. } | CellIdOrphan { .. } => Law::CellIdUnique,
+        }
+    }
+}
+
+impl<const N: usize> GMap<N> {
+    /// Checks every law of the table in the [module docs](self). O(darts · n²).
+    pub fn validate(&self) -> Result<(), InvariantViolation> {
+        let dead = self.dead_id_sets();
+        for d in self.darts() {
+            self.check_dart_links(d)?;
+        }
+        for d in self.darts() {
+            self.check_dart_cells(d, Some(&dead))?;
+        }
+        for dim in 0..=N {
+            self.check_ids_unique(dim, &dead[dim])?;
+        }
+        Ok(())
+    }
+
+    /// Checks the local laws (involution, quasi-manifold, constant cell ids) at the given darts
+    /// and their αi neighbours. O(touched · n³).
+    pub fn validate_local(&self, touched: &[DartId]) -> Result<(), InvariantViolation> {
+        for &d in touched {
+            if !self.contains(d) {
+                continue;
+            }
+            self.check_dart_links(d)?;
+            for i in 0..=N {
+                let e = self.alpha_dyn(i, d);
+                self.check_dart_links(e)?;
+                self.check_dart_cells(e, None)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Involution and quasi-manifold laws at one dart. O(n²).
+    fn check_dart_links(&self, d: DartId) -> Result<(), InvariantViolation> {
+        for i in 0..=N {
+            let image = DartId(self.alpha[d.index() * (N + 1) + i]);
+            if !self.contains(image) {
+                return Err(InvariantViolation::DanglingLink { dart: d, i, target: image });
+            }
+            let back = self.alpha_dyn(i, image);
+            if back != d {
+                return Err(InvariantViolation::NotInvolution { dart: d, i, image, back });
+            }
+        }
+        for i in 0..=N {
+            for j in i + 2..=N {
+                let ij = self.alpha_dyn(i, self.alpha_dyn(j, d));
+                let ji = self.alpha_dyn(j, self.alpha_dyn(i, d));
+                if ij != ji {
+                    return Err(InvariantViolation::QuasiManifold { dart: d, i, j, ij, ji });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Cell ids at one dart: constant across each generator of the cell, and live. O(n²).
+    fn check_dart_cells(&self, d: DartId, dead: Option<&[DartSet]>) -> Result<(), InvariantViolation> {
+        for dim in 0..=N {
+            let id = self.cell_id(dim, d);
+            let live = match dead {
+                Some(dead) => id.0 < self.ids[dim].next && !dead[dim].contains(DartId(id.0)),
+                None => id.0 < self.ids[dim].next,
+            };
+            if !live {
+                return Err(InvariantViolation::CellIdNotLive { dart: d, dim, id });
+            }
+            for j in (0..=N).filter(|&j| j != dim) {
+                let other = self.alpha_dyn(j, d);
+                let other_id = self.cell_id(dim, other);
+                if other_id != id {
+                    return Err(InvariantViolation::CellIdDiffers { dart: d, dim, j, id, other, other_id });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The freed ids of each dimension as bit sets (ids reuse the dart bit set type).
+    fn dead_id_sets(&self) -> Vec<DartSet> {
+        self.ids
+            .iter()
+            .map(|alloc| {
+                let mut set = DartSet::with_capacity(alloc.next as usize);
+                alloc.free.iter().for_each(|&id| {
+                    set.insert(DartId(id));
+                });
+                set
+            })
+            .collect()
+    }
+
+    /// Distinct dim-cells carry distinct ids and every live id is used. One flood per orbit.
+    fn check_ids_unique(&self, dim: usize, dead: &DartSet) -> Result<(), InvariantViolation> {
+        let mask = AlphaMask::cell(N, dim);
+        let mut owner = vec![u32::MAX; self.ids[dim].next as usize];
+        let mut seen = DartSet::with_capacity(self.capacity());
+        let mut stack = Vec::new();
+        for d in self.darts() {
+            if !seen.insert(d) {
+                continue;
+            }
+            let id = self.cell_id(dim, d);
+            if owner[id.index()] != u32::MAX {
+                let first = DartId(owner[id.index()]);
+                return Err(InvariantViolation::CellIdShared { dim, id, first, second: d });
+            }
+            owner[id.index()] = d.0;
+            self.flood(d, mask, &mut seen, &mut stack);
+        }
+        match (0..owner.len()).find(|&k| owner[k] == u32::MAX && !dead.contains(DartId(k as u32))) {
+            Some(k) => Err(InvariantViolation::CellIdOrphan { dim, id: CellId(k as u32) }),
+            None => Ok(()),
+        }
+    }
+}

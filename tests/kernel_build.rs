@@ -1,0 +1,93 @@
+//! Builds from structured meshes: counts against closed forms, validity, round trips.
+
+use topomech::generate::{grid_triangles, kuhn_cube};
+use topomech::{AlphaMask, BuildError, GMap};
+
+fn cube_counts(k: usize) -> [usize; 4] {
+    let v = (k + 1).pow(3);
+    let e = 3 * k * (k + 1) * (k + 1) + 3 * k * k * (k + 1) + k * k * k;
+    let f = 12 * k * k * k + 6 * k * k;
+    [v, e, f, 6 * k * k * k]
+}
+
+#[test]
+fn kuhn_cube_counts_match_closed_forms() {
+    for k in 1..=4 {
+        let (points, tets) = kuhn_cube(k);
+        let (map, report) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+        map.validate().unwrap();
+        assert_eq!(map.dart_count(), 144 * k * k * k);
+        assert_eq!(map.count_cells().0, cube_counts(k).to_vec(), "k = {k}");
+        assert_eq!(map.count_cells_by_traversal(), map.count_cells());
+        assert_eq!(map.boundary_cell_count(), 12 * k * k);
+        assert_eq!(map.components().len(), 1);
+        assert_eq!(map.euler_characteristic(), 1, "a ball has χ = 1");
+        assert!(map.is_orientable());
+        assert!(report.pinched_vertices.is_empty() && report.split_edges.is_empty());
+    }
+}
+
+#[test]
+fn grid_counts_match_closed_forms() {
+    for n in 1..=5 {
+        let (points, tris) = grid_triangles(n);
+        let (map, _) = GMap::<2>::from_triangles(points.len(), &tris).unwrap();
+        map.validate().unwrap();
+        assert_eq!(map.count_cells().0, vec![(n + 1) * (n + 1), 3 * n * n + 2 * n, 2 * n * n]);
+        assert_eq!(map.boundary_cell_count(), 4 * n);
+        assert_eq!(map.euler_characteristic(), 1);
+        let cmap = map.to_combinatorial_map().expect("a disc is orientable");
+        assert!(cmap.is_valid());
+        assert_eq!(cmap.origin.len(), map.dart_count() / 2);
+    }
+}
+
+#[test]
+fn two_tets_touching_at_a_point_make_two_vertices() {
+    let tets = [[0, 1, 2, 3], [0, 4, 5, 6]];
+    let (map, report) = GMap::<3>::from_tets(7, &tets).unwrap();
+    map.validate().unwrap();
+    assert_eq!(report.pinched_vertices, vec![(0, 2)]);
+    assert_eq!(map.count_cells().0, vec![8, 12, 8, 2]);
+    assert_eq!(map.components().len(), 2);
+}
+
+#[test]
+fn a_face_shared_by_three_tets_is_refused_with_the_face_named() {
+    let tets = [[0, 1, 2, 3], [0, 1, 2, 4], [0, 1, 2, 5]];
+    let err = GMap::<3>::from_tets(6, &tets).unwrap_err();
+    assert_eq!(err, BuildError::NonManifold { what: "face", points: vec![0, 1, 2], elements: [0, 1, 2] });
+    assert!(err.to_string().contains("[0, 1, 2]"));
+}
+
+#[test]
+fn bad_indices_and_repeats_are_refused() {
+    assert!(matches!(GMap::<3>::from_tets(3, &[[0, 1, 2, 3]]), Err(BuildError::IndexOutOfRange { index: 3, .. })));
+    assert!(matches!(GMap::<3>::from_tets(4, &[[0, 1, 1, 3]]), Err(BuildError::RepeatedVertex { point: 1, .. })));
+    assert!(matches!(GMap::<3>::from_tets(4, &[]), Err(BuildError::Empty(_))));
+}
+
+#[test]
+fn unsewing_every_face_of_a_cube_gives_free_tets_and_sewing_back_is_isomorphic() {
+    let (points, tets) = kuhn_cube(2);
+    let (original, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+    let mut map = original.clone();
+    let inner: Vec<_> = map.darts().filter(|&d| !map.is_free(3, d)).map(|d| (d, map.alpha::<3>(d))).filter(|(a, b)| a < b).collect();
+    for &(a, _) in &inner {
+        if !map.is_free(3, a) {
+            map.unsew::<3>(a).unwrap();
+        }
+    }
+    map.validate().unwrap();
+    assert_eq!(map.count_cells().0, vec![4 * tets.len(), 6 * tets.len(), 4 * tets.len(), tets.len()]);
+    assert_eq!(map.count_cells(), map.count_cells_by_traversal());
+    for &(a, b) in &inner {
+        if map.is_free(3, a) {
+            map.sew::<3>(a, b).unwrap();
+        }
+    }
+    map.validate().unwrap();
+    assert!(map.is_isomorphic(&original));
+    assert_eq!(map.count_cells(), original.count_cells());
+    let _ = AlphaMask::all(3);
+}

@@ -301,29 +301,43 @@ impl<const N: usize> GMap<N> {
             self.unlink_raw(i, x);
         }
         let mut report = CellChanges { changes: Vec::new(), pairs };
-        for k in 0..report.pairs.len() {
-            let (x, y) = report.pairs[k];
-            for dim in (0..=N).filter(|&dim| dim != i) {
-                self.split_cells(dim, x, y, &mut report.changes);
-            }
+        let ends = touched(&report.pairs);
+        for dim in (0..=N).filter(|&dim| dim != i) {
+            self.split_cells(dim, &ends, &mut report.changes);
         }
         self.after_mutation(&touched(&report.pairs));
         Ok(report)
     }
 
-    /// After an unlink, gives a fresh id to the smaller side if x and y no longer share a cell.
-    fn split_cells(&mut self, dim: usize, x: DartId, y: DartId, changes: &mut Vec<CellChange>) {
-        let old = self.cell_id(dim, x).0;
-        if old != self.cell_id(dim, y).0 {
-            return;
+    /// After unlinking, makes the dim-cell ids exact again. Every piece of a cell that fell apart
+    /// holds an endpoint of an unlinked pair, so it suffices to check each endpoint against an
+    /// *anchor* endpoint of its current id: if they are no longer in one orbit, the piece found
+    /// smaller by the lockstep walk (a complete orbit) gets a fresh id. A piece that got a fresh
+    /// id is complete, so its other endpoints are skipped.
+    fn split_cells(&mut self, dim: usize, ends: &[DartId], changes: &mut Vec<CellChange>) {
+        let mask = AlphaMask::cell(N, dim);
+        let mut anchors: Vec<(u32, DartId)> = Vec::new();
+        let mut complete: Vec<u32> = Vec::new();
+        for &z in ends {
+            let id = self.cell_id(dim, z).0;
+            if complete.contains(&id) {
+                continue;
+            }
+            let Some(slot) = anchors.iter().position(|a| a.0 == id) else {
+                anchors.push((id, z));
+                continue;
+            };
+            let anchor = anchors[slot].1;
+            let Some((side, is_z_side)) = self.split_side(anchor, z, mask) else { continue };
+            let new = self.alloc_cell_id(dim);
+            for &w in &side {
+                self.set_cell_raw(dim, w, new);
+            }
+            complete.push(new);
+            let (dart_kept, dart_new) = if is_z_side { (anchor, z) } else { (z, anchor) };
+            anchors[slot].1 = dart_kept;
+            changes.push(CellChange::Split { dim, kept: CellId(id), new: CellId(new), dart_kept, dart_new });
         }
-        let Some((side, is_y)) = self.split_side(x, y, AlphaMask::cell(N, dim)) else { return };
-        let new = self.alloc_cell_id(dim);
-        for &z in &side {
-            self.set_cell_raw(dim, z, new);
-        }
-        let (dart_kept, dart_new) = if is_y { (x, y) } else { (y, x) };
-        changes.push(CellChange::Split { dim, kept: CellId(old), new: CellId(new), dart_kept, dart_new });
     }
 }
 

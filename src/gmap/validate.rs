@@ -135,8 +135,8 @@ impl<const N: usize> GMap<N> {
         for d in self.darts() {
             self.check_dart_cells(d, Some(&dead))?;
         }
-        for dim in 0..=N {
-            self.check_ids_unique(dim, &dead[dim])?;
+        for (dim, dead_ids) in dead.iter().enumerate() {
+            self.check_ids_unique(dim, dead_ids)?;
         }
         Ok(())
     }

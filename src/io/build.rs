@@ -1,0 +1,295 @@
+//! Shared assembly of a mesh from file records: node tags to point indices, Gmsh element
+//! types, and the per-record checks that can name a line (duplicate tags, non-finite
+//! coordinates, repeated vertices, undefined node tags).
+
+use std::path::Path;
+
+use std::collections::hash_map::Entry;
+
+use rustc_hash::FxHashMap;
+
+use super::{Location, ReadError};
+use crate::mesh::{TetMesh, TriMesh};
+
+/// What a reader does with an element of a given type.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum ElementUse {
+    /// A linear tetrahedron: part of the volume.
+    Tet,
+    /// A linear triangle: kept as a boundary triangle.
+    Triangle,
+    /// A point, line or surface element other than a linear triangle: ignored.
+    Skip,
+}
+
+/// A known Gmsh element type.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct ElementKind {
+    /// Number of nodes of one element.
+    pub nodes: usize,
+    /// What the readers do with it.
+    pub usage: ElementUse,
+}
+
+/// Gmsh element types 1..=31: (type, dimension, nodes, name).
+const GMSH_TYPES: [(i64, u8, usize, &str); 31] = [
+    (1, 1, 2, "2-node line"),
+    (2, 2, 3, "3-node triangle"),
+    (3, 2, 4, "4-node quadrangle"),
+    (4, 3, 4, "4-node tetrahedron"),
+    (5, 3, 8, "8-node hexahedron"),
+    (6, 3, 6, "6-node prism"),
+    (7, 3, 5, "5-node pyramid"),
+    (8, 1, 3, "3-node second-order line"),
+    (9, 2, 6, "6-node second-order triangle"),
+    (10, 2, 9, "9-node second-order quadrangle"),
+    (11, 3, 10, "10-node second-order tetrahedron"),
+    (12, 3, 27, "27-node second-order hexahedron"),
+    (13, 3, 18, "18-node second-order prism"),
+    (14, 3, 14, "14-node second-order pyramid"),
+    (15, 0, 1, "1-node point"),
+    (16, 2, 8, "8-node second-order quadrangle"),
+    (17, 3, 20, "20-node second-order hexahedron"),
+    (18, 3, 15, "15-node second-order prism"),
+    (19, 3, 13, "13-node second-order pyramid"),
+    (20, 2, 9, "9-node third-order incomplete triangle"),
+    (21, 2, 10, "10-node third-order triangle"),
+    (22, 2, 12, "12-node fourth-order incomplete triangle"),
+    (23, 2, 15, "15-node fourth-order triangle"),
+    (24, 2, 15, "15-node fifth-order incomplete triangle"),
+    (25, 2, 21, "21-node fifth-order triangle"),
+    (26, 1, 4, "4-node third-order line"),
+    (27, 1, 5, "5-node fourth-order line"),
+    (28, 1, 6, "6-node fifth-order line"),
+    (29, 3, 20, "20-node third-order tetrahedron"),
+    (30, 3, 35, "35-node fourth-order tetrahedron"),
+    (31, 3, 56, "56-node fifth-order tetrahedron"),
+];
+
+/// Classifies Gmsh element type `t` found at `at`.
+///
+/// # Errors
+/// [`ReadError::UnknownElementType`] for a type outside 1..=31;
+/// [`ReadError::UnsupportedElementType`] for a volume element other than the 4-node
+/// tetrahedron (dropping it would silently leave a hole in the volume).
+pub(crate) fn gmsh_element_kind(path: &Path, at: Location, t: i64) -> Result<ElementKind, ReadError> {
+    let Some(&(_, dim, nodes, name)) = GMSH_TYPES.iter().find(|e| e.0 == t) else {
+        return Err(ReadError::UnknownElementType { path: path.to_path_buf(), at, element_type: t });
+    };
+    let usage = match (t, dim) {
+        (4, _) => ElementUse::Tet,
+        (2, _) => ElementUse::Triangle,
+        (_, 3) => {
+            return Err(ReadError::UnsupportedElementType { path: path.to_path_buf(), at, element_type: t, name })
+        }
+        _ => ElementUse::Skip,
+    };
+    Ok(ElementKind { nodes, usage })
+}
+
+/// Collects points (by file tag) and cells, checking each record as it comes.
+#[derive(Debug, Default)]
+pub(crate) struct MeshBuilder {
+    points: Vec<[f64; 3]>,
+    tags: Vec<u64>,
+    index: FxHashMap<u64, u32>,
+    tets: Vec<[u32; 4]>,
+    triangles: Vec<[u32; 3]>,
+}
+
+impl MeshBuilder {
+    /// An empty builder.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Number of points so far.
+    pub fn point_count(&self) -> usize {
+        self.points.len()
+    }
+
+    /// Reserves room for `n` more points; callers bound `n` by the file size first.
+    pub fn reserve_points(&mut self, n: usize) {
+        self.points.reserve(n);
+        self.tags.reserve(n);
+        self.index.reserve(n);
+    }
+
+    /// Adds the point with file tag `tag`.
+    ///
+    /// # Errors
+    /// `DuplicateNode`, `NonFiniteCoordinate`, `TooManyNodes`.
+    pub fn add_node(&mut self, path: &Path, at: Location, tag: u64, xyz: [f64; 3]) -> Result<(), ReadError> {
+        if !xyz.iter().all(|c| c.is_finite()) {
+            return Err(ReadError::NonFiniteCoordinate { path: path.to_path_buf(), at, tag, coords: xyz });
+        }
+        let Ok(i) = u32::try_from(self.points.len()) else {
+            return Err(too_many(path, at));
+        };
+        if i == u32::MAX {
+            return Err(too_many(path, at));
+        }
+        match self.index.entry(tag) {
+            Entry::Occupied(_) => return Err(ReadError::DuplicateNode { path: path.to_path_buf(), at, tag }),
+            Entry::Vacant(slot) => {
+                slot.insert(i);
+            }
+        }
+        self.points.push(xyz);
+        self.tags.push(tag);
+        Ok(())
+    }
+
+    /// Point indices of the node tags of element `element`, checking that every tag is
+    /// defined and none repeats.
+    fn resolve<const N: usize>(
+        &self,
+        path: &Path,
+        at: Location,
+        element: u64,
+        tags: &[u64],
+    ) -> Result<[u32; N], ReadError> {
+        let mut out = [0u32; N];
+        for k in 0..N {
+            let tag = tags.get(k).copied().unwrap_or(0);
+            let index = *self.index.get(&tag).ok_or_else(|| ReadError::UndefinedNode {
+                path: path.to_path_buf(),
+                at,
+                element,
+                tag,
+            })?;
+            if out[..k].contains(&index) {
+                return Err(ReadError::RepeatedVertex { path: path.to_path_buf(), at, element, tag });
+            }
+            out[k] = index;
+        }
+        Ok(out)
+    }
+
+    /// Adds element `element` (file tag) with node tags `nodes` according to `usage`.
+    ///
+    /// # Errors
+    /// `UndefinedNode`, `RepeatedVertex` (for tets and triangles only).
+    pub fn add_element(
+        &mut self,
+        path: &Path,
+        at: Location,
+        element: u64,
+        usage: ElementUse,
+        nodes: &[u64],
+    ) -> Result<(), ReadError> {
+        match usage {
+            ElementUse::Tet => {
+                let t = self.resolve::<4>(path, at, element, nodes)?;
+                self.tets.push(t);
+            }
+            ElementUse::Triangle => {
+                let t = self.resolve::<3>(path, at, element, nodes)?;
+                self.triangles.push(t);
+            }
+            ElementUse::Skip => {}
+        }
+        Ok(())
+    }
+
+    /// The tet mesh, after [`TetMesh::check`] found no error.
+    ///
+    /// # Errors
+    /// `InvalidMesh` (e.g. no tetrahedra).
+    pub fn into_tet_mesh(self, path: &Path) -> Result<TetMesh, ReadError> {
+        let mesh =
+            TetMesh { points: self.points, tets: self.tets, boundary_triangles: self.triangles, node_tags: self.tags };
+        mesh.check().map_err(|source| ReadError::InvalidMesh { path: path.to_path_buf(), source })?;
+        Ok(mesh)
+    }
+
+    /// The triangle mesh (tets are dropped), after [`TriMesh::check`] found no error.
+    ///
+    /// # Errors
+    /// `InvalidMesh` (e.g. no triangles).
+    pub fn into_tri_mesh(self, path: &Path) -> Result<TriMesh, ReadError> {
+        let mesh = TriMesh { points: self.points, triangles: self.triangles };
+        mesh.check().map_err(|source| ReadError::InvalidMesh { path: path.to_path_buf(), source })?;
+        Ok(mesh)
+    }
+}
+
+fn too_many(path: &Path, at: Location) -> ReadError {
+    ReadError::TooManyNodes { path: path.to_path_buf(), at }
+}
+
+/// Fails with `CountTooLarge` unless `count` items of at least `min_bytes` each fit in the
+/// `remaining` bytes; otherwise returns `count` as `usize` (safe to reserve).
+pub(crate) fn bounded_count(
+    path: &Path,
+    at: Location,
+    what: &'static str,
+    count: u64,
+    min_bytes: usize,
+    remaining: usize,
+) -> Result<usize, ReadError> {
+    let fits =
+        usize::try_from(count).ok().and_then(|c| c.checked_mul(min_bytes.max(1))).is_some_and(|need| need <= remaining);
+    if fits {
+        Ok(count as usize)
+    } else {
+        Err(ReadError::CountTooLarge { path: path.to_path_buf(), at, what, count, remaining })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn at() -> Location {
+        Location::Line(1)
+    }
+
+    #[test]
+    fn element_kinds() {
+        let p = Path::new("x");
+        let tet = gmsh_element_kind(p, at(), 4).unwrap();
+        assert_eq!((tet.nodes, tet.usage), (4, ElementUse::Tet));
+        assert_eq!(gmsh_element_kind(p, at(), 2).unwrap().usage, ElementUse::Triangle);
+        assert_eq!(gmsh_element_kind(p, at(), 15).unwrap().usage, ElementUse::Skip);
+        assert_eq!(gmsh_element_kind(p, at(), 3).unwrap().nodes, 4);
+        for t in [5, 6, 7, 11, 12, 13, 14, 17, 18, 19, 29, 30, 31] {
+            let e = gmsh_element_kind(p, at(), t).unwrap_err();
+            assert!(matches!(e, ReadError::UnsupportedElementType { .. }), "{t}");
+        }
+        for t in [0, -1, 32, 93, i64::MAX] {
+            let e = gmsh_element_kind(p, at(), t).unwrap_err();
+            assert!(matches!(e, ReadError::UnknownElementType { .. }), "{t}");
+        }
+    }
+
+    #[test]
+    fn counts_are_bounded_by_remaining_bytes() {
+        let p = Path::new("x");
+        assert_eq!(bounded_count(p, at(), "node", 2, 8, 16).unwrap(), 2);
+        assert!(bounded_count(p, at(), "node", 3, 8, 16).is_err());
+        assert!(bounded_count(p, at(), "node", u64::MAX, 8, usize::MAX).is_err());
+    }
+
+    #[test]
+    fn builder_checks_records() {
+        let p = Path::new("x");
+        let mut b = MeshBuilder::new();
+        for (i, tag) in [5u64, 9, 2, 70].into_iter().enumerate() {
+            b.add_node(p, at(), tag, [i as f64, 0.0, (i % 2) as f64]).unwrap();
+        }
+        assert!(matches!(b.add_node(p, at(), 9, [0.0; 3]), Err(ReadError::DuplicateNode { tag: 9, .. })));
+        let nan = b.add_node(p, at(), 1, [0.0, f64::NAN, 0.0]);
+        assert!(matches!(nan, Err(ReadError::NonFiniteCoordinate { tag: 1, .. })));
+        let undefined = b.add_element(p, at(), 7, ElementUse::Tet, &[5, 9, 2, 71]);
+        assert!(matches!(undefined, Err(ReadError::UndefinedNode { element: 7, tag: 71, .. })));
+        let repeated = b.add_element(p, at(), 8, ElementUse::Triangle, &[5, 9, 5]);
+        assert!(matches!(repeated, Err(ReadError::RepeatedVertex { element: 8, tag: 5, .. })));
+        b.add_element(p, at(), 1, ElementUse::Skip, &[5, 9]).unwrap();
+        b.add_element(p, at(), 2, ElementUse::Tet, &[70, 2, 9, 5]).unwrap();
+        assert_eq!(b.point_count(), 4);
+        let m = b.into_tet_mesh(p).unwrap();
+        assert_eq!(m.tets, vec![[3, 2, 1, 0]]);
+        assert_eq!(m.node_tags, vec![5, 9, 2, 70]);
+    }
+}

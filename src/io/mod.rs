@@ -1,0 +1,400 @@
+//! Mesh-file readers: Gmsh MSH 4.1 (ASCII and binary), MSH 2.2 ASCII, MSH v1, TetGen
+//! `.node`/`.ele`, and a minimal OBJ reader for triangle surfaces.
+//!
+//! Every reader returns a [`TetMesh`] (or [`TriMesh`]) that has passed [`TetMesh::check`]
+//! (resp. [`TriMesh::check`]) without error, or a [`ReadError`] that names the file, the line
+//! (text files) or byte offset (binary files) and what is wrong. Readers never panic, whatever
+//! the input, and never allocate from a count read in the file before checking it against the
+//! bytes that are left. See `docs/FORMATS.md` for what each reader accepts.
+//!
+//! Only linear tetrahedra (Gmsh type 4) make the volume. Triangles (type 2) are kept in
+//! [`TetMesh::boundary_triangles`] as a cross-check; points, lines and other surface elements
+//! are skipped; other volume elements (hexahedra, prisms, pyramids, higher-order tets) are an
+//! error, because dropping them would leave a hole.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use crate::mesh::{MeshError, TetMesh, TriMesh};
+
+mod build;
+mod msh1;
+mod msh22;
+mod msh41;
+mod obj;
+mod scan;
+mod tetgen;
+
+use build::MeshBuilder;
+
+/// Where in a file a problem is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Location {
+    /// 1-based line number (text files).
+    Line(usize),
+    /// 0-based byte offset (binary files).
+    Byte(usize),
+}
+
+impl fmt::Display for Location {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Location::Line(n) => write!(f, "line {n}"),
+            Location::Byte(n) => write!(f, "byte {n}"),
+        }
+    }
+}
+
+/// Why a mesh file could not be read. Every variant names the file; most name a [`Location`].
+#[derive(Debug, thiserror::Error)]
+pub enum ReadError {
+    /// The file could not be read from disk.
+    #[error("{}: cannot read file: {source}", .path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The file is not in a format this module reads.
+    #[error("{}: unknown mesh format: {reason}", .path.display())]
+    UnknownFormat {
+        /// The file.
+        path: PathBuf,
+        /// What was found instead.
+        reason: String,
+    },
+    /// A known format in a version (or encoding) that is not supported.
+    #[error("{}: {at}: unsupported version `{version}` (supported: {supported})", .path.display())]
+    UnsupportedVersion {
+        /// The file.
+        path: PathBuf,
+        /// Where the version is.
+        at: Location,
+        /// The version found.
+        version: String,
+        /// What is supported.
+        supported: &'static str,
+    },
+    /// The file or section ends before the data it declares.
+    #[error(
+        "{}: {at}: truncated section `{section}`: expected {expected}, found {found}",
+        .path.display()
+    )]
+    Truncated {
+        /// The file.
+        path: PathBuf,
+        /// Where the data stops.
+        at: Location,
+        /// The section being read.
+        section: &'static str,
+        /// What was expected next.
+        expected: String,
+        /// What was found (end of file, or a section marker).
+        found: String,
+    },
+    /// A token that is not what the format requires at this place.
+    #[error(
+        "{}: {at}: garbage token `{token}` in section `{section}`: expected {expected}",
+        .path.display()
+    )]
+    Garbage {
+        /// The file.
+        path: PathBuf,
+        /// Where the token is.
+        at: Location,
+        /// The section being read.
+        section: &'static str,
+        /// The token (shortened).
+        token: String,
+        /// What was expected.
+        expected: String,
+    },
+    /// An element type number that no supported format defines.
+    #[error("{}: {at}: unknown element type {element_type}", .path.display())]
+    UnknownElementType {
+        /// The file.
+        path: PathBuf,
+        /// Where the type is.
+        at: Location,
+        /// The type number.
+        element_type: i64,
+    },
+    /// A known volume element type other than the linear tetrahedron.
+    #[error(
+        "{}: {at}: unsupported element type {element_type} ({name}): only linear \
+         tetrahedra (type 4) can make the volume",
+        .path.display()
+    )]
+    UnsupportedElementType {
+        /// The file.
+        path: PathBuf,
+        /// Where the type is.
+        at: Location,
+        /// The type number (Gmsh numbering; TetGen's 10-node tets are reported as 11).
+        element_type: i64,
+        /// Its name.
+        name: &'static str,
+    },
+    /// An element refers to a node tag that no node record defines.
+    #[error(
+        "{}: {at}: node tag not defined: element {element} refers to node {tag}, which the \
+         node section does not define",
+        .path.display()
+    )]
+    UndefinedNode {
+        /// The file.
+        path: PathBuf,
+        /// Where the element is.
+        at: Location,
+        /// The element's tag (number) in the file.
+        element: u64,
+        /// The undefined node tag.
+        tag: u64,
+    },
+    /// Two node records have the same tag.
+    #[error("{}: {at}: duplicate node tag {tag}", .path.display())]
+    DuplicateNode {
+        /// The file.
+        path: PathBuf,
+        /// Where the second definition is.
+        at: Location,
+        /// The tag.
+        tag: u64,
+    },
+    /// A node coordinate is NaN or infinite.
+    #[error(
+        "{}: {at}: non-finite coordinate (NaN or infinite) for node {tag}: {coords:?}",
+        .path.display()
+    )]
+    NonFiniteCoordinate {
+        /// The file.
+        path: PathBuf,
+        /// Where the node is.
+        at: Location,
+        /// The node's tag.
+        tag: u64,
+        /// Its coordinates.
+        coords: [f64; 3],
+    },
+    /// A tetrahedron or triangle uses the same node twice.
+    #[error("{}: {at}: repeated vertex: element {element} uses node {tag} twice", .path.display())]
+    RepeatedVertex {
+        /// The file.
+        path: PathBuf,
+        /// Where the element is.
+        at: Location,
+        /// The element's tag.
+        element: u64,
+        /// The repeated node tag.
+        tag: u64,
+    },
+    /// A declared count cannot fit in what is left of the file.
+    #[error(
+        "{}: {at}: {what} count {count} is too large for the {remaining} bytes left in the \
+         file (truncated file or corrupt count)",
+        .path.display()
+    )]
+    CountTooLarge {
+        /// The file.
+        path: PathBuf,
+        /// Where the count is.
+        at: Location,
+        /// What is counted.
+        what: &'static str,
+        /// The declared count.
+        count: u64,
+        /// Bytes left after the count.
+        remaining: usize,
+    },
+    /// A declared count disagrees with the records that follow.
+    #[error("{}: {at}: {what}: declared {declared}, found {found}", .path.display())]
+    CountMismatch {
+        /// The file.
+        path: PathBuf,
+        /// Where the mismatch is noticed.
+        at: Location,
+        /// What is counted.
+        what: &'static str,
+        /// The declared count.
+        declared: u64,
+        /// The actual count.
+        found: u64,
+    },
+    /// A required section is absent.
+    #[error("{}: missing section `{section}`", .path.display())]
+    MissingSection {
+        /// The file.
+        path: PathBuf,
+        /// The section.
+        section: &'static str,
+    },
+    /// A structural problem not covered by the other variants.
+    #[error("{}: {at}: {message}", .path.display())]
+    Malformed {
+        /// The file.
+        path: PathBuf,
+        /// Where.
+        at: Location,
+        /// What is wrong.
+        message: String,
+    },
+    /// More nodes than `u32` indices can address.
+    #[error("{}: {at}: too many nodes (at most u32::MAX - 1)", .path.display())]
+    TooManyNodes {
+        /// The file.
+        path: PathBuf,
+        /// Where the node that does not fit is.
+        at: Location,
+    },
+    /// The records parse but the mesh fails [`TetMesh::check`] / [`TriMesh::check`] (e.g. it
+    /// has no tetrahedra).
+    #[error("{}: invalid mesh: {source}", .path.display())]
+    InvalidMesh {
+        /// The file.
+        path: PathBuf,
+        /// The mesh error.
+        #[source]
+        source: MeshError,
+    },
+}
+
+/// At most 40 characters of `s`, with control characters escaped, for messages.
+pub(crate) fn shorten(s: &str) -> String {
+    let mut out: String = s.chars().take(40).flat_map(char::escape_debug).collect();
+    if s.chars().nth(40).is_some() {
+        out.push('…');
+    }
+    out
+}
+
+fn read_file(path: &Path) -> Result<Vec<u8>, ReadError> {
+    std::fs::read(path).map_err(|source| ReadError::Io { path: path.to_path_buf(), source })
+}
+
+fn extension(path: &Path) -> String {
+    path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default()
+}
+
+/// Reads a tetrahedral mesh, choosing the reader by extension and header: `.node` or `.ele`
+/// reads the TetGen pair (the other file has the same stem); anything else must be a Gmsh
+/// MSH file (v1, 2.x ASCII, or 4.1 ASCII/binary), recognised by its first line.
+///
+/// Cost: O(file size) plus O(T) hashing; the whole file is held in memory.
+///
+/// # Errors
+/// Any [`ReadError`]; [`ReadError::UnknownFormat`] for an OBJ file or an unrecognised header.
+pub fn read_mesh(path: &Path) -> Result<TetMesh, ReadError> {
+    match extension(path).as_str() {
+        "node" | "ele" => read_tetgen(&path.with_extension("node"), &path.with_extension("ele")),
+        "obj" => Err(ReadError::UnknownFormat {
+            path: path.to_path_buf(),
+            reason: "OBJ holds a surface, not a volume; use read_tri_mesh".into(),
+        }),
+        _ => parse_msh(&read_file(path)?, path),
+    }
+}
+
+/// Reads a TetGen `.node` / `.ele` pair. O(file sizes).
+///
+/// # Errors
+/// Any [`ReadError`], naming whichever of the two files is at fault.
+pub fn read_tetgen(node_path: &Path, ele_path: &Path) -> Result<TetMesh, ReadError> {
+    let node = read_file(node_path)?;
+    let ele = read_file(ele_path)?;
+    parse_tetgen(&node, node_path, &ele, ele_path)
+}
+
+/// Reads a triangle surface mesh: `.obj` with the OBJ reader, anything else as a Gmsh MSH file
+/// whose triangle elements (type 2) make the surface (tetrahedra, if any, are ignored).
+/// O(file size).
+///
+/// # Errors
+/// Any [`ReadError`]; [`ReadError::InvalidMesh`] when there is no triangle.
+pub fn read_tri_mesh(path: &Path) -> Result<TriMesh, ReadError> {
+    let bytes = read_file(path)?;
+    match extension(path).as_str() {
+        "obj" => parse_obj(&bytes, path),
+        _ => parse_msh_tri(&bytes, path),
+    }
+}
+
+/// The MSH dialect of a file, from its first tokens.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum MshVersion {
+    V1,
+    V2,
+    V41,
+}
+
+fn msh_version(bytes: &[u8], path: &Path) -> Result<MshVersion, ReadError> {
+    let mut sc = scan::Scanner::new(bytes, path);
+    let first = sc.next_raw();
+    match first {
+        Some(t) if t.is("$NOD") => Ok(MshVersion::V1),
+        Some(t) if t.is("$MeshFormat") => match sc.next_raw() {
+            Some(v) if v.is("4.1") => Ok(MshVersion::V41),
+            Some(v) if [&b"2"[..], b"2.0", b"2.1", b"2.2"].contains(&v.raw) => Ok(MshVersion::V2),
+            Some(v) => Err(ReadError::UnsupportedVersion {
+                path: path.to_path_buf(),
+                at: Location::Line(v.line),
+                version: shorten(&v.text()),
+                supported: "MSH 1, 2.0-2.2 ASCII, 4.1 ASCII and binary",
+            }),
+            None => Err(sc.truncated("the format version", "end of file".into())),
+        },
+        Some(t) => Err(ReadError::UnknownFormat {
+            path: path.to_path_buf(),
+            reason: format!("expected `$MeshFormat` or `$NOD` at the start, found `{}`", shorten(&t.text())),
+        }),
+        None => Err(ReadError::UnknownFormat { path: path.to_path_buf(), reason: "the file is empty".into() }),
+    }
+}
+
+fn parse_msh_records(bytes: &[u8], path: &Path) -> Result<MeshBuilder, ReadError> {
+    match msh_version(bytes, path)? {
+        MshVersion::V1 => msh1::parse(bytes, path),
+        MshVersion::V2 => msh22::parse(bytes, path),
+        MshVersion::V41 => msh41::parse(bytes, path),
+    }
+}
+
+/// Parses the bytes of a Gmsh MSH file (any supported version, detected from the header) into
+/// a tet mesh; `path` is only used in errors. O(bytes).
+///
+/// # Errors
+/// Any [`ReadError`] except `Io`.
+pub fn parse_msh(bytes: &[u8], path: &Path) -> Result<TetMesh, ReadError> {
+    parse_msh_records(bytes, path)?.into_tet_mesh(path)
+}
+
+/// Parses the bytes of a Gmsh MSH file into a triangle mesh made of its triangle elements;
+/// `path` is only used in errors. O(bytes).
+///
+/// # Errors
+/// Any [`ReadError`] except `Io`; `InvalidMesh` when there is no triangle.
+pub fn parse_msh_tri(bytes: &[u8], path: &Path) -> Result<TriMesh, ReadError> {
+    parse_msh_records(bytes, path)?.into_tri_mesh(path)
+}
+
+/// Parses the bytes of a TetGen `.node` and `.ele` pair; the paths are only used in errors.
+/// O(bytes).
+///
+/// # Errors
+/// Any [`ReadError`] except `Io`.
+pub fn parse_tetgen(node: &[u8], node_path: &Path, ele: &[u8], ele_path: &Path) -> Result<TetMesh, ReadError> {
+    let mut b = MeshBuilder::new();
+    tetgen::parse_node(node, node_path, &mut b)?;
+    tetgen::parse_ele(ele, ele_path, &mut b)?;
+    b.into_tet_mesh(ele_path)
+}
+
+/// Parses the bytes of an OBJ file (`v` and triangular `f` records); `path` is only used in
+/// errors. O(bytes).
+///
+/// # Errors
+/// Any [`ReadError`] except `Io`.
+pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<TriMesh, ReadError> {
+    obj::parse(bytes, path)?.into_tri_mesh(path)
+}

@@ -1,0 +1,126 @@
+//! Gmsh MSH 2.x ASCII (2.0, 2.1, 2.2): `$MeshFormat`, `$Nodes`, `$Elements`; other sections
+//! are skipped up to their `$End...` marker. Binary 2.x is rejected as unsupported.
+
+use std::path::Path;
+
+use super::build::{bounded_count, gmsh_element_kind, MeshBuilder};
+use super::scan::Scanner;
+use super::{shorten, ReadError};
+
+/// Smallest number of bytes one node record takes (`1 0 0 0\n`).
+const MIN_NODE: usize = 8;
+/// Smallest number of bytes one element record takes (`1 15 0 1\n`).
+const MIN_ELEMENT: usize = 8;
+
+/// Parses an MSH 2.x ASCII file into a builder.
+pub(crate) fn parse(data: &[u8], path: &Path) -> Result<MeshBuilder, ReadError> {
+    let mut sc = Scanner::new(data, path);
+    parse_header(&mut sc)?;
+    let mut b = MeshBuilder::new();
+    let (mut seen_nodes, mut seen_elements) = (false, false);
+    while let Some(t) = sc.next_raw() {
+        match t.raw {
+            b"$Nodes" => {
+                sc.section = "$Nodes";
+                node_records(&mut sc, &mut b)?;
+                sc.expect_marker("$EndNodes")?;
+                seen_nodes = true;
+            }
+            b"$Elements" => {
+                sc.section = "$Elements";
+                if !seen_nodes {
+                    return Err(ReadError::Malformed {
+                        path: path.to_path_buf(),
+                        at: sc.location_of(&t),
+                        message: "`$Elements` before `$Nodes`".into(),
+                    });
+                }
+                element_records(&mut sc, &mut b)?;
+                sc.expect_marker("$EndElements")?;
+                seen_elements = true;
+            }
+            name if name.starts_with(b"$") && !name.starts_with(b"$End") => {
+                sc.section = "unknown";
+                let end = format!("$End{}", String::from_utf8_lossy(&name[1..]));
+                sc.skip_section(&end)?;
+            }
+            _ => {
+                sc.section = "top level";
+                return Err(sc.garbage(&t, "a section start such as `$Nodes`"));
+            }
+        }
+    }
+    for (seen, section) in [(seen_nodes, "$Nodes"), (seen_elements, "$Elements")] {
+        if !seen {
+            return Err(ReadError::MissingSection { path: path.to_path_buf(), section });
+        }
+    }
+    Ok(b)
+}
+
+/// `$MeshFormat` `2.x 0 data-size` `$EndMeshFormat`.
+fn parse_header(sc: &mut Scanner<'_>) -> Result<(), ReadError> {
+    sc.section = "$MeshFormat";
+    sc.expect_marker("$MeshFormat")?;
+    let v = sc.token("the format version")?;
+    let ft = sc.token("the file type (0 = ASCII)")?;
+    match ft.raw {
+        b"0" => {}
+        b"1" => {
+            return Err(ReadError::UnsupportedVersion {
+                path: sc.path().to_path_buf(),
+                at: sc.location_of(&ft),
+                version: format!("{} binary", shorten(&v.text())),
+                supported: "MSH 2.x ASCII only",
+            })
+        }
+        _ => return Err(sc.garbage(&ft, "the file type (0 = ASCII)")),
+    }
+    sc.u64("the data size")?;
+    sc.expect_marker("$EndMeshFormat")
+}
+
+/// The body of a `$Nodes` (2.x) or `$NOD` (v1) section: a count, then `tag x y z` records.
+pub(crate) fn node_records(sc: &mut Scanner<'_>, b: &mut MeshBuilder) -> Result<(), ReadError> {
+    let path = sc.path();
+    let at = sc.here();
+    let count = sc.u64("the number of nodes")?;
+    let n = bounded_count(path, at, "node", count, MIN_NODE, sc.remaining())?;
+    b.reserve_points(n);
+    for _ in 0..n {
+        let at = sc.here();
+        let tag = sc.u64("a node tag")?;
+        let x = sc.f64("node x coordinate")?;
+        let y = sc.f64("node y coordinate")?;
+        let z = sc.f64("node z coordinate")?;
+        b.add_node(path, at, tag, [x, y, z])?;
+    }
+    Ok(())
+}
+
+/// The body of `$Elements`: a count, then
+/// `tag type number-of-tags tag... node-tag...` records.
+fn element_records(sc: &mut Scanner<'_>, b: &mut MeshBuilder) -> Result<(), ReadError> {
+    let path = sc.path();
+    let at = sc.here();
+    let count = sc.u64("the number of elements")?;
+    let n = bounded_count(path, at, "element", count, MIN_ELEMENT, sc.remaining())?;
+    let mut nodes: Vec<u64> = Vec::new();
+    for _ in 0..n {
+        let at = sc.here();
+        let tag = sc.u64("an element tag")?;
+        let type_at = sc.here();
+        let element_type = sc.i64("an element type")?;
+        let tag_count = sc.u64("the number of element tags")?;
+        for _ in 0..tag_count {
+            sc.i64("an element tag (physical, elementary, partition)")?;
+        }
+        let kind = gmsh_element_kind(path, type_at, element_type)?;
+        nodes.clear();
+        for _ in 0..kind.nodes {
+            nodes.push(sc.u64("an element node tag")?);
+        }
+        b.add_element(path, at, tag, kind.usage, &nodes)?;
+    }
+    Ok(())
+}

@@ -1,0 +1,615 @@
+//! Indexed meshes: the plain arrays that mesh files are read into, before a generalized map is
+//! built from them.
+//!
+//! A [`TetMesh`] is a list of points and a list of tetrahedra given by four 0-based point
+//! indices; a [`TriMesh`] is the same for triangles. Both have a `check` method that separates
+//! *errors* (the mesh cannot be used: [`MeshError`]) from *warnings* (the mesh can be used but
+//! something looks wrong: [`MeshReport`], [`TriMeshReport`]).
+//!
+//! | condition | [`TetMesh::check`] | [`TriMesh::check`] |
+//! |---|---|---|
+//! | no cells at all | error [`MeshError::Empty`] | error [`MeshError::Empty`] |
+//! | corner index `>= points.len()` | error [`MeshError::IndexOutOfRange`] | error [`MeshError::IndexOutOfRange`] |
+//! | a cell uses the same point twice | error [`MeshError::RepeatedVertex`] | error [`MeshError::RepeatedVertex`] |
+//! | NaN or infinite coordinate | error [`MeshError::NonFiniteCoordinate`] | error [`MeshError::NonFiniteCoordinate`] |
+//! | `node_tags` neither empty nor one per point | error [`MeshError::TagCountMismatch`] | — |
+//! | more than `u32::MAX - 1` points | error [`MeshError::TooManyPoints`] | error [`MeshError::TooManyPoints`] |
+//! | zero volume / zero area (see [`DEGENERACY_TOLERANCE`]) | warning | warning |
+//! | negative signed volume (inverted tet) | warning | — |
+//! | point used by no cell | warning | warning |
+//! | file triangles that are not boundary faces, or boundary faces missing from the file | warning | — |
+
+use std::fmt;
+
+/// Relative tolerance under which a cell counts as degenerate (a warning, not an error).
+///
+/// A tetrahedron is *zero-volume* when `|6 V| <= DEGENERACY_TOLERANCE * l^3`, where `l` is its
+/// longest edge; a triangle is *zero-area* when `|2 A| <= DEGENERACY_TOLERANCE * l^2`. The test
+/// is scale-invariant, so a tiny but well-shaped cell is not reported.
+pub const DEGENERACY_TOLERANCE: f64 = 1e-12;
+
+/// A tetrahedral volume mesh with 0-based indices into `points`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TetMesh {
+    /// Point coordinates.
+    pub points: Vec<[f64; 3]>,
+    /// Tetrahedra, four indices into `points` each.
+    pub tets: Vec<[u32; 4]>,
+    /// The file's triangle elements (if any), remapped to indices into `points`. They do not take
+    /// part in the volume; [`TetMesh::check`] uses them only as a cross-check of the boundary.
+    pub boundary_triangles: Vec<[u32; 3]>,
+    /// `node_tags[i]` is the tag (number) that point `i` had in the file, for error messages.
+    /// Either empty (mesh built in code) or exactly one entry per point.
+    pub node_tags: Vec<u64>,
+}
+
+/// A triangle surface mesh with 0-based indices into `points`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TriMesh {
+    /// Point coordinates.
+    pub points: Vec<[f64; 3]>,
+    /// Triangles, three indices into `points` each.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// The kind of cell an error is about.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CellKind {
+    /// An entry of [`TetMesh::tets`].
+    Tet,
+    /// An entry of [`TetMesh::boundary_triangles`].
+    BoundaryTriangle,
+    /// An entry of [`TriMesh::triangles`].
+    Triangle,
+}
+
+impl fmt::Display for CellKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            CellKind::Tet => "tet",
+            CellKind::BoundaryTriangle => "boundary triangle",
+            CellKind::Triangle => "triangle",
+        })
+    }
+}
+
+/// A defect that makes a mesh unusable (see the table in the [module docs](self)).
+///
+/// Cell ids are 0-based positions in the cell list, point ids 0-based positions in `points`.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MeshError {
+    /// The mesh has no cell of the kind that makes it (no tetrahedra / no triangles).
+    #[error("empty mesh: no {0} cells")]
+    Empty(CellKind),
+    /// A corner refers to a point that does not exist.
+    #[error(
+        "index out of range: {kind} {cell} corner {corner} refers to point {value}, \
+         but the mesh has {point_count} points"
+    )]
+    IndexOutOfRange {
+        /// Which cell list.
+        kind: CellKind,
+        /// Cell id.
+        cell: usize,
+        /// Corner position within the cell (0-based).
+        corner: usize,
+        /// The offending index.
+        value: u32,
+        /// Number of points in the mesh.
+        point_count: usize,
+    },
+    /// A cell uses the same point at two corners.
+    #[error("repeated vertex: {kind} {cell} uses point {vertex}{} more than once", tag_suffix(.tag))]
+    RepeatedVertex {
+        /// Which cell list.
+        kind: CellKind,
+        /// Cell id.
+        cell: usize,
+        /// The repeated point.
+        vertex: u32,
+        /// The file tag of that point, when known.
+        tag: Option<u64>,
+    },
+    /// A coordinate is NaN or infinite.
+    #[error("non-finite coordinate: point {point}{} is {coords:?}", tag_suffix(.tag))]
+    NonFiniteCoordinate {
+        /// Point id.
+        point: usize,
+        /// The file tag of that point, when known.
+        tag: Option<u64>,
+        /// Its coordinates.
+        coords: [f64; 3],
+    },
+    /// `node_tags` is neither empty nor one entry per point.
+    #[error("node_tags has {tags} entries but there are {points} points")]
+    TagCountMismatch {
+        /// `node_tags.len()`.
+        tags: usize,
+        /// `points.len()`.
+        points: usize,
+    },
+    /// More points than `u32` indices can address (`u32::MAX` is reserved).
+    #[error("too many points: {0} (at most u32::MAX - 1 = 4294967294)")]
+    TooManyPoints(usize),
+}
+
+fn tag_suffix(tag: &Option<u64>) -> String {
+    match tag {
+        Some(t) => format!(" (file tag {t})"),
+        None => String::new(),
+    }
+}
+
+/// Warnings found by [`TetMesh::check`]: the mesh is usable, but these may indicate a problem.
+/// All ids are sorted ascending.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct MeshReport {
+    /// Tets whose volume is zero up to [`DEGENERACY_TOLERANCE`].
+    pub zero_volume_tets: Vec<usize>,
+    /// Tets with negative signed volume (and not zero-volume): inverted orientation.
+    pub inverted_tets: Vec<usize>,
+    /// Points that no tet uses.
+    pub unreferenced_points: Vec<usize>,
+    /// Entries of `boundary_triangles` that are not a boundary face of the tets.
+    pub file_triangles_not_on_boundary: Vec<usize>,
+    /// Number of boundary faces of the tets that are not among `boundary_triangles` (0 when the
+    /// file gave no triangles: the cross-check is then skipped).
+    pub boundary_faces_missing_from_file: usize,
+}
+
+impl MeshReport {
+    /// True when there is no warning at all. O(1).
+    pub fn is_clean(&self) -> bool {
+        self.zero_volume_tets.is_empty()
+            && self.inverted_tets.is_empty()
+            && self.unreferenced_points.is_empty()
+            && self.file_triangles_not_on_boundary.is_empty()
+            && self.boundary_faces_missing_from_file == 0
+    }
+}
+
+/// Warnings found by [`TriMesh::check`]. All ids are sorted ascending.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct TriMeshReport {
+    /// Triangles whose area is zero up to [`DEGENERACY_TOLERANCE`].
+    pub zero_area_triangles: Vec<usize>,
+    /// Points that no triangle uses.
+    pub unreferenced_points: Vec<usize>,
+}
+
+impl TriMeshReport {
+    /// True when there is no warning at all. O(1).
+    pub fn is_clean(&self) -> bool {
+        self.zero_area_triangles.is_empty() && self.unreferenced_points.is_empty()
+    }
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn norm(a: [f64; 3]) -> f64 {
+    dot(a, a).sqrt()
+}
+
+/// Signed volume of the tetrahedron `(a, b, c, d)`: `det[b - a, c - a, d - a] / 6`.
+///
+/// Positive when `d` lies on the side of the plane `(a, b, c)` towards which
+/// `(b - a) x (c - a)` points. O(1).
+pub fn signed_volume(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> f64 {
+    dot(cross(sub(b, a), sub(c, a)), sub(d, a)) / 6.0
+}
+
+/// Area of the triangle `(a, b, c)` (always `>= 0`). O(1).
+pub fn triangle_area(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
+    0.5 * norm(cross(sub(b, a), sub(c, a)))
+}
+
+fn longest_edge(corners: &[[f64; 3]]) -> f64 {
+    let mut longest = 0.0_f64;
+    for (i, &p) in corners.iter().enumerate() {
+        for &q in &corners[i + 1..] {
+            longest = longest.max(norm(sub(p, q)));
+        }
+    }
+    longest
+}
+
+/// The faces of tet `[a, b, c, d]`, each ordered so that its normal (right-hand rule) points
+/// out of the tet when the tet has positive [`signed_volume`]. Face `i` is opposite corner `i`.
+pub(crate) fn oriented_faces(t: [u32; 4]) -> [[u32; 3]; 4] {
+    let [a, b, c, d] = t;
+    [[b, c, d], [a, d, c], [a, b, d], [a, c, b]]
+}
+
+fn sorted3(mut f: [u32; 3]) -> [u32; 3] {
+    f.sort_unstable();
+    f
+}
+
+fn edge_key(a: u32, b: u32) -> u64 {
+    let (lo, hi) = if a < b { (a, b) } else { (b, a) };
+    (u64::from(lo) << 32) | u64::from(hi)
+}
+
+/// Checks that every index in `cells` is below `point_count` and no cell repeats a point.
+fn check_cells<const N: usize>(
+    kind: CellKind,
+    cells: &[[u32; N]],
+    point_count: usize,
+    tags: &[u64],
+) -> Result<(), MeshError> {
+    for (cell, corners) in cells.iter().enumerate() {
+        for (corner, &value) in corners.iter().enumerate() {
+            if value as usize >= point_count {
+                return Err(MeshError::IndexOutOfRange { kind, cell, corner, value, point_count });
+            }
+            if corners[..corner].contains(&value) {
+                return Err(MeshError::RepeatedVertex {
+                    kind,
+                    cell,
+                    vertex: value,
+                    tag: tags.get(value as usize).copied(),
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+fn check_points(points: &[[f64; 3]], tags: &[u64]) -> Result<(), MeshError> {
+    if points.len() >= u32::MAX as usize {
+        return Err(MeshError::TooManyPoints(points.len()));
+    }
+    for (point, p) in points.iter().enumerate() {
+        if !p.iter().all(|x| x.is_finite()) {
+            return Err(MeshError::NonFiniteCoordinate { point, tag: tags.get(point).copied(), coords: *p });
+        }
+    }
+    Ok(())
+}
+
+/// Ids of points that appear in no cell, ascending. O(P + C).
+fn unreferenced<const N: usize>(point_count: usize, cells: &[[u32; N]]) -> Vec<usize> {
+    let mut used = vec![false; point_count];
+    for c in cells {
+        for &v in c {
+            if let Some(u) = used.get_mut(v as usize) {
+                *u = true;
+            }
+        }
+    }
+    (0..point_count).filter(|&i| !used[i]).collect()
+}
+
+impl TetMesh {
+    /// Checks the mesh: `Err` for a defect that makes it unusable, otherwise the list of
+    /// warnings. See the table in the [module docs](self) for what is which.
+    ///
+    /// Cost: O(P + T) plus O((T + B) log(T + B)) for the boundary cross-check when
+    /// `boundary_triangles` is not empty (P points, T tets, B file triangles).
+    ///
+    /// # Errors
+    /// [`MeshError::Empty`], [`MeshError::TooManyPoints`], [`MeshError::TagCountMismatch`],
+    /// [`MeshError::NonFiniteCoordinate`], [`MeshError::IndexOutOfRange`],
+    /// [`MeshError::RepeatedVertex`] (for tets and for `boundary_triangles`).
+    pub fn check(&self) -> Result<MeshReport, MeshError> {
+        if self.tets.is_empty() {
+            return Err(MeshError::Empty(CellKind::Tet));
+        }
+        if !self.node_tags.is_empty() && self.node_tags.len() != self.points.len() {
+            return Err(MeshError::TagCountMismatch { tags: self.node_tags.len(), points: self.points.len() });
+        }
+        check_points(&self.points, &self.node_tags)?;
+        let n = self.points.len();
+        check_cells(CellKind::Tet, &self.tets, n, &self.node_tags)?;
+        check_cells(CellKind::BoundaryTriangle, &self.boundary_triangles, n, &self.node_tags)?;
+        let mut report = MeshReport::default();
+        for (i, t) in self.tets.iter().enumerate() {
+            let c = t.map(|v| self.points[v as usize]);
+            let six_v = 6.0 * signed_volume(c[0], c[1], c[2], c[3]);
+            if six_v.abs() <= DEGENERACY_TOLERANCE * longest_edge(&c).powi(3) {
+                report.zero_volume_tets.push(i);
+            } else if six_v < 0.0 {
+                report.inverted_tets.push(i);
+            }
+        }
+        report.unreferenced_points = unreferenced(n, &self.tets);
+        if !self.boundary_triangles.is_empty() {
+            self.cross_check_boundary(&mut report);
+        }
+        Ok(report)
+    }
+
+    /// Compares `boundary_triangles` (as unoriented vertex sets) with the boundary faces of
+    /// the tets. O((T + B) log(T + B)).
+    fn cross_check_boundary(&self, report: &mut MeshReport) {
+        let mut boundary: Vec<[u32; 3]> = self.boundary_triangles_of_tets().into_iter().map(sorted3).collect();
+        boundary.sort_unstable();
+        let mut in_file: Vec<[u32; 3]> = Vec::with_capacity(self.boundary_triangles.len());
+        for (i, &t) in self.boundary_triangles.iter().enumerate() {
+            let key = sorted3(t);
+            if boundary.binary_search(&key).is_err() {
+                report.file_triangles_not_on_boundary.push(i);
+            } else {
+                in_file.push(key);
+            }
+        }
+        in_file.sort_unstable();
+        in_file.dedup();
+        report.boundary_faces_missing_from_file = boundary.len() - in_file.len();
+    }
+
+    /// Sum of the absolute tet volumes `sum |signed_volume|`. O(T).
+    ///
+    /// Equals the enclosed volume for a valid mesh; inverted tets count positively.
+    /// Panics if an index is out of range (call [`TetMesh::check`] first).
+    pub fn total_volume(&self) -> f64 {
+        self.tets
+            .iter()
+            .map(|t| {
+                let c = t.map(|v| self.points[v as usize]);
+                signed_volume(c[0], c[1], c[2], c[3]).abs()
+            })
+            .sum()
+    }
+
+    /// The distinct edges of the tets, each as `[lo, hi]` with `lo < hi`, sorted. O(T log T).
+    ///
+    /// Computed from sorted 64-bit keys, independently of any map structure, so tests can use
+    /// it as an oracle.
+    pub fn edges(&self) -> Vec<[u32; 2]> {
+        let mut keys: Vec<u64> = Vec::with_capacity(6 * self.tets.len());
+        for &[a, b, c, d] in &self.tets {
+            keys.extend([
+                edge_key(a, b),
+                edge_key(a, c),
+                edge_key(a, d),
+                edge_key(b, c),
+                edge_key(b, d),
+                edge_key(c, d),
+            ]);
+        }
+        keys.sort_unstable();
+        keys.dedup();
+        keys.into_iter().map(|k| [(k >> 32) as u32, (k & 0xffff_ffff) as u32]).collect()
+    }
+
+    /// Number of distinct edges (= springs of a mass/spring model). O(T log T); see
+    /// [`TetMesh::edges`].
+    pub fn edge_count(&self) -> usize {
+        self.edges().len()
+    }
+
+    /// Faces used by exactly one tet, each ordered so that its normal points out of its tet
+    /// (for a positively oriented tet), sorted by their sorted vertex triple. O(T log T).
+    ///
+    /// Computed from sorted keys, independently of any map structure. A face shared by three
+    /// or more tets (non-manifold) is not reported as boundary.
+    pub fn boundary_triangles_of_tets(&self) -> Vec<[u32; 3]> {
+        let mut faces: Vec<([u32; 3], [u32; 3])> = Vec::with_capacity(4 * self.tets.len());
+        for &t in &self.tets {
+            for f in oriented_faces(t) {
+                faces.push((sorted3(f), f));
+            }
+        }
+        faces.sort_unstable_by_key(|&(key, _)| key);
+        let mut out = Vec::new();
+        let mut i = 0;
+        while i < faces.len() {
+            let mut j = i + 1;
+            while j < faces.len() && faces[j].0 == faces[i].0 {
+                j += 1;
+            }
+            if j - i == 1 {
+                out.push(faces[i].1);
+            }
+            i = j;
+        }
+        out
+    }
+
+    /// Number of faces used by exactly one tet. O(T log T); see
+    /// [`TetMesh::boundary_triangles_of_tets`].
+    pub fn boundary_face_count(&self) -> usize {
+        let mut keys: Vec<[u32; 3]> = Vec::with_capacity(4 * self.tets.len());
+        for &t in &self.tets {
+            keys.extend(oriented_faces(t).map(sorted3));
+        }
+        keys.sort_unstable();
+        let mut count = 0;
+        let mut i = 0;
+        while i < keys.len() {
+            let mut j = i + 1;
+            while j < keys.len() && keys[j] == keys[i] {
+                j += 1;
+            }
+            count += usize::from(j - i == 1);
+            i = j;
+        }
+        count
+    }
+
+    /// Drops the points that no tet uses and renumbers the rest, keeping their order.
+    ///
+    /// Returns the new mesh and the map `old index -> new index` (`u32::MAX` for a dropped
+    /// point). `node_tags` follow their points; a boundary triangle with a dropped corner is
+    /// dropped. O(P + T + B). Panics if an index is out of range (call [`TetMesh::check`]
+    /// first).
+    pub fn compact(&self) -> (TetMesh, Vec<u32>) {
+        let mut used = vec![false; self.points.len()];
+        for t in &self.tets {
+            for &v in t {
+                used[v as usize] = true;
+            }
+        }
+        let mut map = vec![u32::MAX; self.points.len()];
+        let mut points = Vec::new();
+        let mut node_tags = Vec::new();
+        for (old, slot) in map.iter_mut().enumerate() {
+            if used[old] {
+                *slot = points.len() as u32;
+                points.push(self.points[old]);
+                if let Some(&tag) = self.node_tags.get(old) {
+                    node_tags.push(tag);
+                }
+            }
+        }
+        let tets = self.tets.iter().map(|t| t.map(|v| map[v as usize])).collect();
+        let boundary_triangles = self
+            .boundary_triangles
+            .iter()
+            .map(|t| t.map(|v| map[v as usize]))
+            .filter(|t| !t.contains(&u32::MAX))
+            .collect();
+        let mesh = TetMesh { points, tets, boundary_triangles, node_tags };
+        (mesh, map)
+    }
+}
+
+impl TriMesh {
+    /// Checks the mesh: `Err` for a defect that makes it unusable, otherwise the list of
+    /// warnings (zero-area triangles, unreferenced points). See the table in the
+    /// [module docs](self). O(P + T).
+    ///
+    /// # Errors
+    /// [`MeshError::Empty`], [`MeshError::TooManyPoints`], [`MeshError::NonFiniteCoordinate`],
+    /// [`MeshError::IndexOutOfRange`], [`MeshError::RepeatedVertex`] (a degenerate triangle).
+    pub fn check(&self) -> Result<TriMeshReport, MeshError> {
+        if self.triangles.is_empty() {
+            return Err(MeshError::Empty(CellKind::Triangle));
+        }
+        check_points(&self.points, &[])?;
+        let n = self.points.len();
+        check_cells(CellKind::Triangle, &self.triangles, n, &[])?;
+        let mut report = TriMeshReport::default();
+        for (i, t) in self.triangles.iter().enumerate() {
+            let c = t.map(|v| self.points[v as usize]);
+            let two_a = 2.0 * triangle_area(c[0], c[1], c[2]);
+            if two_a <= DEGENERACY_TOLERANCE * longest_edge(&c).powi(2) {
+                report.zero_area_triangles.push(i);
+            }
+        }
+        report.unreferenced_points = unreferenced(n, &self.triangles);
+        Ok(report)
+    }
+
+    /// Sum of the triangle areas. O(T). Panics if an index is out of range (call
+    /// [`TriMesh::check`] first).
+    pub fn total_area(&self) -> f64 {
+        self.triangles
+            .iter()
+            .map(|t| {
+                let c = t.map(|v| self.points[v as usize]);
+                triangle_area(c[0], c[1], c[2])
+            })
+            .sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn unit_tet() -> TetMesh {
+        TetMesh {
+            points: vec![[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.]],
+            tets: vec![[0, 1, 2, 3]],
+            boundary_triangles: vec![],
+            node_tags: vec![10, 20, 30, 40],
+        }
+    }
+
+    #[test]
+    fn unit_tet_volume_edges_faces() {
+        let m = unit_tet();
+        assert!((m.total_volume() - 1.0 / 6.0).abs() < 1e-15);
+        assert_eq!(m.edge_count(), 6);
+        assert_eq!(m.boundary_face_count(), 4);
+        assert!(m.check().unwrap().is_clean());
+    }
+
+    #[test]
+    fn oriented_faces_point_outwards() {
+        let m = unit_tet();
+        let centroid = [0.25, 0.25, 0.25];
+        for f in m.boundary_triangles_of_tets() {
+            let c = f.map(|v| m.points[v as usize]);
+            // The centroid must be behind every outward face.
+            assert!(signed_volume(c[0], c[1], c[2], centroid) < 0.0, "{f:?}");
+        }
+    }
+
+    #[test]
+    fn inverted_and_flat_are_warnings() {
+        let mut m = unit_tet();
+        m.tets[0] = [1, 0, 2, 3];
+        assert_eq!(m.check().unwrap().inverted_tets, vec![0]);
+        m.points[3] = [0.5, 0.5, 0.0];
+        let r = m.check().unwrap();
+        assert_eq!(r.zero_volume_tets, vec![0]);
+        assert!(r.inverted_tets.is_empty());
+    }
+
+    #[test]
+    fn errors_carry_ids() {
+        let mut m = unit_tet();
+        m.tets[0] = [0, 1, 1, 3];
+        let e = m.check().unwrap_err();
+        assert_eq!(e, MeshError::RepeatedVertex { kind: CellKind::Tet, cell: 0, vertex: 1, tag: Some(20) });
+        assert!(e.to_string().contains("file tag 20"), "{e}");
+        m.tets[0] = [0, 1, 9, 3];
+        assert!(matches!(m.check(), Err(MeshError::IndexOutOfRange { value: 9, corner: 2, .. })));
+        m.tets[0] = [0, 1, 2, 3];
+        m.points[2][1] = f64::NAN;
+        let e = m.check().unwrap_err();
+        assert!(e.to_string().contains("non-finite"), "{e}");
+        assert!(e.to_string().contains("file tag 30"), "{e}");
+        m.tets.clear();
+        assert_eq!(m.check(), Err(MeshError::Empty(CellKind::Tet)));
+    }
+
+    #[test]
+    fn compact_drops_unused_points() {
+        let mut m = unit_tet();
+        m.points.insert(0, [9., 9., 9.]);
+        m.node_tags.insert(0, 99);
+        m.tets[0] = [1, 2, 3, 4];
+        assert_eq!(m.check().unwrap().unreferenced_points, vec![0]);
+        let (c, map) = m.compact();
+        assert_eq!(map, vec![u32::MAX, 0, 1, 2, 3]);
+        assert_eq!(c, unit_tet());
+    }
+
+    #[test]
+    fn boundary_cross_check() {
+        let mut m = unit_tet();
+        m.boundary_triangles = vec![[0, 2, 1], [3, 2, 1]];
+        let r = m.check().unwrap();
+        assert!(r.file_triangles_not_on_boundary.is_empty());
+        assert_eq!(r.boundary_faces_missing_from_file, 2);
+    }
+
+    #[test]
+    fn tri_mesh_check() {
+        let mut m = TriMesh {
+            points: vec![[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [2., 0., 0.]],
+            triangles: vec![[0, 1, 2]],
+        };
+        let r = m.check().unwrap();
+        assert_eq!(r.unreferenced_points, vec![3]);
+        assert!((m.total_area() - 0.5).abs() < 1e-15);
+        m.triangles.push([0, 1, 3]);
+        assert_eq!(m.check().unwrap().zero_area_triangles, vec![1]);
+        m.triangles.push([0, 0, 3]);
+        assert!(m.check().unwrap_err().to_string().contains("repeated vertex"));
+    }
+}

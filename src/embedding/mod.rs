@@ -1,0 +1,252 @@
+//! Embeddings: attributes attached to i-cells, and the embedding-aware sew/unsew (the third layer
+//! of the mutators, seed 000 §2.2 and §4.3).
+//!
+//! An attribute of the i-cells lives in a flat array indexed by the cell id that the kernel keeps
+//! on every dart ([`GMap::cell_id`]): one value per cell, never one per dart, and no pointer. When a
+//! topological sew or unsew changes cell identities, the kernel reports it as [`CellChanges`]
+//! (`Merged { dim, kept, absorbed }`, `Split { dim, kept, new, dart_kept, dart_new }`); the
+//! [`Embedded`] layer hands every change to the attribute owner's [`CellRules`], **after** the whole
+//! topological operation is done, so a rule sees the final map and can recompute a value from the
+//! geometry around each resulting cell (the mass of a vertex from the tetrahedra now around it)
+//! rather than only copying or halving it.
+//!
+//! ```text
+//!   layer 3  Embedded::sew / unsew      topology + attributes (this module)
+//!   layer 2  GMap::sew_dyn / unsew_dyn  topology, exact cell ids, returns CellChanges
+//!   layer 1  link_raw (crate-private)   may break validity
+//! ```
+//!
+//! With the `expensive-checks` feature every mutating operation of this layer ends with
+//! [`CellRules::check`] (for the mechanical model: the conservation laws).
+
+use crate::gmap::{CellChange, CellChanges, SewError};
+use crate::{CellId, DartId, GMap};
+
+/// A flat array of attributes keyed by the ids of one cell dimension.
+///
+/// Index `id.index()` holds the attribute of cell `id`; slots of dead ids hold stale values that
+/// nothing reads. [`CellArray::grow`] extends it when the kernel hands out larger ids.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct CellArray<T> {
+    values: Vec<T>,
+}
+
+impl<T: Clone> CellArray<T> {
+    /// An array of `len` copies of `fill`. O(len).
+    pub fn filled(len: usize, fill: T) -> Self {
+        CellArray { values: vec![fill; len] }
+    }
+
+    /// Extends the array with `fill` up to `len` slots (never shrinks). Amortized O(growth).
+    pub fn grow(&mut self, len: usize, fill: T) {
+        if self.values.len() < len {
+            self.values.resize(len, fill);
+        }
+    }
+}
+
+impl<T> CellArray<T> {
+    /// An array taking ownership of `values` (slot i = cell id i). O(1).
+    pub fn from_vec(values: Vec<T>) -> Self {
+        CellArray { values }
+    }
+
+    /// Number of slots. O(1).
+    pub fn len(&self) -> usize {
+        self.values.len()
+    }
+
+    /// Whether there is no slot. O(1).
+    pub fn is_empty(&self) -> bool {
+        self.values.is_empty()
+    }
+
+    /// The attribute of `id`, or `None` past the end. O(1).
+    pub fn get(&self, id: CellId) -> Option<&T> {
+        self.values.get(id.index())
+    }
+
+    /// All slots as a slice (slot i = cell id i). O(1).
+    pub fn as_slice(&self) -> &[T] {
+        &self.values
+    }
+
+    /// All slots as a mutable slice. O(1).
+    pub fn as_mut_slice(&mut self) -> &mut [T] {
+        &mut self.values
+    }
+}
+
+impl<T> std::ops::Index<CellId> for CellArray<T> {
+    type Output = T;
+    #[inline(always)]
+    fn index(&self, id: CellId) -> &T {
+        &self.values[id.index()]
+    }
+}
+
+impl<T> std::ops::IndexMut<CellId> for CellArray<T> {
+    #[inline(always)]
+    fn index_mut(&mut self, id: CellId) -> &mut T {
+        &mut self.values[id.index()]
+    }
+}
+
+/// Split and merge rules of a set of cell attributes: what the embedding layer does with the
+/// attributes when a sew merges cells or an unsew splits them.
+///
+/// Every method receives the map *after* the topological operation, so both resulting cells can
+/// be walked.
+pub trait CellRules<const N: usize> {
+    /// What [`CellRules::check`] reports.
+    type Error: std::error::Error + 'static;
+
+    /// Makes room for every cell id the map can now hand out (`map.cell_id_bound(i)` for all i).
+    /// Called before the rules of an operation run.
+    fn grow_to(&mut self, map: &GMap<N>);
+
+    /// The `dim`-cell `kept` (containing `dart_kept`) was split: the darts of the other side,
+    /// `dart_new` among them, now form the cell `new`.
+    fn on_split(&mut self, map: &GMap<N>, dim: usize, kept: CellId, new: CellId, dart_kept: DartId, dart_new: DartId);
+
+    /// The `dim`-cell `absorbed` was merged into `kept`, which now holds the darts of both.
+    fn on_merge(&mut self, map: &GMap<N>, dim: usize, kept: CellId, absorbed: CellId);
+
+    /// Called once after all splits or merges of one operation, with the darts it (un)linked:
+    /// the place for rules that depend on several dimensions at once (e.g. boundary flags).
+    fn after_operation(&mut self, map: &GMap<N>, changes: &CellChanges) {
+        let _ = (map, changes);
+    }
+
+    /// Checks the attributes against the map (laws such as conservation). O(model) typically.
+    ///
+    /// # Errors
+    /// `Self::Error` naming the cell at fault.
+    fn check(&self, map: &GMap<N>) -> Result<(), Self::Error> {
+        let _ = map;
+        Ok(())
+    }
+}
+
+/// Errors of the embedding-aware mutators.
+#[derive(Debug, thiserror::Error)]
+pub enum EmbedError<E: std::error::Error + 'static> {
+    /// The topological operation was refused; map and attributes are unchanged.
+    #[error(transparent)]
+    Sew(#[from] SewError),
+    /// The rules left the attributes inconsistent (only with `expensive-checks`).
+    #[error("attributes broken after {op} of {dart}: {source}")]
+    Check {
+        /// "sew" or "unsew".
+        op: &'static str,
+        /// The dart the operation was called with.
+        dart: DartId,
+        /// What the check found.
+        source: E,
+    },
+}
+
+/// A map together with cell attributes kept consistent by [`CellRules`].
+///
+/// The map is only reachable read-only from outside, so every topological change goes through
+/// [`Embedded::sew`] / [`Embedded::unsew`] and the rules cannot be bypassed. [`Embedded::version`]
+/// counts topological changes; projections built from the map remember it to detect staleness.
+#[derive(Clone, Debug)]
+pub struct Embedded<const N: usize, E> {
+    map: GMap<N>,
+    attrs: E,
+    version: u64,
+}
+
+impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
+    /// Wraps a map and attributes that already agree with it. O(1) (plus [`CellRules::grow_to`]).
+    pub fn new(map: GMap<N>, mut attrs: E) -> Self {
+        attrs.grow_to(&map);
+        Embedded { map, attrs, version: 0 }
+    }
+
+    /// The map (read-only). O(1).
+    pub fn map(&self) -> &GMap<N> {
+        &self.map
+    }
+
+    /// The attributes. O(1).
+    pub fn attrs(&self) -> &E {
+        &self.attrs
+    }
+
+    /// The attributes, mutable (state variables such as positions change every time step). The
+    /// map stays untouchable. O(1).
+    pub fn attrs_mut(&mut self) -> &mut E {
+        &mut self.attrs
+    }
+
+    /// Number of topological operations applied so far. O(1).
+    pub fn version(&self) -> u64 {
+        self.version
+    }
+
+    /// i-sews `d1` and `d2` ([`GMap::sew_dyn`]) and applies the merge rules to every merged cell.
+    /// Cost: the kernel's sew plus the rules (for the mechanical model, O(size of merged cells)).
+    ///
+    /// # Errors
+    /// [`EmbedError::Sew`] when the kernel refuses (nothing changed); [`EmbedError::Check`] under
+    /// `expensive-checks` when the attributes fail their check afterwards.
+    pub fn sew(&mut self, i: usize, d1: DartId, d2: DartId) -> Result<CellChanges, EmbedError<E::Error>> {
+        let changes = self.map.sew_dyn(i, d1, d2)?;
+        self.apply(&changes);
+        self.after("sew", d1)?;
+        Ok(changes)
+    }
+
+    /// i-unsews `d` ([`GMap::unsew_dyn`]) and applies the split rules to every split cell.
+    /// Cost: the kernel's unsew plus the rules (O(size of the split cells) for mechanics).
+    ///
+    /// # Errors
+    /// As [`Embedded::sew`].
+    pub fn unsew(&mut self, i: usize, d: DartId) -> Result<CellChanges, EmbedError<E::Error>> {
+        let changes = self.map.unsew_dyn(i, d)?;
+        self.apply(&changes);
+        self.after("unsew", d)?;
+        Ok(changes)
+    }
+
+    /// Runs the rules of `changes` (already applied to the map).
+    fn apply(&mut self, changes: &CellChanges) {
+        self.version += 1;
+        self.attrs.grow_to(&self.map);
+        for change in &changes.changes {
+            match *change {
+                CellChange::Split { dim, kept, new, dart_kept, dart_new } => {
+                    self.attrs.on_split(&self.map, dim, kept, new, dart_kept, dart_new)
+                }
+                CellChange::Merged { dim, kept, absorbed } => self.attrs.on_merge(&self.map, dim, kept, absorbed),
+            }
+        }
+        self.attrs.after_operation(&self.map, changes);
+    }
+
+    #[cfg(feature = "expensive-checks")]
+    fn after(&self, op: &'static str, dart: DartId) -> Result<(), EmbedError<E::Error>> {
+        self.attrs.check(&self.map).map_err(|source| EmbedError::Check { op, dart, source })
+    }
+
+    #[cfg(not(feature = "expensive-checks"))]
+    #[inline(always)]
+    fn after(&self, _op: &'static str, _dart: DartId) -> Result<(), EmbedError<E::Error>> {
+        Ok(())
+    }
+
+    /// Runs [`CellRules::check`] now, whatever the features.
+    ///
+    /// # Errors
+    /// The check's error.
+    pub fn check(&self) -> Result<(), E::Error> {
+        self.attrs.check(&self.map)
+    }
+
+    /// Splits into map and attributes. O(1).
+    pub fn into_parts(self) -> (GMap<N>, E) {
+        (self.map, self.attrs)
+    }
+}

@@ -1,0 +1,234 @@
+//! `check_conservation`: the laws of [`model`](super::model) recomputed from the map's orbits.
+//!
+//! The check does not trust any stored mass or stiffness. It covers the volumes of the map (a
+//! traversal with a dart set, seed §4.2, independent of the kernel's cell ids for finding the
+//! volumes) and, from each tetrahedron, scatters m_t/4 to its four vertices and E_t·V_t/L_e² to
+//! its six edges, where L_e is measured again on the rest positions of the edge's two vertices.
+//! This volume-centred scatter is a different computation from the vertex- and edge-centred
+//! gathers the split rules use, so a wrong rule cannot hide behind itself. It then compares every
+//! stored value with the recomputed one to a relative [`TOLERANCE`], and Σ_v m_v with Σ_t m_t.
+//!
+//! Cost: O(darts · log) time, O(cell ids) memory.
+
+use crate::gmap::DartSet;
+use crate::{AlphaMask, CellId, DartId, GMap};
+
+use super::geom::{close, norm, sub};
+use super::model::{distinct, stiffness_contribution, Mechanics};
+
+/// Relative tolerance of every conservation comparison.
+pub const TOLERANCE: f64 = 1e-12;
+
+/// A conservation law that does not hold, naming the cell.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ConservationError {
+    /// m_v ≠ Σ_{t ∋ v} m_t / 4.
+    #[error("vertex {vertex} (e.g. {dart}): stored mass {stored} but its tets give {expected}")]
+    VertexMass {
+        /// The vertex id.
+        vertex: CellId,
+        /// A dart of the vertex.
+        dart: DartId,
+        /// The stored value.
+        stored: f64,
+        /// The recomputed value.
+        expected: f64,
+    },
+    /// γ_v ≠ ν · m_v.
+    #[error("vertex {vertex}: stored viscosity {stored} but ν·m gives {expected}")]
+    VertexViscosity {
+        /// The vertex id.
+        vertex: CellId,
+        /// The stored value.
+        stored: f64,
+        /// The recomputed value.
+        expected: f64,
+    },
+    /// L_e differs from the distance between the rest positions of its vertices.
+    #[error("edge {edge} (e.g. {dart}): stored rest length {stored} but its vertices are {expected} apart")]
+    RestLength {
+        /// The edge id.
+        edge: CellId,
+        /// A dart of the edge.
+        dart: DartId,
+        /// The stored value.
+        stored: f64,
+        /// The recomputed value.
+        expected: f64,
+    },
+    /// k_e ≠ Σ_{t ∋ e} E_t V_t / L_e².
+    #[error("edge {edge} (e.g. {dart}): stored stiffness {stored} but its tets give {expected}")]
+    EdgeStiffness {
+        /// The edge id.
+        edge: CellId,
+        /// A dart of the edge.
+        dart: DartId,
+        /// The stored value.
+        stored: f64,
+        /// The recomputed value.
+        expected: f64,
+    },
+    /// c_e ≠ β · k_e.
+    #[error("edge {edge}: stored damping {stored} but β·k gives {expected}")]
+    EdgeDamping {
+        /// The edge id.
+        edge: CellId,
+        /// The stored value.
+        stored: f64,
+        /// The recomputed value.
+        expected: f64,
+    },
+    /// m_t ≠ ρ · V_t.
+    #[error("volume {tet}: stored mass {stored} but ρ·V gives {expected}")]
+    TetMass {
+        /// The volume id.
+        tet: CellId,
+        /// The stored value.
+        stored: f64,
+        /// The recomputed value.
+        expected: f64,
+    },
+    /// The attribute arrays of a dimension are shorter than the map's cell ids (the map changed
+    /// without the embedding layer).
+    #[error("{dim}-cell attributes cover {len} ids but the map uses {bound}")]
+    MissingAttributes {
+        /// Cell dimension.
+        dim: usize,
+        /// Slots in the attribute arrays.
+        len: usize,
+        /// The map's `cell_id_bound(dim)`.
+        bound: usize,
+    },
+    /// Σ_v m_v ≠ Σ_t m_t.
+    #[error("total vertex mass {vertices} differs from total tet mass {tets}")]
+    TotalMass {
+        /// Σ_v m_v.
+        vertices: f64,
+        /// Σ_t m_t.
+        tets: f64,
+    },
+}
+
+/// What the volume-centred scatter recomputes.
+struct Expected {
+    vertex_mass: Vec<f64>,
+    vertex_dart: Vec<Option<DartId>>,
+    edge_stiffness: Vec<f64>,
+    edge_dart: Vec<Option<DartId>>,
+    edge_length: Vec<f64>,
+    tet_mass_total: f64,
+}
+
+/// Verifies laws 1–5 of [`model`](super::model) on every live cell of `map` (see the module
+/// docs). O(darts · log).
+///
+/// # Errors
+/// The first [`ConservationError`] found, vertices first, then edges, then the totals.
+pub fn check_conservation(map: &GMap<3>, mech: &Mechanics) -> Result<(), ConservationError> {
+    for dim in 0..=3 {
+        let (len, bound) = (mech.attribute_len(dim), map.cell_id_bound(dim));
+        if len < bound {
+            return Err(ConservationError::MissingAttributes { dim, len, bound });
+        }
+    }
+    let exp = scatter_from_volumes(map, mech)?;
+    check_vertices(mech, &exp)?;
+    check_edges(mech, &exp)?;
+    let vertices: f64 = exp
+        .vertex_dart
+        .iter()
+        .enumerate()
+        .filter(|(_, d)| d.is_some())
+        .map(|(v, _)| mech.vertex_mass(CellId(v as u32)))
+        .sum();
+    if !close(vertices, exp.tet_mass_total, TOLERANCE) {
+        return Err(ConservationError::TotalMass { vertices, tets: exp.tet_mass_total });
+    }
+    Ok(())
+}
+
+fn scatter_from_volumes(map: &GMap<3>, mech: &Mechanics) -> Result<Expected, ConservationError> {
+    let mut exp = Expected {
+        vertex_mass: vec![0.0; map.cell_id_bound(0)],
+        vertex_dart: vec![None; map.cell_id_bound(0)],
+        edge_stiffness: vec![0.0; map.cell_id_bound(1)],
+        edge_dart: vec![None; map.cell_id_bound(1)],
+        edge_length: vec![0.0; map.cell_id_bound(1)],
+        tet_mass_total: 0.0,
+    };
+    let mut seen = DartSet::with_capacity(map.capacity());
+    for d in map.darts() {
+        if seen.contains(d) {
+            continue;
+        }
+        let volume = map.orbit(d, AlphaMask::cell(3, 3));
+        for &x in &volume {
+            seen.insert(x);
+        }
+        scatter_one(map, mech, &volume, &mut exp)?;
+    }
+    Ok(exp)
+}
+
+/// Adds the contributions of the tet made of `darts` (one volume orbit).
+fn scatter_one(map: &GMap<3>, mech: &Mechanics, darts: &[DartId], exp: &mut Expected) -> Result<(), ConservationError> {
+    let t = map.cell_id(3, darts[0]);
+    let (mass, volume, young) = (mech.tet_mass(t), mech.tet_rest_volume(t), mech.tet_young(t));
+    let expected = mech.material().density * volume;
+    if !close(mass, expected, TOLERANCE) {
+        return Err(ConservationError::TetMass { tet: t, stored: mass, expected });
+    }
+    exp.tet_mass_total += mass;
+    for v in distinct(darts.iter().map(|&x| map.vertex_id(x))) {
+        exp.vertex_mass[v.index()] += mass / 4.0;
+        let dart = darts.iter().copied().find(|&x| map.vertex_id(x) == v);
+        exp.vertex_dart[v.index()] = dart;
+    }
+    for e in distinct(darts.iter().map(|&x| map.cell_id(1, x))) {
+        let x = darts.iter().copied().find(|&x| map.cell_id(1, x) == e).expect("edge of this volume");
+        let length =
+            norm(sub(mech.rest_position[map.vertex_id(map.alpha::<0>(x))], mech.rest_position[map.vertex_id(x)]));
+        exp.edge_stiffness[e.index()] += stiffness_contribution(young, volume, length);
+        exp.edge_dart[e.index()] = Some(x);
+        exp.edge_length[e.index()] = length;
+    }
+    Ok(())
+}
+
+fn check_vertices(mech: &Mechanics, exp: &Expected) -> Result<(), ConservationError> {
+    let nu = mech.material().viscosity;
+    for (v, dart) in exp.vertex_dart.iter().enumerate() {
+        let Some(dart) = *dart else { continue };
+        let vertex = CellId(v as u32);
+        let (stored, expected) = (mech.vertex_mass(vertex), exp.vertex_mass[v]);
+        if !close(stored, expected, TOLERANCE) {
+            return Err(ConservationError::VertexMass { vertex, dart, stored, expected });
+        }
+        let (stored, expected) = (mech.vertex_viscosity(vertex), nu * mech.vertex_mass(vertex));
+        if !close(stored, expected, TOLERANCE) {
+            return Err(ConservationError::VertexViscosity { vertex, stored, expected });
+        }
+    }
+    Ok(())
+}
+
+fn check_edges(mech: &Mechanics, exp: &Expected) -> Result<(), ConservationError> {
+    let beta = mech.material().damping;
+    for (e, dart) in exp.edge_dart.iter().enumerate() {
+        let Some(dart) = *dart else { continue };
+        let edge = CellId(e as u32);
+        let (stored, expected) = (mech.edge_rest_length(edge), exp.edge_length[e]);
+        if !close(stored, expected, TOLERANCE) {
+            return Err(ConservationError::RestLength { edge, dart, stored, expected });
+        }
+        let (stored, expected) = (mech.edge_stiffness(edge), exp.edge_stiffness[e]);
+        if !close(stored, expected, TOLERANCE) {
+            return Err(ConservationError::EdgeStiffness { edge, dart, stored, expected });
+        }
+        let (stored, expected) = (mech.edge_damping(edge), beta * mech.edge_stiffness(edge));
+        if !close(stored, expected, TOLERANCE) {
+            return Err(ConservationError::EdgeDamping { edge, stored, expected });
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,483 @@
+//! Time integrators over a [`SpringSystem`] and state slices, with blow-up detection.
+//!
+//! State y = (x, ẋ), ÿ = a(x, ẋ) = M⁻¹ f(x, ẋ) (zero on fixed slots). With step h:
+//! - [`Integrator::Euler`] (explicit, order 1): x₁ = x₀ + h ẋ₀, ẋ₁ = ẋ₀ + h a(y₀).
+//! - [`Integrator::Symplectic`] (semi-implicit Euler, order 1, symplectic without damping):
+//!   ẋ₁ = ẋ₀ + h a(y₀), x₁ = x₀ + h ẋ₁.
+//! - [`Integrator::Rk4`] (classic Runge–Kutta, order 4, the seed's scheme).
+//! - [`Integrator::Implicit`] (backward Euler linearised once per step, Baraff–Witkin): solve
+//!   (M + h(Γ + C) + h² K) Δẋ = h (f₀ − h K ẋ₀) with matrix-free conjugate gradient, where
+//!   K = −∂f/∂x and C = −∂f/∂ẋ (spring part) are applied spring by spring and never assembled;
+//!   ẋ₁ = ẋ₀ + Δẋ, x₁ = x₀ + h ẋ₁. Each spring's K block is k n nᵀ + k max(0, 1 − L/l)(I − n nᵀ)
+//!   (the transverse term clamped at zero under compression so that the system stays SPD).
+//!   Unconditionally stable for this linearisation: it runs stiff tissue at large steps.
+//!
+//! After every step the state is scanned: a NaN or infinite coordinate, or a kinetic energy above
+//! [`StepConfig::runaway_factor`] times the energy scale of the start (kinetic plus elastic energy
+//! plus M |g| D, with D the diagonal of the bounding box), is returned as [`StepError::BlowUp`]
+//! naming the step and the slot.
+
+use std::str::FromStr;
+
+use rayon::prelude::*;
+
+use super::force::{SpringSystem, PARALLEL_CHUNK};
+use super::geom::{dot, norm, sub, Vec3};
+
+/// The time integration scheme.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Integrator {
+    /// Explicit (forward) Euler.
+    Euler,
+    /// Semi-implicit (symplectic) Euler.
+    Symplectic,
+    /// Classic fourth-order Runge–Kutta.
+    Rk4,
+    /// Linearised backward Euler with matrix-free conjugate gradient.
+    Implicit,
+}
+
+impl Integrator {
+    /// The CLI name: `euler`, `symplectic`, `rk4`, `implicit`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Integrator::Euler => "euler",
+            Integrator::Symplectic => "symplectic",
+            Integrator::Rk4 => "rk4",
+            Integrator::Implicit => "implicit",
+        }
+    }
+}
+
+/// An integrator name that is not one of the four.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unknown integrator {0:?} (expected euler, symplectic, rk4 or implicit)")]
+pub struct UnknownIntegrator(pub String);
+
+impl FromStr for Integrator {
+    type Err = UnknownIntegrator;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.to_ascii_lowercase().as_str() {
+            "euler" => Ok(Integrator::Euler),
+            "symplectic" | "semi-implicit" => Ok(Integrator::Symplectic),
+            "rk4" => Ok(Integrator::Rk4),
+            "implicit" | "backward-euler" => Ok(Integrator::Implicit),
+            _ => Err(UnknownIntegrator(s.to_string())),
+        }
+    }
+}
+
+/// What went wrong in a step.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum StepError {
+    /// The state became non-finite or its energy ran away; the simulation must stop.
+    #[error("simulation blew up at step {step}, vertex slot {slot}: {reason}")]
+    BlowUp {
+        /// Index of the step that produced the bad state (0-based).
+        step: u64,
+        /// The vertex slot at fault (for a map-driven simulation, the vertex id).
+        slot: usize,
+        /// What was found.
+        reason: String,
+    },
+    /// The conjugate gradient of the implicit step did not reach its tolerance.
+    #[error("implicit step {step}: conjugate gradient stopped after {iterations} iterations at relative residual {residual:e}")]
+    SolverFailed {
+        /// The step.
+        step: u64,
+        /// Iterations made.
+        iterations: usize,
+        /// ‖r‖/‖b‖ reached.
+        residual: f64,
+    },
+    /// The time step is not a positive finite number.
+    #[error("time step {0} must be positive and finite")]
+    BadTimeStep(f64),
+    /// The state slices do not match the system.
+    #[error("state has {got} slots, the system {expected}")]
+    SizeMismatch {
+        /// Slots of the system.
+        expected: usize,
+        /// Length of the state given.
+        got: usize,
+    },
+}
+
+/// Parameters of the stepping.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepConfig {
+    /// The scheme.
+    pub integrator: Integrator,
+    /// Time step h.
+    pub dt: f64,
+    /// Split passes across rayon's threads when the system is large (bitwise identical results).
+    pub parallel: bool,
+    /// Kinetic energy above this many times the starting energy scale counts as a blow-up.
+    pub runaway_factor: f64,
+    /// Relative residual at which conjugate gradient stops.
+    pub cg_tolerance: f64,
+    /// Iteration cap of conjugate gradient.
+    pub cg_max_iterations: usize,
+}
+
+impl StepConfig {
+    /// Defaults for `integrator` at step `dt`: serial, runaway factor 1e3, CG to 1e-10 in ≤ 1000
+    /// iterations.
+    pub fn new(integrator: Integrator, dt: f64) -> Self {
+        StepConfig {
+            integrator,
+            dt,
+            parallel: false,
+            runaway_factor: 1e3,
+            cg_tolerance: 1e-10,
+            cg_max_iterations: 1000,
+        }
+    }
+}
+
+/// The integrator's scratch buffers and step counter; reused every step (no allocation).
+#[derive(Clone, Debug)]
+pub struct Stepper {
+    config: StepConfig,
+    step: u64,
+    energy_scale: f64,
+    sf: Vec<Vec3>,
+    acc: Vec<Vec3>,
+    xs: Vec<Vec3>,
+    vs: Vec<Vec3>,
+    ax: Vec<Vec3>,
+    av: Vec<Vec3>,
+    cg: CgBuffers,
+    /// Iterations of the last implicit solve.
+    pub last_cg_iterations: usize,
+}
+
+#[derive(Clone, Debug, Default)]
+struct CgBuffers {
+    dir: Vec<Vec3>,
+    coef: Vec<[f64; 3]>,
+    r: Vec<Vec3>,
+    p: Vec<Vec3>,
+    q: Vec<Vec3>,
+    dv: Vec<Vec3>,
+}
+
+impl Stepper {
+    /// A stepper for `sys` starting from state (x, v): records the energy scale for the runaway
+    /// test. O(slots + springs).
+    ///
+    /// # Errors
+    /// [`StepError::BadTimeStep`], [`StepError::SizeMismatch`].
+    pub fn new(config: StepConfig, sys: &SpringSystem, x: &[Vec3], v: &[Vec3]) -> Result<Self, StepError> {
+        if !(config.dt.is_finite() && config.dt > 0.0) {
+            return Err(StepError::BadTimeStep(config.dt));
+        }
+        check_len(sys, x)?;
+        check_len(sys, v)?;
+        let (n, s) = (sys.slots(), sys.springs());
+        let z = |len| vec![[0.0; 3]; len];
+        Ok(Stepper {
+            config,
+            step: 0,
+            energy_scale: energy_scale(sys, x, v),
+            sf: z(s),
+            acc: z(n),
+            xs: z(n),
+            vs: z(n),
+            ax: z(n),
+            av: z(n),
+            cg: CgBuffers::default(),
+            last_cg_iterations: 0,
+        })
+    }
+
+    /// The configuration. O(1).
+    pub fn config(&self) -> &StepConfig {
+        &self.config
+    }
+
+    /// Steps made so far. O(1).
+    pub fn steps_done(&self) -> u64 {
+        self.step
+    }
+
+    /// Advances (x, v) by one step of the configured scheme, then checks for blow-up.
+    /// O(slots + springs) (times the CG iterations for the implicit scheme).
+    ///
+    /// # Errors
+    /// [`StepError::BlowUp`], [`StepError::SolverFailed`], [`StepError::SizeMismatch`]. After an
+    /// error the state holds the bad values (for inspection); do not continue.
+    pub fn step(&mut self, sys: &SpringSystem, x: &mut [Vec3], v: &mut [Vec3]) -> Result<(), StepError> {
+        check_len(sys, x)?;
+        check_len(sys, v)?;
+        match self.config.integrator {
+            Integrator::Euler => self.euler(sys, x, v),
+            Integrator::Symplectic => self.symplectic(sys, x, v),
+            Integrator::Rk4 => self.rk4(sys, x, v),
+            Integrator::Implicit => self.implicit(sys, x, v)?,
+        }
+        self.check_state(sys, x, v)?;
+        self.step += 1;
+        Ok(())
+    }
+
+    fn euler(&mut self, sys: &SpringSystem, x: &mut [Vec3], v: &mut [Vec3]) {
+        let (h, par) = (self.config.dt, self.config.parallel);
+        sys.accelerations(x, v, &mut self.sf, &mut self.acc, par);
+        axpy(x, h, v);
+        axpy(v, h, &self.acc);
+    }
+
+    fn symplectic(&mut self, sys: &SpringSystem, x: &mut [Vec3], v: &mut [Vec3]) {
+        let (h, par) = (self.config.dt, self.config.parallel);
+        sys.accelerations(x, v, &mut self.sf, &mut self.acc, par);
+        axpy(v, h, &self.acc);
+        axpy(x, h, v);
+    }
+
+    fn rk4(&mut self, sys: &SpringSystem, x: &mut [Vec3], v: &mut [Vec3]) {
+        let (h, par) = (self.config.dt, self.config.parallel);
+        // Stage 1 at y0: (ax, av) = k1, (xs, vs) = y0 + h/2 k1.
+        sys.accelerations(x, v, &mut self.sf, &mut self.acc, par);
+        for i in 0..x.len() {
+            let (vi, ai) = (v[i], self.acc[i]);
+            self.ax[i] = vi;
+            self.av[i] = ai;
+            self.xs[i] = madd(x[i], 0.5 * h, vi);
+            self.vs[i] = madd(vi, 0.5 * h, ai);
+        }
+        // Stages 2 and 3: k = (vs, a(xs, vs)), accumulate 2k, next stage from y0.
+        for c in [0.5 * h, h] {
+            sys.accelerations(&self.xs, &self.vs, &mut self.sf, &mut self.acc, par);
+            for i in 0..x.len() {
+                let (vi, ai) = (self.vs[i], self.acc[i]);
+                self.ax[i] = madd(self.ax[i], 2.0, vi);
+                self.av[i] = madd(self.av[i], 2.0, ai);
+                self.xs[i] = madd(x[i], c, vi);
+                self.vs[i] = madd(v[i], c, ai);
+            }
+        }
+        // Stage 4 and the combination y1 = y0 + h/6 (k1 + 2k2 + 2k3 + k4).
+        sys.accelerations(&self.xs, &self.vs, &mut self.sf, &mut self.acc, par);
+        let w = h / 6.0;
+        for i in 0..x.len() {
+            x[i] = madd(x[i], w, add(self.ax[i], self.vs[i]));
+            v[i] = madd(v[i], w, add(self.av[i], self.acc[i]));
+        }
+    }
+
+    fn check_state(&self, sys: &SpringSystem, x: &[Vec3], v: &[Vec3]) -> Result<(), StepError> {
+        let step = self.step;
+        let bad = |slot, reason: String| Err(StepError::BlowUp { step, slot, reason });
+        let mut kinetic = 0.0;
+        let (mut worst, mut worst_slot) = (-1.0, 0);
+        for i in 0..x.len() {
+            if !(x[i].iter().chain(&v[i]).all(|c| c.is_finite())) {
+                return bad(i, format!("non-finite state x = {:?}, v = {:?}", x[i], v[i]));
+            }
+            let e = 0.5 * sys.mass[i] * dot(v[i], v[i]);
+            kinetic += e;
+            if e > worst {
+                (worst, worst_slot) = (e, i);
+            }
+        }
+        let limit = self.config.runaway_factor * self.energy_scale;
+        if self.energy_scale > 0.0 && kinetic > limit {
+            return bad(worst_slot, format!("kinetic energy {kinetic:e} exceeds {limit:e} (runaway)"));
+        }
+        Ok(())
+    }
+}
+
+fn check_len(sys: &SpringSystem, x: &[Vec3]) -> Result<(), StepError> {
+    if x.len() == sys.slots() {
+        Ok(())
+    } else {
+        Err(StepError::SizeMismatch { expected: sys.slots(), got: x.len() })
+    }
+}
+
+/// Kinetic + elastic energy + M |g| D (D = bounding-box diagonal of x). O(slots + springs).
+fn energy_scale(sys: &SpringSystem, x: &[Vec3], v: &[Vec3]) -> f64 {
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for p in x {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let diag = if x.is_empty() { 0.0 } else { norm(sub(hi, lo)) };
+    let total_mass: f64 = sys.mass.iter().sum();
+    sys.kinetic_energy(v) + sys.elastic_energy(x) + total_mass * norm(sys.gravity) * diag
+}
+
+#[inline(always)]
+fn madd(a: Vec3, s: f64, b: Vec3) -> Vec3 {
+    [a[0] + s * b[0], a[1] + s * b[1], a[2] + s * b[2]]
+}
+
+#[inline(always)]
+fn add(a: Vec3, b: Vec3) -> Vec3 {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+/// y += s·x.
+fn axpy(y: &mut [Vec3], s: f64, x: &[Vec3]) {
+    for (yi, xi) in y.iter_mut().zip(x) {
+        *yi = madd(*yi, s, *xi);
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Implicit (linearised backward) Euler with matrix-free CG.
+
+impl Stepper {
+    fn implicit(&mut self, sys: &SpringSystem, x: &mut [Vec3], v: &mut [Vec3]) -> Result<(), StepError> {
+        let (h, par) = (self.config.dt, self.config.parallel);
+        let n = x.len();
+        let cg = &mut self.cg;
+        for buf in [&mut cg.r, &mut cg.p, &mut cg.q, &mut cg.dv] {
+            buf.resize(n, [0.0; 3]);
+        }
+        cg.dir.resize(sys.springs(), [0.0; 3]);
+        cg.coef.resize(sys.springs(), [0.0; 3]);
+        linearise(sys, x, &mut cg.dir, &mut cg.coef);
+        // b = h f0 + h² K-gather(v0)  (K v0 enters with a minus: −h² K v0, K = −∂f/∂x ⇒ + gather).
+        sys.forces(x, v, &mut self.sf, &mut self.acc, par);
+        spring_products(sys, &cg.dir, &cg.coef, v, 0.0, 1.0, &mut self.sf);
+        let sf: &[Vec3] = &self.sf;
+        let f0: &[Vec3] = &self.acc;
+        sys.per_slot(&mut cg.r, par, |i| {
+            let g = gather(sys, i, sf);
+            if sys.inv_mass[i] > 0.0 {
+                [h * f0[i][0] + h * h * g[0], h * f0[i][1] + h * h * g[1], h * f0[i][2] + h * h * g[2]]
+            } else {
+                [0.0; 3]
+            }
+        });
+        let iterations = self.conjugate_gradient(sys, h)?;
+        self.last_cg_iterations = iterations;
+        let dv = &self.cg.dv;
+        for i in 0..n {
+            v[i] = add(v[i], dv[i]);
+            x[i] = madd(x[i], h, v[i]);
+        }
+        Ok(())
+    }
+
+    /// Solves A Δv = r (r holds b on entry) by CG on the free slots; Δv in `cg.dv`.
+    fn conjugate_gradient(&mut self, sys: &SpringSystem, h: f64) -> Result<usize, StepError> {
+        let par = self.config.parallel;
+        let cg = &mut self.cg;
+        cg.dv.iter_mut().for_each(|d| *d = [0.0; 3]);
+        cg.p.copy_from_slice(&cg.r);
+        let b_norm = dot_all(&cg.r, &cg.r).sqrt();
+        if b_norm == 0.0 {
+            return Ok(0);
+        }
+        let mut rr = dot_all(&cg.r, &cg.r);
+        for it in 0..self.config.cg_max_iterations {
+            if rr.sqrt() <= self.config.cg_tolerance * b_norm {
+                return Ok(it);
+            }
+            apply_system(sys, &cg.dir, &cg.coef, h, &cg.p, &mut self.sf, &mut cg.q, par);
+            let alpha = rr / dot_all(&cg.p, &cg.q);
+            for i in 0..cg.p.len() {
+                cg.dv[i] = madd(cg.dv[i], alpha, cg.p[i]);
+                cg.r[i] = madd(cg.r[i], -alpha, cg.q[i]);
+            }
+            let rr_new = dot_all(&cg.r, &cg.r);
+            let beta = rr_new / rr;
+            rr = rr_new;
+            for i in 0..cg.p.len() {
+                cg.p[i] = madd(cg.r[i], beta, cg.p[i]);
+            }
+        }
+        let residual = rr.sqrt() / b_norm;
+        if residual <= self.config.cg_tolerance.max(1e-6) {
+            return Ok(self.config.cg_max_iterations);
+        }
+        Err(StepError::SolverFailed { step: self.step, iterations: self.config.cg_max_iterations, residual })
+    }
+}
+
+/// Per spring: unit direction n and (k_axial, k_transverse, c) for the K and C blocks.
+fn linearise(sys: &SpringSystem, x: &[Vec3], dir: &mut [Vec3], coef: &mut [[f64; 3]]) {
+    for s in 0..sys.springs() {
+        let [a, b] = sys.ends[s];
+        let d = sub(x[b as usize], x[a as usize]);
+        let l = norm(d);
+        let (k, rest) = (sys.stiffness[s], sys.rest[s]);
+        if l > 0.0 {
+            dir[s] = [d[0] / l, d[1] / l, d[2] / l];
+            coef[s] = [k, k * (1.0 - rest / l).max(0.0), sys.damping[s]];
+        } else {
+            dir[s] = [0.0; 3];
+            coef[s] = [0.0, 0.0, 0.0];
+        }
+    }
+}
+
+/// out_s = wc·C_s w + wk·K_s w with w = u_b − u_a (C_s = c n nᵀ, K_s as in the module docs).
+fn spring_products(
+    sys: &SpringSystem,
+    dir: &[Vec3],
+    coef: &[[f64; 3]],
+    u: &[Vec3],
+    wc: f64,
+    wk: f64,
+    out: &mut [Vec3],
+) {
+    for s in 0..sys.springs() {
+        let [a, b] = sys.ends[s];
+        let w = sub(u[b as usize], u[a as usize]);
+        let n = dir[s];
+        let [k, kt, c] = coef[s];
+        let along = dot(n, w);
+        let axial = wk * (k - kt) * along + wc * c * along;
+        out[s] = [wk * kt * w[0] + axial * n[0], wk * kt * w[1] + axial * n[1], wk * kt * w[2] + axial * n[2]];
+    }
+}
+
+/// Σ_{v = a} y_s − Σ_{v = b} y_s.
+#[inline(always)]
+fn gather(sys: &SpringSystem, i: usize, y: &[Vec3]) -> Vec3 {
+    let mut f = [0.0; 3];
+    for (s, sign) in sys.incident(i) {
+        f = madd(f, sign, y[s]);
+    }
+    f
+}
+
+/// q = S (M + h(Γ + C) + h² K) p, S zeroing fixed slots.
+#[allow(clippy::too_many_arguments)]
+fn apply_system(
+    sys: &SpringSystem,
+    dir: &[Vec3],
+    coef: &[[f64; 3]],
+    h: f64,
+    p: &[Vec3],
+    y: &mut [Vec3],
+    q: &mut [Vec3],
+    par: bool,
+) {
+    spring_products(sys, dir, coef, p, h, h * h, y);
+    let y: &[Vec3] = y;
+    let value = |i: usize| {
+        if sys.inv_mass[i] == 0.0 {
+            return [0.0; 3];
+        }
+        let g = gather(sys, i, y);
+        let d = sys.mass[i] + h * sys.viscosity[i];
+        [d * p[i][0] - g[0], d * p[i][1] - g[1], d * p[i][2] - g[2]]
+    };
+    if par && q.len() > PARALLEL_CHUNK {
+        q.par_iter_mut().enumerate().for_each(|(i, o)| *o = value(i));
+    } else {
+        q.iter_mut().enumerate().for_each(|(i, o)| *o = value(i));
+    }
+}
+
+fn dot_all(a: &[Vec3], b: &[Vec3]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| dot(*x, *y)).sum()
+}

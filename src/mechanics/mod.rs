@@ -1,0 +1,147 @@
+//! A mass/spring model embedded in a 3-G-map (seed 000 §3–§5).
+//!
+//! - [`model`]: the mechanical embeddings keyed by cell id, their laws, and the split/merge rules
+//!   that keep them lawful under [`Body::unsew3`] / [`Body::sew3`];
+//! - [`conservation`]: [`check_conservation`], the laws recomputed from the map's orbits;
+//! - [`force`]: forces on flat arrays ([`SpringSystem`]) and their two-pass, thread-deterministic
+//!   evaluation;
+//! - [`integrate`]: explicit/symplectic Euler, RK4, implicit Euler with matrix-free CG, blow-up
+//!   detection;
+//! - [`projection`]: the indexed projection of a body (seed §5.2) and the orbit-walk reference;
+//! - [`flat`]: the same model built from the tet list without a map (oracle and baseline).
+//!
+//! [`Simulation`] ties a body, its projection and a stepper together. `docs/MECHANICS.md` states
+//! every law with its formula and where the code checks it.
+
+pub mod conservation;
+pub mod flat;
+pub mod force;
+mod geom;
+pub mod integrate;
+pub mod model;
+pub mod projection;
+
+pub use conservation::{check_conservation, ConservationError};
+pub use flat::FlatModel;
+pub use force::SpringSystem;
+pub use geom::Vec3;
+pub use integrate::{Integrator, StepConfig, StepError, Stepper};
+pub use model::{Body, BodyError, Material, Mechanics, ModelError};
+pub use projection::{forces_by_coverage, Projection};
+
+use crate::CellId;
+
+/// Errors of a map-driven simulation.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SimError {
+    /// A step failed; for a body, the slot is the vertex id.
+    #[error(transparent)]
+    Step(#[from] StepError),
+    /// The body changed topologically since the projection was built.
+    #[error("the projection was built at body version {built} but the body is at version {now}: rebuild it")]
+    StaleProjection {
+        /// Version of the projection.
+        built: u64,
+        /// Version of the body.
+        now: u64,
+    },
+}
+
+/// Which vertices to fix, by rest position or id.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PinSpec {
+    /// Vertex ids (points of the input mesh for a fresh body).
+    pub ids: Vec<u32>,
+    /// Fix vertices whose rest coordinate `axis` (0 = x, 1 = y, 2 = z) is ≤ the value.
+    pub below: Option<(usize, f64)>,
+    /// Fix vertices inside the axis-aligned box (min, max), bounds included.
+    pub inside: Option<(Vec3, Vec3)>,
+}
+
+impl PinSpec {
+    /// Whether vertex `id` at rest position `p` is fixed. O(ids).
+    pub fn pins(&self, id: CellId, p: Vec3) -> bool {
+        let below = self.below.is_some_and(|(axis, value)| p[axis] <= value);
+        let inside = self.inside.is_some_and(|(lo, hi)| (0..3).all(|k| lo[k] <= p[k] && p[k] <= hi[k]));
+        below || inside || self.ids.contains(&id.0)
+    }
+}
+
+/// A map-driven simulation: the projection of a body and a stepper that advances the body's own
+/// position and velocity embeddings.
+#[derive(Clone, Debug)]
+pub struct Simulation {
+    /// The indexed projection the step loop runs on.
+    pub projection: Projection,
+    /// The integrator and its buffers.
+    pub stepper: Stepper,
+}
+
+impl Simulation {
+    /// Projects `body` (gravity `gravity`) and prepares `config`'s integrator. Pinned vertices get
+    /// zero velocity. O(darts + E log E).
+    ///
+    /// # Errors
+    /// [`StepError::BadTimeStep`].
+    pub fn new(body: &mut Body, gravity: Vec3, config: StepConfig) -> Result<Self, SimError> {
+        let mech = body.attrs_mut();
+        for (v, &p) in mech.velocity.as_mut_slice().iter_mut().zip(mech.pinned.as_slice()) {
+            if p {
+                *v = [0.0; 3];
+            }
+        }
+        let projection = Projection::build(body, gravity);
+        let slots = projection.system.slots();
+        let mech = body.attrs();
+        let stepper = Stepper::new(
+            config,
+            &projection.system,
+            &mech.position.as_slice()[..slots],
+            &mech.velocity.as_slice()[..slots],
+        )?;
+        Ok(Simulation { projection, stepper })
+    }
+
+    /// One step on the body's positions and velocities. O(springs + vertex ids).
+    ///
+    /// # Errors
+    /// [`SimError::StaleProjection`] if the body changed topologically (call
+    /// [`Simulation::rebuild`]); [`SimError::Step`] on blow-up (the slot is the vertex id).
+    pub fn step(&mut self, body: &mut Body) -> Result<(), SimError> {
+        if !self.projection.is_current(body) {
+            return Err(SimError::StaleProjection { built: self.projection.version(), now: body.version() });
+        }
+        let slots = self.projection.system.slots();
+        let mech = body.attrs_mut();
+        let x = &mut mech.position.as_mut_slice()[..slots];
+        let v = &mut mech.velocity.as_mut_slice()[..slots];
+        self.stepper.step(&self.projection.system, x, v)?;
+        Ok(())
+    }
+
+    /// Rebuilds the projection and the stepper's buffers after topological changes, keeping the
+    /// step count's configuration. O(darts + E log E).
+    ///
+    /// # Errors
+    /// As [`Simulation::new`].
+    pub fn rebuild(&mut self, body: &mut Body) -> Result<(), SimError> {
+        let config = *self.stepper.config();
+        *self = Simulation::new(body, self.projection.system.gravity, config)?;
+        Ok(())
+    }
+
+    /// Kinetic energy of the body's free vertices. O(vertex ids).
+    pub fn kinetic_energy(&self, body: &Body) -> f64 {
+        let slots = self.projection.system.slots();
+        self.projection.system.kinetic_energy(&body.attrs().velocity.as_slice()[..slots])
+    }
+
+    /// Largest distance of a live vertex from its rest position. O(vertex ids).
+    pub fn max_displacement(&self, body: &Body) -> f64 {
+        let m = body.attrs();
+        (0..self.projection.system.slots())
+            .filter(|&v| self.projection.dart_of_vertex(v).is_some())
+            .map(|v| geom::norm(geom::sub(m.position.as_slice()[v], m.rest_position.as_slice()[v])))
+            .fold(0.0, f64::max)
+    }
+}

@@ -1,0 +1,559 @@
+//! The mechanical embeddings of a tetrahedral body and the laws that define them (seed 000 §3.1,
+//! §4.1, §4.3).
+//!
+//! | cell | attributes (keyed by the cell's id) |
+//! |---|---|
+//! | volume t | rest volume V_t, mass m_t = ρ·V_t, Young's modulus E_t |
+//! | edge e | rest length L_e, stiffness k_e, damping c_e |
+//! | face f | boundary flag, outward unit normal (boundary faces, for rendering) |
+//! | vertex v | rest position, position, velocity, force, mass m_v, ambient viscosity γ_v, pinned |
+//!
+//! # Laws
+//! 1. **Vertex mass** (seed eq. 1): m_v = Σ_{t ∋ v} m_t / 4, the sum over the tetrahedra around v
+//!    in the map (the volumes met by the vertex orbit ⟨α1, α2, α3⟩).
+//! 2. **Spring stiffness**: each tet contributes k_{t,e} = E_t · V_t / L_e² to each of its six
+//!    edges, and k_e = Σ_{t ∋ e} k_{t,e} over the tets around e (the edge orbit ⟨α0, α2, α3⟩).
+//!    Why this formula: a spring of stiffness k stretched by a strain ε stores ½ k L² ε²; a tet of
+//!    an isotropic solid under a uniform dilatation ε stores ½ · 9K · ε² · V with bulk modulus K.
+//!    With k_{t,e} L_e² = E V_t the six springs store 3 E V ε², which equals 9/2 K V ε² exactly
+//!    when K = 2E/3, i.e. for Poisson's ratio ν = 1/4 — the ratio that central-force spring
+//!    networks are known to produce (Cauchy relation). It scales correctly (k ∝ E · length),
+//!    favours no edge direction, and is linear in the tets, so an edge dissociated into two keeps
+//!    k = k1 + k2 (springs in parallel).
+//! 3. **Damping** c_e = β · k_e (stiffness-proportional, β in seconds), so c = c1 + c2 too.
+//! 4. **Ambient viscosity** γ_v = ν · m_v (ν in 1/s).
+//! 5. **Mass conservation**: Σ_v m_v = Σ_t m_t, after any dissociation.
+//!
+//! [`check_conservation`](super::check_conservation) verifies all five from the map's orbits.
+//!
+//! # Split and merge rules ([`CellRules`] for [`Mechanics`])
+//! - vertex split: both sides copy rest position, position, velocity and the pinned flag; each
+//!   side's mass and viscosity are recomputed from the tets now around it (m = m1 + m2).
+//! - edge split: both sides copy the rest length; stiffness and damping are recomputed from the
+//!   tets now around each side (k = k1 + k2).
+//! - face split / merge: boundary flags and normals of the faces touched are recomputed.
+//! - vertex merge: position and velocity become the mass-weighted means (momentum is kept), mass
+//!   is recomputed (= m1 + m2); edge merge: stiffness recomputed (= k1 + k2).
+//! - volume split (an unsew inside a tet) has no mechanical meaning: the new volume gets zero mass
+//!   and the conservation check reports it.
+
+use crate::embedding::{CellArray, CellRules, Embedded};
+use crate::gmap::CellChanges;
+use crate::{AlphaMask, BuildError, BuildReport, CellId, DartId, GMap};
+
+use super::conservation::{check_conservation, ConservationError};
+use super::geom::{add, cross, dot, norm, scale, sub, tet_volume, Vec3};
+
+/// Material constants of a homogeneous body.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Material {
+    /// Mass density ρ (mass per unit volume); m_t = ρ·V_t.
+    pub density: f64,
+    /// Young's modulus E (force per unit area); k_{t,e} = E·V_t/L_e².
+    pub young: f64,
+    /// Stiffness-proportional spring damping β (seconds); c_e = β·k_e.
+    pub damping: f64,
+    /// Ambient viscosity per unit mass ν (1/s); γ_v = ν·m_v.
+    pub viscosity: f64,
+}
+
+impl Default for Material {
+    /// ρ = 1, E = 1000, β = 0.001 s, ν = 1 /s: soft tissue in consistent arbitrary units.
+    fn default() -> Self {
+        Material { density: 1.0, young: 1000.0, damping: 0.001, viscosity: 1.0 }
+    }
+}
+
+/// Why a body could not be built.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ModelError {
+    /// The map could not be built from the tetrahedra.
+    #[error(transparent)]
+    Build(#[from] BuildError),
+    /// A material constant is negative, zero where it must not be, or not finite.
+    #[error("material constant {name} = {value} is invalid (must be finite and {rule})")]
+    BadMaterial {
+        /// Which constant.
+        name: &'static str,
+        /// Its value.
+        value: f64,
+        /// What it must be.
+        rule: &'static str,
+    },
+    /// A point coordinate is NaN or infinite.
+    #[error("point {point} has a non-finite coordinate {coords:?}")]
+    NonFinitePoint {
+        /// Point index.
+        point: usize,
+        /// Its coordinates.
+        coords: Vec3,
+    },
+    /// A tetrahedron of zero volume would make a massless, infinitely stiff element.
+    #[error("tetrahedron {tet} has zero volume")]
+    DegenerateTet {
+        /// Tet index (= volume id).
+        tet: usize,
+    },
+}
+
+/// The mechanical attributes of a tetrahedral 3-G-map, all in arrays keyed by cell id.
+///
+/// State variables (positions, velocities, forces, pins) are public fields: the simulation writes
+/// them every step. Parameters bound by the laws (masses, stiffnesses) are private and change only
+/// through the split/merge rules, so the laws cannot be broken from outside.
+#[derive(Clone, Debug)]
+pub struct Mechanics {
+    material: Material,
+    // volumes
+    tet_rest_volume: CellArray<f64>,
+    tet_mass: CellArray<f64>,
+    tet_young: CellArray<f64>,
+    // edges
+    edge_rest_length: CellArray<f64>,
+    edge_stiffness: CellArray<f64>,
+    edge_damping: CellArray<f64>,
+    // faces
+    face_boundary: CellArray<bool>,
+    face_normal: CellArray<Vec3>,
+    // vertices
+    vertex_mass: CellArray<f64>,
+    vertex_viscosity: CellArray<f64>,
+    /// Rest (initial) position of each vertex; rest lengths and volumes are measured on it.
+    pub rest_position: CellArray<Vec3>,
+    /// Current position of each vertex.
+    pub position: CellArray<Vec3>,
+    /// Current velocity of each vertex.
+    pub velocity: CellArray<Vec3>,
+    /// Sum of the forces on each vertex at the last evaluation (seed §4.1 "for optimization").
+    pub force: CellArray<Vec3>,
+    /// Fixed vertices: their velocity stays zero.
+    pub pinned: CellArray<bool>,
+}
+
+/// A mechanical body: a 3-G-map whose sew/unsew keep the [`Mechanics`] attributes lawful.
+pub type Body = Embedded<3, Mechanics>;
+
+/// Errors of the body's topological operations.
+pub type BodyError = crate::embedding::EmbedError<ConservationError>;
+
+impl Mechanics {
+    /// The material constants. O(1).
+    pub fn material(&self) -> &Material {
+        &self.material
+    }
+
+    /// Rest volume V_t of volume `t`. O(1).
+    pub fn tet_rest_volume(&self, t: CellId) -> f64 {
+        self.tet_rest_volume[t]
+    }
+
+    /// Mass m_t = ρ·V_t of volume `t`. O(1).
+    pub fn tet_mass(&self, t: CellId) -> f64 {
+        self.tet_mass[t]
+    }
+
+    /// Young's modulus of volume `t`. O(1).
+    pub fn tet_young(&self, t: CellId) -> f64 {
+        self.tet_young[t]
+    }
+
+    /// Rest length L_e of edge `e`. O(1).
+    pub fn edge_rest_length(&self, e: CellId) -> f64 {
+        self.edge_rest_length[e]
+    }
+
+    /// Stiffness k_e of edge `e`. O(1).
+    pub fn edge_stiffness(&self, e: CellId) -> f64 {
+        self.edge_stiffness[e]
+    }
+
+    /// Damping c_e of edge `e`. O(1).
+    pub fn edge_damping(&self, e: CellId) -> f64 {
+        self.edge_damping[e]
+    }
+
+    /// Mass m_v of vertex `v`. O(1).
+    pub fn vertex_mass(&self, v: CellId) -> f64 {
+        self.vertex_mass[v]
+    }
+
+    /// Ambient viscosity γ_v = ν·m_v of vertex `v`. O(1).
+    pub fn vertex_viscosity(&self, v: CellId) -> f64 {
+        self.vertex_viscosity[v]
+    }
+
+    /// Whether face `f` is on the boundary (its darts are α3-free). O(1).
+    pub fn face_is_boundary(&self, f: CellId) -> bool {
+        self.face_boundary.get(f).copied().unwrap_or(false)
+    }
+
+    /// Outward unit normal of boundary face `f` at the last [`Mechanics::update_normals`] (zero
+    /// for inner faces). O(1).
+    pub fn face_normal(&self, f: CellId) -> Vec3 {
+        self.face_normal[f]
+    }
+
+    /// Number of attribute slots of `dim`-cells (≥ the map's `cell_id_bound(dim)` when in sync).
+    /// O(1).
+    pub fn attribute_len(&self, dim: usize) -> usize {
+        match dim {
+            0 => self.vertex_mass.len().min(self.position.len()),
+            1 => self.edge_stiffness.len(),
+            2 => self.face_normal.len(),
+            _ => self.tet_mass.len(),
+        }
+    }
+
+    /// Recomputes every boundary face normal from the current positions. O(darts).
+    pub fn update_normals(&mut self, map: &GMap<3>) {
+        for d in map.one_dart_per_cell(2) {
+            let f = map.cell_id(2, d);
+            self.face_boundary[f] = map.is_free(3, d);
+            self.face_normal[f] = if self.face_boundary[f] { self.outward_normal(map, d) } else { [0.0; 3] };
+        }
+    }
+
+    /// Unit normal of the face of `d` pointing away from the 4th vertex of d's tet.
+    fn outward_normal(&self, map: &GMap<3>, d: DartId) -> Vec3 {
+        let face = distinct(map.orbit(d, AlphaMask::of(&[0, 1])).into_iter().map(|x| map.vertex_id(x)));
+        let tet = distinct(map.cell_darts(3, d).into_iter().map(|x| map.vertex_id(x)));
+        let apex = tet.iter().find(|v| !face.contains(v));
+        let (Some(apex), [a, b, c]) = (apex, face.as_slice()) else { return [0.0; 3] };
+        let p = |v: &CellId| self.position[*v];
+        let n = cross(sub(p(b), p(a)), sub(p(c), p(a)));
+        let len = norm(n);
+        if len == 0.0 {
+            return [0.0; 3];
+        }
+        let sign = if dot(n, sub(p(apex), p(a))) > 0.0 { -1.0 } else { 1.0 };
+        scale(n, sign / len)
+    }
+
+    /// Total mass Σ_v m_v over the live vertices of `map`. O(darts).
+    pub fn total_vertex_mass(&self, map: &GMap<3>) -> f64 {
+        map.one_dart_per_cell(0).into_iter().map(|d| self.vertex_mass[map.vertex_id(d)]).sum()
+    }
+
+    /// Total mass Σ_t m_t over the live volumes of `map`. O(darts).
+    pub fn total_tet_mass(&self, map: &GMap<3>) -> f64 {
+        map.one_dart_per_cell(3).into_iter().map(|d| self.tet_mass[map.cell_id(3, d)]).sum()
+    }
+
+    /// Law 1 at the vertex of `d`: Σ m_t/4 over the distinct volumes of its orbit. O(vertex).
+    pub fn vertex_mass_from_map(&self, map: &GMap<3>, d: DartId) -> f64 {
+        let tets = distinct(map.cell_darts(0, d).into_iter().map(|x| map.cell_id(3, x)));
+        tets.iter().map(|&t| self.tet_mass[t] / 4.0).sum()
+    }
+
+    /// Law 2 at the edge of `d`: Σ E_t·V_t/L_e² over the distinct volumes of its orbit, with L_e
+    /// the edge's stored rest length. O(edge).
+    pub fn edge_stiffness_from_map(&self, map: &GMap<3>, d: DartId) -> f64 {
+        let l = self.edge_rest_length[map.cell_id(1, d)];
+        let tets = distinct(map.cell_darts(1, d).into_iter().map(|x| map.cell_id(3, x)));
+        tets.iter().map(|&t| stiffness_contribution(self.tet_young[t], self.tet_rest_volume[t], l)).sum()
+    }
+
+    /// Sets the mass and viscosity of the vertex of `d` from law 1 and law 4.
+    fn recompute_vertex(&mut self, map: &GMap<3>, d: DartId) {
+        let v = map.vertex_id(d);
+        self.vertex_mass[v] = self.vertex_mass_from_map(map, d);
+        self.vertex_viscosity[v] = self.material.viscosity * self.vertex_mass[v];
+    }
+
+    /// Sets the stiffness and damping of the edge of `d` from laws 2 and 3.
+    fn recompute_edge(&mut self, map: &GMap<3>, d: DartId) {
+        let e = map.cell_id(1, d);
+        self.edge_stiffness[e] = self.edge_stiffness_from_map(map, d);
+        self.edge_damping[e] = self.material.damping * self.edge_stiffness[e];
+    }
+
+    /// Re-applies the pin set from a predicate on rest positions: `pin(v, rest)`. O(vertex ids).
+    pub fn pin_where(&mut self, mut pin: impl FnMut(CellId, Vec3) -> bool) {
+        for (i, (p, r)) in self.pinned.as_mut_slice().iter_mut().zip(self.rest_position.as_slice()).enumerate() {
+            *p = pin(CellId(i as u32), *r);
+        }
+    }
+
+    fn copy_vertex(&mut self, from: CellId, to: CellId) {
+        self.rest_position[to] = self.rest_position[from];
+        self.position[to] = self.position[from];
+        self.velocity[to] = self.velocity[from];
+        self.pinned[to] = self.pinned[from];
+        self.force[to] = [0.0; 3];
+    }
+
+    fn merge_vertex_state(&mut self, kept: CellId, absorbed: CellId) {
+        let (m1, m2) = (self.vertex_mass[kept], self.vertex_mass[absorbed]);
+        let total = m1 + m2;
+        let (w1, w2) = if total > 0.0 { (m1 / total, m2 / total) } else { (0.5, 0.5) };
+        let mix = |a: Vec3, b: Vec3| add(scale(a, w1), scale(b, w2));
+        self.position[kept] = mix(self.position[kept], self.position[absorbed]);
+        self.velocity[kept] = mix(self.velocity[kept], self.velocity[absorbed]);
+        self.pinned[kept] = self.pinned[kept] || self.pinned[absorbed];
+        self.vertex_mass[absorbed] = 0.0;
+        self.vertex_viscosity[absorbed] = 0.0;
+    }
+}
+
+/// Law 2's per-tet term: k_{t,e} = E·|V|/L², zero for a zero-length edge. O(1).
+pub fn stiffness_contribution(young: f64, volume: f64, rest_length: f64) -> f64 {
+    if rest_length > 0.0 {
+        young * volume.abs() / (rest_length * rest_length)
+    } else {
+        0.0
+    }
+}
+
+/// The distinct values of `ids`, sorted.
+pub(crate) fn distinct(ids: impl Iterator<Item = CellId>) -> Vec<CellId> {
+    let mut v: Vec<CellId> = ids.collect();
+    v.sort_unstable();
+    v.dedup();
+    v
+}
+
+impl CellRules<3> for Mechanics {
+    type Error = ConservationError;
+
+    fn grow_to(&mut self, map: &GMap<3>) {
+        let (nv, ne, nf, nt) = (map.cell_id_bound(0), map.cell_id_bound(1), map.cell_id_bound(2), map.cell_id_bound(3));
+        self.tet_rest_volume.grow(nt, 0.0);
+        self.tet_mass.grow(nt, 0.0);
+        self.tet_young.grow(nt, 0.0);
+        self.edge_rest_length.grow(ne, 0.0);
+        self.edge_stiffness.grow(ne, 0.0);
+        self.edge_damping.grow(ne, 0.0);
+        self.face_boundary.grow(nf, false);
+        self.face_normal.grow(nf, [0.0; 3]);
+        self.vertex_mass.grow(nv, 0.0);
+        self.vertex_viscosity.grow(nv, 0.0);
+        self.rest_position.grow(nv, [0.0; 3]);
+        self.position.grow(nv, [0.0; 3]);
+        self.velocity.grow(nv, [0.0; 3]);
+        self.force.grow(nv, [0.0; 3]);
+        self.pinned.grow(nv, false);
+    }
+
+    fn on_split(&mut self, map: &GMap<3>, dim: usize, kept: CellId, new: CellId, dart_kept: DartId, dart_new: DartId) {
+        match dim {
+            0 => {
+                self.copy_vertex(kept, new);
+                self.recompute_vertex(map, dart_kept);
+                self.recompute_vertex(map, dart_new);
+            }
+            1 => {
+                self.edge_rest_length[new] = self.edge_rest_length[kept];
+                self.recompute_edge(map, dart_kept);
+                self.recompute_edge(map, dart_new);
+            }
+            3 => {
+                self.tet_rest_volume[new] = 0.0;
+                self.tet_mass[new] = 0.0;
+                self.tet_young[new] = self.tet_young[kept];
+            }
+            _ => {} // faces: after_operation
+        }
+    }
+
+    fn on_merge(&mut self, _map: &GMap<3>, dim: usize, kept: CellId, absorbed: CellId) {
+        match dim {
+            // Masses and stiffnesses of merged cells are recomputed in `after_operation`, which
+            // knows the (un)linked darts and so finds a dart of `kept` in O(1).
+            0 => self.merge_vertex_state(kept, absorbed),
+            1 => {
+                self.edge_stiffness[absorbed] = 0.0;
+                self.edge_damping[absorbed] = 0.0;
+            }
+            3 => {
+                self.tet_rest_volume[kept] += self.tet_rest_volume[absorbed];
+                self.tet_mass[kept] += self.tet_mass[absorbed];
+                self.tet_rest_volume[absorbed] = 0.0;
+                self.tet_mass[absorbed] = 0.0;
+            }
+            _ => {}
+        }
+    }
+
+    fn after_operation(&mut self, map: &GMap<3>, changes: &CellChanges) {
+        for (dim, recompute) in
+            [(0, Self::recompute_vertex as fn(&mut Self, &GMap<3>, DartId)), (1, Self::recompute_edge)]
+        {
+            for (kept, _) in changes.merges(dim) {
+                if let Some(d) = dart_of(map, dim, kept, changes) {
+                    recompute(self, map, d);
+                }
+            }
+        }
+        for &(a, b) in &changes.pairs {
+            for d in [a, b] {
+                let f = map.cell_id(2, d);
+                self.face_boundary[f] = map.is_free(3, d);
+                self.face_normal[f] = if self.face_boundary[f] { self.outward_normal(map, d) } else { [0.0; 3] };
+            }
+        }
+    }
+
+    fn check(&self, map: &GMap<3>) -> Result<(), ConservationError> {
+        check_conservation(map, self)
+    }
+}
+
+/// A dart carrying the `dim`-cell `id` among the darts an operation (un)linked. O(pairs).
+fn dart_of(map: &GMap<3>, dim: usize, id: CellId, changes: &CellChanges) -> Option<DartId> {
+    changes.pairs.iter().flat_map(|&(a, b)| [a, b]).find(|&d| map.cell_id(dim, d) == id)
+}
+
+/// For each live vertex id, the input point it stands for (pinched points have several ids).
+///
+/// Uses the builder's documented dart numbering: dart 24t + 6f + k lies on face f of tet t, the
+/// face opposite local corner f, so corner j's vertex id is the one of tet t missing from face j.
+fn vertex_points(map: &GMap<3>, tets: &[[u32; 4]]) -> Vec<u32> {
+    let mut point_of = vec![u32::MAX; map.cell_id_bound(0)];
+    for (t, tet) in tets.iter().enumerate() {
+        let ids: Vec<CellId> = (0..24).map(|k| map.vertex_id(DartId((24 * t + k) as u32))).collect();
+        let all = distinct(ids.iter().copied());
+        for (j, &point) in tet.iter().enumerate() {
+            let face = &ids[6 * j..6 * j + 6];
+            if let Some(&v) = all.iter().find(|v| !face.contains(v)) {
+                point_of[v.index()] = point;
+            }
+        }
+    }
+    point_of
+}
+
+fn check_material(m: &Material) -> Result<(), ModelError> {
+    let bad = |name, value: f64, rule| ModelError::BadMaterial { name, value, rule };
+    if !(m.density.is_finite() && m.density > 0.0) {
+        return Err(bad("density", m.density, "> 0"));
+    }
+    if !(m.young.is_finite() && m.young >= 0.0) {
+        return Err(bad("young", m.young, ">= 0"));
+    }
+    if !(m.damping.is_finite() && m.damping >= 0.0) {
+        return Err(bad("damping", m.damping, ">= 0"));
+    }
+    if !(m.viscosity.is_finite() && m.viscosity >= 0.0) {
+        return Err(bad("viscosity", m.viscosity, ">= 0"));
+    }
+    Ok(())
+}
+
+impl Embedded<3, Mechanics> {
+    /// Builds the map of `tets` over `points` ([`GMap::from_tets`]) and every mechanical
+    /// attribute from the laws, at rest (positions = points, velocities zero, nothing pinned).
+    /// O(T log T).
+    ///
+    /// # Errors
+    /// [`ModelError`]: bad material, non-finite point, zero-volume tet, or a build error.
+    pub fn from_tets(
+        points: &[Vec3],
+        tets: &[[u32; 4]],
+        material: Material,
+    ) -> Result<(Body, BuildReport), ModelError> {
+        check_material(&material)?;
+        if let Some((point, &coords)) = points.iter().enumerate().find(|(_, p)| p.iter().any(|c| !c.is_finite())) {
+            return Err(ModelError::NonFinitePoint { point, coords });
+        }
+        let (map, report) = GMap::<3>::from_tets(points.len(), tets)?;
+        let mut mech = Mechanics::empty(material);
+        mech.grow_to(&map);
+        for (t, tet) in tets.iter().enumerate() {
+            let [a, b, c, d] = tet.map(|v| points[v as usize]);
+            let volume = tet_volume(a, b, c, d);
+            if volume == 0.0 {
+                return Err(ModelError::DegenerateTet { tet: t });
+            }
+            mech.tet_rest_volume[CellId(t as u32)] = volume;
+            mech.tet_mass[CellId(t as u32)] = material.density * volume;
+            mech.tet_young[CellId(t as u32)] = material.young;
+        }
+        for (v, &p) in vertex_points(&map, tets).iter().enumerate() {
+            if p != u32::MAX {
+                mech.rest_position.as_mut_slice()[v] = points[p as usize];
+            }
+        }
+        mech.position = mech.rest_position.clone();
+        mech.init_from_map(&map);
+        Ok((Embedded::new(map, mech), report))
+    }
+
+    /// Dissociates the face of `d` from its neighbour: 3-unsews it and applies the split rules
+    /// (vertex split → masses recomputed, m = m1 + m2; edge split → stiffnesses recomputed,
+    /// k = k1 + k2; both faces become boundary faces with their own normals). The operation the
+    /// cutting of the next issue is made of. Cost: the kernel's unsew + O(split cells).
+    ///
+    /// # Errors
+    /// [`BodyError::Sew`] if `d` is 3-free or not a dart; [`BodyError::Check`] under
+    /// `expensive-checks` if a conservation law broke (a bug).
+    pub fn unsew3(&mut self, d: DartId) -> Result<CellChanges, BodyError> {
+        self.unsew(3, d)
+    }
+
+    /// Sews two boundary faces back together (the inverse of [`Body::unsew3`]): merged vertices
+    /// take mass-weighted positions and velocities, masses and stiffnesses are recomputed.
+    ///
+    /// # Errors
+    /// As [`Body::unsew3`].
+    pub fn sew3(&mut self, d1: DartId, d2: DartId) -> Result<CellChanges, BodyError> {
+        self.sew(3, d1, d2)
+    }
+
+    /// Total kinetic energy ½ Σ m_v |v_v|² over live vertices. O(darts).
+    pub fn kinetic_energy(&self) -> f64 {
+        let m = self.attrs();
+        let live = self.map().one_dart_per_cell(0);
+        live.into_iter()
+            .map(|d| {
+                let v = self.map().vertex_id(d);
+                0.5 * m.vertex_mass[v] * dot(m.velocity[v], m.velocity[v])
+            })
+            .sum()
+    }
+}
+
+impl Mechanics {
+    fn empty(material: Material) -> Self {
+        let z = CellArray::from_vec(Vec::new());
+        Mechanics {
+            material,
+            tet_rest_volume: z.clone(),
+            tet_mass: z.clone(),
+            tet_young: z.clone(),
+            edge_rest_length: z.clone(),
+            edge_stiffness: z.clone(),
+            edge_damping: z.clone(),
+            face_boundary: CellArray::from_vec(Vec::new()),
+            face_normal: CellArray::from_vec(Vec::new()),
+            vertex_mass: z.clone(),
+            vertex_viscosity: z,
+            rest_position: CellArray::from_vec(Vec::new()),
+            position: CellArray::from_vec(Vec::new()),
+            velocity: CellArray::from_vec(Vec::new()),
+            force: CellArray::from_vec(Vec::new()),
+            pinned: CellArray::from_vec(Vec::new()),
+        }
+    }
+
+    /// Rest lengths, stiffnesses, masses and normals of every live cell, from the laws. O(darts).
+    fn init_from_map(&mut self, map: &GMap<3>) {
+        for d in map.one_dart_per_cell(1) {
+            let rest = sub(self.rest_position[map.vertex_id(map.alpha::<0>(d))], self.rest_position[map.vertex_id(d)]);
+            self.edge_rest_length[map.cell_id(1, d)] = norm(rest);
+            self.recompute_edge(map, d);
+        }
+        for d in map.one_dart_per_cell(0) {
+            self.recompute_vertex(map, d);
+        }
+        self.update_normals(map);
+    }
+
+    /// Marks the live vertex ids of `map`: `live[v]` is true iff vertex id v has darts. O(capacity).
+    pub fn live_vertices(map: &GMap<3>) -> Vec<bool> {
+        let mut live = vec![false; map.cell_id_bound(0)];
+        for d in map.darts() {
+            live[map.vertex_id(d).index()] = true;
+        }
+        live
+    }
+}

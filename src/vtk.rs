@@ -1,0 +1,174 @@
+//! ParaView output: VTK XML unstructured grids (`.vtu`, ASCII) and a `.pvd` time series.
+//!
+//! One `.vtu` frame holds the points, the tetrahedra (VTK cell type 10) and per-point vectors
+//! (e.g. velocity, displacement); the `.pvd` file lists the frames with their times so ParaView
+//! plays them as an animation. Cost: O(points + tets) per frame.
+
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+use crate::mechanics::{Body, Vec3};
+use crate::{AlphaMask, CellId};
+
+/// Errors of the VTK writers.
+#[derive(Debug, thiserror::Error)]
+pub enum VtkError {
+    /// The file could not be written.
+    #[error("cannot write {path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// A point array does not have one entry per point.
+    #[error("point array {name} has {got} entries for {expected} points")]
+    BadArray {
+        /// The array's name.
+        name: String,
+        /// Its length.
+        got: usize,
+        /// The number of points.
+        expected: usize,
+    },
+}
+
+/// One frame: points, tets and named per-point vectors.
+#[derive(Clone, Debug, Default)]
+pub struct Frame<'a> {
+    /// Point coordinates.
+    pub points: &'a [Vec3],
+    /// Tetrahedra as four point indices.
+    pub tets: &'a [[u32; 4]],
+    /// Per-point 3-vectors, by name.
+    pub vectors: Vec<(&'a str, &'a [Vec3])>,
+}
+
+impl Frame<'_> {
+    /// The frame as VTU XML text. O(points + tets).
+    ///
+    /// # Errors
+    /// [`VtkError::BadArray`] when a vector array has the wrong length.
+    pub fn to_vtu(&self) -> Result<String, VtkError> {
+        let n = self.points.len();
+        for (name, values) in &self.vectors {
+            if values.len() != n {
+                return Err(VtkError::BadArray { name: name.to_string(), got: values.len(), expected: n });
+            }
+        }
+        let mut s = String::with_capacity(64 * (n + self.tets.len()) + 512);
+        s.push_str("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n");
+        let _ = writeln!(s, "<Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{}\">", self.tets.len());
+        s.push_str("<PointData>\n");
+        for (name, values) in &self.vectors {
+            vector_array(&mut s, name, values);
+        }
+        s.push_str("</PointData>\n<Points>\n");
+        vector_array(&mut s, "Points", self.points);
+        s.push_str("</Points>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n");
+        for t in self.tets {
+            let _ = writeln!(s, "{} {} {} {}", t[0], t[1], t[2], t[3]);
+        }
+        s.push_str("</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n");
+        for i in 0..self.tets.len() {
+            let _ = writeln!(s, "{}", 4 * (i + 1));
+        }
+        s.push_str("</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n");
+        for _ in self.tets {
+            s.push_str("10\n");
+        }
+        s.push_str("</DataArray>\n</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
+        Ok(s)
+    }
+
+    /// Writes the frame to `path`. O(points + tets).
+    ///
+    /// # Errors
+    /// [`VtkError`].
+    pub fn write(&self, path: &Path) -> Result<(), VtkError> {
+        write_file(path, &self.to_vtu()?)
+    }
+}
+
+fn vector_array(s: &mut String, name: &str, values: &[Vec3]) {
+    let _ = writeln!(s, "<DataArray type=\"Float64\" Name=\"{name}\" NumberOfComponents=\"3\" format=\"ascii\">");
+    for v in values {
+        let _ = writeln!(s, "{:e} {:e} {:e}", v[0], v[1], v[2]);
+    }
+    s.push_str("</DataArray>\n");
+}
+
+fn write_file(path: &Path, text: &str) -> Result<(), VtkError> {
+    let io = |source| VtkError::Io { path: path.to_path_buf(), source };
+    let mut f = std::fs::File::create(path).map_err(io)?;
+    f.write_all(text.as_bytes()).map_err(io)
+}
+
+/// A `.pvd` collection being written: frames are recorded as they are saved.
+#[derive(Clone, Debug)]
+pub struct Series {
+    dir: PathBuf,
+    stem: String,
+    frames: Vec<(f64, String)>,
+}
+
+impl Series {
+    /// A series of files `DIR/STEM_NNNNNN.vtu` and `DIR/STEM.pvd`; creates DIR.
+    ///
+    /// # Errors
+    /// [`VtkError::Io`] if DIR cannot be created.
+    pub fn new(dir: &Path, stem: &str) -> Result<Self, VtkError> {
+        std::fs::create_dir_all(dir).map_err(|source| VtkError::Io { path: dir.to_path_buf(), source })?;
+        Ok(Series { dir: dir.to_path_buf(), stem: stem.to_string(), frames: Vec::new() })
+    }
+
+    /// Writes `frame` as the next file, at simulated time `time`, and rewrites the `.pvd`.
+    /// O(frame + frames so far).
+    ///
+    /// # Errors
+    /// [`VtkError`].
+    pub fn push(&mut self, time: f64, frame: &Frame<'_>) -> Result<PathBuf, VtkError> {
+        let name = format!("{}_{:06}.vtu", self.stem, self.frames.len());
+        let path = self.dir.join(&name);
+        frame.write(&path)?;
+        self.frames.push((time, name));
+        self.write_pvd()?;
+        Ok(path)
+    }
+
+    /// The `.pvd` path. O(1).
+    pub fn pvd_path(&self) -> PathBuf {
+        self.dir.join(format!("{}.pvd", self.stem))
+    }
+
+    fn write_pvd(&self) -> Result<(), VtkError> {
+        let mut s =
+            String::from("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n");
+        for (time, name) in &self.frames {
+            let _ = writeln!(s, "<DataSet timestep=\"{time:e}\" part=\"0\" file=\"{name}\"/>");
+        }
+        s.push_str("</Collection>\n</VTKFile>\n");
+        write_file(&self.pvd_path(), &s)
+    }
+}
+
+/// The tets of a body as four vertex ids each (one per volume orbit), ordered so that their rest
+/// signed volume is positive. O(darts).
+pub fn body_tets(body: &Body) -> Vec<[u32; 4]> {
+    let map = body.map();
+    let rest = &body.attrs().rest_position;
+    let mut out = Vec::with_capacity(map.cell_id_bound(3));
+    for d in map.one_dart_per_cell(3) {
+        let mut ids: Vec<u32> = map.orbit(d, AlphaMask::cell(3, 3)).into_iter().map(|x| map.vertex_id(x).0).collect();
+        ids.sort_unstable();
+        ids.dedup();
+        let Ok(mut t) = <[u32; 4]>::try_from(ids.as_slice()) else { continue };
+        let p = t.map(|v| rest[CellId(v)]);
+        if crate::mesh::signed_volume(p[0], p[1], p[2], p[3]) < 0.0 {
+            t.swap(2, 3);
+        }
+        out.push(t);
+    }
+    out
+}

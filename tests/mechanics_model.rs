@@ -1,0 +1,309 @@
+//! Embeddings, conservation laws and the embedding-aware unsew/sew of a mechanical body.
+
+use topomech::embedding::CellRules;
+use topomech::generate::{kuhn_cube, SplitMix64};
+use topomech::mechanics::{
+    check_conservation, forces_by_coverage, Body, ConservationError, FlatModel, Integrator, Material, Projection,
+    SimError, Simulation, StepConfig, Vec3,
+};
+use topomech::{CellId, DartId};
+
+const G: Vec3 = [0.0, 0.0, -9.81];
+
+fn material() -> Material {
+    Material { density: 2.5, young: 700.0, damping: 0.01, viscosity: 0.7 }
+}
+
+fn rel_close(a: f64, b: f64, tol: f64) -> bool {
+    (a - b).abs() <= tol * a.abs().max(b.abs())
+}
+
+/// Slightly irregular Kuhn cube (points jittered) so that tets have different volumes.
+fn jittered_cube(k: usize, seed: u64) -> (Vec<Vec3>, Vec<[u32; 4]>) {
+    let (mut points, tets) = kuhn_cube(k);
+    let mut rng = SplitMix64(seed);
+    for p in &mut points {
+        for c in p.iter_mut() {
+            *c += (rng.below(1000) as f64 / 1000.0 - 0.5) * 0.2;
+        }
+    }
+    (points, tets)
+}
+
+/// The darts (one per face) of the interior faces lying in the plane x = `x` of a Kuhn cube.
+fn faces_in_plane(body: &Body, rest: &[Vec3], x: f64) -> Vec<DartId> {
+    let map = body.map();
+    let mut seen = std::collections::HashSet::new();
+    let mut out = Vec::new();
+    for d in map.darts() {
+        if map.is_free(3, d) || !seen.insert(map.cell_id(2, d)) {
+            continue;
+        }
+        let face = map.orbit(d, topomech::AlphaMask::of(&[0, 1]));
+        if face.iter().all(|&e| rest[map.vertex_id(e).index()][0] == x) {
+            out.push(d);
+        }
+    }
+    out
+}
+
+#[test]
+fn laws_hold_on_a_fresh_body_and_match_the_flat_baseline() {
+    let (points, tets) = jittered_cube(3, 7);
+    let (body, report) = Body::from_tets(&points, &tets, material()).unwrap();
+    assert!(report.pinched_vertices.is_empty());
+    check_conservation(body.map(), body.attrs()).unwrap();
+    let mech = body.attrs();
+    // Σ m_v = ρ Σ V_t, computed from the input directly.
+    let volume: f64 = tets
+        .iter()
+        .map(|t| {
+            let c = t.map(|v| points[v as usize]);
+            topomech::mesh::signed_volume(c[0], c[1], c[2], c[3]).abs()
+        })
+        .sum();
+    assert!(rel_close(mech.total_vertex_mass(body.map()), 2.5 * volume, 1e-12));
+    assert!(rel_close(mech.total_tet_mass(body.map()), 2.5 * volume, 1e-12));
+    // Every vertex mass and spring stiffness equals the flat baseline's (built with no map).
+    let flat = FlatModel::from_tets(&points, &tets, material(), G, &[]).unwrap();
+    for (v, &m) in flat.system.mass.iter().enumerate() {
+        assert!(rel_close(mech.vertex_mass(CellId(v as u32)), m, 1e-12), "vertex {v}");
+    }
+    let projection = Projection::build(&body, G);
+    assert_eq!(projection.system.ends, flat.system.ends);
+    for s in 0..flat.system.springs() {
+        assert!(rel_close(projection.system.stiffness[s], flat.system.stiffness[s], 1e-12), "spring {s}");
+        assert!(rel_close(projection.system.rest[s], flat.system.rest[s], 1e-12), "spring {s}");
+    }
+}
+
+#[test]
+fn an_interior_edge_gets_the_sum_of_its_tets_contributions() {
+    // The Kuhn cube's main diagonal (0,0,0)–(1,1,1) of a unit cube is shared by its 6 tets.
+    let (points, tets) = kuhn_cube(1);
+    let (body, _) = Body::from_tets(&points, &tets, material()).unwrap();
+    let p = Projection::build(&body, G);
+    let s = (0..p.system.springs()).find(|&s| p.system.ends[s] == [0, 7]).expect("diagonal spring");
+    let l = 3f64.sqrt();
+    let expected = 6.0 * 700.0 * (1.0 / 6.0) / (l * l);
+    assert!(rel_close(p.system.stiffness[s], expected, 1e-12), "{} vs {expected}", p.system.stiffness[s]);
+    // Corner vertex 0 belongs to all 6 tets: m = 6 · ρ (1/6) / 4.
+    assert!(rel_close(body.attrs().vertex_mass(CellId(0)), 2.5 / 4.0, 1e-12));
+}
+
+#[test]
+fn unsew3_along_a_plane_splits_masses_and_stiffnesses_conservatively() {
+    let (points, tets) = kuhn_cube(2);
+    let (mut body, _) = Body::from_tets(&points, &tets, material()).unwrap();
+    let before = body.clone();
+    let total = body.attrs().total_vertex_mass(body.map());
+    let faces = faces_in_plane(&body, &points, 1.0);
+    assert_eq!(faces.len(), 8, "the plane x = 1 of a 2-cube holds 8 triangles");
+    let mut vertex_splits = Vec::new();
+    let mut edge_splits = Vec::new();
+    let mut partners = Vec::new();
+    for &d in &faces {
+        partners.push((d, body.map().alpha::<3>(d)));
+        let changes = body.unsew3(d).unwrap();
+        vertex_splits.extend(changes.splits(0));
+        edge_splits.extend(changes.splits(1));
+        check_conservation(body.map(), body.attrs()).unwrap();
+    }
+    // The 9 vertices and 16 edges of the plane each split exactly once.
+    assert_eq!(vertex_splits.len(), 9);
+    assert_eq!(edge_splits.len(), 16);
+    let (m0, m) = (before.attrs(), body.attrs());
+    for &(kept, new, dk, dn) in &vertex_splits {
+        let sum = m.vertex_mass(kept) + m.vertex_mass(new);
+        assert!(rel_close(sum, m0.vertex_mass(kept), 1e-12), "m = m1 + m2 at {kept:?}");
+        assert!(m.vertex_mass(kept) > 0.0 && m.vertex_mass(new) > 0.0);
+        assert_eq!(m.position[new], m.position[kept]);
+        assert_ne!(body.map().vertex_id(dk), body.map().vertex_id(dn));
+    }
+    for &(kept, new, _, _) in &edge_splits {
+        let sum = m.edge_stiffness(kept) + m.edge_stiffness(new);
+        assert!(rel_close(sum, m0.edge_stiffness(kept), 1e-12), "k = k1 + k2 at {kept:?}");
+        assert!(rel_close(m.edge_damping(kept) + m.edge_damping(new), m0.edge_damping(kept), 1e-12));
+    }
+    assert!(rel_close(m.total_vertex_mass(body.map()), total, 1e-12));
+    // The body is now two halves: it must equal the flat model of the two halves, built apart.
+    let (half_points, half_tets) = split_at_plane(&points, &tets, 1.0);
+    let flat = FlatModel::from_tets(&half_points, &half_tets, material(), G, &[]).unwrap();
+    let projection = Projection::build(&body, G);
+    assert_eq!(projection.system.springs(), flat.system.springs());
+    let mut ours: Vec<f64> = projection.system.stiffness.clone();
+    let mut theirs = flat.system.stiffness.clone();
+    ours.sort_by(f64::total_cmp);
+    theirs.sort_by(f64::total_cmp);
+    for (a, b) in ours.iter().zip(&theirs) {
+        assert!(rel_close(*a, *b, 1e-12));
+    }
+    // Every new boundary face has a unit normal pointing out of its own half.
+    for &(d, e) in &partners {
+        for x in [d, e] {
+            let f = body.map().cell_id(2, x);
+            assert!(m.face_is_boundary(f));
+            let n = m.face_normal(f);
+            let tet = body.map().cell_darts(3, x);
+            let cx: f64 = tet.iter().map(|&y| m.position[body.map().vertex_id(y)][0]).sum::<f64>() / tet.len() as f64;
+            let side = if cx < 1.0 { 1.0 } else { -1.0 };
+            assert!((n[0].abs() - 1.0).abs() < 1e-12 && n[0] * side > 0.0, "normal {n:?}");
+        }
+    }
+    // Sewing back restores every mass and stiffness.
+    for &(d, e) in &partners {
+        body.sew3(d, e).unwrap();
+        check_conservation(body.map(), body.attrs()).unwrap();
+    }
+    assert!(body.map().is_isomorphic(before.map()));
+    // Ids may have moved (a merge keeps one side's id), so compare through rest positions.
+    let flat = FlatModel::from_tets(&points, &tets, material(), G, &[]).unwrap();
+    let point_of = |v: u32| points.iter().position(|p| *p == body.attrs().rest_position[CellId(v)]).unwrap() as u32;
+    let p1 = Projection::build(&body, G);
+    let mut springs: Vec<([u32; 2], f64)> = (0..p1.system.springs())
+        .map(|s| {
+            let [a, b] = p1.system.ends[s].map(point_of);
+            ([a.min(b), a.max(b)], p1.system.stiffness[s])
+        })
+        .collect();
+    springs.sort_by_key(|&(e, _)| e);
+    assert_eq!(springs.len(), flat.system.springs());
+    for (s, (ends, k)) in springs.iter().enumerate() {
+        assert_eq!(*ends, flat.system.ends[s]);
+        assert!(rel_close(*k, flat.system.stiffness[s], 1e-12));
+    }
+    for d in body.map().one_dart_per_cell(0) {
+        let v = body.map().vertex_id(d);
+        assert!(rel_close(body.attrs().vertex_mass(v), flat.system.mass[point_of(v.0) as usize], 1e-12));
+    }
+}
+
+/// Duplicates the points with x == plane used by tets on the x > plane side.
+fn split_at_plane(points: &[Vec3], tets: &[[u32; 4]], plane: f64) -> (Vec<Vec3>, Vec<[u32; 4]>) {
+    let mut points = points.to_vec();
+    let n = points.len();
+    let mut copy = vec![u32::MAX; n];
+    let mut out = Vec::new();
+    for tet in tets {
+        let right = tet.iter().any(|&v| points[v as usize][0] > plane);
+        let mut t = *tet;
+        if right {
+            for v in &mut t {
+                if points[*v as usize][0] == plane {
+                    if copy[*v as usize] == u32::MAX {
+                        copy[*v as usize] = points.len() as u32;
+                        points.push(points[*v as usize]);
+                    }
+                    *v = copy[*v as usize];
+                }
+            }
+        }
+        out.push(t);
+    }
+    (points, out)
+}
+
+#[test]
+fn check_conservation_names_the_vertex_when_the_map_changes_behind_its_back() {
+    let (points, tets) = kuhn_cube(2);
+    let (mut body, _) = Body::from_tets(&points, &tets, material()).unwrap();
+    let faces = faces_in_plane(&body, &points, 1.0);
+    // All but one face unsewn through the embedding layer: the laws hold.
+    for &d in &faces[1..] {
+        body.unsew3(d).unwrap();
+    }
+    check_conservation(body.map(), body.attrs()).unwrap();
+    // The last face unsewn on the bare map, behind the rules' back.
+    let (mut map, mut mech) = body.into_parts();
+    let changes = map.unsew_dyn(3, faces[0]).unwrap();
+    let split: Vec<CellId> = changes.splits(0).flat_map(|(kept, new, _, _)| [kept, new]).collect();
+    assert!(!split.is_empty(), "the last face of the plane splits vertices");
+    // Arrays too short for the new ids: reported as such, not a panic.
+    assert!(matches!(check_conservation(&map, &mech), Err(ConservationError::MissingAttributes { dim: 0, .. })));
+    // Arrays grown but values stale: the mass law fails at one of the split vertices.
+    mech.grow_to(&map);
+    match check_conservation(&map, &mech) {
+        Err(ConservationError::VertexMass { vertex, stored, expected, .. }) => {
+            assert!(split.contains(&vertex), "{vertex:?} not among {split:?}");
+            assert!(!rel_close(stored, expected, 1e-12));
+        }
+        other => panic!("stale masses passed the check: {other:?}"),
+    }
+}
+
+#[test]
+fn projection_forces_equal_the_orbit_walk_to_1e_12() {
+    let (points, tets) = jittered_cube(3, 11);
+    let (mut body, _) = Body::from_tets(&points, &tets, material()).unwrap();
+    let mut rng = SplitMix64(99);
+    let mut r = || rng.below(2001) as f64 / 1000.0 - 1.0;
+    {
+        let m = body.attrs_mut();
+        for v in 0..m.position.len() {
+            let id = CellId(v as u32);
+            for c in 0..3 {
+                m.position[id][c] += 0.1 * r();
+                m.velocity[id][c] = r();
+            }
+        }
+    }
+    body.attrs_mut().pin_where(|id, _| id.0 % 7 == 0);
+    for round in 0..2 {
+        if round == 1 {
+            // After a topological change the rebuilt projection still agrees.
+            let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+            body.unsew3(d).unwrap();
+        }
+        let p = Projection::build(&body, G);
+        let n = p.system.slots();
+        let m = body.attrs();
+        let mut sf = vec![[0.0; 3]; p.system.springs()];
+        let mut f = vec![[0.0; 3]; n];
+        p.system.forces(&m.position.as_slice()[..n], &m.velocity.as_slice()[..n], &mut sf, &mut f, false);
+        let reference = forces_by_coverage(&body, G);
+        let scale = reference.iter().flat_map(|v| v.iter()).fold(0.0f64, |a, &b| a.max(b.abs()));
+        assert!(scale > 1.0);
+        for v in 0..n {
+            for c in 0..3 {
+                assert!(
+                    (f[v][c] - reference[v][c]).abs() <= 1e-12 * scale,
+                    "vertex {v}: {:?} vs {:?}",
+                    f[v],
+                    reference[v]
+                );
+            }
+        }
+        // Every spring knows its edge and dart.
+        for s in 0..p.system.springs() {
+            let d = p.dart_of_spring(s);
+            assert_eq!(body.map().cell_id(1, d), p.edge_of_spring(s));
+            assert_eq!(p.spring_of_edge(p.edge_of_spring(s)), Some(s));
+            let ends = [body.map().vertex_id(d).0, body.map().vertex_id(body.map().alpha::<0>(d)).0];
+            assert!(ends.contains(&p.system.ends[s][0]) && ends.contains(&p.system.ends[s][1]));
+        }
+    }
+}
+
+#[test]
+fn a_stale_projection_refuses_to_step() {
+    let (points, tets) = kuhn_cube(2);
+    let (mut body, _) = Body::from_tets(&points, &tets, material()).unwrap();
+    let mut sim = Simulation::new(&mut body, G, StepConfig::new(Integrator::Rk4, 1e-4)).unwrap();
+    sim.step(&mut body).unwrap();
+    let d = faces_in_plane(&body, &points, 1.0)[0];
+    body.unsew3(d).unwrap();
+    assert!(matches!(sim.step(&mut body), Err(SimError::StaleProjection { built: 0, now: 1 })));
+    sim.rebuild(&mut body).unwrap();
+    sim.step(&mut body).unwrap();
+}
+
+#[test]
+fn unsew3_of_a_boundary_dart_is_refused_and_changes_nothing() {
+    let (points, tets) = kuhn_cube(1);
+    let (mut body, _) = Body::from_tets(&points, &tets, material()).unwrap();
+    let d = body.map().darts().find(|&d| body.map().is_free(3, d)).unwrap();
+    let version = body.version();
+    assert!(body.unsew3(d).is_err());
+    assert_eq!(body.version(), version);
+    check_conservation(body.map(), body.attrs()).unwrap();
+}

@@ -1,0 +1,165 @@
+//! The subcommands of the `topomech` binary, one file each, and what they share: the error type
+//! and the report of a map's characteristics (as a table or as JSON).
+//!
+//! Every subcommand is `pub fn run(args: XArgs) -> Result<(), CliError>` in its own file; `main`
+//! prints a returned error as one line on stderr and exits with status 1.
+
+pub mod ambiguity;
+pub mod bench_step;
+pub mod demo;
+pub mod info;
+pub mod simulate;
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use topomech::load::{self, LoadError, Loaded};
+use topomech::{GMap, InvariantViolation};
+
+/// Why a subcommand failed. `main` prints it as `topomech: error: {self}`.
+#[derive(Debug, thiserror::Error)]
+pub enum CliError {
+    /// The mesh could not be read, checked or built; the message names the file (and the line or
+    /// byte when the reader knows it).
+    #[error(transparent)]
+    Load(#[from] LoadError),
+    /// The map was built but breaks a law of n-G-maps: a bug in topomech, reported, not hidden.
+    #[error("{}: the map breaks an n-G-map law (a topomech bug): {violation}", .path.display())]
+    Invalid {
+        /// The mesh file.
+        path: PathBuf,
+        /// The first law found broken.
+        violation: InvariantViolation,
+    },
+    /// Writing to stdout failed (a closed pipe is not reported: see `main`).
+    #[error("cannot write the output: {0}")]
+    Output(#[from] std::io::Error),
+    /// The JSON report could not be encoded.
+    #[error("cannot encode the JSON report: {0}")]
+    Json(#[from] serde_json::Error),
+    /// Any other failure of a subcommand, with its own message (for subcommands whose errors are
+    /// defined in the library, e.g. the mechanics).
+    #[error(transparent)]
+    Other(Box<dyn std::error::Error + Send + Sync>),
+}
+
+/// The characteristics `topomech info --json` prints: exactly these keys, in this order.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct InfoJson {
+    /// Live darts (24 per tet).
+    pub darts: usize,
+    /// 0-cells.
+    pub vertices: usize,
+    /// 1-cells (the springs of a mass/spring model).
+    pub edges: usize,
+    /// 2-cells.
+    pub faces: usize,
+    /// 3-cells (the tets).
+    pub volumes: usize,
+    /// 2-cells made of α3-free darts.
+    pub boundary_faces: usize,
+    /// Connected components (orbits of all involutions).
+    pub components: usize,
+    /// V − E + F − T.
+    pub euler_characteristic: i64,
+    /// Whether `validate()` passed.
+    pub valid: bool,
+    /// Time of `GMap::from_tets` in milliseconds, rounded to the microsecond.
+    pub build_ms: f64,
+}
+
+/// Everything `info` and the demo report about a loaded mesh.
+#[derive(Debug, Clone)]
+pub struct Characteristics {
+    /// The fields of the JSON report.
+    pub json: InfoJson,
+    /// Points in the file.
+    pub points: usize,
+    /// Tetrahedra in the file.
+    pub tets: usize,
+    /// Whether every component is orientable.
+    pub orientable: bool,
+    /// Memory of topology and cell ids per live dart.
+    pub bytes_per_dart: f64,
+    /// The first broken law, when `valid` is false.
+    pub violation: Option<InvariantViolation>,
+}
+
+impl Characteristics {
+    /// Measures `loaded.map`: cell counts from the id allocators, boundary, components,
+    /// orientability and a full `validate()`. O(darts · n²).
+    pub fn of(loaded: &Loaded) -> Self {
+        let map: &GMap<3> = &loaded.map;
+        let cells = map.count_cells();
+        let violation = map.validate().err();
+        Characteristics {
+            json: InfoJson {
+                darts: map.dart_count(),
+                vertices: cells.0[0],
+                edges: cells.0[1],
+                faces: cells.0[2],
+                volumes: cells.0[3],
+                boundary_faces: map.boundary_cell_count(),
+                components: map.components().len(),
+                euler_characteristic: cells.euler_characteristic(),
+                valid: violation.is_none(),
+                build_ms: (loaded.build_ms * 1e3).round() / 1e3,
+            },
+            points: loaded.mesh.points.len(),
+            tets: loaded.mesh.tets.len(),
+            orientable: map.is_orientable(),
+            bytes_per_dart: map.bytes_per_dart(),
+            violation,
+        }
+    }
+
+    /// `Err(CliError::Invalid)` when the map failed validation. O(1).
+    pub fn ensure_valid(&self, path: &std::path::Path) -> Result<(), CliError> {
+        match &self.violation {
+            Some(v) => Err(CliError::Invalid { path: path.to_path_buf(), violation: v.clone() }),
+            None => Ok(()),
+        }
+    }
+
+    /// The report as `label  value` rows, one per line. O(1).
+    pub fn write_table(&self, out: &mut dyn Write) -> std::io::Result<()> {
+        let j = &self.json;
+        let yes_no = |b: bool| if b { "yes" } else { "NO" };
+        let rows: [(&str, String); 14] = [
+            ("file points / tets", format!("{} / {}", self.points, self.tets)),
+            ("darts", j.darts.to_string()),
+            ("vertices", j.vertices.to_string()),
+            ("edges", j.edges.to_string()),
+            ("faces", j.faces.to_string()),
+            ("volumes", j.volumes.to_string()),
+            ("boundary faces", j.boundary_faces.to_string()),
+            ("components", j.components.to_string()),
+            ("Euler characteristic", j.euler_characteristic.to_string()),
+            ("orientable", yes_no(self.orientable).to_string()),
+            ("valid", yes_no(j.valid).to_string()),
+            ("build time", format!("{:.2} ms", j.build_ms)),
+            ("bytes per dart", format!("{:.1}", self.bytes_per_dart)),
+            ("memory (topology)", format!("{:.2} MiB", self.bytes_per_dart * j.darts as f64 / (1024.0 * 1024.0))),
+        ];
+        for (label, value) in rows {
+            writeln!(out, "  {label:<22}{value}")?;
+        }
+        Ok(())
+    }
+
+    /// The JSON object of [`InfoJson`] on one line. O(1).
+    pub fn write_json(&self, out: &mut dyn Write) -> Result<(), CliError> {
+        serde_json::to_writer(&mut *out, &self.json)?;
+        writeln!(out)?;
+        Ok(())
+    }
+}
+
+/// Prints the warnings of a load (mesh check, build report) to stderr, one line each.
+pub fn print_warnings(loaded: &Loaded) {
+    let mut err = std::io::stderr().lock();
+    for line in load::warning_lines(loaded) {
+        // A closed stderr leaves nobody to tell; the warning is dropped.
+        let _ = writeln!(err, "{line}");
+    }
+}

@@ -1,0 +1,261 @@
+//! `topomech simulate MESH --steps N --dt DT --integrator euler|symplectic|rk4|implicit …`: run the
+//! map-driven mass/spring simulation of a mesh, write ParaView frames, print a summary.
+
+use std::io::{IsTerminal, Write};
+use std::path::PathBuf;
+use std::time::Instant;
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use topomech::load;
+use topomech::mechanics::{Body, Integrator, Material, PinSpec, Simulation, StepConfig, Vec3};
+use topomech::vtk::{body_tets, Frame, Series};
+
+use super::{print_warnings, CliError};
+
+/// Arguments of `topomech simulate`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct SimulateArgs {
+    /// Tetrahedral mesh file (any format `topomech info` reads).
+    pub mesh: PathBuf,
+    /// Number of time steps.
+    #[arg(long, default_value_t = 1000)]
+    pub steps: u64,
+    /// Time step (seconds). Explicit schemes need dt below about 2/ω_max (printed on stderr).
+    #[arg(long, default_value_t = 1e-4)]
+    pub dt: f64,
+    /// euler, symplectic, rk4 or implicit.
+    #[arg(long, default_value = "rk4")]
+    pub integrator: Integrator,
+    /// Fix the vertices whose rest coordinate is at most VALUE, e.g. `x=0.5` or `z=-1`.
+    #[arg(long, value_name = "AXIS=VALUE", value_parser = parse_pin_below)]
+    pub pin_below: Option<(usize, f64)>,
+    /// Fix these vertex ids (comma-separated).
+    #[arg(long, value_delimiter = ',')]
+    pub pin: Vec<u32>,
+    /// Gravity acceleration `X,Y,Z`.
+    #[arg(long, value_parser = parse_vec3, default_value = "0,0,-9.81", allow_hyphen_values = true)]
+    pub gravity: Vec3,
+    /// Mass density ρ.
+    #[arg(long, default_value_t = Material::default().density)]
+    pub density: f64,
+    /// Young's modulus E (spring stiffness k = Σ E·V_t/L²).
+    #[arg(long, default_value_t = Material::default().young)]
+    pub young: f64,
+    /// Stiffness-proportional spring damping β in seconds (c = β·k).
+    #[arg(long, default_value_t = Material::default().damping)]
+    pub damping: f64,
+    /// Ambient viscosity per unit mass ν in 1/s (γ = ν·m).
+    #[arg(long, default_value_t = Material::default().viscosity)]
+    pub viscosity: f64,
+    /// Worker threads (1 = serial; more splits the force passes, same results bit for bit).
+    #[arg(long, default_value_t = 1)]
+    pub threads: usize,
+    /// Write `frame_NNNNNN.vtu` files and `frames.pvd` into this directory.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Frames to write when --out is given (evenly spaced, the initial state included).
+    #[arg(long, default_value_t = 50)]
+    pub frames: u64,
+    /// Print one JSON object: steps, dt, integrator, step_us_median, total_mass,
+    /// kinetic_energy, max_displacement.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The JSON summary: exactly these keys, in this order.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct SimulateJson {
+    /// Steps made.
+    pub steps: u64,
+    /// Time step.
+    pub dt: f64,
+    /// Scheme name.
+    pub integrator: &'static str,
+    /// Median wall time of one step in microseconds.
+    pub step_us_median: f64,
+    /// Σ of vertex masses at the end (equal to ρ × volume).
+    pub total_mass: f64,
+    /// Kinetic energy at the end.
+    pub kinetic_energy: f64,
+    /// Largest distance of a vertex from its rest position at the end.
+    pub max_displacement: f64,
+}
+
+fn parse_pin_below(s: &str) -> Result<(usize, f64), String> {
+    let (axis, value) = s.split_once('=').ok_or_else(|| format!("expected AXIS=VALUE, got {s:?}"))?;
+    let axis = match axis.trim().to_ascii_lowercase().as_str() {
+        "x" | "0" => 0,
+        "y" | "1" => 1,
+        "z" | "2" => 2,
+        other => return Err(format!("axis must be x, y or z, got {other:?}")),
+    };
+    let value: f64 = value.trim().parse().map_err(|e| format!("bad value {value:?}: {e}"))?;
+    Ok((axis, value))
+}
+
+fn parse_vec3(s: &str) -> Result<Vec3, String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    let [x, y, z] = parts.as_slice() else { return Err(format!("expected X,Y,Z, got {s:?}")) };
+    let p = |t: &str| t.trim().parse::<f64>().map_err(|e| format!("bad number {t:?}: {e}"));
+    Ok([p(x)?, p(y)?, p(z)?])
+}
+
+fn other(e: impl std::error::Error + Send + Sync + 'static) -> CliError {
+    CliError::Other(Box::new(e))
+}
+
+/// Loads the mesh, builds the body, runs `--steps` steps and prints the summary (a table, or
+/// JSON). Cost: O(steps · (springs + vertices)) plus the frames.
+///
+/// # Errors
+/// [`CliError::Load`] for a bad mesh; [`CliError::Other`] for a bad material, a blow-up (naming
+/// the step and vertex), a bad thread count or an unwritable output directory.
+pub fn run(args: SimulateArgs) -> Result<(), CliError> {
+    let threads = args.threads.max(1);
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(other)?;
+    pool.install(|| simulate(&args, threads > 1))
+}
+
+fn simulate(args: &SimulateArgs, parallel: bool) -> Result<(), CliError> {
+    let loaded = load::load_tet_map(&args.mesh)?;
+    print_warnings(&loaded);
+    let material =
+        Material { density: args.density, young: args.young, damping: args.damping, viscosity: args.viscosity };
+    let (mut body, _) = Body::from_tets(&loaded.mesh.points, &loaded.mesh.tets, material).map_err(other)?;
+    let pins = PinSpec { ids: args.pin.clone(), below: args.pin_below, inside: None };
+    body.attrs_mut().pin_where(|id, p| pins.pins(id, p));
+    let mut config = StepConfig::new(args.integrator, args.dt);
+    config.parallel = parallel;
+    let mut sim = Simulation::new(&mut body, args.gravity, config).map_err(other)?;
+    let omega = sim.projection.system.omega_max();
+    if args.integrator != Integrator::Implicit && omega * args.dt > 2.0 {
+        eprintln!(
+            "topomech: warning: dt = {} exceeds the explicit stability bound 2/ω_max = {:.3e}",
+            args.dt,
+            2.0 / omega
+        );
+    }
+    let mut frames = FrameWriter::new(args, &body)?;
+    frames.maybe_write(0, &body)?;
+    let bar = progress_bar(args.steps);
+    let mut times = Vec::with_capacity(args.steps as usize);
+    for step in 1..=args.steps {
+        let start = Instant::now();
+        sim.step(&mut body).map_err(other)?;
+        times.push(start.elapsed().as_secs_f64() * 1e6);
+        frames.maybe_write(step, &body)?;
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    let summary = SimulateJson {
+        steps: args.steps,
+        dt: args.dt,
+        integrator: args.integrator.name(),
+        step_us_median: median(&mut times),
+        total_mass: body.attrs().total_vertex_mass(body.map()),
+        kinetic_energy: sim.kinetic_energy(&body),
+        max_displacement: sim.max_displacement(&body),
+    };
+    print_summary(args, &summary, &sim, frames.pvd())
+}
+
+fn print_summary(
+    args: &SimulateArgs,
+    s: &SimulateJson,
+    sim: &Simulation,
+    pvd: Option<PathBuf>,
+) -> Result<(), CliError> {
+    let mut out = std::io::stdout().lock();
+    if args.json {
+        serde_json::to_writer(&mut out, s)?;
+        writeln!(out)?;
+    } else {
+        let sys = &sim.projection.system;
+        let fixed = sys.inv_mass.iter().zip(&sys.mass).filter(|(&w, &m)| w == 0.0 && m > 0.0).count();
+        writeln!(out, "{}", args.mesh.display())?;
+        let (springs, slots) = (sys.springs(), sys.slots());
+        writeln!(out, "  {:<22}mass/spring ({springs} springs, {slots} vertex slots, {fixed} fixed)", "system")?;
+        writeln!(out, "  {:<22}{} × {} s ({})", "steps", s.steps, s.dt, s.integrator)?;
+        writeln!(out, "  {:<22}{:.2} µs", "median step", s.step_us_median)?;
+        writeln!(out, "  {:<22}{:.6e}", "total mass", s.total_mass)?;
+        writeln!(out, "  {:<22}{:.6e}", "kinetic energy", s.kinetic_energy)?;
+        writeln!(out, "  {:<22}{:.6e}", "max displacement", s.max_displacement)?;
+        if let Some(p) = pvd {
+            writeln!(out, "  {:<22}{}", "ParaView series", p.display())?;
+        }
+    }
+    out.flush()?;
+    Ok(())
+}
+
+/// A progress bar on stderr, hidden when stderr is not a terminal.
+fn progress_bar(steps: u64) -> ProgressBar {
+    if !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::with_draw_target(Some(steps), ProgressDrawTarget::stderr());
+    if let Ok(style) = ProgressStyle::with_template("{bar:40} {pos}/{len} steps  {per_sec}  eta {eta}") {
+        bar.set_style(style);
+    }
+    bar
+}
+
+/// Median of `v` (sorts it); 0 for an empty slice.
+pub fn median(v: &mut [f64]) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// Writes evenly spaced frames of the body when `--out` is given.
+struct FrameWriter {
+    series: Option<Series>,
+    tets: Vec<[u32; 4]>,
+    every: u64,
+    dt: f64,
+}
+
+impl FrameWriter {
+    fn new(args: &SimulateArgs, body: &Body) -> Result<Self, CliError> {
+        let series = match &args.out {
+            Some(dir) => Some(Series::new(dir, "frame").map_err(other)?),
+            None => None,
+        };
+        let tets = if series.is_some() { body_tets(body) } else { Vec::new() };
+        let every = (args.steps / args.frames.max(1)).max(1);
+        Ok(FrameWriter { series, tets, every, dt: args.dt })
+    }
+
+    fn maybe_write(&mut self, step: u64, body: &Body) -> Result<(), CliError> {
+        let Some(series) = &mut self.series else { return Ok(()) };
+        if step % self.every != 0 {
+            return Ok(());
+        }
+        let m = body.attrs();
+        let displacement: Vec<Vec3> = m
+            .position
+            .as_slice()
+            .iter()
+            .zip(m.rest_position.as_slice())
+            .map(|(p, r)| [p[0] - r[0], p[1] - r[1], p[2] - r[2]])
+            .collect();
+        let frame = Frame {
+            points: m.position.as_slice(),
+            tets: &self.tets,
+            vectors: vec![("velocity", m.velocity.as_slice()), ("displacement", &displacement)],
+        };
+        series.push(step as f64 * self.dt, &frame).map_err(other)?;
+        Ok(())
+    }
+
+    fn pvd(&self) -> Option<PathBuf> {
+        self.series.as_ref().map(Series::pvd_path)
+    }
+}

@@ -1,0 +1,263 @@
+//! The `topomech` binary, run as a user would: the demo, `info --json` on the reference meshes,
+//! and bad input (which must give a non-zero status and a one-line error, never a panic).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const BIN: &str = env!("CARGO_BIN_EXE_topomech");
+const SHARED_MESHES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes");
+const BUILTIN: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/data/liver_547_v22.msh");
+
+/// The keys of `info --json`, in order.
+const KEYS: [&str; 10] = [
+    "darts",
+    "vertices",
+    "edges",
+    "faces",
+    "volumes",
+    "boundary_faces",
+    "components",
+    "euler_characteristic",
+    "valid",
+    "build_ms",
+];
+
+/// (file, nodes, tets, edges, boundary faces), copied from the table of
+/// `../shared/meshes/README.md` (counts made by meshio and an independent reader).
+const REFERENCE: [(&str, u64, u64, u64, u64); 8] = [
+    ("liver_547.msh", 547, 1852, 2833, 870),
+    ("liver_547_v22.msh", 547, 1852, 2833, 870),
+    ("liver_547.node", 547, 1852, 2833, 870),
+    ("liver_1814.msh", 1814, 7453, 10409, 2286),
+    ("box_458.msh", 458, 1566, 2377, 708),
+    ("box_458_v22.msh", 458, 1566, 2377, 708),
+    ("sfepy_cube_medium_tetra.msh", 448, 1782, 2493, 528),
+    ("sofa_liver_v1.msh", 181, 596, 914, 276),
+];
+
+fn run(args: &[&str]) -> Output {
+    Command::new(BIN).args(args).output().expect("the topomech binary runs")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// A scratch file under Cargo's per-test temporary directory.
+fn scratch(name: &str, contents: &[u8]) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("topomech-cli");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, contents).unwrap();
+    path
+}
+
+/// The value of `label` in a `  label   value` table row of `text`.
+fn table_value<'a>(text: &'a str, label: &str) -> Option<&'a str> {
+    text.lines().find_map(|l| {
+        let rest = l.trim_start().strip_prefix(label)?;
+        rest.starts_with("  ").then(|| rest.trim())
+    })
+}
+
+fn info_json(path: &Path) -> serde_json::Map<String, serde_json::Value> {
+    let out = run(&["info", "--json", path.to_str().unwrap()]);
+    assert!(out.status.success(), "{}: {}", path.display(), stderr(&out));
+    let text = stdout(&out);
+    assert_eq!(text.lines().count(), 1, "one JSON line: {text}");
+    let value: serde_json::Value = serde_json::from_str(&text).expect("valid JSON");
+    value.as_object().expect("a JSON object").clone()
+}
+
+fn check_json(path: &Path, (nodes, tets, edges, boundary): (u64, u64, u64, u64)) {
+    let obj = info_json(path);
+    let keys: Vec<&str> = obj.keys().map(String::as_str).collect();
+    let mut expected_keys = KEYS.to_vec();
+    expected_keys.sort_unstable();
+    let mut sorted_keys = keys.clone();
+    sorted_keys.sort_unstable();
+    assert_eq!(sorted_keys, expected_keys, "{}", path.display());
+    let int = |k: &str| obj[k].as_u64().unwrap_or_else(|| panic!("{k} is a non-negative integer"));
+    let name = path.display();
+    assert_eq!(int("vertices"), nodes, "{name}");
+    assert_eq!(int("volumes"), tets, "{name}");
+    assert_eq!(int("edges"), edges, "{name}");
+    assert_eq!(int("boundary_faces"), boundary, "{name}");
+    assert_eq!(int("faces"), (4 * tets + boundary) / 2, "{name}: each face has two tet sides unless on the boundary");
+    assert_eq!(int("darts"), 24 * tets, "{name}");
+    assert_eq!(int("components"), 1, "{name}");
+    assert_eq!(obj["euler_characteristic"].as_i64(), Some(1), "{name}: a ball");
+    assert_eq!(obj["valid"], serde_json::Value::Bool(true), "{name}");
+    let ms = obj["build_ms"].as_f64().expect("build_ms is a number");
+    assert!(ms >= 0.0 && ms.is_finite(), "{name}: build_ms = {ms}");
+}
+
+#[test]
+fn no_arguments_runs_the_demo_on_the_builtin_liver() {
+    let out = run(&[]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    assert_eq!(table_value(&text, "vertices"), Some("547"), "{text}");
+    assert_eq!(table_value(&text, "volumes"), Some("1852"), "{text}");
+    assert_eq!(table_value(&text, "edges"), Some("2833"), "{text}");
+    assert_eq!(table_value(&text, "boundary faces"), Some("870"), "{text}");
+    assert_eq!(table_value(&text, "faces"), Some("4139"), "{text}");
+    assert_eq!(table_value(&text, "darts"), Some("44448"), "{text}");
+    assert_eq!(table_value(&text, "components"), Some("1"), "{text}");
+    assert_eq!(table_value(&text, "Euler characteristic"), Some("1"), "{text}");
+    assert_eq!(table_value(&text, "valid"), Some("yes"), "{text}");
+    assert_eq!(table_value(&text, "orientable"), Some("yes"), "{text}");
+    assert!(table_value(&text, "build time").is_some_and(|v| v.ends_with(" ms")), "{text}");
+    assert!(text.contains("4139 -> 4140 -> 4139"), "face dissociation adds one face: {text}");
+    assert!(text.contains("870 -> 872 -> 870"), "and two boundary faces: {text}");
+    assert_eq!(table_value(&text, "isomorphic after sew"), Some("yes (every step validated)"), "{text}");
+    assert!(stderr(&out).is_empty(), "the built-in mesh has no warning: {}", stderr(&out));
+}
+
+#[test]
+fn demo_subcommand_and_json_agree_with_the_table() {
+    let out = run(&["demo", "--json"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let value: serde_json::Value = serde_json::from_str(&stdout(&out)).expect("valid JSON");
+    assert_eq!(value["vertices"], 547);
+    assert_eq!(value["boundary_faces"], 870);
+    let table = stdout(&run(&["demo"]));
+    assert_eq!(table_value(&table, "edges"), Some(value["edges"].to_string().as_str()));
+}
+
+#[test]
+fn info_json_on_the_builtin_copy_in_data() {
+    check_json(Path::new(BUILTIN), (547, 1852, 2833, 870));
+}
+
+#[test]
+fn info_json_on_the_shared_reference_meshes() {
+    let dir = Path::new(SHARED_MESHES);
+    if !dir.is_dir() {
+        println!("note: {} is absent; skipping the reference meshes", dir.display());
+        return;
+    }
+    for (file, nodes, tets, edges, boundary) in REFERENCE {
+        check_json(&dir.join(file), (nodes, tets, edges, boundary));
+    }
+}
+
+#[test]
+fn info_prints_a_table_naming_the_file() {
+    let out = run(&["info", BUILTIN]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    assert_eq!(text.lines().next(), Some(BUILTIN));
+    assert_eq!(table_value(&text, "volumes"), Some("1852"), "{text}");
+    assert_eq!(table_value(&text, "valid"), Some("yes"), "{text}");
+}
+
+/// Runs `info` on `path` and checks the failure contract; returns stderr.
+fn expect_failure(path: &Path) -> String {
+    for json in [false, true] {
+        let mut args = vec!["info", path.to_str().unwrap()];
+        if json {
+            args.push("--json");
+        }
+        let out = run(&args);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{}: {err}", path.display());
+        assert!(!err.contains("panicked"), "{err}");
+        assert!(!err.contains("RUST_BACKTRACE"), "{err}");
+        assert!(stdout(&out).is_empty(), "nothing on stdout: {}", stdout(&out));
+        assert_eq!(err.lines().count(), 1, "one line: {err}");
+        assert!(err.starts_with("topomech: error: "), "{err}");
+        assert!(err.contains(path.to_str().unwrap()), "names the file: {err}");
+    }
+    stderr(&run(&["info", path.to_str().unwrap()]))
+}
+
+const HEADER: &str = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n";
+
+/// An MSH 2.2 file with the given node lines and tet lines (`a b c d` node tags).
+fn msh22(nodes: &[&str], tets: &[&str]) -> String {
+    let mut s = format!("{HEADER}$Nodes\n{}\n", nodes.len());
+    for (k, n) in nodes.iter().enumerate() {
+        s += &format!("{} {n}\n", k + 1);
+    }
+    s += &format!("$EndNodes\n$Elements\n{}\n", tets.len());
+    for (k, t) in tets.iter().enumerate() {
+        s += &format!("{} 4 2 1 1 {t}\n", k + 1);
+    }
+    s + "$EndElements\n"
+}
+
+const SIX_NODES: [&str; 6] = ["0 0 0", "1 0 0", "0 1 0", "0 0 1", "0 0 -1", "1 1 1"];
+
+#[test]
+fn a_missing_file_is_named() {
+    let path = Path::new(env!("CARGO_TARGET_TMPDIR")).join("no-such-dir/missing.msh");
+    let err = expect_failure(&path);
+    assert!(err.contains("cannot read"), "{err}");
+}
+
+#[test]
+fn a_garbage_file_is_an_unknown_format() {
+    let path = scratch("garbage.msh", b"hello, this is not a mesh\n\x00\xff\xfe");
+    let err = expect_failure(&path);
+    assert!(err.contains("unknown mesh format"), "{err}");
+}
+
+#[test]
+fn truncated_files_name_the_line() {
+    let full = std::fs::read(BUILTIN).unwrap();
+    for (k, cut) in [full.len() / 3, full.len() / 2, full.len() - 200, full.len() - 10].into_iter().enumerate() {
+        let path = scratch(&format!("truncated_{k}.msh"), &full[..cut]);
+        let err = expect_failure(&path);
+        assert!(err.contains("line "), "cut at byte {cut}: {err}");
+    }
+}
+
+#[test]
+fn a_face_shared_by_three_tets_is_not_a_quasi_manifold() {
+    let text = msh22(&SIX_NODES, &["1 2 3 4", "1 3 2 5", "1 2 3 6"]);
+    let path = scratch("three_tets_one_face.msh", text.as_bytes());
+    let err = expect_failure(&path);
+    assert!(err.contains("not a quasi-manifold"), "{err}");
+    assert!(err.contains("file node tags [1, 2, 3]"), "{err}");
+}
+
+#[test]
+fn a_nan_coordinate_names_the_node_and_line() {
+    let mut nodes = SIX_NODES;
+    nodes[3] = "0 nan 1";
+    let text = msh22(&nodes[..5], &["1 2 3 4", "1 3 2 5"]);
+    let path = scratch("nan.msh", text.as_bytes());
+    let err = expect_failure(&path);
+    assert!(err.contains("non-finite coordinate"), "{err}");
+    // Node 4 is on line 9: 3 header lines, `$Nodes`, the count, then nodes 1..4.
+    assert!(err.contains("line 9"), "{err}");
+}
+
+#[test]
+fn warnings_go_to_stderr_and_the_load_succeeds() {
+    // Tet 2 is inverted (node 5 is below the base, like node 4 above it) and node 6 is unused.
+    let text = msh22(&SIX_NODES, &["1 2 3 4", "1 2 3 5"]);
+    let path = scratch("inverted.msh", text.as_bytes());
+    let out = run(&["info", "--json", path.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(err.contains("1 inverted tets") && err.contains("first: 1"), "{err}");
+    assert!(err.contains("1 unreferenced points") && err.contains("first: 5"), "{err}");
+    let value: serde_json::Value = serde_json::from_str(&stdout(&out)).expect("stdout stays pure JSON");
+    assert_eq!(value["volumes"], 2);
+    assert_eq!(value["boundary_faces"], 6);
+    assert_eq!(value["valid"], true);
+}
+
+#[test]
+fn a_bad_command_line_is_a_usage_error_not_a_panic() {
+    let out = run(&["info"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("Usage"), "{}", stderr(&out));
+    assert!(!stderr(&out).contains("panicked"));
+}

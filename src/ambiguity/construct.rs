@@ -1,0 +1,380 @@
+//! How the maps of the study are made: polygons glued along edges (2D), and small tetrahedral
+//! complexes with some interior faces dissociated (3D). Both are plain data, stored in the test
+//! vectors next to the darts, so a vector can be rebuilt two ways.
+
+use crate::gmap::{DartId, GMap, SewError};
+use crate::BuildError;
+
+/// A 2-G-map made of polygons glued edge to edge.
+///
+/// Polygon p with s sides has darts 2(o + k) and 2(o + k) + 1 on its side k (o = sides of the
+/// polygons before p): α0 joins the two darts of a side, α1 joins dart 2(o + k) + 1 to
+/// 2(o + (k + 1) mod s). Dart 2(o + k) is the *start* of side k when walking around the polygon.
+/// A glued pair of sides (a, b) 2-sews start(a) to start(b) when `same_direction` (the word
+/// `… x … x …`, orientation-reversing for consistently walked polygons) or to end(b) otherwise
+/// (`… x … x⁻¹ …`). Unglued sides are boundary.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+pub struct Gluing {
+    /// Number of sides of each polygon (1-gons and 2-gons are allowed in a G-map).
+    pub sides: Vec<u8>,
+    /// Glued sides `[a, b, same_direction]` (global side indices, same_direction as 0/1).
+    pub pairs: Vec<[u16; 3]>,
+}
+
+/// Why a construction could not be turned into a map.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ConstructError {
+    /// A side index past the last side, a side glued twice or to itself.
+    #[error("side {side} cannot be glued (there are {sides} sides; each side is glued at most once)")]
+    BadSide {
+        /// The side.
+        side: u16,
+        /// Number of sides.
+        sides: usize,
+    },
+    /// The kernel refused a sew.
+    #[error(transparent)]
+    Sew(#[from] SewError),
+    /// The tetrahedra do not form a quasi-manifold.
+    #[error(transparent)]
+    Build(#[from] BuildError),
+    /// A cut names two tets that do not share a glued face.
+    #[error("tets {0} and {1} do not share a glued face")]
+    NoSharedFace(u32, u32),
+    /// A polygon with no side, or too many darts.
+    #[error("polygon {0} has no side")]
+    EmptyPolygon(usize),
+}
+
+impl Gluing {
+    /// Total number of sides.
+    pub fn side_count(&self) -> usize {
+        self.sides.iter().map(|&s| s as usize).sum()
+    }
+
+    /// The 2-G-map (4 darts per side). Errors name the first bad side or refused sew.
+    /// O(sides).
+    pub fn build(&self) -> Result<GMap<2>, ConstructError> {
+        let total = self.side_count();
+        let mut map = GMap::<2>::new();
+        for _ in 0..2 * total {
+            map.create_dart().map_err(|_| ConstructError::BadSide { side: 0, sides: total })?;
+        }
+        let mut offset = 0u32;
+        for (p, &s) in self.sides.iter().enumerate() {
+            if s == 0 {
+                return Err(ConstructError::EmptyPolygon(p));
+            }
+            let s = s as u32;
+            for k in 0..s {
+                map.sew::<0>(DartId(2 * (offset + k)), DartId(2 * (offset + k) + 1))?;
+            }
+            for k in 0..s {
+                map.sew::<1>(DartId(2 * (offset + k) + 1), DartId(2 * (offset + (k + 1) % s)))?;
+            }
+            offset += s;
+        }
+        let mut used = vec![false; total];
+        for &[a, b, same] in &self.pairs {
+            for side in [a, b] {
+                let slot = used.get_mut(side as usize).ok_or(ConstructError::BadSide { side, sides: total })?;
+                if *slot {
+                    return Err(ConstructError::BadSide { side, sides: total });
+                }
+                *slot = true;
+            }
+            let target = if same != 0 { 2 * b as u32 } else { 2 * b as u32 + 1 };
+            map.sew::<2>(DartId(2 * a as u32), DartId(target))?;
+        }
+        Ok(map)
+    }
+
+    /// The gluing as a word per polygon: letters for glued sides (`x'` = x⁻¹), `·` for boundary
+    /// sides, e.g. `(a b a' b')` for the torus. O(sides).
+    pub fn word(&self) -> String {
+        let total = self.side_count();
+        let mut label = vec!["·".to_string(); total];
+        for (n, &[a, b, same]) in self.pairs.iter().enumerate() {
+            let letter = char::from(b'a' + (n % 26) as u8).to_string();
+            label[a as usize] = letter.clone();
+            label[b as usize] = if same != 0 { letter } else { format!("{letter}'") };
+        }
+        let mut out = Vec::new();
+        let mut offset = 0;
+        for &s in &self.sides {
+            out.push(format!("({})", label[offset..offset + s as usize].join(" ")));
+            offset += s as usize;
+        }
+        out.join(" ")
+    }
+}
+
+/// Every gluing of polygons with 1..=`max_polygon` sides, `max_sides` sides in total, the
+/// polygons in non-increasing size, every partial matching of sides with both directions.
+/// Connectedness is not required here (the finder drops disconnected maps). Bounded: for
+/// `max_sides` = 6 there are a few thousand. The recursion depth is at most `max_sides`.
+pub fn gluings(max_sides: usize, max_polygon: usize) -> Vec<Gluing> {
+    let mut out = Vec::new();
+    let mut partitions = Vec::new();
+    partitions_into(max_sides, max_polygon, &mut Vec::new(), &mut partitions);
+    for sides in partitions {
+        let total: usize = sides.iter().map(|&s| s as usize).sum();
+        let mut matchings = Vec::new();
+        matchings_of(&mut vec![false; total], &mut Vec::new(), &mut matchings);
+        for pairs in matchings {
+            for bits in 0u32..(1 << pairs.len()) {
+                let pairs = pairs.iter().enumerate().map(|(k, &(a, b))| [a, b, ((bits >> k) & 1) as u16]).collect();
+                out.push(Gluing { sides: sides.clone(), pairs });
+            }
+        }
+    }
+    out
+}
+
+/// Non-increasing sequences of parts in 1..=max_part with sum in 1..=budget.
+fn partitions_into(budget: usize, max_part: usize, prefix: &mut Vec<u8>, out: &mut Vec<Vec<u8>>) {
+    for part in (1..=max_part.min(budget)).rev() {
+        prefix.push(part as u8);
+        out.push(prefix.clone());
+        partitions_into(budget - part, part, prefix, out);
+        prefix.pop();
+    }
+}
+
+/// Every partial matching of the sides not yet used: the first unused side is either left alone
+/// or paired with a later unused side.
+fn matchings_of(used: &mut [bool], prefix: &mut Vec<(u16, u16)>, out: &mut Vec<Vec<(u16, u16)>>) {
+    let Some(first) = used.iter().position(|&u| !u) else {
+        out.push(prefix.clone());
+        return;
+    };
+    used[first] = true;
+    matchings_of(used, prefix, out);
+    for other in first + 1..used.len() {
+        if used[other] {
+            continue;
+        }
+        used[other] = true;
+        prefix.push((first as u16, other as u16));
+        matchings_of(used, prefix, out);
+        prefix.pop();
+        used[other] = false;
+    }
+    used[first] = false;
+}
+
+/// A tetrahedral complex with some interior faces dissociated: `GMap::from_tets` then one
+/// `unsew::<3>` per cut, a cut naming the two tets whose common face is dissociated.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+pub struct CutComplex {
+    /// Number of points.
+    pub points: usize,
+    /// The tetrahedra.
+    pub tets: Vec<[u32; 4]>,
+    /// The cuts `[t1, t2]`, in order.
+    pub cuts: Vec<[u32; 2]>,
+}
+
+impl CutComplex {
+    /// The 3-G-map after the cuts. Errors: the build's, or a cut whose tets no longer share a
+    /// glued face. O(tets + cuts).
+    pub fn build(&self) -> Result<GMap<3>, ConstructError> {
+        let (mut map, _) = GMap::<3>::from_tets(self.points, &self.tets)?;
+        for &[t1, t2] in &self.cuts {
+            let d = shared_face_dart(&map, t1, t2).ok_or(ConstructError::NoSharedFace(t1, t2))?;
+            map.unsew::<3>(d)?;
+        }
+        Ok(map)
+    }
+}
+
+/// A dart of tet `t1` that is 3-sewn to tet `t2`, for maps laid out by `GMap::from_tets` (darts
+/// 24·t .. 24·t + 24; unsew does not move darts). O(24).
+pub fn shared_face_dart(map: &GMap<3>, t1: u32, t2: u32) -> Option<DartId> {
+    let first = 24 * t1 as usize;
+    if first + 24 > map.capacity() {
+        return None;
+    }
+    (first..first + 24)
+        .map(|d| DartId(d as u32))
+        .find(|&d| map.contains(d) && !map.is_free(3, d) && map.cell_id(3, map.alpha::<3>(d)).0 == t2)
+}
+
+/// The pairs of tets sharing a glued face, `[t1, t2]` with t1 < t2, each once. O(darts).
+pub fn glued_faces(map: &GMap<3>) -> Vec<[u32; 2]> {
+    let mut out: Vec<[u32; 2]> = map
+        .sewn_pairs(3)
+        .map(|(x, y)| {
+            let (a, b) = (map.cell_id(3, x).0, map.cell_id(3, y).0);
+            [a.min(b), a.max(b)]
+        })
+        .collect();
+    out.sort_unstable();
+    out.dedup();
+    out
+}
+
+/// Every connected complex of at most `max_tets` tets on points 0..`points` whose first tet is
+/// [0, 1, 2, 3] and whose tets are in increasing lexicographic order, that builds (no face shared
+/// by three tets), with every subset of its glued faces cut. Bounded: C(C(points, 4) − 1,
+/// max_tets − 1) complexes times 2^(glued faces) cut sets.
+pub fn cut_complexes(points: usize, max_tets: usize) -> Vec<CutComplex> {
+    let all: Vec<[u32; 4]> = combinations4(points as u32);
+    let mut out = Vec::new();
+    let mut chosen = vec![0usize];
+    subsets_from(&all, 1, max_tets, &mut chosen, &mut |idx| {
+        let tets: Vec<[u32; 4]> = idx.iter().map(|&i| all[i]).collect();
+        let used = tets.iter().flatten().copied().max().map_or(0, |m| m as usize + 1);
+        if !points_connected(&tets) {
+            return;
+        }
+        let Ok((map, _)) = GMap::<3>::from_tets(used, &tets) else { return };
+        let faces = glued_faces(&map);
+        for bits in 0u32..(1 << faces.len()) {
+            let cuts = (0..faces.len()).filter(|&k| (bits >> k) & 1 == 1).map(|k| faces[k]).collect();
+            out.push(CutComplex { points: used, tets: tets.clone(), cuts });
+        }
+    });
+    out
+}
+
+fn combinations4(n: u32) -> Vec<[u32; 4]> {
+    let mut out = Vec::new();
+    for a in 0..n {
+        for b in a + 1..n {
+            for c in b + 1..n {
+                for d in c + 1..n {
+                    out.push([a, b, c, d]);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Calls `visit` on `chosen` and on every extension by increasing indices ≥ `from`, up to `max`
+/// elements. Recursion depth ≤ `max`.
+fn subsets_from(all: &[[u32; 4]], from: usize, max: usize, chosen: &mut Vec<usize>, visit: &mut dyn FnMut(&[usize])) {
+    visit(chosen);
+    if chosen.len() == max {
+        return;
+    }
+    for next in from..all.len() {
+        chosen.push(next);
+        subsets_from(all, next + 1, max, chosen, visit);
+        chosen.pop();
+    }
+}
+
+/// Whether the tets are connected through shared points. O(tets²).
+fn points_connected(tets: &[[u32; 4]]) -> bool {
+    let mut reached = vec![false; tets.len()];
+    let mut stack = vec![0];
+    reached[0] = true;
+    while let Some(t) = stack.pop() {
+        for u in 0..tets.len() {
+            if !reached[u] && tets[u].iter().any(|p| tets[t].contains(p)) {
+                reached[u] = true;
+                stack.push(u);
+            }
+        }
+    }
+    reached.iter().all(|&r| r)
+}
+
+/// A 3-G-map made of tetrahedra whose faces are glued to each other (the 3D analogue of
+/// [`Gluing`]): tet t has darts 24·t + 6·f + k as laid out by `GMap::from_tets` (face f, flag k);
+/// a glued pair `[a, b, k]` of faces (global index 4·t + f) 3-sews dart 0 of face a to dart k of
+/// face b, one of the six ways to match two triangles.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+pub struct FaceGluing {
+    /// Number of tetrahedra.
+    pub tets: u8,
+    /// Glued faces `[a, b, k]` with k in 0..6.
+    pub pairs: Vec<[u16; 3]>,
+}
+
+impl FaceGluing {
+    /// The 3-G-map (24 darts per tet). Errors: a bad face index or a refused sew. O(tets).
+    pub fn build(&self) -> Result<GMap<3>, ConstructError> {
+        let n = self.tets as u32;
+        let tets: Vec<[u32; 4]> = (0..n).map(|t| [4 * t, 4 * t + 1, 4 * t + 2, 4 * t + 3]).collect();
+        let (mut map, _) = GMap::<3>::from_tets(4 * n as usize, &tets)?;
+        let faces = 4 * self.tets as usize;
+        for &[a, b, k] in &self.pairs {
+            if a as usize >= faces || b as usize >= faces || k >= 6 {
+                return Err(ConstructError::BadSide { side: a.max(b), sides: faces });
+            }
+            map.sew::<3>(DartId(6 * a as u32), DartId(6 * b as u32 + k as u32))?;
+        }
+        Ok(map)
+    }
+}
+
+/// Every gluing of the faces of 1..=`max_tets` tets with at most `max_pairs` glued pairs, in
+/// the six ways each. Bounded: for 2 tets and 2 pairs, about eight thousand.
+pub fn face_gluings(max_tets: u8, max_pairs: usize) -> Vec<FaceGluing> {
+    let mut out = Vec::new();
+    for tets in 1..=max_tets {
+        let mut matchings = Vec::new();
+        matchings_of(&mut vec![false; 4 * tets as usize], &mut Vec::new(), &mut matchings);
+        for pairs in matchings.into_iter().filter(|m| m.len() <= max_pairs) {
+            let ways = 6usize.pow(pairs.len() as u32);
+            for code in 0..ways {
+                let mut c = code;
+                let pairs = pairs
+                    .iter()
+                    .map(|&(a, b)| {
+                        let k = (c % 6) as u16;
+                        c /= 6;
+                        [a, b, k]
+                    })
+                    .collect();
+                out.push(FaceGluing { tets, pairs });
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn torus_and_klein_bottle_words_build_closed_surfaces() {
+        let torus = Gluing { sides: vec![4], pairs: vec![[0, 2, 0], [1, 3, 0]] };
+        let klein = Gluing { sides: vec![4], pairs: vec![[0, 2, 0], [1, 3, 1]] };
+        assert_eq!(torus.word(), "(a b a' b')");
+        for (g, orientable) in [(&torus, true), (&klein, false)] {
+            let map = g.build().expect("valid gluing");
+            assert!(map.validate().is_ok());
+            assert_eq!(map.count_cells().0, vec![1, 2, 1]);
+            assert_eq!(map.is_orientable(), orientable);
+            assert_eq!(map.boundary_darts().count(), 0);
+        }
+    }
+
+    #[test]
+    fn gluing_a_side_twice_is_refused() {
+        let bad = Gluing { sides: vec![3], pairs: vec![[0, 1, 0], [1, 2, 0]] };
+        assert!(matches!(bad.build(), Err(ConstructError::BadSide { side: 1, .. })));
+    }
+
+    #[test]
+    fn enumeration_counts_match_the_closed_forms() {
+        // One 2-gon: matchings of 2 sides are {} and {01} with two directions: 3 gluings; the
+        // partitions of ≤ 2 into parts ≤ 2 are (1), (2), (1 1): 1 + 3 + 3 = 7 gluings.
+        assert_eq!(gluings(2, 2).len(), 7);
+    }
+
+    #[test]
+    fn a_cut_complex_dissociates_the_named_face() {
+        let c = CutComplex { points: 5, tets: vec![[0, 1, 2, 3], [1, 2, 3, 4]], cuts: vec![[0, 1]] };
+        let map = c.build().expect("valid complex");
+        assert!(glued_faces(&map).is_empty());
+        assert_eq!(map.count_cells().0, vec![8, 12, 8, 2]);
+        let again = CutComplex { cuts: vec![[0, 1], [0, 1]], ..c };
+        assert!(matches!(again.build(), Err(ConstructError::NoSharedFace(0, 1))));
+    }
+}

@@ -1,0 +1,138 @@
+//! A map as plain data: the α links of its darts, renumbered 0..darts. The form stored in the
+//! JSON test vectors, so that any other engine can rebuild the maps.
+
+use crate::gmap::{DartId, GMap, SewError};
+
+/// The darts of an n-G-map with their α links: `alpha[d][i]` = αi(d), darts numbered densely in
+/// increasing order of the map's own ids. Cell ids are not stored (they are derived data).
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct DartsJson {
+    /// The dimension n.
+    pub dim: usize,
+    /// One row of n + 1 links per dart.
+    pub alpha: Vec<Vec<u32>>,
+}
+
+/// Why a [`DartsJson`] does not describe a valid n-G-map.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum DartsError {
+    /// The stored dimension is not the one asked for.
+    #[error("the darts are those of a {found}-map, not of a {expected}-map")]
+    Dimension {
+        /// The dimension asked for.
+        expected: usize,
+        /// The stored one.
+        found: usize,
+    },
+    /// A row does not have n + 1 entries, or names a dart out of range.
+    #[error("dart {dart}: row {row:?} is not n + 1 links into 0..{darts}")]
+    BadRow {
+        /// The dart.
+        dart: usize,
+        /// Its row.
+        row: Vec<u32>,
+        /// Number of darts.
+        darts: usize,
+    },
+    /// αi is not an involution at this dart.
+    #[error("alpha{i} is not an involution at dart {dart}")]
+    NotInvolution {
+        /// The dart.
+        dart: usize,
+        /// The involution.
+        i: usize,
+    },
+    /// The kernel refused a sew: the links break the quasi-manifold law.
+    #[error("rebuilding alpha{i} at dart {dart}: {source}")]
+    Sew {
+        /// The dart.
+        dart: usize,
+        /// The involution.
+        i: usize,
+        /// The kernel's reason.
+        source: SewError,
+    },
+    /// The kernel could not create the darts.
+    #[error("cannot create dart {0}")]
+    Create(usize),
+}
+
+impl DartsJson {
+    /// The links of `map`, renumbered. O(darts · n).
+    pub fn of<const N: usize>(map: &GMap<N>) -> Self {
+        let mut rank = vec![u32::MAX; map.capacity()];
+        for (r, d) in map.darts().enumerate() {
+            rank[d.index()] = r as u32;
+        }
+        let alpha = map.darts().map(|d| (0..=N).map(|i| rank[map.alpha_dyn(i, d).index()]).collect()).collect();
+        DartsJson { dim: N, alpha }
+    }
+
+    /// Rebuilds the map through the public kernel API only: creates the darts, then sews α0,
+    /// α1, …, αn in that order (when αi is sewn, the involutions αj with j ≤ i − 2 it must commute
+    /// with are already in place and those with j ≥ i + 2 are still free, so every orbit sew
+    /// links exactly the stored pairs). O(darts · n²).
+    pub fn to_map<const N: usize>(&self) -> Result<GMap<N>, DartsError> {
+        if self.dim != N {
+            return Err(DartsError::Dimension { expected: N, found: self.dim });
+        }
+        self.check_rows()?;
+        let mut map = GMap::<N>::new();
+        for d in 0..self.alpha.len() {
+            map.create_dart().map_err(|_| DartsError::Create(d))?;
+        }
+        for i in 0..=N {
+            for (d, row) in self.alpha.iter().enumerate() {
+                let e = row[i] as usize;
+                if e == d || !map.is_free(i, DartId(d as u32)) {
+                    continue;
+                }
+                map.sew_dyn(i, DartId(d as u32), DartId(e as u32)).map_err(|source| DartsError::Sew {
+                    dart: d,
+                    i,
+                    source,
+                })?;
+            }
+        }
+        Ok(map)
+    }
+
+    fn check_rows(&self) -> Result<(), DartsError> {
+        let darts = self.alpha.len();
+        for (d, row) in self.alpha.iter().enumerate() {
+            if row.len() != self.dim + 1 || row.iter().any(|&e| e as usize >= darts) {
+                return Err(DartsError::BadRow { dart: d, row: row.clone(), darts });
+            }
+            if let Some(i) = (0..=self.dim).find(|&i| self.alpha[row[i] as usize][i] as usize != d) {
+                return Err(DartsError::NotInvolution { dart: d, i });
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_trip_of_a_tet_pair_is_isomorphic() {
+        let (map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [1, 2, 3, 4]]).expect("valid tets");
+        let json = DartsJson::of(&map);
+        let back: GMap<3> = json.to_map().expect("valid darts");
+        assert!(back.validate().is_ok());
+        assert!(back.is_isomorphic(&map));
+        assert_eq!(back.count_cells(), map.count_cells());
+    }
+
+    #[test]
+    fn broken_rows_are_refused() {
+        let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).expect("valid triangle");
+        let mut json = DartsJson::of(&map);
+        json.alpha[0][0] = 2;
+        assert!(matches!(json.to_map::<2>(), Err(DartsError::NotInvolution { .. })));
+        assert!(matches!(json.to_map::<3>(), Err(DartsError::Dimension { .. })));
+        json.alpha[0].pop();
+        assert!(matches!(json.to_map::<2>(), Err(DartsError::BadRow { .. })));
+    }
+}

@@ -1,0 +1,248 @@
+//! `topomech ambiguity [MESH] [--cuts K] [--seed S] [--json]`: the random cut campaign of
+//! `docs/ambiguity.md` — the g-map and the naive indexed model cut side by side — and, with
+//! `--catalogue`, the exhaustive search for maps sharing an adjacency graph.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use topomech::ambiguity::campaign::{campaign_k, KStats, Run};
+use topomech::ambiguity::catalogue::{campaign_vectors, catalogue, symptom_name, Bounds, Catalogue};
+use topomech::ambiguity::vector::Vector;
+use topomech::generate::{kuhn_cube, SplitMix64};
+
+use super::CliError;
+
+/// Arguments of `topomech ambiguity`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct AmbiguityArgs {
+    /// Tetrahedral mesh file (any format `topomech info` reads). Default: the built-in liver_547
+    /// (547 points, 1852 tets); `kuhn:K` builds a Kuhn cube with 6K³ tets instead.
+    pub mesh: Option<PathBuf>,
+    /// Cuts per sequence; several values separated by commas.
+    #[arg(long, value_delimiter = ',', default_values_t = vec![1usize, 5, 10, 50])]
+    pub cuts: Vec<usize>,
+    /// Seed of the random cut sequences.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Random sequences per number of cuts.
+    #[arg(long, default_value_t = 100)]
+    pub sequences: usize,
+    /// Print one JSON object (keys pairs_found, graph_kind, sequences_tried, mesh, tets, per_k,
+    /// first_pairs, and catalogue with --catalogue).
+    #[arg(long)]
+    pub json: bool,
+    /// Also run the exhaustive search over small 2D and 3D complexes.
+    #[arg(long)]
+    pub catalogue: bool,
+    /// Write the test vectors (catalogue and shrunk campaign findings) as JSON files into DIR.
+    #[arg(long, value_name = "DIR")]
+    pub write_vectors: Option<PathBuf>,
+    /// Most tests per delta-debugging pass when shrinking a finding for --write-vectors.
+    #[arg(long, default_value_t = 4000)]
+    pub shrink_budget: usize,
+}
+
+/// A finding of the campaign, shrunk when asked.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Finding {
+    /// Cuts of the sequence.
+    pub k: usize,
+    /// Its symptoms.
+    pub symptoms: Vec<&'static str>,
+    /// The cuts `[t1, t2]`.
+    pub cuts: Vec<[u32; 2]>,
+}
+
+/// The JSON report.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct AmbiguityJson {
+    /// Sequences where the cut g-map and the uncut one share their vertex–edge graph while the
+    /// maps differ (summed over every k).
+    pub pairs_found: usize,
+    /// The graph of those pairs.
+    pub graph_kind: &'static str,
+    /// Random sequences run.
+    pub sequences_tried: usize,
+    /// Sequences after which the indexed model is ambiguous (summed over every k).
+    pub indexed_ambiguous: usize,
+    /// The mesh (a path, the built-in mesh's name, or `kuhn:K`).
+    pub mesh: String,
+    /// Its tets.
+    pub tets: usize,
+    /// The seed.
+    pub seed: u64,
+    /// Statistics per number of cuts.
+    pub per_k: Vec<KStats>,
+    /// The first sequence showing each symptom.
+    pub first_pairs: Vec<Finding>,
+    /// The exhaustive search, with --catalogue.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub catalogue: Option<CatalogueJson>,
+}
+
+/// The catalogue part of the JSON report (counts and names, not the darts).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct CatalogueJson {
+    /// Per dimension and graph.
+    pub counts: Vec<topomech::ambiguity::catalogue::GroupCount>,
+    /// (name, description) of each pair vector.
+    pub pairs: Vec<(String, String)>,
+}
+
+/// Runs the campaign (and the catalogue) and prints the report.
+///
+/// # Errors
+/// [`CliError::Load`] when the mesh cannot be read or built; [`CliError::Other`] when a cut fails
+/// (a bug) or the vectors cannot be written; [`CliError::Output`] / [`CliError::Json`] on output.
+pub fn run(args: AmbiguityArgs) -> Result<(), CliError> {
+    let (name, points, tets) = load_mesh(args.mesh.as_deref())?;
+    let mut rng = SplitMix64(args.seed);
+    let mut per_k = Vec::new();
+    let mut firsts: Vec<(usize, Run)> = Vec::new();
+    for &k in &args.cuts {
+        let (stats, runs) = campaign_k(points, &tets, k, args.sequences, &mut rng).map_err(other)?;
+        per_k.push(stats);
+        firsts.extend(runs.into_iter().map(|r| (k, r)));
+    }
+    let cat = args.catalogue.then(|| catalogue(Bounds::CATALOGUE));
+    if let Some(dir) = &args.write_vectors {
+        write_vectors(dir, points, &tets, &firsts, cat.as_ref(), args.shrink_budget)?;
+    }
+    let report = AmbiguityJson {
+        pairs_found: per_k.iter().map(|s| count(s, "skeleton_unchanged")).sum(),
+        graph_kind: "vertex_edge",
+        sequences_tried: per_k.iter().map(|s| s.sequences).sum(),
+        indexed_ambiguous: per_k.iter().map(|s| s.ambiguous).sum(),
+        mesh: name,
+        tets: tets.len(),
+        seed: args.seed,
+        per_k,
+        first_pairs: firsts.iter().map(|(k, r)| finding(*k, r)).collect(),
+        catalogue: cat.map(|c| CatalogueJson {
+            counts: c.counts,
+            pairs: c.pairs.into_iter().map(|p| (p.name, p.description)).collect(),
+        }),
+    };
+    let mut out = std::io::stdout().lock();
+    if args.json {
+        serde_json::to_writer(&mut out, &report)?;
+        writeln!(out)?;
+    } else {
+        write_table(&mut out, &report)?;
+    }
+    out.flush()?;
+    Ok(())
+}
+
+fn other(e: impl std::error::Error + Send + Sync + 'static) -> CliError {
+    CliError::Other(Box::new(e))
+}
+
+fn count(s: &KStats, symptom: &str) -> usize {
+    s.symptoms.iter().filter(|(x, _)| symptom_name(*x) == symptom).map(|x| x.1).sum()
+}
+
+/// The mesh: the file given, `kuhn:K`, or the built-in liver.
+fn load_mesh(path: Option<&Path>) -> Result<(String, usize, Vec<[u32; 4]>), CliError> {
+    let kuhn = path.and_then(|p| p.to_str()).and_then(|s| s.strip_prefix("kuhn:")).map(str::parse::<usize>);
+    match (path, kuhn) {
+        (_, Some(Ok(k))) if (1..=16).contains(&k) => {
+            let (points, tets) = kuhn_cube(k);
+            Ok((format!("kuhn:{k}"), points.len(), tets))
+        }
+        (_, Some(_)) => Err(CliError::Other("kuhn:K needs K in 1..=16".into())),
+        (Some(p), None) => from_loaded(topomech::load::load_tet_map(p)?),
+        (None, None) => from_loaded(topomech::load::load_builtin()?),
+    }
+}
+
+fn from_loaded(loaded: topomech::load::Loaded) -> Result<(String, usize, Vec<[u32; 4]>), CliError> {
+    Ok((loaded.path.display().to_string(), loaded.mesh.points.len(), loaded.mesh.tets))
+}
+
+/// A run as a finding (shrinking is `--write-vectors`'s job).
+fn finding(k: usize, run: &Run) -> Finding {
+    Finding { k, symptoms: run.symptoms().into_iter().map(symptom_name).collect(), cuts: run.cuts.clone() }
+}
+
+fn write_vectors(
+    dir: &Path,
+    points: usize,
+    tets: &[[u32; 4]],
+    firsts: &[(usize, Run)],
+    cat: Option<&Catalogue>,
+    budget: usize,
+) -> Result<(), CliError> {
+    std::fs::create_dir_all(dir)?;
+    let runs: Vec<Run> = firsts.iter().map(|(_, r)| r.clone()).collect();
+    let (indexed, pairs) = campaign_vectors(points, tets, &runs, budget.max(1)).map_err(other)?;
+    let mut vectors: Vec<Vector> = indexed.into_iter().map(|i| Vector::Indexed(Box::new(i))).collect();
+    vectors.extend(pairs.into_iter().map(|p| Vector::Pair(Box::new(p))));
+    if let Some(c) = cat {
+        vectors.extend(c.pairs.iter().cloned().map(|p| Vector::Pair(Box::new(p))));
+    }
+    for v in &vectors {
+        let file = dir.join(format!("{}.json", v.name()));
+        std::fs::write(&file, serde_json::to_string_pretty(v)? + "\n")?;
+    }
+    Ok(())
+}
+
+fn write_table(out: &mut dyn Write, r: &AmbiguityJson) -> std::io::Result<()> {
+    writeln!(out, "{} ({} tets), seed {}", r.mesh, r.tets, r.seed)?;
+    writeln!(
+        out,
+        "  {:>4} {:>6} {:>10} {:>7} {:>12} {:>10} {:>9} {:>12} {:>10}",
+        "k", "seqs", "ambiguous", "wrong", "face_shared", "pinched", "nm_edge", "gluing_diff", "skeleton"
+    )?;
+    for s in &r.per_k {
+        let c = |name| count(s, name);
+        writeln!(
+            out,
+            "  {:>4} {:>6} {:>10} {:>7} {:>12} {:>10} {:>9} {:>12} {:>10}",
+            s.k,
+            s.sequences,
+            s.ambiguous,
+            s.wrong,
+            c("face_still_shared"),
+            c("pinched_point"),
+            c("non_manifold_edge"),
+            c("gluing_differs"),
+            c("skeleton_unchanged")
+        )?;
+    }
+    writeln!(
+        out,
+        "pairs_found {} (graph_kind {}), sequences_tried {}",
+        r.pairs_found, r.graph_kind, r.sequences_tried
+    )?;
+    for f in &r.first_pairs {
+        let shown: Vec<[u32; 2]> = f.cuts.iter().take(5).copied().collect();
+        writeln!(
+            out,
+            "  first with {:?}: k = {}, cuts {:?}{}",
+            f.symptoms,
+            f.k,
+            shown,
+            if f.cuts.len() > 5 { " …" } else { "" }
+        )?;
+    }
+    if let Some(c) = &r.catalogue {
+        writeln!(out, "exhaustive search:")?;
+        for g in &c.counts {
+            writeln!(
+                out,
+                "  {}D {:<12} {:?}: {} classes, {} ambiguous groups",
+                g.dim,
+                g.graph_kind.name(),
+                g.multiplicity,
+                g.classes,
+                g.groups
+            )?;
+        }
+        for (name, text) in &c.pairs {
+            writeln!(out, "  {name}: {text}")?;
+        }
+    }
+    Ok(())
+}

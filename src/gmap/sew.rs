@@ -118,7 +118,9 @@ impl CellChanges {
     /// The splits of `dim`-cells, as (kept, new, dart_kept, dart_new).
     pub fn splits(&self, dim: usize) -> impl Iterator<Item = (CellId, CellId, DartId, DartId)> + '_ {
         self.changes.iter().filter_map(move |c| match *c {
-            CellChange::Split { dim: k, kept, new, dart_kept, dart_new } if k == dim => Some((kept, new, dart_kept, dart_new)),
+            CellChange::Split { dim: k, kept, new, dart_kept, dart_new } if k == dim => {
+                Some((kept, new, dart_kept, dart_new))
+            }
             _ => None,
         })
     }
@@ -195,8 +197,13 @@ impl<const N: usize> GMap<N> {
             head += 1;
             for j in mask.indices().filter(|&j| j <= N) {
                 let (xj, yj) = (self.alpha_dyn(j, x), self.alpha_dyn(j, y));
-                self.pair_up(i, (d1, d2), (xj, yj), &mut pairing, &mut pairs)
-                    .map_err(|_| SewError::OrbitsDiffer { d1, d2, i, at: x, j })?;
+                self.pair_up(i, (d1, d2), (xj, yj), &mut pairing, &mut pairs).map_err(|_| SewError::OrbitsDiffer {
+                    d1,
+                    d2,
+                    i,
+                    at: x,
+                    j,
+                })?;
             }
         }
         Ok(pairs)
@@ -255,26 +262,29 @@ impl<const N: usize> GMap<N> {
         for &(x, y) in &pairs {
             self.link_raw(i, x, y);
         }
+        let keep: Vec<u32> = (0..=N).map(|dim| self.cell_id(dim, d1).0).collect();
         let mut report = CellChanges { changes: Vec::new(), pairs };
         for k in 0..report.pairs.len() {
             let (x, y) = report.pairs[k];
             for dim in (0..=N).filter(|&dim| dim != i) {
-                self.merge_cells(dim, x, y, &mut report.changes);
+                self.merge_cells(dim, x, y, keep[dim], &mut report.changes);
             }
         }
         self.after_mutation(&touched(&report.pairs));
         Ok(report)
     }
 
-    /// After a link, gives y's dim-cell the id of x's if they differ.
-    fn merge_cells(&mut self, dim: usize, x: DartId, y: DartId, changes: &mut Vec<CellChange>) {
+    /// After a link, makes the dim-cells of x and y carry one id: x's, unless y's is `keep` (the
+    /// id d1 had before the sew, which always survives when two cells merge).
+    fn merge_cells(&mut self, dim: usize, x: DartId, y: DartId, keep: u32, changes: &mut Vec<CellChange>) {
         let (kx, ky) = (self.cell_id(dim, x).0, self.cell_id(dim, y).0);
         if kx == ky {
             return;
         }
-        self.relabel(dim, y, AlphaMask::cell(N, dim), ky, kx);
-        self.release_cell_id(dim, ky);
-        changes.push(CellChange::Merged { dim, kept: CellId(kx), absorbed: CellId(ky) });
+        let (from_dart, kept, absorbed) = if ky == keep { (x, ky, kx) } else { (y, kx, ky) };
+        self.relabel(dim, from_dart, AlphaMask::cell(N, dim), absorbed, kept);
+        self.release_cell_id(dim, absorbed);
+        changes.push(CellChange::Merged { dim, kept: CellId(kept), absorbed: CellId(absorbed) });
     }
 
     /// I-unsews d from αi(d), with the whole orbit ⟨αj : |i − j| ≥ 2⟩(d). Errors leave the map
@@ -291,12 +301,18 @@ impl<const N: usize> GMap<N> {
         if self.is_free(i, d) {
             return Err(SewError::AlreadyFree { dart: d, i });
         }
-        let pairs: Vec<(DartId, DartId)> = self
+        // Each pair {x, αi(x)} once. The orbit usually holds only one side of a pair (αi(x) is
+        // in it only for twisted orbits), so the pair is normalised rather than filtered on x < y.
+        let mut pairs: Vec<(DartId, DartId)> = self
             .orbit(d, AlphaMask::commuting_with(N, i))
             .into_iter()
-            .map(|x| (x, self.alpha_dyn(i, x)))
-            .filter(|&(x, y)| x < y)
+            .map(|x| {
+                let y = self.alpha_dyn(i, x);
+                (x.min(y), x.max(y))
+            })
             .collect();
+        pairs.sort_unstable();
+        pairs.dedup();
         for &(x, _) in &pairs {
             self.unlink_raw(i, x);
         }

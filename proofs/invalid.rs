@@ -1,0 +1,85 @@
+//! Every single raw corruption of every small valid map: `validate()` must fail exactly when a
+//! law is broken and name a broken law with a true witness.
+
+use crate::laws::{all_maps, check_validate_names_law};
+use topomech::gmap::Law;
+use topomech::ops::{self, RawEdit};
+use topomech::{DartId, GMap};
+
+/// Every raw edit on a map with `cap` slots: each link and unlink, and each cell id overwrite
+/// with an id in 0..=bound (one past the allocator, so never allocated).
+fn all_edits<const N: usize>(map: &GMap<N>) -> Vec<RawEdit> {
+    let cap = map.capacity() as u32;
+    let mut edits = Vec::new();
+    for i in 0..=N {
+        for a in 0..cap {
+            edits.push(RawEdit::Unlink { i, a: DartId(a) });
+            for b in 0..cap {
+                edits.push(RawEdit::Link { i, a: DartId(a), b: DartId(b) });
+            }
+        }
+    }
+    for dim in 0..=N {
+        for d in 0..cap {
+            for id in 0..=map.cell_id_bound(dim) as u32 {
+                edits.push(RawEdit::SetCell { dim, d: DartId(d), id });
+            }
+        }
+    }
+    edits
+}
+
+/// Checks every edit of every map on ≤ k darts, with and without one dead dart slot; returns
+/// how often each law was named.
+fn corruptions<const N: usize>(k: usize) -> Vec<(Law, usize)> {
+    let mut named: Vec<(Law, usize)> = Vec::new();
+    for darts in 1..=k {
+        for table in all_maps::<N>(darts) {
+            for with_dead in [false, true] {
+                let mut map = ops::from_alpha_table::<N>(&table).unwrap();
+                if with_dead {
+                    let d = map.create_dart().unwrap();
+                    map.delete_dart(d).unwrap();
+                }
+                for edit in all_edits(&map) {
+                    let mut broken = map.clone();
+                    if !ops::raw_edit_unchecked(&mut broken, edit) {
+                        continue;
+                    }
+                    check_validate_names_law(&broken).unwrap_or_else(|e| panic!("{table:?} + {edit:?}: {e}"));
+                    if let Err(v) = broken.validate() {
+                        match named.iter_mut().find(|(l, _)| *l == v.law()) {
+                            Some((_, c)) => *c += 1,
+                            None => named.push((v.law(), 1)),
+                        }
+                    }
+                }
+            }
+        }
+    }
+    named
+}
+
+#[test]
+fn validate_names_the_broken_law_n1() {
+    let named = corruptions::<1>(3);
+    for law in [Law::Involution, Law::CellIdConstant, Law::CellIdUnique] {
+        assert!(named.iter().any(|(l, c)| *l == law && *c > 0), "{law:?} never produced: {named:?}");
+    }
+}
+
+#[test]
+fn validate_names_the_broken_law_n2() {
+    let named = corruptions::<2>(3);
+    for law in [Law::Involution, Law::QuasiManifold, Law::CellIdConstant, Law::CellIdUnique] {
+        assert!(named.iter().any(|(l, c)| *l == law && *c > 0), "{law:?} never produced: {named:?}");
+    }
+}
+
+#[test]
+fn validate_names_the_broken_law_n3() {
+    let named = corruptions::<3>(3);
+    for law in [Law::Involution, Law::QuasiManifold, Law::CellIdConstant] {
+        assert!(named.iter().any(|(l, c)| *l == law && *c > 0), "{law:?} never produced: {named:?}");
+    }
+}

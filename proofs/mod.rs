@@ -1,0 +1,22 @@
+//! Proofs by exhaustion and Kani-style harnesses for the kernel (`cargo test --test proofs`).
+//!
+//! * [`enumerate`]: every n-G-map on up to k darts (n = 1, 2, 3; all tuples of involutions
+//!   satisfying the quasi-manifold law), and on each every sew and unsew: a refusal changes
+//!   nothing and agrees with `is_sewable`; an accepted one leaves a valid map whose cell ids
+//!   equal a labelling by orbits and agree with the reported changes. Also `is_isomorphic`
+//!   against brute force over all relabellings.
+//! * [`invalid`]: every single raw corruption of small valid maps; `validate()` must fail iff
+//!   some law is broken, and must name a law that is broken, with a true witness.
+//! * [`harnesses`]: Kani proof harnesses that run here as seeded randomized tests through
+//!   [`kani_shim`], and unchanged under `cargo kani --tests`.
+//!
+//! The laws themselves live in shared `check_*` functions (`topomech::ops` and [`laws`]).
+//! Scope: `TOPOMECH_PROOF_DARTS` overrides the dart bound (see docs/VERIFICATION.md).
+#![allow(unexpected_cfgs)]
+
+mod enumerate;
+#[cfg(any(kani, test))]
+mod harnesses;
+mod invalid;
+mod kani_shim;
+mod laws;

@@ -1,0 +1,113 @@
+//! Property tests (proptest) of the kernel: random operation sequences from `topomech::ops`
+//! on seeded maps for n = 1, 2, 3, with every law of `ops::check_after_op` checked after every
+//! step, and isomorphism round trips through copies with permuted dart ids.
+//!
+//! The byte strings proptest generates are decoded by the same `ops::decode` the fuzz target
+//! uses, so a failure here shrinks to bytes that can be dropped into `fuzz/corpus/kernel_ops/`.
+
+use proptest::prelude::*;
+use topomech::ops::{self, KernelOp, Seed};
+use topomech::{DartId, GMap};
+
+fn seed_kind() -> impl Strategy<Value = Seed> {
+    prop_oneof![Just(Seed::Structured), Just(Seed::Soup), Just(Seed::Wild)]
+}
+
+/// A start map (one `Grow`) followed by up to 120 decoded operations.
+fn op_sequence() -> impl Strategy<Value = Vec<KernelOp>> {
+    (seed_kind(), any::<u16>(), prop::collection::vec(any::<u8>(), 0..400)).prop_map(|(kind, seed, bytes)| {
+        let mut ops = vec![KernelOp::Grow { kind, seed: u32::from(seed) }];
+        ops.extend(ops::decode(&bytes).into_iter().take(120));
+        ops
+    })
+}
+
+/// Runs the operations without checks (the maps used by the isomorphism properties).
+fn build<const N: usize>(ops: &[KernelOp]) -> GMap<N> {
+    let mut map = GMap::<N>::new();
+    for op in ops {
+        let _ = ops::apply(&mut map, op);
+    }
+    map
+}
+
+/// Copy with permuted ids is isomorphic (both ways, and by the explicit map from a dart of each
+/// component); breaking one αi link of the copy makes it non-isomorphic.
+fn check_permuted_copy<const N: usize>(map: &GMap<N>, perm_seed: u64) -> Result<(), TestCaseError> {
+    let perm = ops::random_permutation(map.dart_count(), perm_seed);
+    let copy = ops::permuted_copy(map, &perm).map_err(|e| TestCaseError::fail(e.to_string()))?;
+    prop_assert!(map.is_isomorphic(&copy) && copy.is_isomorphic(map), "permuted copy not isomorphic");
+    let ranks: Vec<DartId> = map.darts().collect();
+    if let Some(&d) = ranks.first() {
+        let image = DartId(perm[0]);
+        let pairs = map.isomorphism_from(d, &copy, image);
+        prop_assert!(pairs.is_some(), "no isomorphism sends the first dart to its image");
+        for (x, y) in pairs.unwrap() {
+            let rank = ranks.binary_search(&x).unwrap();
+            prop_assert_eq!(y, DartId(perm[rank]), "isomorphism disagrees with the permutation");
+        }
+    }
+    let mut broken = copy.clone();
+    let sewn = broken.darts().find_map(|d| (0..=N).find(|&i| !broken.is_free(i, d)).map(|i| (i, d)));
+    if let Some((i, d)) = sewn {
+        broken.unsew_dyn(i, d).unwrap();
+        prop_assert!(!map.is_isomorphic(&broken), "a copy with alpha{} cut at {:?} is still isomorphic", i, d);
+    }
+    broken.create_dart().unwrap();
+    prop_assert!(!map.is_isomorphic(&broken), "a copy with an extra dart is still isomorphic");
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+    #[test]
+    fn laws_hold_after_every_op_n1(ops in op_sequence()) {
+        ops::run_ops(&mut GMap::<1>::new(), &ops).map_err(TestCaseError::fail)?;
+    }
+
+    #[test]
+    fn laws_hold_after_every_op_n2(ops in op_sequence()) {
+        ops::run_ops(&mut GMap::<2>::new(), &ops).map_err(TestCaseError::fail)?;
+    }
+
+    #[test]
+    fn laws_hold_after_every_op_n3(ops in op_sequence()) {
+        ops::run_ops(&mut GMap::<3>::new(), &ops).map_err(TestCaseError::fail)?;
+    }
+
+    #[test]
+    fn permuted_copies_are_isomorphic_n1(ops in op_sequence(), perm_seed in any::<u64>()) {
+        check_permuted_copy(&build::<1>(&ops), perm_seed)?;
+    }
+
+    #[test]
+    fn permuted_copies_are_isomorphic_n2(ops in op_sequence(), perm_seed in any::<u64>()) {
+        check_permuted_copy(&build::<2>(&ops), perm_seed)?;
+    }
+
+    #[test]
+    fn permuted_copies_are_isomorphic_n3(ops in op_sequence(), perm_seed in any::<u64>()) {
+        check_permuted_copy(&build::<3>(&ops), perm_seed)?;
+    }
+
+    #[test]
+    fn encode_inverts_decode(bytes in prop::collection::vec(any::<u8>(), 0..300)) {
+        let ops = ops::decode(&bytes);
+        prop_assert_eq!(ops::decode(&ops::encode(&ops)), ops);
+    }
+}
+
+/// `is_isomorphic` must not be fooled by equal counts: a closed 2-gon (one component) and two
+/// loops (each an edge whose α1 joins its own two ends) both have 4 darts, 2 vertices, 2 edges.
+#[test]
+fn same_counts_different_structure_is_not_isomorphic() {
+    let two_gon: ops::AlphaTable = vec![vec![1, 3], vec![0, 2], vec![3, 1], vec![2, 0]];
+    let two_loops: ops::AlphaTable = vec![vec![1, 1], vec![0, 0], vec![3, 3], vec![2, 2]];
+    let a = ops::from_alpha_table::<1>(&two_gon).unwrap();
+    let b = ops::from_alpha_table::<1>(&two_loops).unwrap();
+    assert_eq!((a.dart_count(), a.count_cells()), (b.dart_count(), b.count_cells()));
+    assert_eq!((a.components().len(), b.components().len()), (1, 2));
+    assert!(!a.is_isomorphic(&b) && !b.is_isomorphic(&a));
+    assert!(a.is_isomorphic(&ops::permuted_copy(&a, &[2, 0, 3, 1]).unwrap()));
+}

@@ -43,6 +43,12 @@ enum Command {
     Simulate(cli::simulate::SimulateArgs),
     /// Benchmarks: `bench step MESH` times map-driven vs flat-array steps.
     Bench(cli::bench_step::BenchArgs),
+    /// Cut a body along a plane (face separation) and report before/after.
+    Cut(cli::cut::CutArgs),
+    /// Remove tets by id or inside a ball and report before/after.
+    Remove(cli::cut::RemoveArgs),
+    /// Simulate a hanging body that tears where its stress exceeds a threshold.
+    Tear(cli::cut::TearArgs),
 }
 
 impl Command {
@@ -53,6 +59,9 @@ impl Command {
             Command::Ambiguity(args) => cli::ambiguity::run(args),
             Command::Simulate(args) => cli::simulate::run(args),
             Command::Bench(args) => cli::bench_step::run(args),
+            Command::Cut(args) => cli::cut::run(args),
+            Command::Remove(args) => cli::cut::run_remove(args),
+            Command::Tear(args) => cli::cut::run_tear(args),
         }
     }
 }

@@ -245,6 +245,14 @@ impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
         self.attrs.check(&self.map)
     }
 
+    /// Map and attributes, both mutable, bypassing the rules: only for crate operations that keep
+    /// the attributes lawful themselves (volume removal deletes an isolated volume's darts,
+    /// `crate::cut`). Counts as a topological change: bumps [`Embedded::version`]. O(1).
+    pub(crate) fn parts_mut_bypassing_rules(&mut self) -> (&mut GMap<N>, &mut E) {
+        self.version += 1;
+        (&mut self.map, &mut self.attrs)
+    }
+
     /// Splits into map and attributes. O(1).
     pub fn into_parts(self) -> (GMap<N>, E) {
         (self.map, self.attrs)

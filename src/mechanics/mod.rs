@@ -27,7 +27,7 @@ pub use force::SpringSystem;
 pub use geom::Vec3;
 pub use integrate::{Integrator, StepConfig, StepError, Stepper};
 pub use model::{Body, BodyError, Material, Mechanics, ModelError};
-pub use projection::{forces_by_coverage, Projection};
+pub use projection::{forces_by_coverage, Projection, ProjectionMismatch, TouchedCells};
 
 use crate::CellId;
 
@@ -127,6 +127,27 @@ impl Simulation {
     pub fn rebuild(&mut self, body: &mut Body) -> Result<(), SimError> {
         let config = *self.stepper.config();
         *self = Simulation::new(body, self.projection.system.gravity, config)?;
+        Ok(())
+    }
+
+    /// Follows topological changes incrementally ([`Projection::update`] with `touched`), then
+    /// re-sizes the stepper's buffers (a new [`Stepper`]: the step counter and the energy scale
+    /// of the runaway test restart). O(touched cells) + O(slots + springs) for the CSR and buffers.
+    ///
+    /// # Errors
+    /// As [`Simulation::new`].
+    pub fn update(&mut self, body: &mut Body, touched: &TouchedCells) -> Result<(), SimError> {
+        self.projection.update(body, touched);
+        let config = *self.stepper.config();
+        let slots = self.projection.system.slots();
+        let mech = body.attrs_mut();
+        for (v, &w) in mech.velocity.as_mut_slice()[..slots].iter_mut().zip(&self.projection.system.inv_mass) {
+            if w == 0.0 {
+                *v = [0.0; 3];
+            }
+        }
+        let (x, v) = (&mech.position.as_slice()[..slots], &mech.velocity.as_slice()[..slots]);
+        self.stepper = Stepper::new(config, &self.projection.system, x, v)?;
         Ok(())
     }
 

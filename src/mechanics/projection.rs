@@ -18,11 +18,24 @@
 //! incremental update (next issue) only has to touch the slots and springs named by the
 //! operation's `CellChanges`, through these maps.
 //!
+//! # Incremental update
+//! [`Projection::update`] applies a topological operation's [`TouchedCells`] (the vertex and edge
+//! ids it split, merged, renamed the ends of, or deleted, each with a dart of the cell now):
+//! per-vertex values of those slots are re-read, springs of split edges are appended, springs of
+//! deleted edges are swap-removed, springs whose end vertex got a new id get their ends fixed.
+//! That part costs O(touched cells). The CSR of incident springs inside [`SpringSystem`] is then
+//! rebuilt in one linear pass, O(slots + springs) with no map walk and no sort (the CSR is
+//! private to `force.rs`; making it appendable is what a fully local update still needs).
+//! Spring order differs from a fresh build (appended, not sorted), so the two are compared with
+//! [`Projection::equivalent`], cell by cell.
+//!
 //! [`forces_by_coverage`] computes the same forces the paper's first way, by covering the
 //! map's edges and vertices with a dart set: the reference the projection is tested against.
 
-use crate::gmap::DartSet;
-use crate::{AlphaMask, CellId, DartId};
+use rustc_hash::FxHashMap;
+
+use crate::gmap::{CellChanges, DartSet};
+use crate::{AlphaMask, CellId, DartId, GMap};
 
 use super::force::{spring_force, SpringSystem};
 use super::geom::Vec3;
@@ -84,6 +97,137 @@ impl Projection {
         self.version
     }
 
+    /// Applies the topological changes listed in `touched` (see the module docs, "Incremental
+    /// update"): afterwards the projection is [`Projection::equivalent`] to a fresh
+    /// [`Projection::build`] of `body` and [`Projection::is_current`] holds.
+    /// Cost: O(touched cells) plus one O(slots + springs) CSR pass.
+    pub fn update(&mut self, body: &Body, touched: &TouchedCells) {
+        let map = body.map();
+        let mech = body.attrs();
+        let sys = &mut self.system;
+        let n = map.cell_id_bound(0);
+        if sys.mass.len() < n {
+            sys.mass.resize(n, 0.0);
+            sys.inv_mass.resize(n, 0.0);
+            sys.viscosity.resize(n, 0.0);
+            self.vertex_dart.resize(n, None);
+        }
+        if self.edge_spring.len() < map.cell_id_bound(1) {
+            self.edge_spring.resize(map.cell_id_bound(1), u32::MAX);
+        }
+        for (v, d) in resolve(map, 0, &touched.vertices) {
+            self.vertex_dart[v.index()] = d;
+            let (m, g) = if d.is_some() { (mech.vertex_mass(v), mech.vertex_viscosity(v)) } else { (0.0, 0.0) };
+            let fixed = d.is_none() || mech.pinned[v] || m <= 0.0;
+            sys.mass[v.index()] = m;
+            sys.viscosity[v.index()] = g;
+            sys.inv_mass[v.index()] = if fixed { 0.0 } else { 1.0 / m };
+        }
+        for (e, d) in resolve(map, 1, &touched.edges) {
+            match d {
+                Some(d) => self.set_spring(map, mech, e, d),
+                None => self.remove_spring(e),
+            }
+        }
+        self.refresh_csr();
+        self.version = body.version();
+    }
+
+    /// Writes (or appends) the spring of live edge `e`, a dart of which is `d`.
+    fn set_spring(&mut self, map: &GMap<3>, mech: &Mechanics, e: CellId, d: DartId) {
+        let (a, b) = (map.vertex_id(d).0, map.vertex_id(map.alpha::<0>(d)).0);
+        let ends = [a.min(b), a.max(b)];
+        let existing = self.spring_of_edge(e);
+        let sys = &mut self.system;
+        let s = match existing {
+            Some(s) => s,
+            None => {
+                sys.ends.push(ends);
+                sys.rest.push(0.0);
+                sys.stiffness.push(0.0);
+                sys.damping.push(0.0);
+                self.spring_edge.push(e);
+                self.spring_dart.push(d);
+                self.edge_spring[e.index()] = (sys.ends.len() - 1) as u32;
+                sys.ends.len() - 1
+            }
+        };
+        sys.ends[s] = ends;
+        sys.rest[s] = mech.edge_rest_length(e);
+        sys.stiffness[s] = mech.edge_stiffness(e);
+        sys.damping[s] = mech.edge_damping(e);
+        self.spring_dart[s] = d;
+    }
+
+    /// Swap-removes the spring of the dead edge `e`, if any.
+    fn remove_spring(&mut self, e: CellId) {
+        let Some(s) = self.spring_of_edge(e) else { return };
+        let sys = &mut self.system;
+        sys.ends.swap_remove(s);
+        sys.rest.swap_remove(s);
+        sys.stiffness.swap_remove(s);
+        sys.damping.swap_remove(s);
+        self.spring_dart.swap_remove(s);
+        self.spring_edge.swap_remove(s);
+        self.edge_spring[e.index()] = u32::MAX;
+        if let Some(&moved) = self.spring_edge.get(s) {
+            self.edge_spring[moved.index()] = s as u32;
+        }
+    }
+
+    /// Rebuilds the CSR of incident springs from the current arrays. O(slots + springs).
+    fn refresh_csr(&mut self) {
+        let sys = std::mem::take(&mut self.system);
+        let fixed: Vec<bool> = sys.inv_mass.iter().map(|&w| w == 0.0).collect();
+        self.system = SpringSystem::new(
+            sys.ends,
+            sys.rest,
+            sys.stiffness,
+            sys.damping,
+            sys.mass,
+            &fixed,
+            sys.viscosity,
+            sys.gravity,
+        );
+    }
+
+    /// Whether `self` and `other` project the same body: same slots with the same mass, inverse
+    /// mass, viscosity and liveness, and for every edge id the same spring (ends, rest length,
+    /// stiffness, damping), whatever the spring order. Values are compared bit for bit (both read
+    /// the same stored attributes). O(slots + springs).
+    ///
+    /// # Errors
+    /// The first [`ProjectionMismatch`] found.
+    pub fn equivalent(&self, other: &Projection) -> Result<(), ProjectionMismatch> {
+        let (a, b) = (&self.system, &other.system);
+        if a.slots() != b.slots() || a.springs() != b.springs() || a.gravity != b.gravity {
+            return Err(ProjectionMismatch::Sizes {
+                slots: (a.slots(), b.slots()),
+                springs: (a.springs(), b.springs()),
+            });
+        }
+        for v in 0..a.slots() {
+            let same = a.mass[v] == b.mass[v]
+                && a.inv_mass[v] == b.inv_mass[v]
+                && a.viscosity[v] == b.viscosity[v]
+                && self.vertex_dart[v].is_some() == other.vertex_dart[v].is_some();
+            if !same {
+                return Err(ProjectionMismatch::Vertex { slot: v });
+            }
+        }
+        for (s, &e) in self.spring_edge.iter().enumerate() {
+            let Some(t) = other.spring_of_edge(e) else { return Err(ProjectionMismatch::Spring { edge: e }) };
+            let same = a.ends[s] == b.ends[t]
+                && a.rest[s] == b.rest[t]
+                && a.stiffness[s] == b.stiffness[t]
+                && a.damping[s] == b.damping[t];
+            if !same {
+                return Err(ProjectionMismatch::Spring { edge: e });
+            }
+        }
+        Ok(())
+    }
+
     /// The edge of spring s. O(1).
     pub fn edge_of_spring(&self, s: usize) -> CellId {
         self.spring_edge[s]
@@ -103,6 +247,108 @@ impl Projection {
     pub fn dart_of_vertex(&self, slot: usize) -> Option<DartId> {
         self.vertex_dart.get(slot).copied().flatten()
     }
+}
+
+/// How two projections of the same body differ ([`Projection::equivalent`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ProjectionMismatch {
+    /// Different numbers of slots or springs, or different gravity.
+    #[error("sizes differ: slots {slots:?}, springs {springs:?} (or gravity)")]
+    Sizes {
+        /// (self, other) slot counts.
+        slots: (usize, usize),
+        /// (self, other) spring counts.
+        springs: (usize, usize),
+    },
+    /// Slot `slot` has a different mass, inverse mass, viscosity or liveness.
+    #[error("vertex slot {slot} differs")]
+    Vertex {
+        /// The slot (= vertex id).
+        slot: usize,
+    },
+    /// The spring of edge `edge` is missing on one side or has different values.
+    #[error("spring of edge {edge} differs or is missing")]
+    Spring {
+        /// The edge id.
+        edge: CellId,
+    },
+}
+
+/// The vertex and edge ids a topological operation touched, each with a dart of the cell at the
+/// time it was recorded (`None`: the cell was deleted or absorbed). Records accumulate over a
+/// batch of operations; [`Projection::update`] keeps, per id, the latest record whose dart still
+/// carries that id (no valid dart: the cell is gone).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TouchedCells {
+    /// Vertex ids and a dart of each.
+    pub vertices: Vec<(CellId, Option<DartId>)>,
+    /// Edge ids and a dart of each.
+    pub edges: Vec<(CellId, Option<DartId>)>,
+}
+
+impl TouchedCells {
+    /// Records what `changes` (already applied to `map`) did to vertices and edges: both sides of
+    /// every split, the survivor and the absorbed id of every merge, and every edge around a
+    /// vertex that got a new id (its spring's ends changed). O(changes + stars of renamed
+    /// vertices).
+    pub fn record(&mut self, map: &GMap<3>, changes: &CellChanges) {
+        for (kept, new, dk, dn) in changes.splits(0) {
+            self.vertices.push((kept, Some(dk)));
+            self.vertices.push((new, Some(dn)));
+            self.edges_around(map, dn);
+        }
+        for (kept, new, dk, dn) in changes.splits(1) {
+            self.edges.push((kept, Some(dk)));
+            self.edges.push((new, Some(dn)));
+        }
+        let darts = || changes.pairs.iter().flat_map(|&(a, b)| [a, b]);
+        for (kept, absorbed) in changes.merges(0) {
+            self.vertices.push((absorbed, None));
+            if let Some(d) = darts().find(|&d| map.vertex_id(d) == kept) {
+                self.vertices.push((kept, Some(d)));
+                self.edges_around(map, d);
+            }
+        }
+        for (kept, absorbed) in changes.merges(1) {
+            self.edges.push((absorbed, None));
+            if let Some(d) = darts().find(|&d| map.cell_id(1, d) == kept) {
+                self.edges.push((kept, Some(d)));
+            }
+        }
+    }
+
+    /// Every edge of the star of the vertex of `d`. O(vertex orbit).
+    fn edges_around(&mut self, map: &GMap<3>, d: DartId) {
+        for x in map.cell_darts(0, d) {
+            self.edges.push((map.cell_id(1, x), Some(x)));
+        }
+    }
+
+    /// Appends the records of `other` (a later operation of the same batch). O(|other|).
+    pub fn extend(&mut self, other: TouchedCells) {
+        self.vertices.extend(other.vertices);
+        self.edges.extend(other.edges);
+    }
+
+    /// Whether nothing was recorded. O(1).
+    pub fn is_empty(&self) -> bool {
+        self.vertices.is_empty() && self.edges.is_empty()
+    }
+}
+
+/// Per id, the latest record whose dart still carries the id in dimension `dim`, or `None`.
+fn resolve(map: &GMap<3>, dim: usize, records: &[(CellId, Option<DartId>)]) -> Vec<(CellId, Option<DartId>)> {
+    let mut out: FxHashMap<CellId, Option<DartId>> = FxHashMap::default();
+    for &(id, d) in records.iter().rev() {
+        let valid = d.filter(|&d| map.contains(d) && map.cell_id(dim, d) == id);
+        let slot = out.entry(id).or_insert(None);
+        if slot.is_none() {
+            *slot = valid;
+        }
+    }
+    let mut v: Vec<_> = out.into_iter().collect();
+    v.sort_unstable_by_key(|&(id, _)| id);
+    v
 }
 
 fn system_of(

@@ -1,0 +1,293 @@
+//! `topomech cut MESH --plane PX,PY,PZ,NX,NY,NZ`, `topomech remove MESH --tets ID,…|--sphere
+//! X,Y,Z,R` and `topomech tear MESH --threshold F --steps N`: cut a body (issue 4, seed §3.2,
+//! §4.3, §5.1), write the result as VTU and report before/after characteristics, optionally as
+//! JSON `{"before": {…}, "after": {…}, "cut_faces": N, "timings_us": {…}}`.
+
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use topomech::cut::{self, Plane};
+use topomech::load;
+use topomech::mechanics::{check_conservation, Body, Integrator, Material, Simulation, StepConfig, Vec3};
+use topomech::vtk::{body_tets, Frame};
+use topomech::CellId;
+
+use super::{print_warnings, CliError};
+
+/// Options shared by the three subcommands.
+#[derive(Debug, Clone, clap::Args)]
+pub struct CommonArgs {
+    /// Tetrahedral mesh file (any format `topomech info` reads).
+    pub mesh: PathBuf,
+    /// Mass density ρ.
+    #[arg(long, default_value_t = Material::default().density)]
+    pub density: f64,
+    /// Write the cut body to this VTU file.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Arguments of `topomech cut`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct CutArgs {
+    /// Mesh, density, output.
+    #[command(flatten)]
+    pub common: CommonArgs,
+    /// The plane: a point and a normal, `PX,PY,PZ,NX,NY,NZ`.
+    #[arg(long, value_parser = parse_numbers::<6>, allow_hyphen_values = true)]
+    pub plane: [f64; 6],
+}
+
+/// Arguments of `topomech remove`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct RemoveArgs {
+    /// Mesh, density, output.
+    #[command(flatten)]
+    pub common: CommonArgs,
+    /// Tet ids to remove (0-based positions in the file), comma-separated.
+    #[arg(long, value_delimiter = ',', conflicts_with = "sphere")]
+    pub tets: Vec<u32>,
+    /// Remove the tets whose centroid lies in the ball `X,Y,Z,R`.
+    #[arg(long, value_parser = parse_numbers::<4>, allow_hyphen_values = true)]
+    pub sphere: Option<[f64; 4]>,
+}
+
+/// Arguments of `topomech tear`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct TearArgs {
+    /// Mesh, density, output.
+    #[command(flatten)]
+    pub common: CommonArgs,
+    /// Tear vertices whose largest principal tensile stress exceeds this force.
+    #[arg(long)]
+    pub threshold: f64,
+    /// Time steps (symplectic Euler); tearing is checked after each.
+    #[arg(long, default_value_t = 200)]
+    pub steps: u64,
+    /// Time step (seconds).
+    #[arg(long, default_value_t = 1e-4)]
+    pub dt: f64,
+    /// Fix the vertices whose rest z is at most this value (default: the lowest 10% of the body).
+    #[arg(long, allow_hyphen_values = true)]
+    pub pin_z: Option<f64>,
+    /// Gravity along z (negative pulls down); large values stretch the body.
+    #[arg(long, default_value_t = -200.0, allow_hyphen_values = true)]
+    pub gravity_z: f64,
+    /// Vertices torn per step at most.
+    #[arg(long, default_value_t = 4)]
+    pub per_step: usize,
+}
+
+/// The characteristics of a body in the JSON report (exactly these keys, in this order).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct BodyStats {
+    /// 0-cells.
+    pub vertices: usize,
+    /// 1-cells (springs).
+    pub edges: usize,
+    /// 2-cells.
+    pub faces: usize,
+    /// 3-cells (tets).
+    pub volumes: usize,
+    /// α3-free faces.
+    pub boundary_faces: usize,
+    /// Connected components.
+    pub components: usize,
+    /// Σ_v m_v.
+    pub total_mass: f64,
+    /// Mass removed so far.
+    pub removed_mass: f64,
+    /// Σ_e k_e.
+    pub stiffness_sum: f64,
+    /// Whether `validate()` passed.
+    pub valid: bool,
+    /// Whether `check_conservation()` passed.
+    pub conservation_ok: bool,
+}
+
+/// The JSON report of the three subcommands.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct CutReport {
+    /// Before the operation.
+    pub before: BodyStats,
+    /// After it.
+    pub after: BodyStats,
+    /// Faces dissociated.
+    pub cut_faces: usize,
+    /// Timings in microseconds by phase.
+    pub timings_us: BTreeMap<String, u64>,
+}
+
+/// The statistics of `body`. O(darts).
+pub fn stats(body: &Body, removed_mass: f64) -> BodyStats {
+    let map = body.map();
+    let counts = map.count_cells().0;
+    let mech = body.attrs();
+    BodyStats {
+        vertices: counts[0],
+        edges: counts[1],
+        faces: counts[2],
+        volumes: counts[3],
+        boundary_faces: map.boundary_cell_count(),
+        components: map.components().len(),
+        total_mass: mech.total_vertex_mass(map),
+        removed_mass,
+        stiffness_sum: map.one_dart_per_cell(1).into_iter().map(|d| mech.edge_stiffness(map.cell_id(1, d))).sum(),
+        valid: map.validate().is_ok(),
+        conservation_ok: check_conservation(map, mech).is_ok(),
+    }
+}
+
+/// `topomech cut`.
+///
+/// # Errors
+/// [`CliError`] when the mesh cannot be loaded, the plane is bad, or the output cannot be written.
+pub fn run(args: CutArgs) -> Result<(), CliError> {
+    let (mut body, load_us) = load_body(&args.common)?;
+    let before = stats(&body, 0.0);
+    let [px, py, pz, nx, ny, nz] = args.plane;
+    let t = Instant::now();
+    let inc = cut::incise_plane(&mut body, &Plane { point: [px, py, pz], normal: [nx, ny, nz] }).map_err(other)?;
+    let cut_us = t.elapsed().as_micros() as u64;
+    let timings = BTreeMap::from([("load".to_string(), load_us), ("cut".to_string(), cut_us)]);
+    finish(&args.common, &body, before, 0.0, inc.cut_faces(), timings)
+}
+
+/// `topomech remove`.
+///
+/// # Errors
+/// As [`run`]; also a tet id that does not exist.
+pub fn run_remove(args: RemoveArgs) -> Result<(), CliError> {
+    let (mut body, load_us) = load_body(&args.common)?;
+    let before = stats(&body, 0.0);
+    let mut ids: Vec<u32> = args.tets.clone();
+    if let Some([x, y, z, r]) = args.sphere {
+        ids.extend(tets_in_ball(&body, [x, y, z], r));
+    }
+    let t = Instant::now();
+    let (mut removed, mut faces) = (0.0, 0);
+    for id in ids {
+        let r = cut::remove_volume(&mut body, CellId(id)).map_err(other)?;
+        removed += r.removed_mass;
+        faces += r.dissociations.len();
+    }
+    let cut_us = t.elapsed().as_micros() as u64;
+    let timings = BTreeMap::from([("load".to_string(), load_us), ("remove".to_string(), cut_us)]);
+    finish(&args.common, &body, before, removed, faces, timings)
+}
+
+/// `topomech tear`.
+///
+/// # Errors
+/// As [`run`]; also a bad time step or a blow-up.
+pub fn run_tear(args: TearArgs) -> Result<(), CliError> {
+    let (mut body, load_us) = load_body(&args.common)?;
+    let before = stats(&body, 0.0);
+    let rest = body.attrs().rest_position.as_slice().to_vec();
+    let (lo, hi) = rest.iter().fold((f64::MAX, f64::MIN), |(lo, hi), p| (lo.min(p[2]), hi.max(p[2])));
+    let pin_z = args.pin_z.unwrap_or(lo + 0.1 * (hi - lo));
+    body.attrs_mut().pin_where(|_, p| p[2] <= pin_z);
+    let config = StepConfig::new(Integrator::Symplectic, args.dt);
+    let mut sim = Simulation::new(&mut body, [0.0, 0.0, args.gravity_z], config).map_err(other)?;
+    let (mut faces, mut step_us, mut tear_us) = (0, 0u64, 0u64);
+    for _ in 0..args.steps {
+        let t = Instant::now();
+        sim.step(&mut body).map_err(other)?;
+        step_us += t.elapsed().as_micros() as u64;
+        let t = Instant::now();
+        let torn = cut::tear_step(&mut body, &mut sim, args.threshold, args.per_step).map_err(other)?;
+        tear_us += t.elapsed().as_micros() as u64;
+        faces += torn.tears.iter().map(|t| t.dissociations.len()).sum::<usize>();
+    }
+    let timings =
+        BTreeMap::from([("load".to_string(), load_us), ("steps".to_string(), step_us), ("tear".to_string(), tear_us)]);
+    finish(&args.common, &body, before, 0.0, faces, timings)
+}
+
+fn load_body(common: &CommonArgs) -> Result<(Body, u64), CliError> {
+    let t = Instant::now();
+    let loaded = load::load_tet_map(&common.mesh)?;
+    print_warnings(&loaded);
+    let material = Material { density: common.density, ..Material::default() };
+    let (body, _) = Body::from_tets(&loaded.mesh.points, &loaded.mesh.tets, material).map_err(other)?;
+    Ok((body, t.elapsed().as_micros() as u64))
+}
+
+/// Tet (volume) ids whose centroid at rest is within distance r of c.
+fn tets_in_ball(body: &Body, c: Vec3, r: f64) -> Vec<u32> {
+    let map = body.map();
+    let rest = &body.attrs().rest_position;
+    let mut out = Vec::new();
+    for d in map.one_dart_per_cell(3) {
+        let mut ids: Vec<CellId> = map.cell_darts(3, d).into_iter().map(|x| map.vertex_id(x)).collect();
+        ids.sort_unstable();
+        ids.dedup();
+        let n = ids.len() as f64;
+        let g: Vec<f64> = (0..3).map(|k| ids.iter().map(|v| rest[*v][k]).sum::<f64>() / n).collect();
+        if (0..3).map(|k| (g[k] - c[k]).powi(2)).sum::<f64>() <= r * r {
+            out.push(map.cell_id(3, d).0);
+        }
+    }
+    out.sort_unstable();
+    out
+}
+
+fn finish(
+    common: &CommonArgs,
+    body: &Body,
+    before: BodyStats,
+    removed: f64,
+    cut_faces: usize,
+    mut timings_us: BTreeMap<String, u64>,
+) -> Result<(), CliError> {
+    if let Some(path) = &common.out {
+        let t = Instant::now();
+        write_vtu(body, path)?;
+        timings_us.insert("write".to_string(), t.elapsed().as_micros() as u64);
+    }
+    let report = CutReport { before, after: stats(body, removed), cut_faces, timings_us };
+    let mut out = std::io::stdout().lock();
+    if common.json {
+        writeln!(out, "{}", serde_json::to_string_pretty(&report)?)?;
+    } else {
+        let (b, a) = (&report.before, &report.after);
+        writeln!(out, "cut faces      {}", report.cut_faces)?;
+        writeln!(
+            out,
+            "cells V/E/F/T  {}/{}/{}/{} -> {}/{}/{}/{}",
+            b.vertices, b.edges, b.faces, b.volumes, a.vertices, a.edges, a.faces, a.volumes
+        )?;
+        writeln!(out, "boundary faces {} -> {}", b.boundary_faces, a.boundary_faces)?;
+        writeln!(out, "components     {} -> {}", b.components, a.components)?;
+        writeln!(out, "total mass     {} -> {} (removed {})", b.total_mass, a.total_mass, a.removed_mass)?;
+        writeln!(out, "valid {}  conservation {}", a.valid, a.conservation_ok)?;
+    }
+    Ok(())
+}
+
+fn write_vtu(body: &Body, path: &Path) -> Result<(), CliError> {
+    let tets = body_tets(body);
+    let frame = Frame {
+        points: body.attrs().position.as_slice(),
+        tets: &tets,
+        vectors: vec![("velocity", body.attrs().velocity.as_slice())],
+    };
+    frame.write(path).map_err(other)
+}
+
+fn parse_numbers<const K: usize>(s: &str) -> Result<[f64; K], String> {
+    let parts: Vec<f64> = s
+        .split(',')
+        .map(|t| t.trim().parse::<f64>().map_err(|e| format!("bad number {t:?}: {e}")))
+        .collect::<Result<_, _>>()?;
+    <[f64; K]>::try_from(parts.as_slice()).map_err(|_| format!("expected {K} comma-separated numbers, got {s:?}"))
+}
+
+fn other(e: impl std::error::Error + Send + Sync + 'static) -> CliError {
+    CliError::Other(Box::new(e))
+}

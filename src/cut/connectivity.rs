@@ -1,0 +1,41 @@
+//! Connectivity after cutting (seed, conclusion): the connected components of the map, each a
+//! body part that can be simulated on its own, with its mass.
+
+use crate::mechanics::Body;
+use crate::DartId;
+
+/// One connected component (orbit of all involutions).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Component {
+    /// Its smallest dart.
+    pub dart: DartId,
+    /// Number of volumes (tets) in it.
+    pub volumes: usize,
+    /// Number of vertices in it.
+    pub vertices: usize,
+    /// Σ m_v over its vertices (= Σ m_t over its tets, by the conservation laws).
+    pub mass: f64,
+}
+
+/// The components of `body`, ordered by smallest dart. O(darts).
+pub fn components(body: &Body) -> Vec<Component> {
+    let (map, mech) = (body.map(), body.attrs());
+    let (label, count) = map.component_labels();
+    let mut out: Vec<Component> =
+        (0..count).map(|_| Component { dart: DartId(u32::MAX), volumes: 0, vertices: 0, mass: 0.0 }).collect();
+    for d in map.darts() {
+        let c = &mut out[label[d.index()] as usize];
+        if c.dart.0 == u32::MAX {
+            c.dart = d;
+        }
+    }
+    for d in map.one_dart_per_cell(0) {
+        let c = &mut out[label[d.index()] as usize];
+        c.vertices += 1;
+        c.mass += mech.vertex_mass(map.vertex_id(d));
+    }
+    for d in map.one_dart_per_cell(3) {
+        out[label[d.index()] as usize].volumes += 1;
+    }
+    out
+}

@@ -1,0 +1,99 @@
+//! Face dissociation (volume separation, seed §3.2 and Appendix A).
+
+use crate::gmap::CellChanges;
+use crate::mechanics::{Body, TouchedCells};
+use crate::{CellId, DartId};
+
+use super::CutError;
+
+/// One cell that a dissociation split in two: `kept` stays with the side of `dart_kept`, the
+/// darts on the side of `dart_new` now carry the fresh id `new`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SplitCell {
+    /// Id of the side that kept it.
+    pub kept: CellId,
+    /// Fresh id of the other side.
+    pub new: CellId,
+    /// A dart of the kept side.
+    pub dart_kept: DartId,
+    /// A dart of the new side.
+    pub dart_new: DartId,
+}
+
+/// What one face dissociation did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Dissociation {
+    /// The dart the face was named by.
+    pub dart: DartId,
+    /// Its former α3 image (now on the other, separate face).
+    pub opposite: DartId,
+    /// The face ids after the operation: (side of `dart`, side of `opposite`).
+    pub faces: (CellId, CellId),
+    /// Vertices of the face that dissociated (their two sides no longer share a vertex orbit).
+    pub vertices: Vec<SplitCell>,
+    /// Edges of the face that dissociated.
+    pub edges: Vec<SplitCell>,
+    /// Vertex and edge ids whose projected values changed (for `Projection::update`).
+    pub touched: TouchedCells,
+}
+
+/// Dissociates the face of `d` from the face it is α3-sewn to: α3-unsews the six (for a
+/// triangle) darts of the face with the six of the other side ([`Body::unsew3`]); every vertex and
+/// edge of the face whose two sides no longer share an orbit is dissociated, the new side gets a
+/// fresh id with a copy of position and velocity, and both sides get masses and stiffnesses
+/// recomputed from the tets now around them (m = m1 + m2, k = k1 + k2).
+///
+/// Cost: O(face + split cells' orbits) — the kernel's unsew walks both sides of each cell it might
+/// split in lockstep, and the rules recompute each split cell from its orbit.
+///
+/// # Errors
+/// [`CutError::NoSuchDart`], [`CutError::BoundaryFace`] (body unchanged); [`CutError::Body`] if the
+/// embedding layer's check fails (a bug, `expensive-checks` only).
+pub fn dissociate_face(body: &mut Body, d: DartId) -> Result<Dissociation, CutError> {
+    let map = body.map();
+    if !map.contains(d) {
+        return Err(CutError::NoSuchDart(d));
+    }
+    if map.is_free(3, d) {
+        return Err(CutError::BoundaryFace { face: map.cell_id(2, d), dart: d });
+    }
+    let opposite = map.alpha::<3>(d);
+    let changes = body.unsew3(d)?;
+    Ok(report(body, d, opposite, &changes))
+}
+
+/// [`dissociate_face`] of the face with id `f`. O(darts) to find a dart of it ([`face_dart`]),
+/// then as [`dissociate_face`].
+///
+/// # Errors
+/// [`CutError::NoSuchFace`], then as [`dissociate_face`].
+pub fn dissociate_face_id(body: &mut Body, f: CellId) -> Result<Dissociation, CutError> {
+    let d = face_dart(body, f).ok_or(CutError::NoSuchFace(f))?;
+    dissociate_face(body, d)
+}
+
+/// A dart of face `f`, or `None` if no live dart carries that id. O(darts).
+pub fn face_dart(body: &Body, f: CellId) -> Option<DartId> {
+    let map = body.map();
+    map.darts().find(|&d| map.cell_id(2, d) == f)
+}
+
+fn report(body: &Body, d: DartId, opposite: DartId, changes: &CellChanges) -> Dissociation {
+    let map = body.map();
+    let split = |dim| {
+        changes
+            .splits(dim)
+            .map(|(kept, new, dart_kept, dart_new)| SplitCell { kept, new, dart_kept, dart_new })
+            .collect::<Vec<_>>()
+    };
+    let mut touched = TouchedCells::default();
+    touched.record(map, changes);
+    Dissociation {
+        dart: d,
+        opposite,
+        faces: (map.cell_id(2, d), map.cell_id(2, opposite)),
+        vertices: split(0),
+        edges: split(1),
+        touched,
+    }
+}

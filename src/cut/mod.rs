@@ -1,0 +1,92 @@
+//! Cutting a mechanical body (seed 000 §3.2, §4.3, §5.1, Appendix A): face dissociation, volume
+//! removal, incision along a plane, tearing, and connectivity — each keeping the map valid and
+//! the conservation laws of [`crate::mechanics::model`] exact.
+//!
+//! ```text
+//!   dissociate_face   α3-unsew of one face; vertices/edges whose two sides no longer share an
+//!                     orbit are dissociated: masses split m = m1 + m2, stiffnesses k = k1 + k2
+//!   remove_volume     dissociate the tet's inner faces, then delete its 24 darts; report the
+//!                     mass and stiffness that left with it
+//!   incise_plane      dissociate every inner face whose two tets' centroids lie on opposite sides
+//!   tear_vertex       the closed fan of faces around a vertex (walk α2 α3 α2 α1), dissociated
+//!   components        connected parts and their masses
+//! ```
+//!
+//! Every operation returns what it changed, including the [`TouchedCells`] that
+//! [`Projection::update`](crate::mechanics::Projection::update) needs to follow incrementally.
+//! A bad id or an operation that does not apply returns a [`CutError`] and changes nothing.
+
+mod connectivity;
+mod dissociate;
+mod incise;
+mod remove;
+mod tear;
+
+pub use connectivity::{components, Component};
+pub use dissociate::{dissociate_face, dissociate_face_id, face_dart, Dissociation, SplitCell};
+pub use incise::{incise_plane, tet_sides, Incision, Plane};
+pub use remove::{remove_volume, volume_dart, Removal};
+pub use tear::{fan_darts, principal_stress, tear_step, tear_vertex, Stress, Tear, TearStep};
+
+use crate::gmap::{DartError, SewError};
+use crate::mechanics::{BodyError, SimError};
+use crate::{CellId, DartId};
+
+pub use crate::mechanics::TouchedCells;
+
+/// Why a cutting operation was refused or failed. When it is refused (every variant but
+/// [`CutError::Body`], [`CutError::Kernel`], [`CutError::Dart`] and [`CutError::Sim`]) the body is
+/// unchanged.
+#[derive(Debug, thiserror::Error)]
+pub enum CutError {
+    /// A dart id that is not live in the body's map.
+    #[error("{0} does not exist in this body")]
+    NoSuchDart(DartId),
+    /// A face id that no live dart carries.
+    #[error("face {0} does not exist in this body")]
+    NoSuchFace(CellId),
+    /// The face is α3-free: it is on the boundary already, there is nothing to dissociate.
+    #[error("face {face} (dart {dart}) is a boundary face: nothing to dissociate")]
+    BoundaryFace {
+        /// The face id.
+        face: CellId,
+        /// The dart given or found.
+        dart: DartId,
+    },
+    /// A volume id that no live dart carries (never created, or already removed).
+    #[error("volume {0} does not exist (never created or already removed)")]
+    NoSuchVolume(CellId),
+    /// The volume is not a tetrahedron (24 darts).
+    #[error("volume {volume} (dart {dart}) has {darts} darts, not the 24 of a tetrahedron")]
+    NotATet {
+        /// The volume id.
+        volume: CellId,
+        /// A dart of it.
+        dart: DartId,
+        /// Its dart count.
+        darts: usize,
+    },
+    /// A vertex id that no live dart carries.
+    #[error("vertex {0} does not exist in this body")]
+    NoSuchVertex(CellId),
+    /// The plane's point or normal is not finite, or the normal is zero.
+    #[error("cut plane point {point:?} / normal {normal:?} is not finite or the normal is zero")]
+    BadPlane {
+        /// Point on the plane.
+        point: [f64; 3],
+        /// Normal.
+        normal: [f64; 3],
+    },
+    /// The embedding layer refused or its check failed (a bug if the check failed).
+    #[error(transparent)]
+    Body(#[from] BodyError),
+    /// A kernel unsew inside an isolated tet failed (a bug).
+    #[error("unsewing inside an isolated volume: {0}")]
+    Kernel(#[from] SewError),
+    /// A kernel dart deletion failed (a bug).
+    #[error("deleting the darts of an isolated volume: {0}")]
+    Dart(#[from] DartError),
+    /// The simulation could not follow the change.
+    #[error(transparent)]
+    Sim(#[from] SimError),
+}

@@ -1,0 +1,112 @@
+//! Volume removal (seed §3.2): isolate the tet by dissociating its faces, then delete its darts.
+
+use crate::embedding::CellRules;
+use crate::mechanics::model::stiffness_contribution;
+use crate::mechanics::{Body, TouchedCells};
+use crate::{CellId, DartId, GMap};
+
+use super::{dissociate_face, CutError, Dissociation};
+
+/// What one volume removal did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Removal {
+    /// The removed volume id (now free).
+    pub volume: CellId,
+    /// Its mass m_t: the body's total mass dropped by exactly this.
+    pub removed_mass: f64,
+    /// Σ over its six edges of its stiffness contribution E_t·V_t/L_e²: the body's total spring
+    /// stiffness dropped by this.
+    pub removed_stiffness: f64,
+    /// The dissociations of its inner faces (its neighbours' faces became boundary faces).
+    pub dissociations: Vec<Dissociation>,
+    /// Vertex and edge ids whose projected values changed or that disappeared.
+    pub touched: TouchedCells,
+}
+
+/// A dart of volume `t`, or `None` if no live dart carries that id. Tries dart 24·t first (the
+/// builder's numbering), then scans. O(1) when the numbering still holds, else O(darts).
+pub fn volume_dart(body: &Body, t: CellId) -> Option<DartId> {
+    let map = body.map();
+    let guess = DartId(t.0.wrapping_mul(24));
+    if map.contains(guess) && map.cell_id(3, guess) == t {
+        return Some(guess);
+    }
+    map.darts().find(|&d| map.cell_id(3, d) == t)
+}
+
+/// Removes the tetrahedron `t`: dissociates each of its faces that is α3-sewn (mass and stiffness
+/// of its vertices and edges are shared out by the split rules, seed §3.2), so the tet becomes a
+/// component of its own whose vertices carry exactly m_t/4 each and whose edges carry exactly its
+/// stiffness contributions; then unlinks its 24 darts inside the kernel and deletes them. What
+/// remains sums to the old totals minus [`Removal::removed_mass`] and
+/// [`Removal::removed_stiffness`].
+///
+/// Cost: O(darts) to find the tet when the builder's numbering no longer holds (O(1) otherwise),
+/// plus four dissociations and O(24²) for the inner unlinking.
+///
+/// # Errors
+/// [`CutError::NoSuchVolume`] (never existed or already removed), [`CutError::NotATet`] — body
+/// unchanged; [`CutError::Body`], [`CutError::Kernel`], [`CutError::Dart`] are bugs.
+pub fn remove_volume(body: &mut Body, t: CellId) -> Result<Removal, CutError> {
+    let d = volume_dart(body, t).ok_or(CutError::NoSuchVolume(t))?;
+    let darts = body.map().cell_darts(3, d);
+    if darts.len() != 24 {
+        return Err(CutError::NotATet { volume: t, dart: d, darts: darts.len() });
+    }
+    let (removed_mass, removed_stiffness) = mass_and_stiffness(body, t, &darts);
+    let mut touched = TouchedCells::default();
+    let mut dissociations = Vec::new();
+    for x in one_dart_per_face(body.map(), &darts) {
+        if !body.map().is_free(3, x) {
+            let dis = dissociate_face(body, x)?;
+            touched.extend(dis.touched.clone());
+            dissociations.push(dis);
+        }
+    }
+    let map = body.map();
+    for &x in &darts {
+        touched.vertices.push((map.vertex_id(x), None));
+        touched.edges.push((map.cell_id(1, x), None));
+    }
+    delete_isolated(body, &darts)?;
+    Ok(Removal { volume: t, removed_mass, removed_stiffness, dissociations, touched })
+}
+
+/// m_t and Σ_e E_t·V_t/L_e² of the tet `t` made of `darts`.
+fn mass_and_stiffness(body: &Body, t: CellId, darts: &[DartId]) -> (f64, f64) {
+    let (map, mech) = (body.map(), body.attrs());
+    let mut edges: Vec<CellId> = darts.iter().map(|&x| map.cell_id(1, x)).collect();
+    edges.sort_unstable();
+    edges.dedup();
+    let (young, volume) = (mech.tet_young(t), mech.tet_rest_volume(t));
+    let stiffness = edges.iter().map(|&e| stiffness_contribution(young, volume, mech.edge_rest_length(e))).sum();
+    (mech.tet_mass(t), stiffness)
+}
+
+/// One dart of each distinct face among `darts`.
+fn one_dart_per_face(map: &GMap<3>, darts: &[DartId]) -> Vec<DartId> {
+    let mut faces: Vec<(CellId, DartId)> = darts.iter().map(|&x| (map.cell_id(2, x), x)).collect();
+    faces.sort_unstable_by_key(|&(f, _)| f);
+    faces.dedup_by_key(|&mut (f, _)| f);
+    faces.into_iter().map(|(_, x)| x).collect()
+}
+
+/// Unlinks every α0/α1/α2 link among the darts of an isolated volume with the kernel's unsew
+/// (each step keeps the map valid), deletes the darts and grows the attribute arrays to the ids
+/// the kernel may have handed out meanwhile. The attributes of the deleted cells stay as dead
+/// slots, which nothing reads.
+fn delete_isolated(body: &mut Body, darts: &[DartId]) -> Result<(), CutError> {
+    let (map, mech) = body.parts_mut_bypassing_rules();
+    for &x in darts {
+        for i in 0..3 {
+            if !map.is_free(i, x) {
+                map.unsew_dyn(i, x)?;
+            }
+        }
+    }
+    for &x in darts {
+        map.delete_dart(x)?;
+    }
+    mech.grow_to(map);
+    Ok(())
+}

@@ -1,0 +1,241 @@
+//! Tearing (seed §5.1, Fig. 10): split a vertex whose inner stress is too high by dissociating the
+//! closed fan of faces around it, starting from the face whose normal best matches the stress.
+//!
+//! The fan walk from a dart d0 of the start face at vertex v: d_{k+1} = α1 α2 α3 α2 (d_k) (apply
+//! α2, then α3, α2, α1). α2 turns to the other face of the tet on the current edge, α3 crosses into
+//! the neighbouring tet, α2 turns to the other face of that tet on the same edge, α1 moves to the
+//! other edge of that face at v. No α0 is used, so every dart stays on v. The walk stops when it
+//! comes back to d0, or before an α3 that is free (the surface); in that case it starts again from
+//! α1(d0) to collect the other half of the fan.
+
+use crate::mechanics::{Body, Simulation, TouchedCells, Vec3};
+use crate::{AlphaMask, CellId, DartId, GMap};
+
+use super::{dissociate_face, CutError, Dissociation};
+
+/// The tensile stress at a vertex: the largest principal value of σ_v = Σ_s T_s n_s n_sᵀ over the
+/// springs at v, with T_s = max(0, k_s (l_s − L_s)) the spring's tension and n_s its unit
+/// direction, and the principal direction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stress {
+    /// The largest eigenvalue of σ_v (a force: the "inner force" compared with the threshold).
+    pub magnitude: f64,
+    /// Its unit eigenvector (zero when the magnitude is zero).
+    pub direction: Vec3,
+}
+
+/// What tearing one vertex did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Tear {
+    /// The vertex torn.
+    pub vertex: CellId,
+    /// One dart per fan face, in walk order (first half, then the second half).
+    pub fan: Vec<DartId>,
+    /// Dissociations of the fan's inner faces.
+    pub dissociations: Vec<Dissociation>,
+    /// Whether the vertex was split (some dissociation split `vertex`).
+    pub split: bool,
+    /// Everything the projection must re-read.
+    pub touched: TouchedCells,
+}
+
+/// What [`tear_step`] did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TearStep {
+    /// One entry per torn vertex.
+    pub tears: Vec<Tear>,
+}
+
+/// σ_v's principal pair for every vertex slot of `sim`'s projection, from `body`'s current
+/// positions. O(springs + slots).
+pub fn principal_stress(body: &Body, sim: &Simulation) -> Vec<Stress> {
+    let sys = &sim.projection.system;
+    let x = body.attrs().position.as_slice();
+    let mut sigma = vec![[[0.0f64; 3]; 3]; sys.slots()];
+    for s in 0..sys.springs() {
+        let [a, b] = sys.ends[s];
+        let d = sub(x[b as usize], x[a as usize]);
+        let l = dot(d, d).sqrt();
+        let tension = sys.stiffness[s] * (l - sys.rest[s]);
+        if l == 0.0 || tension <= 0.0 {
+            continue;
+        }
+        for v in [a, b] {
+            for (i, row) in sigma[v as usize].iter_mut().enumerate() {
+                for (j, e) in row.iter_mut().enumerate() {
+                    *e += tension * d[i] * d[j] / (l * l);
+                }
+            }
+        }
+    }
+    sigma.iter().map(largest_eigenpair).collect()
+}
+
+/// Largest eigenpair of a symmetric positive semi-definite 3×3 matrix by power iteration started
+/// from its largest column (64 iterations at most). O(1).
+fn largest_eigenpair(m: &[[f64; 3]; 3]) -> Stress {
+    let mut v =
+        (0..3).map(|j| [m[0][j], m[1][j], m[2][j]]).fold([0.0; 3], |a, c| if dot(c, c) > dot(a, a) { c } else { a });
+    if dot(v, v) == 0.0 {
+        return Stress { magnitude: 0.0, direction: [0.0; 3] };
+    }
+    let mut lambda = 0.0;
+    for _ in 0..64 {
+        let w = mul(m, v);
+        let n = dot(w, w).sqrt();
+        if n == 0.0 {
+            break;
+        }
+        v = [w[0] / n, w[1] / n, w[2] / n];
+        let next = dot(v, mul(m, v));
+        let done = (next - lambda).abs() <= 1e-14 * next.abs();
+        lambda = next;
+        if done {
+            break;
+        }
+    }
+    Stress { magnitude: lambda, direction: v }
+}
+
+/// One dart per face of the fan around the vertex of `d0`, starting with `d0`'s face, in walk
+/// order (module docs). Faces met twice are listed once. Every walk is bounded by the dart count.
+/// O(fan).
+pub fn fan_darts(map: &GMap<3>, d0: DartId) -> Vec<DartId> {
+    let mut faces: Vec<CellId> = Vec::new();
+    let mut out = Vec::new();
+    let mut push = |d: DartId, out: &mut Vec<DartId>| {
+        let f = map.cell_id(2, d);
+        if !faces.contains(&f) {
+            faces.push(f);
+            out.push(d);
+        }
+    };
+    let closed = walk(map, d0, |d| push(d, &mut out));
+    if !closed {
+        let mut second = Vec::new();
+        walk(map, map.alpha::<1>(d0), |d| second.push(d));
+        for d in second {
+            push(d, &mut out);
+        }
+    }
+    out
+}
+
+/// Walks α2 α3 α2 α1 from `start`, visiting each dart; true if it came back to `start`.
+fn walk(map: &GMap<3>, start: DartId, mut visit: impl FnMut(DartId)) -> bool {
+    let mut d = start;
+    for _ in 0..=map.dart_count() {
+        visit(d);
+        let x = map.alpha::<2>(d);
+        if map.is_free(3, x) {
+            return false;
+        }
+        d = map.alpha::<1>(map.alpha::<2>(map.alpha::<3>(x)));
+        if d == start {
+            return true;
+        }
+    }
+    false
+}
+
+/// Unit normal of the face of `d` from current positions (zero if degenerate). O(face).
+fn face_normal(body: &Body, d: DartId) -> Vec3 {
+    let (map, mech) = (body.map(), body.attrs());
+    let mut ids: Vec<CellId> = map.orbit(d, AlphaMask::of(&[0, 1])).into_iter().map(|x| map.vertex_id(x)).collect();
+    ids.sort_unstable();
+    ids.dedup();
+    let [a, b, c] = ids.as_slice() else { return [0.0; 3] };
+    let p = |v: &CellId| mech.position[*v];
+    let n = cross(sub(p(b), p(a)), sub(p(c), p(a)));
+    let len = dot(n, n).sqrt();
+    if len == 0.0 {
+        return [0.0; 3];
+    }
+    [n[0] / len, n[1] / len, n[2] / len]
+}
+
+/// Tears vertex `v` along `direction`: among the inner faces around v, the one whose normal is
+/// closest to ±`direction` starts the fan ([`fan_darts`]); every inner face of the fan is then
+/// dissociated. `v` is a vertex id; `hint`, when given and still on v, saves the O(darts) search.
+///
+/// Cost: O(star of v) to choose the face and walk the fan, plus one dissociation per fan face.
+///
+/// # Errors
+/// [`CutError::NoSuchVertex`] (no live dart carries `v`; body unchanged); [`CutError::Body`] is a
+/// bug. A vertex with no inner face is left as is (an empty fan).
+pub fn tear_vertex(body: &mut Body, v: CellId, direction: Vec3, hint: Option<DartId>) -> Result<Tear, CutError> {
+    let map = body.map();
+    let on_v = |d: DartId| map.contains(d) && map.vertex_id(d) == v;
+    let start = hint.filter(|&d| on_v(d)).or_else(|| map.darts().find(|&d| on_v(d)));
+    let start = start.ok_or(CutError::NoSuchVertex(v))?;
+    let inner: Vec<DartId> = map.cell_darts(0, start).into_iter().filter(|&d| !map.is_free(3, d)).collect();
+    let best = inner.iter().copied().max_by(|&a, &b| {
+        let score = |d| dot(face_normal(body, d), direction).abs();
+        score(a).total_cmp(&score(b)).then(b.cmp(&a))
+    });
+    let mut tear =
+        Tear { vertex: v, fan: Vec::new(), dissociations: Vec::new(), split: false, touched: TouchedCells::default() };
+    let Some(d0) = best else { return Ok(tear) };
+    tear.fan = fan_darts(body.map(), d0);
+    for &d in &tear.fan {
+        if body.map().is_free(3, d) {
+            continue;
+        }
+        let dis = dissociate_face(body, d)?;
+        tear.split |= dis.vertices.iter().any(|s| s.kept == v);
+        tear.touched.extend(dis.touched.clone());
+        tear.dissociations.push(dis);
+    }
+    Ok(tear)
+}
+
+/// One tearing pass inside a simulation loop: computes [`principal_stress`], tears the vertices
+/// whose stress exceeds `threshold`, strongest first (at most `max_vertices`; a vertex already
+/// split this pass is skipped), then lets `sim` follow the changes ([`Simulation::update`]).
+///
+/// Cost: O(springs + slots) for the stresses, plus the tears and the update.
+///
+/// # Errors
+/// [`CutError::Body`] or [`CutError::Sim`] (bugs or a bad time step).
+pub fn tear_step(
+    body: &mut Body,
+    sim: &mut Simulation,
+    threshold: f64,
+    max_vertices: usize,
+) -> Result<TearStep, CutError> {
+    let stress = principal_stress(body, sim);
+    let mut order: Vec<usize> = (0..stress.len()).filter(|&v| stress[v].magnitude > threshold).collect();
+    order.sort_by(|&a, &b| stress[b].magnitude.total_cmp(&stress[a].magnitude).then(a.cmp(&b)));
+    let mut out = TearStep::default();
+    let mut touched = TouchedCells::default();
+    for v in order.into_iter().take(max_vertices) {
+        let id = CellId(v as u32);
+        let Some(hint) = sim.projection.dart_of_vertex(v) else { continue };
+        if touched.vertices.iter().any(|&(t, _)| t == id) {
+            continue;
+        }
+        let tear = tear_vertex(body, id, stress[v].direction, Some(hint))?;
+        touched.extend(tear.touched.clone());
+        out.tears.push(tear);
+    }
+    if !touched.is_empty() {
+        sim.update(body, &touched)?;
+    }
+    Ok(out)
+}
+
+fn sub(a: Vec3, b: Vec3) -> Vec3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn dot(a: Vec3, b: Vec3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn cross(a: Vec3, b: Vec3) -> Vec3 {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+fn mul(m: &[[f64; 3]; 3], v: Vec3) -> Vec3 {
+    [dot(m[0], v), dot(m[1], v), dot(m[2], v)]
+}

@@ -12,7 +12,9 @@
 //! several vertices or edges there: the first keeps the point's index, the others get fresh ids,
 //! and [`BuildReport`] lists them. Unreferenced points leave free vertex ids.
 //!
-//! Cost: O(tets) expected (one hash-map look-up per face, one flood fill per cell dimension).
+//! Cost: O(tets + points) for tetrahedra (faces matched by a counting sort on their smallest
+//! point; edges and vertices labelled by floods over the 6 edges and 4 corners of each tet rather
+//! than over its 24 darts); O(triangles) expected for triangles (one hash-map look-up per edge).
 
 use rustc_hash::FxHashMap;
 
@@ -156,18 +158,28 @@ impl GMap<3> {
         check_elements(points, tets)?;
         let darts = tets.len().checked_mul(24).filter(|&n| n < u32::MAX as usize - 1);
         let darts = darts.ok_or(BuildError::TooLarge(tets.len().saturating_mul(24)))?;
+        let partner = match_tet_faces(points, tets)?;
         let mut map = GMap::<3>::new();
         map.alloc_darts_raw(darts);
         for t in 0..tets.len() {
             map.link_tet_template(t);
         }
-        let faces = map.link_tet_faces(tets)?;
+        let faces = map.link_tet_faces(tets, &partner);
         map.set_id_alloc_raw(2, faces, Vec::new());
         map.set_id_alloc_raw(3, tets.len() as u32, Vec::new());
-        map.label_by_flood(1);
-        let corner = |d: DartId| tets[d.index() / 24][TET.vertex[d.index() % 24] as usize];
-        let mut report = map.label_vertices(points, corner);
-        report.split_edges = map.split_edges(corner);
+        let (edge_of, edges) = label_tet_edges(tets, &partner);
+        let (corner_of, vertex_ids, orbits_of) = label_tet_corners(points, tets, &partner);
+        for t in 0..tets.len() {
+            for (k, (&v, &e)) in TET.vertex.iter().zip(&TET_DART_EDGE).enumerate() {
+                let d = DartId((t * 24 + k) as u32);
+                map.set_cell_raw(0, d, corner_of[t * 4 + v as usize]);
+                map.set_cell_raw(1, d, edge_of[t * 6 + e as usize]);
+            }
+        }
+        map.set_id_alloc_raw(1, edges, Vec::new());
+        let mut report = vertex_report(&orbits_of);
+        map.set_id_alloc_raw(0, vertex_ids, report.unreferenced_points.clone());
+        report.split_edges = split_edges(edge_points(tets, &edge_of, edges));
         map.after_build();
         Ok((map, report))
     }
@@ -186,35 +198,20 @@ impl GMap<3> {
         }
     }
 
-    /// 3-links tets sharing a face and labels faces; returns the number of faces.
-    fn link_tet_faces(&mut self, tets: &[[u32; 4]]) -> Result<u32, BuildError> {
-        let mut first_seen: FxHashMap<[u32; 3], (u32, u32)> = FxHashMap::default();
-        first_seen.reserve(tets.len() * 2 + 4);
+    /// 3-links the tet faces paired in `partner` and labels faces in order of first appearance;
+    /// returns the number of faces. O(tets).
+    fn link_tet_faces(&mut self, tets: &[[u32; 4]], partner: &[u32]) -> u32 {
         let mut faces = 0u32;
-        for (t, tet) in tets.iter().enumerate() {
-            for f in 0..4 {
-                let c = face_corners(f).map(|k| tet[k]);
-                let key = sorted(c);
-                let tf = (t * 4 + f) as u32;
-                match first_seen.get_mut(&key) {
-                    None => {
-                        first_seen.insert(key, (tf, u32::MAX));
-                        self.label_face(tf, faces);
-                        faces += 1;
-                    }
-                    Some(slot) if slot.1 == u32::MAX => {
-                        slot.1 = tf;
-                        let other = slot.0;
-                        self.sew_tet_faces(tets, other, tf);
-                    }
-                    Some(slot) => {
-                        let elements = [slot.0 as usize / 4, slot.1 as usize / 4, t];
-                        return Err(BuildError::NonManifold { what: "face", points: key.to_vec(), elements });
-                    }
-                }
+        for (tf, &other) in partner.iter().enumerate() {
+            let tf = tf as u32;
+            if other == NO_FACE || other > tf {
+                self.label_face(tf, faces);
+                faces += 1;
+            } else {
+                self.sew_tet_faces(tets, other, tf);
             }
         }
-        Ok(faces)
+        faces
     }
 
     fn label_face(&mut self, tf: u32, id: u32) {
@@ -226,18 +223,242 @@ impl GMap<3> {
     /// α3-links face `a` (= 4·tet + local face) with face `b` dart by dart, matching each dart's
     /// (point, other point of its edge), and gives b the face id of a.
     fn sew_tet_faces(&mut self, tets: &[[u32; 4]], a: u32, b: u32) {
-        let flag = |tf: u32, k: u32| {
-            let local = (tf % 4 * 6 + k) as usize;
-            let tet = &tets[tf as usize / 4];
-            (tet[TET.vertex[local] as usize], tet[TET.other[local] as usize])
-        };
+        let face_points = |tf: u32| face_corners(tf as usize % 4).map(|k| tets[tf as usize / 4][k]);
+        let (pa, pb) = (face_points(a), face_points(b));
+        let perm = pa.map(|p| pb.iter().position(|&q| q == p).expect("faces with equal point sets"));
         let id = self.cell_id(2, DartId(a * 6)).0;
         for k in 0..6 {
-            let key = flag(a, k);
-            let kb = (0..6).find(|&kb| flag(b, kb) == key).expect("faces with equal point sets");
-            self.link_raw(3, DartId(a * 6 + k), DartId(b * 6 + kb));
+            let kb = FLAG_OF[perm[FLAG_VERTEX[k]]][perm[FLAG_OTHER[k]]] as u32;
+            self.link_raw(3, DartId(a * 6 + k as u32), DartId(b * 6 + kb));
             self.set_cell_raw(2, DartId(b * 6 + kb), id);
         }
+    }
+}
+
+/// Marks a tet face with no partner (a boundary face).
+const NO_FACE: u32 = u32::MAX;
+
+/// The flag k of a face with (vertex, other end of its edge) = (local corners v, o): the inverse
+/// of (FLAG_VERTEX, FLAG_OTHER). The diagonal is unused.
+const FLAG_OF: [[u8; 3]; 3] = [[u8::MAX, 0, 5], [1, u8::MAX, 2], [4, 3, u8::MAX]];
+
+/// The six edges of a tet as pairs of local corners.
+const TET_EDGES: [[usize; 2]; 6] = [[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]];
+
+const fn tet_edge_index(u: usize, w: usize) -> usize {
+    let (a, b) = if u < w { (u, w) } else { (w, u) };
+    match (a, b) {
+        (0, 1) => 0,
+        (0, 2) => 1,
+        (0, 3) => 2,
+        (1, 2) => 3,
+        (1, 3) => 4,
+        _ => 5,
+    }
+}
+
+/// The local edge of each of the 24 darts of a tet.
+const TET_DART_EDGE: [u8; 24] = {
+    let mut e = [0u8; 24];
+    let mut k = 0;
+    while k < 24 {
+        e[k] = tet_edge_index(TET.vertex[k] as usize, TET.other[k] as usize) as u8;
+        k += 1;
+    }
+    e
+};
+
+/// The `count` local items (corners or edges) of a tet sorted by the smallest dart that carries
+/// them, given the item of each dart: labelling items in this order within each tet, tets in
+/// order, gives the ids a flood over darts in increasing order would give.
+fn items_by_first_dart(count: usize, item_of_dart: impl Fn(usize) -> usize) -> Vec<usize> {
+    let mut first = vec![usize::MAX; count];
+    for k in (0..24).rev() {
+        first[item_of_dart(k)] = k;
+    }
+    let mut items: Vec<usize> = (0..count).collect();
+    items.sort_by_key(|&i| first[i]);
+    items
+}
+
+/// The position of point p among the corners of tet (p must be one of them).
+#[inline]
+fn corner_of_point(tet: &[u32; 4], p: u32) -> usize {
+    tet.iter().position(|&q| q == p).expect("neighbouring tets share the face's points")
+}
+
+/// For every tet face 4t + f, the other tet face with the same three points, or `NO_FACE`.
+/// Faces are bucketed by their smallest point (a counting sort) and sorted within each bucket,
+/// so no hashing is needed. O(tets + points).
+///
+/// Errors: [`BuildError::NonManifold`] for the first face (in input order) seen a third time.
+fn match_tet_faces(points: usize, tets: &[[u32; 4]]) -> Result<Vec<u32>, BuildError> {
+    let key = |tet: &[u32; 4], f: usize| sorted(face_corners(f).map(|k| tet[k]));
+    let mut start = vec![0u32; points + 1];
+    for tet in tets {
+        for f in 0..4 {
+            start[key(tet, f)[0] as usize + 1] += 1;
+        }
+    }
+    for p in 0..points {
+        start[p + 1] += start[p];
+    }
+    let mut fill = start.clone();
+    let mut bucket = vec![(0u64, 0u32); tets.len() * 4];
+    for (t, tet) in tets.iter().enumerate() {
+        for f in 0..4 {
+            let [a, b, c] = key(tet, f);
+            bucket[fill[a as usize] as usize] = ((u64::from(b) << 32) | u64::from(c), (t * 4 + f) as u32);
+            fill[a as usize] += 1;
+        }
+    }
+    let mut partner = vec![NO_FACE; tets.len() * 4];
+    // (third face, points, first face, second face) of the earliest face seen three times.
+    let mut third: Option<(u32, [u32; 3], u32, u32)> = None;
+    for a in 0..points {
+        let faces = &mut bucket[start[a] as usize..start[a + 1] as usize];
+        faces.sort_unstable();
+        for run in faces.chunk_by(|x, y| x.0 == y.0) {
+            match run {
+                [_] => {}
+                [(_, f1), (_, f2)] => {
+                    partner[*f1 as usize] = *f2;
+                    partner[*f2 as usize] = *f1;
+                }
+                [(bc, f1), (_, f2), (_, f3), ..] => {
+                    if third.is_none_or(|w| *f3 < w.0) {
+                        third = Some((*f3, [a as u32, (bc >> 32) as u32, *bc as u32], *f1, *f2));
+                    }
+                }
+                [] => unreachable!("chunks are never empty"),
+            }
+        }
+    }
+    match third {
+        None => Ok(partner),
+        Some((f3, points, f1, f2)) => Err(BuildError::NonManifold {
+            what: "face",
+            points: points.to_vec(),
+            elements: [f1 as usize / 4, f2 as usize / 4, f3 as usize / 4],
+        }),
+    }
+}
+
+/// Edge ids of every (tet, local edge) pair, by a flood over tet edges joined through shared
+/// faces: the edge orbits ⟨α0, α2, α3⟩ of the built map, numbered as a flood over darts in
+/// increasing order would. Returns the ids (6 per tet) and the number of edges. O(tets).
+fn label_tet_edges(tets: &[[u32; 4]], partner: &[u32]) -> (Vec<u32>, u32) {
+    let order = items_by_first_dart(6, |k| TET_DART_EDGE[k] as usize);
+    let mut label = vec![u32::MAX; tets.len() * 6];
+    let mut stack = Vec::new();
+    let mut next = 0u32;
+    for t in 0..tets.len() {
+        for &e in &order {
+            if label[t * 6 + e] != u32::MAX {
+                continue;
+            }
+            label[t * 6 + e] = next;
+            stack.push(t * 6 + e);
+            while let Some(x) = stack.pop() {
+                let (tx, [u, w]) = (x / 6, TET_EDGES[x % 6]);
+                let (pu, pw) = (tets[tx][u], tets[tx][w]);
+                for f in (0..4).filter(|&f| f != u && f != w) {
+                    let other = partner[tx * 4 + f];
+                    if other == NO_FACE {
+                        continue;
+                    }
+                    let ty = other as usize / 4;
+                    let y = ty * 6 + tet_edge_index(corner_of_point(&tets[ty], pu), corner_of_point(&tets[ty], pw));
+                    if label[y] == u32::MAX {
+                        label[y] = next;
+                        stack.push(y);
+                    }
+                }
+            }
+            next += 1;
+        }
+    }
+    (label, next)
+}
+
+/// Vertex ids of every (tet, corner) pair, by a flood over tet corners joined through shared
+/// faces (the vertex orbits ⟨α1, α2, α3⟩): the first orbit of point p gets id p, any further one
+/// a fresh id, in the order of a flood over darts in increasing order. Returns the ids (4 per
+/// tet), the id bound, and the number of orbits of each point. O(tets + points).
+fn label_tet_corners(points: usize, tets: &[[u32; 4]], partner: &[u32]) -> (Vec<u32>, u32, Vec<usize>) {
+    let order = items_by_first_dart(4, |k| TET.vertex[k] as usize);
+    let mut label = vec![u32::MAX; tets.len() * 4];
+    let mut orbits_of = vec![0usize; points];
+    let mut next = points as u32;
+    let mut stack = Vec::new();
+    for t in 0..tets.len() {
+        for &v in &order {
+            if label[t * 4 + v] != u32::MAX {
+                continue;
+            }
+            let p = tets[t][v];
+            let id = if orbits_of[p as usize] == 0 { p } else { (next, next += 1).0 };
+            orbits_of[p as usize] += 1;
+            label[t * 4 + v] = id;
+            stack.push(t * 4 + v);
+            while let Some(x) = stack.pop() {
+                let (tx, vx) = (x / 4, x % 4);
+                for f in (0..4).filter(|&f| f != vx) {
+                    let other = partner[tx * 4 + f];
+                    if other == NO_FACE {
+                        continue;
+                    }
+                    let ty = other as usize / 4;
+                    let y = ty * 4 + corner_of_point(&tets[ty], p);
+                    if label[y] == u32::MAX {
+                        label[y] = id;
+                        stack.push(y);
+                    }
+                }
+            }
+        }
+    }
+    (label, next, orbits_of)
+}
+
+/// The sorted point pair of every edge id, from the per-(tet, local edge) ids.
+fn edge_points(tets: &[[u32; 4]], edge_of: &[u32], edges: u32) -> Vec<u64> {
+    let mut keys = vec![u64::MAX; edges as usize];
+    for (node, &id) in edge_of.iter().enumerate() {
+        if keys[id as usize] == u64::MAX {
+            let [u, w] = TET_EDGES[node % 6];
+            let [a, b] = sorted([tets[node / 6][u], tets[node / 6][w]]);
+            keys[id as usize] = (u64::from(a) << 32) | u64::from(b);
+        }
+    }
+    keys
+}
+
+/// Point pairs carried by more than one edge, from the packed pair of every edge. O(E log E).
+fn split_edges(mut keys: Vec<u64>) -> Vec<([u32; 2], usize)> {
+    keys.sort_unstable();
+    let mut out: Vec<([u32; 2], usize)> = Vec::new();
+    for w in keys.windows(2) {
+        if w[0] == w[1] {
+            let pair = [(w[0] >> 32) as u32, w[0] as u32];
+            match out.last_mut() {
+                Some(last) if last.0 == pair => last.1 += 1,
+                _ => out.push((pair, 2)),
+            }
+        }
+    }
+    out
+}
+
+/// The vertex part of a build report, from the number of vertex orbits of each point.
+fn vertex_report(orbits_of: &[usize]) -> BuildReport {
+    BuildReport {
+        pinched_vertices: (0..orbits_of.len())
+            .filter(|&p| orbits_of[p] > 1)
+            .map(|p| (p as u32, orbits_of[p]))
+            .collect(),
+        split_edges: Vec::new(),
+        unreferenced_points: (0..orbits_of.len() as u32).filter(|&p| orbits_of[p as usize] == 0).collect(),
     }
 }
 
@@ -291,7 +512,9 @@ impl GMap<2> {
                         let a0 = DartId(slot.0);
                         let a1 = self.alpha_dyn(0, a0);
                         let id = self.cell_id(1, a0).0;
-                        let same = |a: DartId, b: DartId| triangles[a.index() / 6][FLAG_VERTEX[a.index() % 6]] == tri[FLAG_VERTEX[b.index() % 6]];
+                        let same = |a: DartId, b: DartId| {
+                            triangles[a.index() / 6][FLAG_VERTEX[a.index() % 6]] == tri[FLAG_VERTEX[b.index() % 6]]
+                        };
                         let (b0, b1) = if same(a0, d0) { (d0, d1) } else { (d1, d0) };
                         self.link_raw(2, a0, b0);
                         self.link_raw(2, a1, b1);
@@ -310,26 +533,12 @@ impl GMap<2> {
 }
 
 impl<const N: usize> GMap<N> {
-    /// Gives every dim-cell a sequential id by flood fill (ids must be unset, `NONE`).
-    pub(crate) fn label_by_flood(&mut self, dim: usize) {
-        let mask = AlphaMask::cell(N, dim);
-        let mut next = 0u32;
-        let mut stack = Vec::new();
-        for d in 0..self.capacity() as u32 {
-            if self.cell_id(dim, DartId(d)).0 == u32::MAX {
-                self.flood_label(dim, DartId(d), mask, next, &mut stack);
-                next += 1;
-            }
-        }
-        self.set_id_alloc_raw(dim, next, Vec::new());
-    }
-
-    /// Labels the unlabelled orbit of d with `id`.
-    fn flood_label(&mut self, dim: usize, d: DartId, mask: AlphaMask, id: u32, stack: &mut Vec<DartId>) {
+    /// Labels the unlabelled orbit of d under the generators `gens` with `id`.
+    fn flood_label(&mut self, dim: usize, d: DartId, gens: &[usize], id: u32, stack: &mut Vec<DartId>) {
         self.set_cell_raw(dim, d, id);
         stack.push(d);
         while let Some(x) = stack.pop() {
-            for j in mask.indices().filter(|&j| j <= N) {
+            for &j in gens {
                 let y = self.alpha_dyn(j, x);
                 if self.cell_id(dim, y).0 == u32::MAX {
                     self.set_cell_raw(dim, y, id);
@@ -342,6 +551,7 @@ impl<const N: usize> GMap<N> {
     /// Vertex ids: the first vertex orbit of point p gets id p, any further one a fresh id.
     fn label_vertices(&mut self, points: usize, corner: impl Fn(DartId) -> u32) -> BuildReport {
         let mask = AlphaMask::cell(N, 0);
+        let gens: Vec<usize> = mask.indices().filter(|&j| j <= N).collect();
         let mut orbits_of = vec![0usize; points];
         let mut next = points as u32;
         let mut stack = Vec::new();
@@ -353,39 +563,11 @@ impl<const N: usize> GMap<N> {
             let p = corner(d);
             let id = if orbits_of[p as usize] == 0 { p } else { (next, next += 1).0 };
             orbits_of[p as usize] += 1;
-            self.flood_label(0, d, mask, id, &mut stack);
+            self.flood_label(0, d, &gens, id, &mut stack);
         }
-        let unreferenced: Vec<u32> = (0..points as u32).filter(|&p| orbits_of[p as usize] == 0).collect();
-        self.set_id_alloc_raw(0, next, unreferenced.clone());
-        BuildReport {
-            pinched_vertices: (0..points).filter(|&p| orbits_of[p] > 1).map(|p| (p as u32, orbits_of[p])).collect(),
-            split_edges: Vec::new(),
-            unreferenced_points: unreferenced,
-        }
-    }
-
-    /// Point pairs carried by more than one edge orbit. O(edges log edges).
-    fn split_edges(&self, corner: impl Fn(DartId) -> u32) -> Vec<([u32; 2], usize)> {
-        let mut keys: Vec<(u64, u32)> = self
-            .one_dart_per_cell(1)
-            .into_iter()
-            .map(|d| {
-                let [a, b] = sorted([corner(d), corner(self.alpha_dyn(0, d))]);
-                (((a as u64) << 32) | b as u64, 0)
-            })
-            .collect();
-        keys.sort_unstable();
-        let mut out: Vec<([u32; 2], usize)> = Vec::new();
-        for w in keys.windows(2) {
-            if w[0].0 == w[1].0 {
-                let pair = [(w[0].0 >> 32) as u32, w[0].0 as u32];
-                match out.last_mut() {
-                    Some(last) if last.0 == pair => last.1 += 1,
-                    _ => out.push((pair, 2)),
-                }
-            }
-        }
-        out
+        let report = vertex_report(&orbits_of);
+        self.set_id_alloc_raw(0, next, report.unreferenced_points.clone());
+        report
     }
 
     /// The checks every builder runs before handing a map out.

@@ -72,7 +72,8 @@ fn unsewing_every_face_of_a_cube_gives_free_tets_and_sewing_back_is_isomorphic()
     let (points, tets) = kuhn_cube(2);
     let (original, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
     let mut map = original.clone();
-    let inner: Vec<_> = map.darts().filter(|&d| !map.is_free(3, d)).map(|d| (d, map.alpha::<3>(d))).filter(|(a, b)| a < b).collect();
+    let inner: Vec<_> =
+        map.darts().filter(|&d| !map.is_free(3, d)).map(|d| (d, map.alpha::<3>(d))).filter(|(a, b)| a < b).collect();
     for &(a, _) in &inner {
         if !map.is_free(3, a) {
             map.unsew::<3>(a).unwrap();

@@ -1,6 +1,7 @@
 //! Global characteristics: cell counts, components, boundary, Euler characteristic,
 //! orientability.
 
+use super::orbit::{generators, VisitBits};
 use super::{AlphaMask, DartId, DartSet, GMap};
 
 /// Number of i-cells for each i in 0..=n.
@@ -41,35 +42,36 @@ impl<const N: usize> GMap<N> {
 
     /// Number of i-cells for every i, found by walking orbits (independent of cell ids).
     /// O(darts · n²).
+    ///
+    /// The n + 1 floods run interleaved in one sweep over the darts (each dart starts the floods
+    /// of the dimensions it has not been reached in yet), so the rows a sweep brings into cache
+    /// serve every dimension.
     pub fn count_cells_by_traversal(&self) -> CellCounts {
-        CellCounts((0..=N).map(|i| self.count_orbits(AlphaMask::cell(N, i))).collect())
+        let gens: Vec<([usize; 8], usize)> = (0..=N).map(|i| generators(N, AlphaMask::cell(N, i))).collect();
+        let mut seen: Vec<VisitBits> = (0..=N).map(|_| VisitBits::new(self.capacity())).collect();
+        let mut counts = vec![0usize; N + 1];
+        let mut stack = Vec::new();
+        self.for_each_live(|d| {
+            for dim in 0..=N {
+                if seen[dim].insert(d) {
+                    counts[dim] += 1;
+                    let (g, len) = &gens[dim];
+                    self.flood(d, &g[..*len], &mut seen[dim], &mut stack);
+                }
+            }
+        });
+        CellCounts(counts)
     }
 
     /// Number of distinct orbits ⟨mask⟩ over all live darts. O(darts · n).
     pub fn count_orbits(&self, mask: AlphaMask) -> usize {
-        let mut seen = DartSet::with_capacity(self.capacity());
-        let mut stack = Vec::new();
-        let mut count = 0;
-        for d in self.darts() {
-            if seen.insert(d) {
-                count += 1;
-                self.flood(d, mask, &mut seen, &mut stack);
-            }
-        }
-        count
+        self.for_each_orbit(mask, |_| {})
     }
 
     /// One dart per connected component (orbit of all involutions), smallest first. O(darts · n).
     pub fn components(&self) -> Vec<DartId> {
-        let mut seen = DartSet::with_capacity(self.capacity());
-        let mut stack = Vec::new();
         let mut roots = Vec::new();
-        for d in self.darts() {
-            if seen.insert(d) {
-                roots.push(d);
-                self.flood(d, AlphaMask::all(N), &mut seen, &mut stack);
-            }
-        }
+        self.for_each_orbit(AlphaMask::all(N), |d| roots.push(d));
         roots
     }
 
@@ -77,13 +79,25 @@ impl<const N: usize> GMap<N> {
     /// O(darts · n).
     pub fn component_labels(&self) -> (Vec<u32>, usize) {
         let mut label = vec![u32::MAX; self.capacity()];
-        let roots = self.components();
-        for (k, &r) in roots.iter().enumerate() {
-            for d in self.orbit(r, AlphaMask::all(N)) {
-                label[d.index()] = k as u32;
+        let mut stack = Vec::new();
+        let mut count = 0u32;
+        self.for_each_live(|d| {
+            if label[d as usize] != u32::MAX {
+                return;
             }
-        }
-        (label, roots.len())
+            label[d as usize] = count;
+            stack.push(d);
+            while let Some(x) = stack.pop() {
+                for &y in self.alpha_row(x) {
+                    if label[y as usize] == u32::MAX {
+                        label[y as usize] = count;
+                        stack.push(y);
+                    }
+                }
+            }
+            count += 1;
+        });
+        (label, count as usize)
     }
 
     /// The αn-free darts: the boundary. O(capacity).

@@ -46,9 +46,10 @@ impl<const N: usize> GMap<N> {
         let mut used = vec![false; other.capacity()];
         for root in self.components() {
             let size = self.orbit(root, AlphaMask::all(N)).len();
-            let found = other.darts().filter(|c| !used[c.index()]).find_map(|c| {
-                self.isomorphism_from(root, other, c).filter(|pairs| pairs.len() == size)
-            });
+            let found = other
+                .darts()
+                .filter(|c| !used[c.index()])
+                .find_map(|c| self.isomorphism_from(root, other, c).filter(|pairs| pairs.len() == size));
             match found {
                 Some(pairs) => pairs.iter().for_each(|&(_, y)| used[y.index()] = true),
                 None => return false,

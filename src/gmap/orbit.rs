@@ -4,46 +4,136 @@
 //! Walks are breadth-first, visit generators in increasing index order (so the order is
 //! deterministic), and are bounded by the number of live darts.
 
-use rustc_hash::FxHashSet;
+use super::{AlphaMask, CellId, DartId, GMap};
 
-use super::{AlphaMask, CellId, DartId, DartSet, GMap};
-
-/// A visited set tuned for orbits: linear scan while small, hashing beyond.
+/// A visited set tuned for single orbits: linear scan while small, then an open-addressing hash
+/// table of dart ids (Fibonacci hashing, linear probing, grown at half load).
 pub(crate) struct SmallDartSet {
     small: Vec<u32>,
-    large: Option<FxHashSet<u32>>,
+    table: Vec<u32>,
+    len: usize,
 }
 
 impl SmallDartSet {
-    const LINEAR_LIMIT: usize = 48;
+    const LINEAR_LIMIT: usize = 24;
+    const EMPTY: u32 = u32::MAX;
 
     pub(crate) fn new() -> Self {
-        SmallDartSet { small: Vec::new(), large: None }
+        SmallDartSet { small: Vec::new(), table: Vec::new(), len: 0 }
+    }
+
+    #[inline(always)]
+    fn slot(table_len: usize, d: u32) -> usize {
+        let shift = 64 - table_len.trailing_zeros();
+        (u64::from(d).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> shift) as usize
+    }
+
+    /// Inserts into the table (which has room); returns whether d was absent.
+    #[inline]
+    fn table_insert(table: &mut [u32], d: u32) -> bool {
+        let mask = table.len() - 1;
+        let mut k = Self::slot(table.len(), d);
+        loop {
+            match table[k] {
+                Self::EMPTY => {
+                    table[k] = d;
+                    return true;
+                }
+                x if x == d => return false,
+                _ => k = (k + 1) & mask,
+            }
+        }
+    }
+
+    fn grow(&mut self) {
+        let old = std::mem::replace(&mut self.table, vec![Self::EMPTY; (self.len * 4).next_power_of_two().max(128)]);
+        for &d in old.iter().chain(self.small.iter()).filter(|&&d| d != Self::EMPTY) {
+            Self::table_insert(&mut self.table, d);
+        }
+        self.small.clear();
     }
 
     /// Inserts d; returns whether it was absent.
     #[inline]
     pub(crate) fn insert(&mut self, d: DartId) -> bool {
-        if let Some(set) = &mut self.large {
-            return set.insert(d.0);
+        if self.table.is_empty() {
+            if self.small.contains(&d.0) {
+                return false;
+            }
+            self.small.push(d.0);
+            self.len += 1;
+            if self.small.len() > Self::LINEAR_LIMIT {
+                self.grow();
+            }
+            return true;
         }
-        if self.small.contains(&d.0) {
+        if !Self::table_insert(&mut self.table, d.0) {
             return false;
         }
-        self.small.push(d.0);
-        if self.small.len() > Self::LINEAR_LIMIT {
-            self.large = Some(self.small.drain(..).collect());
+        self.len += 1;
+        if self.len * 2 > self.table.len() {
+            self.grow();
         }
         true
     }
 
     #[inline]
     pub(crate) fn contains(&self, d: DartId) -> bool {
-        match &self.large {
-            Some(set) => set.contains(&d.0),
-            None => self.small.contains(&d.0),
+        if self.table.is_empty() {
+            return self.small.contains(&d.0);
+        }
+        let mask = self.table.len() - 1;
+        let mut k = Self::slot(self.table.len(), d.0);
+        loop {
+            match self.table[k] {
+                Self::EMPTY => return false,
+                x if x == d.0 => return true,
+                _ => k = (k + 1) & mask,
+            }
         }
     }
+}
+
+/// A fixed-size bit set over dart slots (or ids): the visited set of whole-map traversals. No
+/// growth and no count, so the hot test-and-set is one load, one store and one bounds check.
+pub(crate) struct VisitBits {
+    words: Vec<u64>,
+}
+
+impl VisitBits {
+    /// An empty set of slots 0..len.
+    pub(crate) fn new(len: usize) -> Self {
+        VisitBits { words: vec![0; len.div_ceil(64)] }
+    }
+
+    /// Adds slot i (< len); returns whether it was absent.
+    #[inline(always)]
+    pub(crate) fn insert(&mut self, i: u32) -> bool {
+        let w = &mut self.words[i as usize >> 6];
+        let bit = 1u64 << (i & 63);
+        let absent = *w & bit == 0;
+        *w |= bit;
+        absent
+    }
+
+    /// Whether slot i is in the set (false past the end).
+    #[inline(always)]
+    pub(crate) fn contains(&self, i: u32) -> bool {
+        self.words.get(i as usize >> 6).is_some_and(|w| w & (1u64 << (i & 63)) != 0)
+    }
+}
+
+/// The generators of `mask` that exist in an n-map, in increasing order, as an array and a
+/// length: hot loops iterate `&gens[..len]` instead of testing eight bits per dart.
+#[inline]
+pub(crate) fn generators(n: usize, mask: AlphaMask) -> ([usize; 8], usize) {
+    let mut gens = [0usize; 8];
+    let mut len = 0;
+    for i in (0..=n.min(7)).filter(|&i| mask.contains(i)) {
+        gens[len] = i;
+        len += 1;
+    }
+    (gens, len)
 }
 
 impl<const N: usize> GMap<N> {
@@ -52,13 +142,15 @@ impl<const N: usize> GMap<N> {
         let mut seen = SmallDartSet::new();
         let mut out = vec![d];
         seen.insert(d);
+        let (gens, len) = generators(N, mask);
         let mut head = 0;
         while head < out.len() {
             let x = out[head];
             head += 1;
-            for i in mask.indices().filter(|&i| i <= N) {
-                let y = self.alpha_dyn(i, x);
-                if seen.insert(y) {
+            let row = self.alpha_row(x.0);
+            for &i in &gens[..len] {
+                let y = DartId(row[i]);
+                if y != x && seen.insert(y) {
                     out.push(y);
                 }
             }
@@ -90,6 +182,7 @@ impl<const N: usize> GMap<N> {
         let mut head = [0usize, 0usize];
         seen[0].insert(a);
         seen[1].insert(b);
+        let (gens, len) = generators(N, mask);
         loop {
             for side in 0..2 {
                 if head[side] == queue[side].len() {
@@ -97,8 +190,12 @@ impl<const N: usize> GMap<N> {
                 }
                 let x = queue[side][head[side]];
                 head[side] += 1;
-                for i in mask.indices().filter(|&i| i <= N) {
-                    let y = self.alpha_dyn(i, x);
+                let row = self.alpha_row(x.0);
+                for &i in &gens[..len] {
+                    let y = DartId(row[i]);
+                    if y == x {
+                        continue;
+                    }
                     if seen[1 - side].contains(y) {
                         return None;
                     }
@@ -125,28 +222,66 @@ impl<const N: usize> GMap<N> {
     /// One dart per i-cell, found by walking orbits with a mark and ignoring cell ids: the
     /// independent oracle for [`GMap::one_dart_per_cell`]. O(darts · n).
     pub fn one_dart_per_cell_by_traversal(&self, i: usize) -> Vec<DartId> {
-        let mask = AlphaMask::cell(N, i);
-        let mut seen = DartSet::with_capacity(self.capacity());
-        let mut stack = Vec::new();
         let mut out = Vec::new();
-        for d in self.darts() {
-            if seen.insert(d) {
-                out.push(d);
-                self.flood(d, mask, &mut seen, &mut stack);
-            }
-        }
+        self.for_each_orbit(AlphaMask::cell(N, i), |d| out.push(d));
         out
     }
 
-    /// Marks in `seen` every dart of ⟨mask⟩(d) (d itself already marked). Returns the number of
-    /// darts newly marked, d included. O(orbit · n), iterative.
-    pub(crate) fn flood(&self, d: DartId, mask: AlphaMask, seen: &mut DartSet, stack: &mut Vec<DartId>) -> usize {
+    /// Calls `first(d)` once per orbit ⟨mask⟩, with d the smallest dart of the orbit, in increasing
+    /// order of d. Returns the number of orbits. O(darts · |mask|), one bit per dart of memory.
+    pub(crate) fn for_each_orbit(&self, mask: AlphaMask, mut first: impl FnMut(DartId)) -> usize {
+        let (gens, len) = generators(N, mask);
+        let mut seen = VisitBits::new(self.capacity());
+        let mut stack = Vec::new();
+        let mut count = 0;
+        self.for_each_live(|d| {
+            if seen.insert(d) {
+                count += 1;
+                first(DartId(d));
+                self.flood(d, &gens[..len], &mut seen, &mut stack);
+            }
+        });
+        count
+    }
+
+    /// Calls f on every live dart index in increasing order, a 64-dart word at a time. O(capacity).
+    #[inline]
+    pub(crate) fn for_each_live(&self, mut f: impl FnMut(u32)) {
+        for (w, &word) in self.alive.iter().enumerate() {
+            let mut bits = word;
+            while bits != 0 {
+                f((w * 64) as u32 + bits.trailing_zeros());
+                bits &= bits - 1;
+            }
+        }
+    }
+
+    /// The n + 1 links of dart slot d, α0(d) … αn(d).
+    #[inline(always)]
+    pub(crate) fn alpha_row(&self, d: u32) -> &[u32] {
+        let base = d as usize * (N + 1);
+        &self.alpha[base..base + N + 1]
+    }
+
+    /// The n + 1 cell ids of dart slot d.
+    #[inline(always)]
+    pub(crate) fn cell_row(&self, d: u32) -> &[u32] {
+        let base = d as usize * (N + 1);
+        &self.cell[base..base + N + 1]
+    }
+
+    /// Marks in `seen` every dart of the orbit of d under the generators `gens` (d itself already
+    /// marked). Returns the number of darts newly marked, d included. O(orbit · |gens|),
+    /// iterative (depth-first with an explicit stack).
+    #[inline]
+    pub(crate) fn flood(&self, d: u32, gens: &[usize], seen: &mut VisitBits, stack: &mut Vec<u32>) -> usize {
         stack.clear();
         stack.push(d);
         let mut count = 1;
         while let Some(x) = stack.pop() {
-            for i in mask.indices().filter(|&i| i <= N) {
-                let y = self.alpha_dyn(i, x);
+            let row = self.alpha_row(x);
+            for &i in gens {
+                let y = row[i];
                 if seen.insert(y) {
                     count += 1;
                     stack.push(y);
@@ -165,10 +300,11 @@ impl<const N: usize> GMap<N> {
             return 0;
         }
         self.set_cell_raw(i, d, to);
+        let (gens, len) = generators(N, mask);
         let mut stack = vec![d];
         let mut count = 1;
         while let Some(x) = stack.pop() {
-            for j in mask.indices().filter(|&j| j <= N) {
+            for &j in &gens[..len] {
                 let y = self.alpha_dyn(j, x);
                 if self.cell_id(i, y).0 == from {
                     self.set_cell_raw(i, y, to);

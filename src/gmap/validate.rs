@@ -9,7 +9,14 @@
 //!
 //! `validate()` costs O(darts · n²): one sequential pass for the first three laws and one
 //! flood-fill per dimension for the last. The local check costs O(touched · n²).
+//!
+//! Two paths, one verdict: a fast path decides whether every law holds (one pass reading each
+//! dart's row and its n + 1 neighbours' rows, then per dimension #orbits = #distinct ids =
+//! #live ids, which given constant live ids is equivalent to uniqueness with no orphan); only
+//! when it finds a violation does the detailed path run, which checks the laws in the table's
+//! order and names the first violation.
 
+use super::orbit::{generators, VisitBits};
 use super::{AlphaMask, CellId, DartId, DartSet, GMap};
 
 /// The law a violation breaks.
@@ -127,7 +134,18 @@ impl InvariantViolation {
 
 impl<const N: usize> GMap<N> {
     /// Checks every law of the table in the [module docs](self). O(darts · n²).
+    ///
+    /// Errors: the first violation in the order of the table (involution and quasi-manifold laws
+    /// of every dart first, then cell ids of every dart, then uniqueness per dimension).
     pub fn validate(&self) -> Result<(), InvariantViolation> {
+        if self.all_laws_hold() {
+            return Ok(());
+        }
+        self.validate_detailed()
+    }
+
+    /// The detailed path: names the first violation. O(darts · n²).
+    fn validate_detailed(&self) -> Result<(), InvariantViolation> {
         let dead = self.dead_id_sets();
         for d in self.darts() {
             self.check_dart_links(d)?;
@@ -135,10 +153,64 @@ impl<const N: usize> GMap<N> {
         for d in self.darts() {
             self.check_dart_cells(d, Some(&dead))?;
         }
-        for (dim, dead_ids) in dead.iter().enumerate() {
-            self.check_ids_unique(dim, dead_ids)?;
+        for (dim, dead) in dead.iter().enumerate() {
+            self.check_ids_unique(dim, dead)?;
         }
         Ok(())
+    }
+
+    /// The fast path: whether every law holds. Same verdict as [`Self::validate_detailed`].
+    fn all_laws_hold(&self) -> bool {
+        let mut dead = Vec::with_capacity(N + 1);
+        let mut live = Vec::with_capacity(N + 1);
+        for alloc in &self.ids {
+            let mut set = VisitBits::new(alloc.next as usize);
+            let freed = alloc.free.iter().filter(|&&id| id < alloc.next && set.insert(id)).count();
+            dead.push(set);
+            live.push(alloc.next as usize - freed);
+        }
+        let mut used: Vec<VisitBits> = self.ids.iter().map(|a| VisitBits::new(a.next as usize)).collect();
+        let mut distinct = vec![0usize; N + 1];
+        let mut ok = true;
+        self.for_each_live(|d| {
+            if ok && self.dart_laws_hold(d, &dead) {
+                let cells = self.cell_row(d);
+                for dim in 0..=N {
+                    distinct[dim] += used[dim].insert(cells[dim]) as usize;
+                }
+            } else {
+                ok = false;
+            }
+        });
+        // Ids are now known to be constant on cells and live, so each orbit carries one id and
+        // every carried id is live: ids are unique iff #orbits = #distinct ids, and no live id is
+        // an orphan iff #distinct ids = #live ids.
+        ok && distinct == live && self.count_cells_by_traversal().0 == distinct
+    }
+
+    /// The involution, quasi-manifold and constant-live-id laws at dart slot d, reading its row
+    /// and its neighbours' rows once. Same verdict as `check_dart_links` + `check_dart_cells`.
+    #[inline]
+    fn dart_laws_hold(&self, d: u32, dead: &[VisitBits]) -> bool {
+        let links = self.alpha_row(d);
+        let cells = self.cell_row(d);
+        for (i, &e) in links.iter().enumerate() {
+            if !self.contains(DartId(e)) || self.alpha_row(e)[i] != d {
+                return false;
+            }
+            let other = self.cell_row(e);
+            if (0..=N).any(|dim| dim != i && other[dim] != cells[dim]) {
+                return false;
+            }
+        }
+        for i in 0..=N {
+            for j in i + 2..=N {
+                if self.alpha_row(links[j])[i] != self.alpha_row(links[i])[j] {
+                    return false;
+                }
+            }
+        }
+        (0..=N).all(|dim| cells[dim] < self.ids[dim].next && !dead[dim].contains(cells[dim]))
     }
 
     /// Checks the local laws (involution, quasi-manifold, constant cell ids) at the given darts
@@ -220,12 +292,12 @@ impl<const N: usize> GMap<N> {
 
     /// Distinct dim-cells carry distinct ids and every live id is used. One flood per orbit.
     fn check_ids_unique(&self, dim: usize, dead: &DartSet) -> Result<(), InvariantViolation> {
-        let mask = AlphaMask::cell(N, dim);
+        let (gens, len) = generators(N, AlphaMask::cell(N, dim));
         let mut owner = vec![u32::MAX; self.ids[dim].next as usize];
-        let mut seen = DartSet::with_capacity(self.capacity());
+        let mut seen = VisitBits::new(self.capacity());
         let mut stack = Vec::new();
         for d in self.darts() {
-            if !seen.insert(d) {
+            if !seen.insert(d.0) {
                 continue;
             }
             let id = self.cell_id(dim, d);
@@ -234,7 +306,7 @@ impl<const N: usize> GMap<N> {
                 return Err(InvariantViolation::CellIdShared { dim, id, first, second: d });
             }
             owner[id.index()] = d.0;
-            self.flood(d, mask, &mut seen, &mut stack);
+            self.flood(d.0, &gens[..len], &mut seen, &mut stack);
         }
         match (0..owner.len()).find(|&k| owner[k] == u32::MAX && !dead.contains(DartId(k as u32))) {
             Some(k) => Err(InvariantViolation::CellIdOrphan { dim, id: CellId(k as u32) }),

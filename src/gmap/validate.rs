@@ -147,8 +147,13 @@ impl<const N: usize> GMap<N> {
     /// The detailed path: names the first violation. O(darts · n²).
     fn validate_detailed(&self) -> Result<(), InvariantViolation> {
         let dead = self.dead_id_sets();
+        // Involutions everywhere first, so that a broken link is named as such and not as a
+        // quasi-manifold violation seen from a neighbour.
         for d in self.darts() {
-            self.check_dart_links(d)?;
+            self.check_dart_involutions(d)?;
+        }
+        for d in self.darts() {
+            self.check_dart_quasi_manifold(d)?;
         }
         for d in self.darts() {
             self.check_dart_cells(d, Some(&dead))?;
@@ -232,6 +237,12 @@ impl<const N: usize> GMap<N> {
 
     /// Involution and quasi-manifold laws at one dart. O(n²).
     fn check_dart_links(&self, d: DartId) -> Result<(), InvariantViolation> {
+        self.check_dart_involutions(d)?;
+        self.check_dart_quasi_manifold(d)
+    }
+
+    /// The involution law at one dart: every αi(d) is live and αi(αi(d)) = d. O(n).
+    fn check_dart_involutions(&self, d: DartId) -> Result<(), InvariantViolation> {
         for i in 0..=N {
             let image = DartId(self.alpha[d.index() * (N + 1) + i]);
             if !self.contains(image) {
@@ -242,16 +253,31 @@ impl<const N: usize> GMap<N> {
                 return Err(InvariantViolation::NotInvolution { dart: d, i, image, back });
             }
         }
+        Ok(())
+    }
+
+    /// The quasi-manifold law at one dart. A dead dart met on the way is reported as a dangling
+    /// link of the dart that points to it. O(n²).
+    fn check_dart_quasi_manifold(&self, d: DartId) -> Result<(), InvariantViolation> {
         for i in 0..=N {
             for j in i + 2..=N {
-                let ij = self.alpha_dyn(i, self.alpha_dyn(j, d));
-                let ji = self.alpha_dyn(j, self.alpha_dyn(i, d));
+                let ij = self.live_alpha(i, self.live_alpha(j, d)?)?;
+                let ji = self.live_alpha(j, self.live_alpha(i, d)?)?;
                 if ij != ji {
                     return Err(InvariantViolation::QuasiManifold { dart: d, i, j, ij, ji });
                 }
             }
         }
         Ok(())
+    }
+
+    /// αi(d) if it is a live dart (d must be live), else the dangling link. O(1).
+    fn live_alpha(&self, i: usize, d: DartId) -> Result<DartId, InvariantViolation> {
+        let image = DartId(self.alpha[d.index() * (N + 1) + i]);
+        if !self.contains(image) {
+            return Err(InvariantViolation::DanglingLink { dart: d, i, target: image });
+        }
+        Ok(image)
     }
 
     /// Cell ids at one dart: constant across each generator of the cell, and live. O(n²).

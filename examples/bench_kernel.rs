@@ -147,7 +147,7 @@ fn main() {
     let per_dim: Vec<Timing> = (0..=3)
         .map(|i| median_timing(reps, || measure(|| (), |()| map.one_dart_per_cell_by_traversal(i).len())))
         .collect();
-    let plane = args.mesh.is_none().then(|| (points.as_slice(), (args.k / 2) as f64));
+    let plane = args.mesh.is_none().then_some((points.as_slice(), (args.k / 2) as f64));
     let cut = faces_to_cut(&map, plane);
     let mut work = map.clone();
     let (unsew, sew) = sew_unsew(&mut work, &cut, reps);

@@ -1,0 +1,304 @@
+//! Adaptive-resolution subdivision with levels (seed 004, §4.3–§5).
+//!
+//! A [`LeveledMap`] is the paper's extended G-map G = (B_i, α0^i | i ∈ [0, k], α1, …, αn): one
+//! [`GMap`] (the finest level G_k, always valid) plus, per dart,
+//! - the *dart level*: the level at which the dart was created, so B_i = {d : level(d) ≤ i} and
+//!   B_0 ⊂ B_1 ⊂ … ⊂ B_k by construction;
+//! - the resolution levels μa (edge), μf (face) and μt (tetrahedron, 3D only; 0 in 2D);
+//! - the history of its links: for every αj that an operation of level L changed, the value the
+//!   link had *before* level L. The paper stores only α0^i because it subdivides uniformly;
+//!   adaptive refinement also changes α1 (a vertex inserted on an edge by a neighbour becomes a
+//!   corner later) and in 3D α2, so the history is kept for every αj.
+//!
+//! [`LeveledMap::level`] rebuilds G_i = (B_i, α0^i, α1^i, …) as a [`GMap`] of its own.
+//!
+//! # Level order
+//! Operations are applied in non-decreasing level order: an operation of level L requires
+//! L ≥ [`LeveledMap::max_level`]. That is the order of the paper's algorithms (refine a zone level
+//! by level) and it makes every G_i exact: a level-L change is always the latest one.
+//!
+//! # Laws checked by [`LeveledMap::check_levels`]
+//! μt ≤ μf ≤ μa for every dart (Theorem 1 and its corollary); μa constant on edges, μf on faces,
+//! μt on volumes of the finest level; dart levels ≤ max level.
+
+mod ops;
+mod tri;
+
+use crate::gmap::{AlphaMask, DartId, GMap, InvariantViolation};
+
+/// The largest level an operation may use.
+pub const MAX_LEVEL: u8 = 250;
+
+/// A link value that an operation of level `level` overwrote: before `level`, αj(d) was `old`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct LinkChange {
+    level: u8,
+    j: u8,
+    old: u32,
+}
+
+/// Per-dart resolution levels (seed 004, §4.3): μa, μf, μt.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Mu {
+    /// Edge resolution level μa.
+    pub edge: u8,
+    /// Face resolution level μf.
+    pub face: u8,
+    /// Tetrahedron (volume) resolution level μt; 0 in 2D.
+    pub tet: u8,
+}
+
+/// Errors of the subdivision operations. The map is unchanged when one is returned.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum SubdivideError {
+    /// The dart is not live.
+    #[error("{0} does not exist in this map")]
+    NoSuchDart(DartId),
+    /// Operations must come in non-decreasing level order.
+    #[error("level {level} is below the map's maximum level {max_level}: operations must not go back in level")]
+    LevelBelowMax {
+        /// The requested level.
+        level: u8,
+        /// The map's current maximum level.
+        max_level: u8,
+    },
+    /// The level is above [`MAX_LEVEL`].
+    #[error("level {0} is above the maximum {MAX_LEVEL}")]
+    LevelTooHigh(u8),
+    /// A cell can only be subdivided at a level above its own resolution level.
+    #[error("the {dim}-cell of {dart} already has level {cell_level} ≥ {level}")]
+    AlreadyAtLevel {
+        /// A dart of the cell.
+        dart: DartId,
+        /// 1 = edge, 2 = face, 3 = tetrahedron.
+        dim: usize,
+        /// Its current resolution level.
+        cell_level: u8,
+        /// The requested level.
+        level: u8,
+    },
+    /// The face is not a triangle (three corners, any number of inserted vertices on its sides).
+    #[error("the face of {dart} has {corners} corners, not 3")]
+    NotATriangle {
+        /// A dart of the face.
+        dart: DartId,
+        /// Corners found.
+        corners: usize,
+    },
+    /// The operation exists for these dimensions only (faces: n ∈ {2, 3}).
+    #[error("this operation is not defined for {0}-G-maps")]
+    WrongDimension(usize),
+    /// The edge has an α0-free dart: it has no second vertex to split between.
+    #[error("the edge of {0} is open (α0-free)")]
+    OpenEdge(DartId),
+}
+
+/// Violations of the level laws found by [`LeveledMap::check_levels`] and [`LeveledMap::check_all`].
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum LevelError {
+    /// μt ≤ μf ≤ μa is broken at a dart.
+    #[error("{dart}: μt = {}, μf = {}, μa = {} breaks μt ≤ μf ≤ μa", .mu.tet, .mu.face, .mu.edge)]
+    MuOrder {
+        /// The dart.
+        dart: DartId,
+        /// Its levels.
+        mu: Mu,
+    },
+    /// A resolution level differs between two darts of one cell of the finest level.
+    #[error("μ of the {dim}-cell differs between {dart} ({a}) and {other} ({b})")]
+    MuNotConstant {
+        /// 1 = μa on edges, 2 = μf on faces, 3 = μt on volumes.
+        dim: usize,
+        /// A dart.
+        dart: DartId,
+        /// Its level.
+        a: u8,
+        /// A dart of the same cell.
+        other: DartId,
+        /// Its level.
+        b: u8,
+    },
+    /// A dart of B_i has an image outside B_i at level i.
+    #[error("level {level}: α{j}({dart}) = {image} is not in B_{level}")]
+    NotClosed {
+        /// The level.
+        level: u8,
+        /// The dart.
+        dart: DartId,
+        /// The involution.
+        j: usize,
+        /// Its image.
+        image: DartId,
+    },
+    /// The G-map extracted at a level breaks a G-map law.
+    #[error("level {level} is not a valid G-map: {source}")]
+    InvalidLevel {
+        /// The level.
+        level: u8,
+        /// The law broken.
+        source: InvariantViolation,
+    },
+    /// The finest map breaks a G-map law.
+    #[error("the finest map is not valid: {0}")]
+    InvalidMap(InvariantViolation),
+}
+
+/// An extracted level G_i together with the ids its darts have in the leveled map.
+#[derive(Clone, Debug)]
+pub struct LevelView<const N: usize> {
+    /// G_i as a G-map of its own (dart k of `map` is dart `darts[k]` of the leveled map).
+    pub map: GMap<N>,
+    /// The leveled-map dart of each dart of `map`.
+    pub darts: Vec<DartId>,
+}
+
+/// A G-map with adaptive resolution levels. See the [module docs](self).
+#[derive(Clone, Debug)]
+pub struct LeveledMap<const N: usize> {
+    map: GMap<N>,
+    dart_level: Vec<u8>,
+    mu: Vec<Mu>,
+    /// Whether the vertex of the dart inside its face is an inserted (flat) vertex of a side of
+    /// the face rather than one of its corners.
+    flat: Vec<bool>,
+    history: Vec<Vec<LinkChange>>,
+    max_level: u8,
+    points: Vec<[f64; 3]>,
+    op: ops::OpLog,
+}
+
+impl<const N: usize> LeveledMap<N> {
+    /// Wraps a G-map as level 0: every dart gets level 0 and μ = 0. `points[v]` is the position of
+    /// the vertex with id v (may be empty when geometry is not needed; new vertices then get the
+    /// origin). O(capacity).
+    pub fn new(map: GMap<N>, points: Vec<[f64; 3]>) -> Self {
+        let cap = map.capacity();
+        LeveledMap {
+            map,
+            dart_level: vec![0; cap],
+            mu: vec![Mu::default(); cap],
+            flat: vec![false; cap],
+            history: vec![Vec::new(); cap],
+            max_level: 0,
+            points,
+            op: ops::OpLog::default(),
+        }
+    }
+
+    /// The finest level G_k. O(1).
+    pub fn map(&self) -> &GMap<N> {
+        &self.map
+    }
+
+    /// The largest level any operation has used (k). O(1).
+    pub fn max_level(&self) -> u8 {
+        self.max_level
+    }
+
+    /// The level at which dart `d` was created. O(1). Panics if `d` was never allocated.
+    pub fn dart_level(&self, d: DartId) -> u8 {
+        self.dart_level[d.index()]
+    }
+
+    /// μa, μf, μt of dart `d`. O(1). Panics if `d` was never allocated.
+    pub fn mu(&self, d: DartId) -> Mu {
+        self.mu[d.index()]
+    }
+
+    /// Vertex positions keyed by vertex id (new vertices are edge midpoints). O(1).
+    pub fn points(&self) -> &[[f64; 3]] {
+        &self.points
+    }
+
+    /// Position of the vertex of dart `d` (the origin if no geometry was given). O(1).
+    pub fn position(&self, d: DartId) -> [f64; 3] {
+        self.points.get(self.map.vertex_id(d).index()).copied().unwrap_or([0.0; 3])
+    }
+
+    /// Number of darts of B_i (created at a level ≤ i). O(capacity).
+    pub fn darts_at_level(&self, i: u8) -> usize {
+        self.map.darts().filter(|d| self.dart_level[d.index()] <= i).count()
+    }
+
+    /// αj^i(d): the image of d by αj at level i (the paper's α0^i for j = 0). O(changes of d).
+    pub fn alpha_at(&self, i: u8, j: usize, d: DartId) -> DartId {
+        // The history of d is in non-decreasing level order; the first change made after level i
+        // holds the value the link had at level i.
+        self.history[d.index()]
+            .iter()
+            .find(|c| c.j as usize == j && c.level > i)
+            .map_or_else(|| self.map.alpha_dyn(j, d), |c| DartId(c.old))
+    }
+
+    /// Extracts G_i = (B_i, α0^i, α1^i, …, αn^i) as a G-map of its own, with fresh dense dart and
+    /// cell ids. O(capacity + |B_i| · n).
+    ///
+    /// Errors: [`LevelError::NotClosed`] if some αj^i leaves B_i (a bug of this module).
+    pub fn level(&self, i: u8) -> Result<LevelView<N>, LevelError> {
+        let darts: Vec<DartId> = self.map.darts().filter(|d| self.dart_level[d.index()] <= i).collect();
+        let mut index = vec![u32::MAX; self.map.capacity()];
+        for (k, d) in darts.iter().enumerate() {
+            index[d.index()] = k as u32;
+        }
+        let mut out = GMap::<N>::new();
+        out.alloc_darts_raw(darts.len());
+        for (k, &d) in darts.iter().enumerate() {
+            for j in 0..=N {
+                let image = self.alpha_at(i, j, d);
+                let target = index[image.index()];
+                if target == u32::MAX {
+                    return Err(LevelError::NotClosed { level: i, dart: d, j, image });
+                }
+                out.link_raw(j, DartId(k as u32), DartId(target));
+            }
+        }
+        for dim in 0..=N {
+            let reps = out.one_dart_per_cell_by_traversal(dim);
+            for (id, &r) in reps.iter().enumerate() {
+                for x in out.orbit(r, AlphaMask::cell(N, dim)) {
+                    out.set_cell_raw(dim, x, id as u32);
+                }
+            }
+            out.set_id_alloc_raw(dim, reps.len() as u32, Vec::new());
+        }
+        Ok(LevelView { map: out, darts })
+    }
+
+    /// Checks the level laws on the finest map: μt ≤ μf ≤ μa at every dart, μa constant on
+    /// edges, μf on faces, μt on volumes, dart levels ≤ max level. O(darts · n).
+    ///
+    /// Errors: the first [`LevelError::MuOrder`] or [`LevelError::MuNotConstant`] found.
+    pub fn check_levels(&self) -> Result<(), LevelError> {
+        for d in self.map.darts() {
+            let mu = self.mu[d.index()];
+            if !(mu.tet <= mu.face && mu.face <= mu.edge) || self.dart_level[d.index()] > self.max_level {
+                return Err(LevelError::MuOrder { dart: d, mu });
+            }
+            for j in 0..=N {
+                let e = self.map.alpha_dyn(j, d);
+                let other = self.mu[e.index()];
+                let pairs = [(1, mu.edge, other.edge), (2, mu.face, other.face), (3, mu.tet, other.tet)];
+                for (dim, a, b) in pairs {
+                    // αj keeps the dim-cell for every j ≠ dim (in 2D, μt is 0 everywhere).
+                    if j != dim && a != b {
+                        return Err(LevelError::MuNotConstant { dim, dart: d, a, other: e, b });
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Every law: the finest map valid, [`Self::check_levels`], and every level 0..=k extracted
+    /// and valid (B_{i−1} ⊂ B_i holds by construction of B_i from dart levels).
+    /// O(k · capacity · n²).
+    pub fn check_all(&self) -> Result<(), LevelError> {
+        self.map.validate().map_err(LevelError::InvalidMap)?;
+        self.check_levels()?;
+        for i in 0..=self.max_level {
+            let view = self.level(i)?;
+            view.map.validate().map_err(|source| LevelError::InvalidLevel { level: i, source })?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,232 @@
+//! Edge subdivision (any dimension) and triangle 1→4 subdivision in 2-G-maps (seed 004, §4.3.1,
+//! §4.3.2, §5.1).
+//!
+//! ```text
+//!            c2                         c2
+//!           /  \                       /  \
+//!          /    \                   m20 -- m12
+//!         /      \      1→4         / \    / \
+//!        /        \    ─────►      /   \  /   \
+//!      c0 -------- c1            c0 -- m01 --- c1
+//! ```
+//! A side that a neighbour already split keeps its midpoint (the inserted vertex of lowest dart
+//! level on that side); the others are split now, which also splits the neighbour's edge (its
+//! face then has an inserted *flat* vertex and keeps its face level).
+
+use super::{LeveledMap, Mu, SubdivideError};
+use crate::gmap::{AlphaMask, DartId};
+
+/// One side of a triangle face: the corner dart it starts from and its inserted (flat) vertices
+/// in order, each as (dart on the incoming half, dart on the outgoing half).
+#[derive(Clone, Debug)]
+struct Side {
+    start: DartId,
+    flats: Vec<(DartId, DartId)>,
+}
+
+impl<const N: usize> LeveledMap<N> {
+    /// Inserts a vertex in the middle of the edge of `d` at level `level` (the paper's
+    /// `subdividedge`). Every dart x of the edge gets a new dart x' with α0^level(x) = x'; the
+    /// new darts are α1-linked pairwise at the new vertex and αj-linked (j ≥ 2) like their
+    /// partners. All darts of the two halves take μa = level. Returns α0(d) afterwards.
+    /// O(edge · n).
+    ///
+    /// Errors: [`SubdivideError::NoSuchDart`], [`SubdivideError::OpenEdge`],
+    /// [`SubdivideError::AlreadyAtLevel`] (μa(d) ≥ level), the level-order errors.
+    pub fn split_edge(&mut self, d: DartId, level: u8) -> Result<DartId, SubdivideError> {
+        self.check_op_level(level)?;
+        self.check_edge(d, level)?;
+        self.begin(level);
+        let m = self.split_edge_raw(d);
+        self.finish();
+        Ok(m)
+    }
+
+    fn check_edge(&self, d: DartId, level: u8) -> Result<(), SubdivideError> {
+        if !self.map.contains(d) {
+            return Err(SubdivideError::NoSuchDart(d));
+        }
+        if let Some(x) = self.map.orbit(d, AlphaMask::cell(N, 1)).into_iter().find(|&x| self.map.is_free(0, x)) {
+            return Err(SubdivideError::OpenEdge(x));
+        }
+        let cell_level = self.mu[d.index()].edge;
+        if cell_level >= level {
+            return Err(SubdivideError::AlreadyAtLevel { dart: d, dim: 1, cell_level, level });
+        }
+        Ok(())
+    }
+
+    /// The topology of [`Self::split_edge`] inside a running operation. The edge must be closed.
+    pub(super) fn split_edge_raw(&mut self, d: DartId) -> DartId {
+        let level = self.op_level();
+        let edge = self.map.orbit(d, AlphaMask::cell(N, 1));
+        let ends: Vec<DartId> = edge.iter().map(|&x| self.map.alpha_dyn(0, x)).collect();
+        let fresh: Vec<DartId> = edge
+            .iter()
+            .map(|&x| {
+                let mu = self.mu[x.index()];
+                self.new_dart(Mu { edge: level, ..mu }, true)
+            })
+            .collect();
+        let prime = |x: DartId| fresh[edge.iter().position(|&e| e == x).expect("edge orbit is closed")];
+        for k in 0..edge.len() {
+            self.link(0, edge[k], fresh[k]);
+        }
+        for k in 0..edge.len() {
+            self.link(1, fresh[k], prime(ends[k]));
+            for j in 2..=N {
+                let other = self.map.alpha_dyn(j, edge[k]);
+                self.link(j, fresh[k], prime(other));
+            }
+        }
+        for &x in &edge {
+            self.mu[x.index()].edge = level;
+        }
+        let m = prime(d);
+        self.note_midpoint(m, d, ends[0]);
+        m
+    }
+}
+
+impl<const N: usize> LeveledMap<N> {
+    /// Subdivides the triangle face of `d` into four at level `level` (the paper's triangle
+    /// subdivision; in a 3-G-map the face is split on both of its sides, so the α3-adjacent
+    /// volume sees the same four faces): its three sides are split at their midpoints (existing inserted vertices
+    /// are reused) and three edges are inserted between the midpoints. Every dart of the four
+    /// children takes μf = level; their edges and the α2-adjacent halves take μa = level.
+    /// Returns one dart of each child: the corner triangles at the three corners, then the
+    /// central one. O(face + touched cells).
+    ///
+    /// Errors: [`SubdivideError::WrongDimension`] (n ∉ {2, 3}), [`SubdivideError::NoSuchDart`],
+    /// [`SubdivideError::AlreadyAtLevel`] (μf(d) ≥ level), [`SubdivideError::NotATriangle`],
+    /// [`SubdivideError::OpenEdge`], the level-order errors. The map is unchanged on error.
+    pub fn subdivide_triangle(&mut self, d: DartId, level: u8) -> Result<[DartId; 4], SubdivideError> {
+        if !(2..=3).contains(&N) {
+            return Err(SubdivideError::WrongDimension(N));
+        }
+        self.check_op_level(level)?;
+        if !self.map.contains(d) {
+            return Err(SubdivideError::NoSuchDart(d));
+        }
+        let cell_level = self.mu[d.index()].face;
+        if cell_level >= level {
+            return Err(SubdivideError::AlreadyAtLevel { dart: d, dim: 2, cell_level, level });
+        }
+        let sides = self.triangle_sides(d)?;
+        if let Some(s) = sides.iter().find(|s| self.map.is_free(0, s.start)) {
+            return Err(SubdivideError::OpenEdge(s.start));
+        }
+        self.begin(level);
+        let mids: Vec<(DartId, DartId)> = sides.iter().map(|s| self.side_midpoint(s)).collect();
+        let (m_in, m_out): (Vec<DartId>, Vec<DartId>) = mids.into_iter().unzip();
+        self.insert_edge_2d(m_in[0], m_out[2]);
+        self.insert_edge_2d(m_out[0], m_in[1]);
+        let (e, f) = self.insert_edge_2d(m_out[1], m_in[2]);
+        let center = if self.map.same_orbit(f, sides[2].start, AlphaMask::of(&[0, 1])) { e } else { f };
+        for &x in m_in.iter().chain(&m_out) {
+            self.flat[x.index()] = false;
+        }
+        let children = [sides[0].start, sides[1].start, sides[2].start, center];
+        for c in children {
+            self.set_child_levels(c, level);
+        }
+        self.finish();
+        Ok(children)
+    }
+
+    /// The three sides of the triangle face of `d`, from a corner. O(face).
+    fn triangle_sides(&self, d: DartId) -> Result<Vec<Side>, SubdivideError> {
+        let face = self.map.orbit(d, AlphaMask::of(&[0, 1]));
+        let corner = face.iter().copied().find(|&x| !self.flat[x.index()]);
+        let corner = corner.ok_or(SubdivideError::NotATriangle { dart: d, corners: 0 })?;
+        let mut sides = Vec::new();
+        let mut x = corner;
+        let mut current = Side { start: x, flats: Vec::new() };
+        // Each step crosses one edge; the face has face.len() / 2 edges at most.
+        for _ in 0..face.len() {
+            let y = self.map.alpha_dyn(0, x);
+            let z = self.map.alpha_dyn(1, y);
+            if self.flat[y.index()] {
+                current.flats.push((y, z));
+            } else {
+                sides.push(std::mem::replace(&mut current, Side { start: z, flats: Vec::new() }));
+            }
+            x = z;
+            if x == corner {
+                break;
+            }
+        }
+        if sides.len() != 3 {
+            return Err(SubdivideError::NotATriangle { dart: d, corners: sides.len() });
+        }
+        Ok(sides)
+    }
+
+    /// The two darts of the face at the midpoint of a side (incoming half, outgoing half),
+    /// splitting the side now if nobody split it before.
+    fn side_midpoint(&mut self, side: &Side) -> (DartId, DartId) {
+        let oldest = side.flats.iter().min_by_key(|(a, _)| self.dart_level[a.index()]).copied();
+        match oldest {
+            Some(pair) => pair,
+            None => {
+                let m = self.split_edge_raw(side.start);
+                (m, self.map.alpha_dyn(1, m))
+            }
+        }
+    }
+
+    /// Inserts an edge in the face of `a` and `b` between their vertices (α1(a) and α1(b) are
+    /// separated), splitting the face in two. Returns the two new darts at the vertex of `a`, one
+    /// in each of the two faces. O(face).
+    fn insert_edge_2d(&mut self, a: DartId, b: DartId) -> (DartId, DartId) {
+        let (a1, b1) = (self.map.alpha_dyn(1, a), self.map.alpha_dyn(1, b));
+        let mut x = a1;
+        let end = loop {
+            x = self.map.alpha_dyn(0, x);
+            if x == b || x == b1 {
+                break x;
+            }
+            x = self.map.alpha_dyn(1, x);
+        };
+        let other = if end == b { b1 } else { b };
+        let level = self.op_level();
+        let mu = Mu { edge: level, face: level, tet: self.mu[a.index()].tet };
+        let [e1, e2, f1, f2] = [(); 4].map(|_| self.new_dart(mu, false));
+        self.link(0, e1, e2);
+        self.link(0, f1, f2);
+        self.link(2, e1, f1);
+        self.link(2, e2, f2);
+        self.link(1, a1, e1);
+        self.link(1, end, e2);
+        self.link(1, a, f1);
+        self.link(1, other, f2);
+        if N >= 3 && !self.map.is_free(3, a) {
+            let tet = self.mu[self.map.alpha_dyn(3, a).index()].tet;
+            let mirror = [(); 4].map(|_| self.new_dart(Mu { tet, ..mu }, false));
+            for (k, x) in [e1, e2, f1, f2].into_iter().enumerate() {
+                self.link(3, x, mirror[k]);
+            }
+            let [e1m, e2m, f1m, f2m] = mirror;
+            self.link(0, e1m, e2m);
+            self.link(0, f1m, f2m);
+            self.link(2, e1m, f1m);
+            self.link(2, e2m, f2m);
+            let side = [a1, end, a, other].map(|x| self.map.alpha_dyn(3, x));
+            self.link(1, side[0], e1m);
+            self.link(1, side[1], e2m);
+            self.link(1, side[2], f1m);
+            self.link(1, side[3], f2m);
+        }
+        (e1, f1)
+    }
+
+    /// μf = level on the face of `c`, μa = level on its edges (both sides). O(face).
+    fn set_child_levels(&mut self, c: DartId, level: u8) {
+        for x in self.map.orbit(c, AlphaMask::cell(N, 2)) {
+            self.mu[x.index()].face = level;
+            for y in self.map.orbit(x, AlphaMask::cell(N, 1)) {
+                self.mu[y.index()].edge = level;
+            }
+        }
+    }
+}

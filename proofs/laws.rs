@@ -169,7 +169,9 @@ pub fn witness_holds<const N: usize>(map: &GMap<N>, v: &InvariantViolation) -> b
 /// The law `validate()` must name when several are broken: the first in the order of its table
 /// (a broken involution is the cause, not the quasi-manifold failure a neighbour then shows).
 fn first_in_table_order(broken: &[Law]) -> Option<Law> {
-    [Law::Involution, Law::QuasiManifold, Law::CellIdConstant, Law::CellIdUnique].into_iter().find(|l| broken.contains(l))
+    [Law::Involution, Law::QuasiManifold, Law::CellIdConstant, Law::CellIdUnique]
+        .into_iter()
+        .find(|l| broken.contains(l))
 }
 
 /// `validate()` fails iff [`broken_laws`] finds a law broken, names the first of them in table

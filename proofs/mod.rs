@@ -7,6 +7,8 @@
 //!   against brute force over all relabellings.
 //! * [`invalid`]: every single raw corruption of small valid maps; `validate()` must fail iff
 //!   some law is broken, and must name a law that is broken, with a true witness.
+//! * [`cut_dissociation`]: every order of dissociating every subset of inner faces (and removing
+//!   tets) on two tets, a closed fan of three and the Kuhn cube k = 1, every cut law checked.
 //! * [`harnesses`]: Kani proof harnesses that run here as seeded randomized tests through
 //!   [`kani_shim`], and unchanged under `cargo kani --tests`.
 //!
@@ -14,6 +16,7 @@
 //! Scope: `TOPOMECH_PROOF_DARTS` overrides the dart bound (see docs/VERIFICATION.md).
 #![allow(unexpected_cfgs)]
 
+mod cut_dissociation;
 mod enumerate;
 #[cfg(any(kani, test))]
 mod harnesses;

@@ -5,50 +5,26 @@
 
 mod cut_common;
 
-use cut_common::{Harness, Op};
+use cut_common::{decode, run_bytes, run_ops, Harness, Op, MAX_OPS, OP_BYTES};
 use proptest::prelude::*;
-use topomech::generate::{kuhn_cube, SplitMix64};
 use topomech::mechanics::Vec3;
 
-fn op_strategy() -> impl Strategy<Value = Op> {
-    let dir = (-1.0f64..1.0, -1.0f64..1.0, 0.1f64..1.0).prop_map(|(x, y, z)| [x, y, z] as Vec3);
-    prop_oneof![
-        6 => any::<usize>().prop_map(Op::Dissociate),
-        1 => any::<usize>().prop_map(Op::DissociateBoundary),
-        3 => any::<usize>().prop_map(Op::Remove),
-        1 => any::<usize>().prop_map(Op::RemoveAgain),
-        1 => (any::<usize>(), dir.clone()).prop_map(|(k, n)| Op::Incise(k, n)),
-        2 => (any::<usize>(), dir).prop_map(|(k, n)| Op::Tear(k, n)),
-    ]
-}
-
-fn jittered_cube(k: usize, seed: u64) -> (Vec<Vec3>, Vec<[u32; 4]>) {
-    let (mut points, tets) = kuhn_cube(k);
-    let mut rng = SplitMix64(seed);
-    for p in &mut points {
-        for c in p.iter_mut() {
-            *c += (rng.below(1000) as f64 / 1000.0 - 0.5) * 0.2;
-        }
-    }
-    (points, tets)
-}
-
 fn run(mut h: Harness, ops: &[Op]) -> Result<(), TestCaseError> {
-    h.check().map_err(TestCaseError::fail)?;
-    for (i, &op) in ops.iter().enumerate() {
-        h.apply(op).map_err(|e| TestCaseError::fail(format!("step {i} {op:?}: {e}")))?;
-        h.check().map_err(|e| TestCaseError::fail(format!("after step {i} {op:?}: {e}")))?;
-    }
-    Ok(())
+    run_ops(&mut h, ops).map_err(TestCaseError::fail)
+}
+
+/// Byte strings of the fuzz target's encoding ([`decode`]): a header and 1–13 ops.
+fn scenario_bytes() -> impl Strategy<Value = Vec<u8>> {
+    (any::<[u8; 2]>(), prop::collection::vec(any::<[u8; OP_BYTES]>(), 1..14))
+        .prop_map(|(h, ops)| h.into_iter().chain(ops.into_iter().flatten()).collect())
 }
 
 proptest! {
     #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
 
     #[test]
-    fn cut_sequences_on_kuhn_cubes(k in 1usize..=2, seed in any::<u64>(), ops in prop::collection::vec(op_strategy(), 1..14)) {
-        let (points, tets) = jittered_cube(k, seed);
-        run(Harness::new(points, tets), &ops)?;
+    fn cut_sequences_on_kuhn_cubes(bytes in scenario_bytes()) {
+        run_bytes(&bytes).map_err(TestCaseError::fail)?;
     }
 }
 
@@ -56,15 +32,28 @@ proptest! {
     #![proptest_config(ProptestConfig { cases: 3, ..ProptestConfig::default() })]
 
     #[test]
-    fn cut_sequences_on_liver_547(ops in prop::collection::vec(op_strategy(), 1..5)) {
+    fn cut_sequences_on_liver_547(bytes in scenario_bytes()) {
         let path = std::path::Path::new("/work/shared/meshes/liver_547.msh");
         if !path.exists() {
             eprintln!("liver_547.msh absent: skipped");
             return Ok(());
         }
         let mesh = topomech::io::read_mesh(path).unwrap();
-        run(Harness::new(mesh.points, mesh.tets), &ops)?;
+        let ops = decode(&bytes).ops;
+        run(Harness::new(mesh.points, mesh.tets).unwrap(), &ops[..ops.len().min(4)])?;
     }
+}
+
+/// Every byte string decodes; the header and each op group land where the format says.
+#[test]
+fn decoder_reads_the_documented_format() {
+    let s = decode(&[3, 7, 0, 5, 1, 0, 10, 2, 0, 0b11_000_111, 9]);
+    assert_eq!((s.k, s.seed), (2, 7));
+    assert_eq!(s.ops.len(), 2, "trailing partial group ignored");
+    assert_eq!(s.ops[0], Op::Dissociate(5 + 256));
+    assert_eq!(s.ops[1], Op::Incise(2, [1.0, -1.0, 1.0]));
+    assert_eq!(decode(&[]).ops, vec![]);
+    assert_eq!(decode(&vec![0u8; 4 * 100]).ops.len(), MAX_OPS);
 }
 
 /// The oracle is not vacuous: on two tets sharing a face it predicts the counts the kernel's own
@@ -72,7 +61,7 @@ proptest! {
 #[test]
 fn oracle_agrees_with_hand_counts() {
     let points = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
-    let mut h = Harness::new(points, vec![[0, 1, 2, 3], [0, 1, 2, 4]]);
+    let mut h = Harness::new(points, vec![[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
     assert_eq!(h.oracle.counts(), ([5, 9, 7, 2], 6, 1));
     h.apply(Op::Dissociate(0)).unwrap();
     assert_eq!(h.oracle.counts(), ([8, 12, 8, 2], 8, 2));
@@ -82,4 +71,83 @@ fn oracle_agrees_with_hand_counts() {
     h.check().unwrap();
     h.apply(Op::RemoveAgain(0)).unwrap();
     h.check().unwrap();
+}
+
+/// One edit of a spring system's incidence lists.
+#[derive(Clone, Debug)]
+enum Edit {
+    Slot,
+    Spring(usize, usize),
+    Move(usize, usize, usize),
+    Remove(usize),
+}
+
+fn edit_strategy() -> impl Strategy<Value = Edit> {
+    prop_oneof![
+        1 => Just(Edit::Slot),
+        4 => (any::<usize>(), any::<usize>()).prop_map(|(a, b)| Edit::Spring(a, b)),
+        3 => (any::<usize>(), any::<usize>(), any::<usize>()).prop_map(|(s, a, b)| Edit::Move(s, a, b)),
+        2 => any::<usize>().prop_map(Edit::Remove),
+    ]
+}
+
+/// Two distinct slots picked by (a, b) among n ≥ 2.
+fn pick_ends(n: usize, a: usize, b: usize) -> [u32; 2] {
+    let a = a % n;
+    let b = (a + 1 + b % (n - 1)) % n;
+    [a as u32, b as u32]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+
+    /// The incidence lists edited in place (appending slots and springs, moving spring ends,
+    /// swap-removing springs, with segment moves and compactions) always hold exactly the springs
+    /// of `ends`, and give the same forces as a system built fresh from the same arrays (up to the
+    /// summation order inside each vertex).
+    #[test]
+    fn incidence_lists_follow_edits(edits in prop::collection::vec(edit_strategy(), 1..120)) {
+        use topomech::mechanics::SpringSystem;
+        let n0 = 4;
+        let mut sys = SpringSystem::new(
+            vec![[0, 1], [1, 2], [2, 3]], vec![1.0; 3], vec![10.0, 20.0, 30.0], vec![0.1; 3],
+            vec![1.0; n0], &[false; 4], vec![0.0; n0], [0.0, 0.0, -1.0],
+        );
+        for e in &edits {
+            let n = sys.slots();
+            match *e {
+                Edit::Slot => { sys.push_slot(1.0 + n as f64, false, 0.01); }
+                Edit::Spring(a, b) => { sys.push_spring(pick_ends(n, a, b), 0.5, 1.0 + a as f64 % 7.0, 0.2); }
+                Edit::Move(s, a, b) if sys.springs() > 0 => {
+                    let s = s % sys.springs();
+                    sys.set_spring(s, pick_ends(n, a, b), 0.7, 3.0, 0.3);
+                }
+                Edit::Remove(s) if sys.springs() > 0 => { sys.swap_remove_spring(s % sys.springs()); }
+                _ => {}
+            }
+            prop_assert!(sys.check_incidence().is_ok(), "{:?}", sys.check_incidence());
+        }
+        let fixed: Vec<bool> = sys.inv_mass.iter().map(|&w| w == 0.0).collect();
+        let fresh = SpringSystem::new(
+            sys.ends.clone(), sys.rest.clone(), sys.stiffness.clone(), sys.damping.clone(),
+            sys.mass.clone(), &fixed, sys.viscosity.clone(), sys.gravity,
+        );
+        let n = sys.slots();
+        let x: Vec<Vec3> = (0..n).map(|i| [i as f64 * 0.37, (i * i % 5) as f64 * 0.11, (i % 3) as f64]).collect();
+        let v: Vec<Vec3> = (0..n).map(|i| [0.01 * i as f64, -0.02, 0.0]).collect();
+        let (mut sf1, mut sf2) = (vec![[0.0; 3]; sys.springs()], vec![[0.0; 3]; sys.springs()]);
+        let (mut f1, mut f2) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
+        sys.forces(&x, &v, &mut sf1, &mut f1, false);
+        fresh.forces(&x, &v, &mut sf2, &mut f2, false);
+        for i in 0..n {
+            for c in 0..3 {
+                let (a, b) = (f1[i][c], f2[i][c]);
+                prop_assert!((a - b).abs() <= 1e-9 * (1.0 + a.abs().max(b.abs())), "slot {} force {:?} vs fresh {:?}", i, f1[i], f2[i]);
+            }
+        }
+        let deg = |s: &SpringSystem, i| { let mut l: Vec<_> = s.incident(i).map(|(k, w)| (k, w as i8)).collect(); l.sort_unstable(); l };
+        for i in 0..n {
+            prop_assert_eq!(deg(&sys, i), deg(&fresh, i));
+        }
+    }
 }

@@ -10,6 +10,8 @@
 //!   incise_plane      dissociate every inner face whose two tets' centroids lie on opposite sides
 //!   tear_vertex       the closed fan of faces around a vertex (walk α2 α3 α2 α1), dissociated
 //!   components        connected parts and their masses
+//!   ops               one generator of cut sequences (decoder, oracle, law checks) for the
+//!                     proptest suite, the fuzz target and the replay test
 //! ```
 //!
 //! Every operation returns what it changed, including the [`TouchedCells`] that
@@ -19,6 +21,7 @@
 mod connectivity;
 mod dissociate;
 mod incise;
+pub mod ops;
 mod remove;
 mod tear;
 

@@ -8,9 +8,26 @@
 //!   b is −F_s (Hooke's law plus damping along the spring).
 //!
 //! [`SpringSystem`] evaluates them in two passes: one over the springs writing F_s into an array,
-//! then one over the vertices gathering, through a CSR list of incident springs, the F_s of the
-//! springs that start at v minus those that end at v. No two writes go to the same slot, so both
-//! passes split freely across threads and the result is bitwise the same for any thread count.
+//! then one over the vertices gathering, through a list of incident springs per vertex, the F_s of
+//! the springs that start at v minus those that end at v. No two writes go to the same slot, so
+//! both passes split freely across threads and the result is bitwise the same for any thread
+//! count: each vertex sums its own list in its stored order.
+//!
+//! # Incidence lists with slack
+//! The lists live in one array `adj`; vertex v owns the segment `adj[start..start + cap]`, whose
+//! first `heads` entries are the springs with a = v and the next `len − heads` those with b = v:
+//!
+//! ```text
+//!   adj: … | s3 s9 │ s4 · · | s1 s2 s7 │ s8 | …      (│ = heads/tails border, · = slack)
+//!          └── v ─────────┘ └── w ─────────┘
+//! ```
+//!
+//! A fresh [`SpringSystem::new`] packs the segments tightly in slot order with heads before tails
+//! (the classic CSR, so a fresh build sums in the same order as before). The mutators
+//! ([`SpringSystem::push_slot`], [`SpringSystem::push_spring`], [`SpringSystem::set_spring`],
+//! [`SpringSystem::swap_remove_spring`]) edit only the segments of the ends involved, O(degree):
+//! a full segment moves to the end of `adj` with twice the capacity, and the array is compacted
+//! once the abandoned space exceeds the live entries (amortised O(degree) per change).
 
 use rayon::prelude::*;
 
@@ -22,7 +39,8 @@ pub const PARALLEL_CHUNK: usize = 4096;
 /// The mass/spring system as flat arrays: what the step loop reads.
 ///
 /// Vertices are *slots* `0..slots()`: positions and velocities are passed in as slices of that
-/// length. A slot with `inv_mass == 0` does not move (pinned, dead or massless).
+/// length. A slot with `inv_mass == 0` does not move (pinned, dead or massless). Equality compares
+/// the arrays and, per slot, the incident lists in order (not where they sit in memory).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct SpringSystem {
     /// Spring end slots (a, b).
@@ -41,14 +59,13 @@ pub struct SpringSystem {
     pub viscosity: Vec<f64>,
     /// Gravity acceleration g.
     pub gravity: Vec3,
-    /// CSR of incident springs: for slot v, `adj[off[2v]..off[2v+1]]` are the springs with a = v,
-    /// `adj[off[2v+1]..off[2v+2]]` those with b = v.
-    off: Vec<u32>,
-    adj: Vec<u32>,
+    /// Incident springs per slot (module docs). Change `ends` only through the mutators, which
+    /// keep it in step; [`SpringSystem::check_incidence`] verifies it.
+    inc: Incidence,
 }
 
 impl SpringSystem {
-    /// A system from its arrays; builds the CSR. O(slots + springs).
+    /// A system from its arrays; builds the incidence lists packed (module docs). O(slots + springs).
     ///
     /// Panics if the arrays disagree in length or an end is out of range (a bug of the builder).
     #[allow(clippy::too_many_arguments)]
@@ -66,8 +83,91 @@ impl SpringSystem {
         assert!(rest.len() == ends.len() && stiffness.len() == ends.len() && damping.len() == ends.len());
         assert!(fixed.len() == n && viscosity.len() == n);
         let inv_mass = mass.iter().zip(fixed).map(|(&m, &f)| if f || m <= 0.0 { 0.0 } else { 1.0 / m }).collect();
-        let (off, adj) = incidence(n, &ends);
-        SpringSystem { ends, rest, stiffness, damping, mass, inv_mass, viscosity, gravity, off, adj }
+        let inc = Incidence::packed(n, &ends);
+        SpringSystem { ends, rest, stiffness, damping, mass, inv_mass, viscosity, gravity, inc }
+    }
+
+    /// Appends a slot with mass `mass` (fixed when `fixed` or `mass <= 0`) and viscosity
+    /// `viscosity`, with no spring; returns its index. O(1) amortised.
+    pub fn push_slot(&mut self, mass: f64, fixed: bool, viscosity: f64) -> usize {
+        self.mass.push(0.0);
+        self.inv_mass.push(0.0);
+        self.viscosity.push(0.0);
+        self.inc.push_slot();
+        let v = self.mass.len() - 1;
+        self.set_slot(v, mass, fixed, viscosity);
+        v
+    }
+
+    /// Sets slot v's mass, fixedness and viscosity (`inv_mass` = 0 when fixed or `mass <= 0`,
+    /// else 1/mass). O(1). Panics if v is not a slot.
+    pub fn set_slot(&mut self, v: usize, mass: f64, fixed: bool, viscosity: f64) {
+        self.mass[v] = mass;
+        self.viscosity[v] = viscosity;
+        self.inv_mass[v] = if fixed || mass <= 0.0 { 0.0 } else { 1.0 / mass };
+    }
+
+    /// Appends spring `ends` = (a, b) with rest length, stiffness and damping; returns its index.
+    /// O(degree of a and b) amortised. Panics if an end is not a slot or a = b.
+    pub fn push_spring(&mut self, ends: [u32; 2], rest: f64, stiffness: f64, damping: f64) -> usize {
+        assert!(ends[0] != ends[1] && (ends[0].max(ends[1]) as usize) < self.slots(), "bad spring ends {ends:?}");
+        let s = self.ends.len();
+        self.ends.push(ends);
+        self.rest.push(rest);
+        self.stiffness.push(stiffness);
+        self.damping.push(damping);
+        self.inc.insert(ends[0] as usize, true, s as u32);
+        self.inc.insert(ends[1] as usize, false, s as u32);
+        s
+    }
+
+    /// Rewrites spring s: its ends (moving it between incidence lists when they change), rest
+    /// length, stiffness and damping. O(degree of the old and new ends) amortised. Panics if s is
+    /// not a spring, an end is not a slot or a = b.
+    pub fn set_spring(&mut self, s: usize, ends: [u32; 2], rest: f64, stiffness: f64, damping: f64) {
+        assert!(ends[0] != ends[1] && (ends[0].max(ends[1]) as usize) < self.slots(), "bad spring ends {ends:?}");
+        let old = self.ends[s];
+        if old != ends {
+            self.inc.remove(old[0] as usize, true, s as u32);
+            self.inc.remove(old[1] as usize, false, s as u32);
+            self.inc.insert(ends[0] as usize, true, s as u32);
+            self.inc.insert(ends[1] as usize, false, s as u32);
+            self.ends[s] = ends;
+        }
+        self.rest[s] = rest;
+        self.stiffness[s] = stiffness;
+        self.damping[s] = damping;
+    }
+
+    /// Removes spring s; the last spring takes its index (its incidence entries are renamed).
+    /// Returns the former index of the moved spring, `None` if s was last. O(degree of the ends
+    /// of both springs). Panics if s is not a spring.
+    pub fn swap_remove_spring(&mut self, s: usize) -> Option<usize> {
+        let [a, b] = self.ends[s];
+        self.inc.remove(a as usize, true, s as u32);
+        self.inc.remove(b as usize, false, s as u32);
+        let last = self.ends.len() - 1;
+        let moved = (last != s).then(|| {
+            let [la, lb] = self.ends[last];
+            self.inc.rename(la as usize, true, last as u32, s as u32);
+            self.inc.rename(lb as usize, false, last as u32, s as u32);
+            last
+        });
+        self.ends.swap_remove(s);
+        self.rest.swap_remove(s);
+        self.stiffness.swap_remove(s);
+        self.damping.swap_remove(s);
+        moved
+    }
+
+    /// Whether the incidence lists hold exactly the springs of `ends`: spring s once in the head
+    /// list of `ends[s][0]` and once in the tail list of `ends[s][1]`, nothing else, segments
+    /// inside `adj` and disjoint. O(slots + springs).
+    ///
+    /// # Errors
+    /// [`IncidenceError`] naming the first slot found wrong.
+    pub fn check_incidence(&self) -> Result<(), IncidenceError> {
+        self.inc.check(self.slots(), &self.ends)
     }
 
     /// Number of vertex slots. O(1).
@@ -123,13 +223,13 @@ impl SpringSystem {
     /// Σ over incident springs (+F_s where v = a, −F_s where v = b). O(degree).
     #[inline(always)]
     fn gather(&self, i: usize, sf: &[Vec3]) -> Vec3 {
-        let (o0, o1, o2) = (self.off[2 * i] as usize, self.off[2 * i + 1] as usize, self.off[2 * i + 2] as usize);
+        let (heads, tails) = self.inc.lists(i);
         let mut f = [0.0; 3];
-        for &s in &self.adj[o0..o1] {
+        for &s in heads {
             let g = sf[s as usize];
             f = [f[0] + g[0], f[1] + g[1], f[2] + g[2]];
         }
-        for &s in &self.adj[o1..o2] {
+        for &s in tails {
             let g = sf[s as usize];
             f = [f[0] - g[0], f[1] - g[1], f[2] - g[2]];
         }
@@ -183,9 +283,8 @@ impl SpringSystem {
 
     /// The springs incident to slot i as (spring, sign): +1 where i is end a. O(degree).
     pub fn incident(&self, i: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
-        let (o0, o1, o2) = (self.off[2 * i] as usize, self.off[2 * i + 1] as usize, self.off[2 * i + 2] as usize);
-        let heads = self.adj[o0..o1].iter().map(|&s| (s as usize, 1.0));
-        heads.chain(self.adj[o1..o2].iter().map(|&s| (s as usize, -1.0)))
+        let (heads, tails) = self.inc.lists(i);
+        heads.iter().map(|&s| (s as usize, 1.0)).chain(tails.iter().map(|&s| (s as usize, -1.0)))
     }
 
     /// Kinetic energy ½ Σ m |v|² over free slots. O(slots).
@@ -265,24 +364,202 @@ fn spring_scale(dx: f64, dy: f64, dz: f64, dvx: f64, dvy: f64, dvz: f64, rest: f
     }
 }
 
-/// CSR of incident springs (see [`SpringSystem`]). O(slots + springs).
-fn incidence(n: usize, ends: &[[u32; 2]]) -> (Vec<u32>, Vec<u32>) {
-    let mut count = vec![0u32; 2 * n + 1];
-    for &[a, b] in ends {
-        count[2 * a as usize + 1] += 1;
-        count[2 * b as usize + 2] += 1;
+/// Why [`SpringSystem::check_incidence`] failed.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum IncidenceError {
+    /// The per-slot table does not have one entry per slot.
+    #[error("incidence table has {got} slots, the system {expected}")]
+    SlotCount {
+        /// Slots of the system.
+        expected: usize,
+        /// Entries of the table.
+        got: usize,
+    },
+    /// Slot `slot`'s segment runs outside `adj`, overlaps another one, or its counts are
+    /// inconsistent (heads ≤ len ≤ cap).
+    #[error("slot {slot}: segment out of bounds, overlapping or inconsistent")]
+    Segment {
+        /// The slot.
+        slot: usize,
+    },
+    /// Slot `slot`'s lists are not the springs whose ends name it.
+    #[error("slot {slot}: incident springs differ from the spring ends")]
+    Lists {
+        /// The slot.
+        slot: usize,
+    },
+}
+
+/// Where slot v's lists sit in `adj` (module docs).
+#[derive(Clone, Copy, Debug, Default)]
+struct Segment {
+    start: u32,
+    heads: u32,
+    len: u32,
+    cap: u32,
+}
+
+/// Incidence lists with slack (module docs).
+#[derive(Clone, Debug, Default)]
+struct Incidence {
+    seg: Vec<Segment>,
+    adj: Vec<u32>,
+    /// Entries of `adj` owned by no segment (abandoned by moves).
+    garbage: usize,
+}
+
+impl PartialEq for Incidence {
+    fn eq(&self, other: &Self) -> bool {
+        self.seg.len() == other.seg.len() && (0..self.seg.len()).all(|v| self.lists(v) == other.lists(v))
     }
-    for i in 1..count.len() {
-        count[i] += count[i - 1];
+}
+
+impl Incidence {
+    /// Tight CSR: slot order, heads then tails, spring order within each. O(slots + springs).
+    fn packed(n: usize, ends: &[[u32; 2]]) -> Self {
+        let mut seg = vec![Segment::default(); n];
+        for &[a, b] in ends {
+            seg[a as usize].heads += 1;
+            seg[a as usize].len += 1;
+            seg[b as usize].len += 1;
+        }
+        let mut start = 0u32;
+        for g in &mut seg {
+            g.start = start;
+            g.cap = g.len;
+            start += g.len;
+        }
+        let mut adj = vec![0u32; 2 * ends.len()];
+        let mut fill: Vec<[u32; 2]> = seg.iter().map(|g| [g.start, g.start + g.heads]).collect();
+        for (s, &[a, b]) in ends.iter().enumerate() {
+            for (v, side) in [(a as usize, 0), (b as usize, 1)] {
+                adj[fill[v][side] as usize] = s as u32;
+                fill[v][side] += 1;
+            }
+        }
+        Incidence { seg, adj, garbage: 0 }
     }
-    let off = count.clone();
-    let mut next = count;
-    let mut adj = vec![0u32; 2 * ends.len()];
-    for (s, &[a, b]) in ends.iter().enumerate() {
-        for slot in [2 * a as usize, 2 * b as usize + 1] {
-            adj[next[slot] as usize] = s as u32;
-            next[slot] += 1;
+
+    /// (heads, tails) of slot v. O(1).
+    #[inline(always)]
+    fn lists(&self, v: usize) -> (&[u32], &[u32]) {
+        let g = self.seg[v];
+        let (o0, o1, o2) = (g.start as usize, (g.start + g.heads) as usize, (g.start + g.len) as usize);
+        (&self.adj[o0..o1], &self.adj[o1..o2])
+    }
+
+    fn push_slot(&mut self) {
+        self.seg.push(Segment { start: self.adj.len() as u32, ..Segment::default() });
+    }
+
+    /// Adds spring s to v's head list (`head`) or tail list. O(degree) amortised.
+    fn insert(&mut self, v: usize, head: bool, s: u32) {
+        if self.seg[v].len == self.seg[v].cap {
+            self.grow(v);
+        }
+        let g = &mut self.seg[v];
+        let (o1, o2) = ((g.start + g.heads) as usize, (g.start + g.len) as usize);
+        if head {
+            // The first tail moves to the end of the tails; s takes its place.
+            self.adj[o2] = self.adj[o1];
+            self.adj[o1] = s;
+            g.heads += 1;
+        } else {
+            self.adj[o2] = s;
+        }
+        g.len += 1;
+    }
+
+    /// Removes spring s from v's head or tail list (panics if absent: a bug). O(degree).
+    fn remove(&mut self, v: usize, head: bool, s: u32) {
+        let p = self.position(v, head, s);
+        let g = &mut self.seg[v];
+        let (last_head, last) = ((g.start + g.heads) as usize - 1, (g.start + g.len) as usize - 1);
+        if head {
+            self.adj[p] = self.adj[last_head];
+            self.adj[last_head] = self.adj[last];
+            g.heads -= 1;
+        } else {
+            self.adj[p] = self.adj[last];
+        }
+        g.len -= 1;
+    }
+
+    /// Renames spring `from` to `to` in v's head or tail list. O(degree).
+    fn rename(&mut self, v: usize, head: bool, from: u32, to: u32) {
+        let p = self.position(v, head, from);
+        self.adj[p] = to;
+    }
+
+    fn position(&self, v: usize, head: bool, s: u32) -> usize {
+        let g = self.seg[v];
+        let range = if head { g.start..g.start + g.heads } else { g.start + g.heads..g.start + g.len };
+        let found = range.clone().find(|&p| self.adj[p as usize] == s);
+        found.unwrap_or_else(|| panic!("spring {s} missing from slot {v}'s incidence list {range:?}")) as usize
+    }
+
+    /// Moves v's full segment to the end of `adj` with twice the capacity (at least 4), then
+    /// compacts if the abandoned space exceeds the live entries. O(degree) amortised.
+    fn grow(&mut self, v: usize) {
+        let g = self.seg[v];
+        let new_start = self.adj.len();
+        self.adj.extend_from_within(g.start as usize..(g.start + g.len) as usize);
+        let cap = (2 * g.cap).max(4);
+        self.adj.resize(new_start + cap as usize, 0);
+        self.garbage += g.cap as usize;
+        self.seg[v] = Segment { start: new_start as u32, cap, ..g };
+        if self.garbage > self.adj.len() / 2 {
+            self.compact();
         }
     }
-    (off, adj)
+
+    /// Repacks every segment in slot order keeping one spare entry of slack each. O(slots + springs).
+    fn compact(&mut self) {
+        let mut adj = Vec::with_capacity(self.adj.len() - self.garbage);
+        for g in &mut self.seg {
+            let (from, len) = (g.start as usize, g.len as usize);
+            g.start = adj.len() as u32;
+            adj.extend_from_slice(&self.adj[from..from + len]);
+            g.cap = g.len + 1;
+            adj.push(0);
+        }
+        self.adj = adj;
+        self.garbage = 0;
+    }
+
+    fn check(&self, n: usize, ends: &[[u32; 2]]) -> Result<(), IncidenceError> {
+        if self.seg.len() != n {
+            return Err(IncidenceError::SlotCount { expected: n, got: self.seg.len() });
+        }
+        let mut by_start: Vec<usize> = (0..n).collect();
+        by_start.sort_unstable_by_key(|&v| self.seg[v].start);
+        let mut end = 0u64;
+        for v in by_start {
+            let g = self.seg[v];
+            let ok = g.heads <= g.len && g.len <= g.cap && g.start as u64 + g.cap as u64 <= self.adj.len() as u64;
+            if !ok || (g.cap > 0 && (g.start as u64) < end) {
+                return Err(IncidenceError::Segment { slot: v });
+            }
+            end = end.max(g.start as u64 + g.cap as u64);
+        }
+        let mut expected: Vec<[Vec<u32>; 2]> = vec![[Vec::new(), Vec::new()]; n];
+        for (s, &[a, b]) in ends.iter().enumerate() {
+            for (v, side) in [(a as usize, 0), (b as usize, 1)] {
+                if v >= n {
+                    return Err(IncidenceError::Lists { slot: v });
+                }
+                expected[v][side].push(s as u32);
+            }
+        }
+        for (v, [eh, et]) in expected.into_iter().enumerate() {
+            let (h, t) = self.lists(v);
+            let (mut h, mut t) = (h.to_vec(), t.to_vec());
+            h.sort_unstable();
+            t.sort_unstable();
+            if h != eh || t != et {
+                return Err(IncidenceError::Lists { slot: v });
+            }
+        }
+        Ok(())
+    }
 }

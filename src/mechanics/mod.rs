@@ -23,7 +23,7 @@ pub mod projection;
 
 pub use conservation::{check_conservation, ConservationError};
 pub use flat::FlatModel;
-pub use force::SpringSystem;
+pub use force::{IncidenceError, SpringSystem};
 pub use geom::Vec3;
 pub use integrate::{Integrator, StepConfig, StepError, Stepper};
 pub use model::{Body, BodyError, Material, Mechanics, ModelError};
@@ -132,7 +132,9 @@ impl Simulation {
 
     /// Follows topological changes incrementally ([`Projection::update`] with `touched`), then
     /// re-sizes the stepper's buffers (a new [`Stepper`]: the step counter and the energy scale
-    /// of the runaway test restart). O(touched cells) + O(slots + springs) for the CSR and buffers.
+    /// of the runaway test restart). The projection part is O(touched cells · degree); the new
+    /// stepper costs O(slots + springs) (its buffers and energy scale) until `Stepper` can grow
+    /// its buffers in place.
     ///
     /// # Errors
     /// As [`Simulation::new`].

@@ -103,21 +103,21 @@ pub enum ModelError {
 /// through the split/merge rules, so the laws cannot be broken from outside.
 #[derive(Clone, Debug)]
 pub struct Mechanics {
-    material: Material,
+    pub(crate) material: Material,
     // volumes
-    tet_rest_volume: CellArray<f64>,
-    tet_mass: CellArray<f64>,
-    tet_young: CellArray<f64>,
+    pub(crate) tet_rest_volume: CellArray<f64>,
+    pub(crate) tet_mass: CellArray<f64>,
+    pub(crate) tet_young: CellArray<f64>,
     // edges
-    edge_rest_length: CellArray<f64>,
-    edge_stiffness: CellArray<f64>,
-    edge_damping: CellArray<f64>,
+    pub(crate) edge_rest_length: CellArray<f64>,
+    pub(crate) edge_stiffness: CellArray<f64>,
+    pub(crate) edge_damping: CellArray<f64>,
     // faces
-    face_boundary: CellArray<bool>,
-    face_normal: CellArray<Vec3>,
+    pub(crate) face_boundary: CellArray<bool>,
+    pub(crate) face_normal: CellArray<Vec3>,
     // vertices
-    vertex_mass: CellArray<f64>,
-    vertex_viscosity: CellArray<f64>,
+    pub(crate) vertex_mass: CellArray<f64>,
+    pub(crate) vertex_viscosity: CellArray<f64>,
     /// Rest (initial) position of each vertex; rest lengths and volumes are measured on it.
     pub rest_position: CellArray<Vec3>,
     /// Current position of each vertex.

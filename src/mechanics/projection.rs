@@ -23,9 +23,10 @@
 //! ids it split, merged, renamed the ends of, or deleted, each with a dart of the cell now):
 //! per-vertex values of those slots are re-read, springs of split edges are appended, springs of
 //! deleted edges are swap-removed, springs whose end vertex got a new id get their ends fixed.
-//! That part costs O(touched cells). The CSR of incident springs inside [`SpringSystem`] is then
-//! rebuilt in one linear pass, O(slots + springs) with no map walk and no sort (the CSR is
-//! private to `force.rs`; making it appendable is what a fully local update still needs).
+//! The incidence lists inside [`SpringSystem`] follow through its mutators (`push_slot`,
+//! `push_spring`, `set_spring`, `swap_remove_spring`), each O(degree of the ends involved), so the
+//! whole update costs O(touched cells · degree) (amortised; plus the slots for new ids), with no
+//! pass over the mesh.
 //! Spring order differs from a fresh build (appended, not sorted), so the two are compared with
 //! [`Projection::equivalent`], cell by cell.
 //!
@@ -37,7 +38,7 @@ use rustc_hash::FxHashMap;
 use crate::gmap::{CellChanges, DartSet};
 use crate::{AlphaMask, CellId, DartId, GMap};
 
-use super::force::{spring_force, SpringSystem};
+use super::force::{spring_force, IncidenceError, SpringSystem};
 use super::geom::Vec3;
 use super::model::{Body, Mechanics};
 
@@ -100,17 +101,15 @@ impl Projection {
     /// Applies the topological changes listed in `touched` (see the module docs, "Incremental
     /// update"): afterwards the projection is [`Projection::equivalent`] to a fresh
     /// [`Projection::build`] of `body` and [`Projection::is_current`] holds.
-    /// Cost: O(touched cells) plus one O(slots + springs) CSR pass.
+    /// Cost: O(touched cells · degree + new ids) amortised (see [`SpringSystem`]'s incidence
+    /// lists); nothing proportional to the mesh.
     pub fn update(&mut self, body: &Body, touched: &TouchedCells) {
         let map = body.map();
         let mech = body.attrs();
-        let sys = &mut self.system;
         let n = map.cell_id_bound(0);
-        if sys.mass.len() < n {
-            sys.mass.resize(n, 0.0);
-            sys.inv_mass.resize(n, 0.0);
-            sys.viscosity.resize(n, 0.0);
-            self.vertex_dart.resize(n, None);
+        while self.system.slots() < n {
+            self.system.push_slot(0.0, true, 0.0);
+            self.vertex_dart.push(None);
         }
         if self.edge_spring.len() < map.cell_id_bound(1) {
             self.edge_spring.resize(map.cell_id_bound(1), u32::MAX);
@@ -118,10 +117,8 @@ impl Projection {
         for (v, d) in resolve(map, 0, &touched.vertices) {
             self.vertex_dart[v.index()] = d;
             let (m, g) = if d.is_some() { (mech.vertex_mass(v), mech.vertex_viscosity(v)) } else { (0.0, 0.0) };
-            let fixed = d.is_none() || mech.pinned[v] || m <= 0.0;
-            sys.mass[v.index()] = m;
-            sys.viscosity[v.index()] = g;
-            sys.inv_mass[v.index()] = if fixed { 0.0 } else { 1.0 / m };
+            let fixed = d.is_none() || mech.pinned[v];
+            self.system.set_slot(v.index(), m, fixed, g);
         }
         for (e, d) in resolve(map, 1, &touched.edges) {
             match d {
@@ -129,44 +126,33 @@ impl Projection {
                 None => self.remove_spring(e),
             }
         }
-        self.refresh_csr();
         self.version = body.version();
     }
 
-    /// Writes (or appends) the spring of live edge `e`, a dart of which is `d`.
+    /// Writes (or appends) the spring of live edge `e`, a dart of which is `d`. O(degree of its
+    /// old and new ends).
     fn set_spring(&mut self, map: &GMap<3>, mech: &Mechanics, e: CellId, d: DartId) {
         let (a, b) = (map.vertex_id(d).0, map.vertex_id(map.alpha::<0>(d)).0);
         let ends = [a.min(b), a.max(b)];
-        let existing = self.spring_of_edge(e);
-        let sys = &mut self.system;
-        let s = match existing {
-            Some(s) => s,
+        let (rest, k, c) = (mech.edge_rest_length(e), mech.edge_stiffness(e), mech.edge_damping(e));
+        match self.spring_of_edge(e) {
+            Some(s) => {
+                self.system.set_spring(s, ends, rest, k, c);
+                self.spring_dart[s] = d;
+            }
             None => {
-                sys.ends.push(ends);
-                sys.rest.push(0.0);
-                sys.stiffness.push(0.0);
-                sys.damping.push(0.0);
+                let s = self.system.push_spring(ends, rest, k, c);
                 self.spring_edge.push(e);
                 self.spring_dart.push(d);
-                self.edge_spring[e.index()] = (sys.ends.len() - 1) as u32;
-                sys.ends.len() - 1
+                self.edge_spring[e.index()] = s as u32;
             }
-        };
-        sys.ends[s] = ends;
-        sys.rest[s] = mech.edge_rest_length(e);
-        sys.stiffness[s] = mech.edge_stiffness(e);
-        sys.damping[s] = mech.edge_damping(e);
-        self.spring_dart[s] = d;
+        }
     }
 
-    /// Swap-removes the spring of the dead edge `e`, if any.
+    /// Swap-removes the spring of the dead edge `e`, if any. O(degree of the two springs' ends).
     fn remove_spring(&mut self, e: CellId) {
         let Some(s) = self.spring_of_edge(e) else { return };
-        let sys = &mut self.system;
-        sys.ends.swap_remove(s);
-        sys.rest.swap_remove(s);
-        sys.stiffness.swap_remove(s);
-        sys.damping.swap_remove(s);
+        self.system.swap_remove_spring(s);
         self.spring_dart.swap_remove(s);
         self.spring_edge.swap_remove(s);
         self.edge_spring[e.index()] = u32::MAX;
@@ -175,31 +161,18 @@ impl Projection {
         }
     }
 
-    /// Rebuilds the CSR of incident springs from the current arrays. O(slots + springs).
-    fn refresh_csr(&mut self) {
-        let sys = std::mem::take(&mut self.system);
-        let fixed: Vec<bool> = sys.inv_mass.iter().map(|&w| w == 0.0).collect();
-        self.system = SpringSystem::new(
-            sys.ends,
-            sys.rest,
-            sys.stiffness,
-            sys.damping,
-            sys.mass,
-            &fixed,
-            sys.viscosity,
-            sys.gravity,
-        );
-    }
-
     /// Whether `self` and `other` project the same body: same slots with the same mass, inverse
     /// mass, viscosity and liveness, and for every edge id the same spring (ends, rest length,
-    /// stiffness, damping), whatever the spring order. Values are compared bit for bit (both read
-    /// the same stored attributes). O(slots + springs).
+    /// stiffness, damping), whatever the spring order; and each side's incidence lists hold
+    /// exactly its springs ([`SpringSystem::check_incidence`]). Values are compared bit for bit
+    /// (both read the same stored attributes). O(slots + springs).
     ///
     /// # Errors
     /// The first [`ProjectionMismatch`] found.
     pub fn equivalent(&self, other: &Projection) -> Result<(), ProjectionMismatch> {
         let (a, b) = (&self.system, &other.system);
+        a.check_incidence().map_err(ProjectionMismatch::Incidence)?;
+        b.check_incidence().map_err(ProjectionMismatch::Incidence)?;
         if a.slots() != b.slots() || a.springs() != b.springs() || a.gravity != b.gravity {
             return Err(ProjectionMismatch::Sizes {
                 slots: (a.slots(), b.slots()),
@@ -266,6 +239,9 @@ pub enum ProjectionMismatch {
         /// The slot (= vertex id).
         slot: usize,
     },
+    /// One side's incidence lists disagree with its spring ends.
+    #[error("incidence lists: {0}")]
+    Incidence(IncidenceError),
     /// The spring of edge `edge` is missing on one side or has different values.
     #[error("spring of edge {edge} differs or is missing")]
     Spring {

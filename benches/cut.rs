@@ -48,7 +48,9 @@ fn fixture(name: &str, points: &[Vec3], tets: &[[u32; 4]]) -> Fixture {
 }
 
 fn small() -> Option<Fixture> {
-    let mesh = topomech::io::read_mesh(Path::new("/work/shared/meshes/liver_547.msh")).ok()?;
+    let mesh =
+        topomech::io::read_mesh(Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes/liver_547.msh")))
+            .ok()?;
     Some(fixture("liver_547", &mesh.points, &mesh.tets))
 }
 

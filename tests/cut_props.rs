@@ -33,7 +33,7 @@ proptest! {
 
     #[test]
     fn cut_sequences_on_liver_547(bytes in scenario_bytes()) {
-        let path = std::path::Path::new("/work/shared/meshes/liver_547.msh");
+        let path = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes/liver_547.msh"));
         if !path.exists() {
             eprintln!("liver_547.msh absent: skipped");
             return Ok(());

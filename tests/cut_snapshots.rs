@@ -7,7 +7,7 @@ use std::process::Command;
 
 #[test]
 fn plane_cut_of_liver_547_json() {
-    let mesh = "/work/shared/meshes/liver_547.msh";
+    let mesh = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes/liver_547.msh");
     if !std::path::Path::new(mesh).exists() {
         eprintln!("{mesh} absent: skipped");
         return;

@@ -40,6 +40,7 @@ pub mod load;
 pub mod mechanics;
 pub mod mesh;
 pub mod ops;
+pub mod store;
 pub mod subdivide;
 pub mod vtk;
 

@@ -49,6 +49,8 @@ enum Command {
     Remove(cli::cut::RemoveArgs),
     /// Simulate a hanging body that tears where its stress exceeds a threshold.
     Tear(cli::cut::TearArgs),
+    /// Validate a `.tmap`/`.tmapb` map file and list each broken law (exit 0 valid, 1 broken, 2 unreadable).
+    Check(cli::check::CheckArgs),
 }
 
 impl Command {
@@ -62,6 +64,7 @@ impl Command {
             Command::Cut(args) => cli::cut::run(args),
             Command::Remove(args) => cli::cut::run_remove(args),
             Command::Tear(args) => cli::cut::run_tear(args),
+            Command::Check(args) => cli::check::run(args),
         }
     }
 }

@@ -316,6 +316,34 @@ impl<const N: usize> GMap<N> {
         self.ids[i] = IdAlloc { next, free };
     }
 
+    /// The id allocator of dimension i as (next, free list): for the file format (`crate::store`).
+    pub(crate) fn id_alloc_raw(&self, i: usize) -> (u32, &[u32]) {
+        (self.ids[i].next, &self.ids[i].free)
+    }
+
+    /// The free dart slots in reuse order (the last is reused first): for `crate::store`.
+    pub(crate) fn free_dart_slots_raw(&self) -> &[u32] {
+        &self.free_darts
+    }
+
+    /// Raw one-sided write αi(d) = target (the partner row is not touched). For `crate::store`.
+    pub(crate) fn set_alpha_raw(&mut self, i: usize, d: DartId, target: DartId) {
+        self.alpha[d.index() * (N + 1) + i] = target.0;
+    }
+
+    /// Raw: kills dart d (its row becomes free links and unset ids) and pushes its slot on the
+    /// free-slot list, with no check and no cell-id release. For `crate::store`'s loader.
+    pub(crate) fn kill_dart_raw(&mut self, d: DartId) {
+        let base = d.index() * (N + 1);
+        for i in 0..=N {
+            self.alpha[base + i] = d.0;
+            self.cell[base + i] = NONE;
+        }
+        self.alive[d.index() / 64] &= !(1u64 << (d.0 % 64));
+        self.n_alive -= 1;
+        self.free_darts.push(d.0);
+    }
+
     pub(crate) fn alloc_cell_id(&mut self, i: usize) -> u32 {
         self.ids[i].alloc()
     }

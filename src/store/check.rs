@@ -1,0 +1,249 @@
+//! `check_all_laws`: every broken law of a raw document, not only the first.
+
+use crate::gmap::InvariantViolation;
+use crate::mechanics::ConservationError;
+use crate::{CellId, DartId, GMap};
+
+use super::raw::RawMap;
+use super::Document;
+
+/// One broken law found by [`check_all_laws`].
+#[derive(Debug, Clone, PartialEq)]
+pub enum Finding {
+    /// A law of n-G-maps (involution, quasi-manifold, cell ids), with the darts involved.
+    Map(InvariantViolation),
+    /// A conservation law of the mechanical attributes (checked only when the map is valid).
+    Conservation(ConservationError),
+}
+
+impl std::fmt::Display for Finding {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Finding::Map(v) => write!(f, "{v}"),
+            Finding::Conservation(c) => write!(f, "conservation: {c}"),
+        }
+    }
+}
+
+/// What [`check_all_laws`] found.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CheckReport {
+    /// Verdict: no law is broken. For n ≤ 3 this is the kernel's own `validate()` (and
+    /// `check_conservation` for a body), so the listing can never contradict it.
+    pub valid: bool,
+    /// The broken laws found, in the order of the kernel's table, at most the limit asked for.
+    pub findings: Vec<Finding>,
+    /// Whether more were found than the limit.
+    pub truncated: bool,
+}
+
+/// Lists up to `limit` broken laws of `doc`: involution (dangling links, αi(αi(d)) ≠ d),
+/// quasi-manifold (αiαj ≠ αjαi for j ≥ i + 2), cell ids constant and live on each cell, cell ids
+/// unique (one id per orbit, no orphan live id), then conservation for a body whose map is valid.
+/// The verdict comes from the kernel's `validate()` when n ≤ 3; the listing is a separate pass
+/// on the raw arrays that never stops at the first violation.
+/// Cost O(capacity · n² + cell ids) time and memory.
+pub fn check_all_laws(doc: &Document, limit: usize) -> CheckReport {
+    let mut out = Collector { findings: Vec::new(), limit, truncated: false };
+    let raw = &doc.map;
+    let live = raw.live();
+    involution_and_quasi_manifold(raw, &live, &mut out);
+    cell_ids_constant(raw, &live, &mut out);
+    cell_ids_unique(raw, &live, &mut out);
+    let verdict = kernel_verdict(raw);
+    let map_valid = verdict.as_ref().map_or(out.findings.is_empty(), |v| v.is_ok());
+    if let Some(Err(first)) = &verdict {
+        // Never report "invalid" with an empty listing: the kernel's first violation is a finding.
+        if out.findings.is_empty() {
+            out.push(Finding::Map(first.clone()));
+        }
+    }
+    let mut valid = map_valid;
+    if map_valid {
+        if let (Some(mech), 3) = (&doc.mechanics, raw.dimension) {
+            if let Ok(map) = raw.to_gmap_raw::<3>() {
+                if let Err(e) = crate::mechanics::check_conservation(&map, &mech.to_mechanics()) {
+                    valid = false;
+                    out.push(Finding::Conservation(e));
+                }
+            }
+        }
+    }
+    CheckReport { valid, findings: out.findings, truncated: out.truncated }
+}
+
+struct Collector {
+    findings: Vec<Finding>,
+    limit: usize,
+    truncated: bool,
+}
+
+impl Collector {
+    fn push(&mut self, f: Finding) {
+        if self.findings.len() < self.limit {
+            self.findings.push(f);
+        } else {
+            self.truncated = true;
+        }
+    }
+
+    fn map(&mut self, v: InvariantViolation) {
+        self.push(Finding::Map(v));
+    }
+}
+
+/// The kernel's verdict for n ≤ 3 (`None` for higher dimensions).
+fn kernel_verdict(raw: &RawMap) -> Option<Result<(), InvariantViolation>> {
+    fn verdict<const N: usize>(raw: &RawMap) -> Option<Result<(), InvariantViolation>> {
+        raw.to_gmap_raw::<N>().ok().map(|m: GMap<N>| m.validate())
+    }
+    match raw.dimension {
+        1 => verdict::<1>(raw),
+        2 => verdict::<2>(raw),
+        3 => verdict::<3>(raw),
+        _ => None,
+    }
+}
+
+/// αi(d) if it is a live dart.
+fn link(raw: &RawMap, live: &[bool], i: usize, d: u32) -> Option<u32> {
+    let a = raw.alpha(i, d);
+    live[a as usize].then_some(a)
+}
+
+fn involution_and_quasi_manifold(raw: &RawMap, live: &[bool], out: &mut Collector) {
+    let n = raw.dimension;
+    let mut link_ok = vec![true; live.len() * (n + 1)];
+    for d in (0..raw.capacity).filter(|&d| live[d as usize]) {
+        for i in 0..=n {
+            let dart = DartId(d);
+            match link(raw, live, i, d) {
+                None => out.map(InvariantViolation::DanglingLink { dart, i, target: DartId(raw.alpha(i, d)) }),
+                Some(a) if raw.alpha(i, a) != d => {
+                    let back = DartId(raw.alpha(i, a));
+                    out.map(InvariantViolation::NotInvolution { dart, i, image: DartId(a), back });
+                }
+                Some(_) => continue,
+            }
+            link_ok[d as usize * (n + 1) + i] = false;
+        }
+    }
+    let ok = |i: usize, d: u32| link_ok[d as usize * (n + 1) + i];
+    for d in (0..raw.capacity).filter(|&d| live[d as usize]) {
+        for i in 0..=n {
+            for j in i + 2..=n {
+                if !(ok(i, d) && ok(j, d) && ok(i, raw.alpha(j, d)) && ok(j, raw.alpha(i, d))) {
+                    continue;
+                }
+                let (ij, ji) = (raw.alpha(i, raw.alpha(j, d)), raw.alpha(j, raw.alpha(i, d)));
+                if ij != ji {
+                    out.map(InvariantViolation::QuasiManifold {
+                        dart: DartId(d),
+                        i,
+                        j,
+                        ij: DartId(ij),
+                        ji: DartId(ji),
+                    });
+                }
+            }
+        }
+    }
+}
+
+fn is_live_id(raw: &RawMap, dim: usize, id: u32, dead_ids: &[Vec<bool>]) -> bool {
+    id < raw.ids[dim].next && !dead_ids[dim][id as usize]
+}
+
+fn dead_id_table(raw: &RawMap) -> Vec<Vec<bool>> {
+    raw.ids
+        .iter()
+        .map(|rec| {
+            let mut dead = vec![false; rec.next as usize];
+            rec.free.iter().for_each(|&id| dead[id as usize] = true);
+            dead
+        })
+        .collect()
+}
+
+fn cell_ids_constant(raw: &RawMap, live: &[bool], out: &mut Collector) {
+    let n = raw.dimension;
+    let dead_ids = dead_id_table(raw);
+    for d in (0..raw.capacity).filter(|&d| live[d as usize]) {
+        for dim in 0..=n {
+            let id = raw.cell(dim, d);
+            if !is_live_id(raw, dim, id, &dead_ids) {
+                out.map(InvariantViolation::CellIdNotLive { dart: DartId(d), dim, id: CellId(id) });
+            }
+            for j in (0..=n).filter(|&j| j != dim) {
+                // Each unordered pair once; a dangling link was reported already.
+                let Some(a) = link(raw, live, j, d).filter(|&a| a > d) else { continue };
+                let other_id = raw.cell(dim, a);
+                if other_id != id {
+                    let (dart, other) = (DartId(d), DartId(a));
+                    out.map(InvariantViolation::CellIdDiffers {
+                        dart,
+                        dim,
+                        j,
+                        id: CellId(id),
+                        other,
+                        other_id: CellId(other_id),
+                    });
+                }
+            }
+        }
+    }
+}
+
+/// Per dimension: flood-fills the orbits ⟨αj : j ≠ dim⟩ over live links (dangling ones are
+/// skipped: they were reported), records the first orbit of each id, and reports a
+/// second orbit carrying it and live ids no dart carries.
+fn cell_ids_unique(raw: &RawMap, live: &[bool], out: &mut Collector) {
+    let n = raw.dimension;
+    let dead_ids = dead_id_table(raw);
+    let cap = raw.capacity as usize;
+    for (dim, dead) in dead_ids.iter().enumerate() {
+        let mut owner: Vec<u32> = vec![u32::MAX; raw.ids[dim].next as usize];
+        let mut carried = vec![false; raw.ids[dim].next as usize];
+        let mut seen = vec![false; cap];
+        let mut stack = Vec::new();
+        for start in (0..raw.capacity).filter(|&d| live[d as usize]) {
+            if seen[start as usize] {
+                continue;
+            }
+            seen[start as usize] = true;
+            stack.push(start);
+            // Ids met in this orbit, each reported at most once per orbit.
+            let mut orbit_ids: Vec<u32> = Vec::new();
+            while let Some(d) = stack.pop() {
+                let id = raw.cell(dim, d);
+                if id < raw.ids[dim].next && !orbit_ids.contains(&id) {
+                    orbit_ids.push(id);
+                }
+                for j in (0..=n).filter(|&j| j != dim) {
+                    if let Some(a) = link(raw, live, j, d) {
+                        if !std::mem::replace(&mut seen[a as usize], true) {
+                            stack.push(a);
+                        }
+                    }
+                }
+            }
+            for id in orbit_ids {
+                carried[id as usize] = true;
+                match owner[id as usize] {
+                    u32::MAX => owner[id as usize] = start,
+                    first => out.map(InvariantViolation::CellIdShared {
+                        dim,
+                        id: CellId(id),
+                        first: DartId(first),
+                        second: DartId(start),
+                    }),
+                }
+            }
+        }
+        for id in 0..raw.ids[dim].next {
+            if !carried[id as usize] && !dead[id as usize] {
+                out.map(InvariantViolation::CellIdOrphan { dim, id: CellId(id) });
+            }
+        }
+    }
+}

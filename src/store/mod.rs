@@ -1,0 +1,388 @@
+//! Save and load a complete map with its embeddings: a readable text form (`.tmap`) and a compact
+//! binary form (`.tmapb`), both versioned and documented in `docs/FILE_FORMAT.md`.
+//!
+//! A file holds a [`Document`]: the raw arrays of a map ([`RawMap`]: every dart slot's αi links and
+//! cell ids, the free dart slots, the cell-id allocators) and, for a mechanical body, its
+//! attributes ([`RawMechanics`]). Round trips are exact: the loaded map equals the saved one slot
+//! for slot (same dart ids, links, cell ids, allocators, reuse order) and every float is the same
+//! bit pattern.
+//!
+//! Loading never repairs. [`decode`] checks the *structure* (magic, version, counts bounded by the
+//! data actually present, dart ids in range, finite floats, checksum of the binary form) and gives
+//! a raw document; [`load_map`] / [`load_body`] then require every law (`GMap::validate`, and
+//! `check_conservation` for a body) and return the first broken one as an error. [`check_all_laws`]
+//! lists each broken law of a raw document (what `topomech check` prints).
+//!
+//! ```
+//! use topomech::store::{self, Document, Format};
+//! use topomech::GMap;
+//!
+//! let (map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+//! let doc = Document::from_map(&map);
+//! for format in [Format::Text, Format::Binary] {
+//!     let bytes = store::encode(&doc, format).unwrap();
+//!     let back: GMap<3> = store::decode(&bytes).unwrap().into_map().unwrap();
+//!     assert!(back.is_isomorphic(&map));
+//!     assert!(topomech::ops::same_raw(&back, &map));
+//! }
+//! ```
+//!
+//! Writes are atomic: [`save_document`] writes a temporary file in the target's directory, flushes
+//! and fsyncs it, then renames it into place, so a crash or an error leaves either the old file or
+//! the new one, never half of one.
+
+mod binary;
+mod check;
+mod raw;
+mod structure;
+mod text;
+
+use std::fmt;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+pub use check::{check_all_laws, CheckReport, Finding};
+pub use raw::{IdAllocRecord, RawMap, RawMechanics, VertexRecord};
+
+use crate::mechanics::{Body, ConservationError};
+use crate::{GMap, InvariantViolation};
+
+/// The version of both forms this library writes and the only one it reads.
+pub const VERSION: u32 = 1;
+/// First token of the text form.
+pub const TEXT_MAGIC: &str = "topomech-gmap";
+/// First 8 bytes of the binary form (the CR LF catches text-mode transfers).
+pub const BINARY_MAGIC: [u8; 8] = *b"TMAPB\0\r\n";
+/// Largest dimension a file may declare (the kernel supports 1..=7).
+pub const MAX_DIMENSION: usize = 7;
+
+/// Which of the two forms.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// `.tmap`: one line per dart, floats in Rust's shortest round-trip notation.
+    Text,
+    /// `.tmapb`: little-endian arrays with an FNV-1a 64 checksum.
+    Binary,
+}
+
+impl Format {
+    /// `Binary` for a path ending in `.tmapb`, `Text` otherwise. O(1).
+    pub fn from_path(path: &Path) -> Format {
+        match path.extension().and_then(|e| e.to_str()) {
+            Some("tmapb") => Format::Binary,
+            _ => Format::Text,
+        }
+    }
+}
+
+/// Where in a file a problem is: a line of the text form or a byte offset of the binary form.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Where {
+    /// 1-based line of the text form.
+    Line(usize),
+    /// 0-based byte offset in the binary form.
+    Byte(usize),
+}
+
+impl fmt::Display for Where {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Where::Line(l) => write!(f, "line {l}"),
+            Where::Byte(b) => write!(f, "byte {b}"),
+        }
+    }
+}
+
+/// Why a file could not be written, read, or accepted.
+#[derive(Debug, thiserror::Error)]
+pub enum StoreError {
+    /// The operating system refused (open, write, fsync, rename).
+    #[error("{}: {source}", .path.display())]
+    Io {
+        /// The file (or the temporary file next to it).
+        path: PathBuf,
+        /// The system error.
+        source: std::io::Error,
+    },
+    /// The file starts with neither magic.
+    #[error("not a topomech map file: it starts with {found:?}, not {TEXT_MAGIC:?} or the binary magic")]
+    BadMagic {
+        /// The first bytes, escaped.
+        found: String,
+    },
+    /// The file was written by another version of the format.
+    #[error("{at}: format version {found} is not supported (this topomech reads version {VERSION})")]
+    UnsupportedVersion {
+        /// Where the version is.
+        at: Where,
+        /// The version in the file.
+        found: u64,
+    },
+    /// The declared dimension is 0 or above [`MAX_DIMENSION`].
+    #[error("{at}: dimension {found} is not in 1..={MAX_DIMENSION}")]
+    BadDimension {
+        /// Where the dimension is.
+        at: Where,
+        /// The dimension in the file.
+        found: u64,
+    },
+    /// The file holds an n-G-map of another dimension than the one asked for.
+    #[error("the file holds a {found}-G-map, not a {expected}-G-map")]
+    WrongDimension {
+        /// Dimension in the file.
+        found: usize,
+        /// Dimension asked for.
+        expected: usize,
+    },
+    /// The file ends before the data it announces.
+    #[error("{at}: the file is truncated: expected {expected}")]
+    Truncated {
+        /// Where the data should have been.
+        at: Where,
+        /// What was expected.
+        expected: String,
+    },
+    /// The binary form's checksum does not match its content.
+    #[error("checksum mismatch: the file says {stored:#018x} but its content hashes to {computed:#018x} (corrupted)")]
+    Checksum {
+        /// Checksum stored in the file.
+        stored: u64,
+        /// Checksum of the bytes read.
+        computed: u64,
+    },
+    /// Bytes or lines after the end of the document.
+    #[error("{at}: unexpected data after the end of the document")]
+    TrailingData {
+        /// Where the extra data starts.
+        at: Where,
+    },
+    /// A line of the text form does not follow the grammar.
+    #[error("{at}: {message}")]
+    Syntax {
+        /// The line.
+        at: Where,
+        /// What is wrong.
+        message: String,
+    },
+    /// A dart id is not below the dart capacity.
+    #[error("{at}: dart {dart} is out of range (the map has {capacity} dart slots)")]
+    DartOutOfRange {
+        /// Where the id is.
+        at: Where,
+        /// The id.
+        dart: u64,
+        /// The capacity declared.
+        capacity: u64,
+    },
+    /// A count is larger than the data that can follow it, or inconsistent with another count.
+    #[error("{at}: {what} = {count} is impossible here (at most {limit})")]
+    BadCount {
+        /// Where the count is.
+        at: Where,
+        /// Which count.
+        what: &'static str,
+        /// The count.
+        count: u64,
+        /// The largest possible value.
+        limit: u64,
+    },
+    /// A dead dart slot, a free list or a record id is inconsistent (e.g. listed twice).
+    #[error("{at}: {message}")]
+    Inconsistent {
+        /// Where.
+        at: Where,
+        /// What.
+        message: String,
+    },
+    /// A float is NaN or infinite.
+    #[error("{at}: {field} of record {index} is not finite")]
+    NonFinite {
+        /// Where the value is.
+        at: Where,
+        /// Which attribute.
+        field: &'static str,
+        /// Which cell id (or 0 for the material).
+        index: usize,
+    },
+    /// The map breaks an n-G-map law (use [`decode`] + [`check_all_laws`] to list them all).
+    #[error("the map breaks an n-G-map law: {0}")]
+    BrokenLaw(#[from] InvariantViolation),
+    /// The mechanical attributes break a conservation law.
+    #[error("the attributes break a conservation law: {0}")]
+    Conservation(#[from] ConservationError),
+    /// A body was asked for but the file holds no mechanical attributes.
+    #[error("the file holds a bare map, not a mechanical body")]
+    NoMechanics,
+    /// Saving: the body holds values the format cannot represent exactly (non-finite floats).
+    #[error("cannot save: {what}")]
+    Unrepresentable {
+        /// What.
+        what: String,
+    },
+}
+
+/// A decoded file: the raw map and, for a body, its attributes. Not checked against the laws.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Document {
+    /// Every dart slot, link, cell id and allocator.
+    pub map: RawMap,
+    /// The mechanical attributes of a body (3-G-maps only).
+    pub mechanics: Option<RawMechanics>,
+}
+
+impl Document {
+    /// The document of a bare map. O(capacity · n).
+    pub fn from_map<const N: usize>(map: &GMap<N>) -> Self {
+        Document { map: RawMap::from_map(map), mechanics: None }
+    }
+
+    /// The document of a body (map + mechanics). O(capacity + cells).
+    pub fn from_body(body: &Body) -> Self {
+        Document { map: RawMap::from_map(body.map()), mechanics: Some(RawMechanics::from_mechanics(body.attrs())) }
+    }
+
+    /// The map, required to satisfy every law. O(darts · n²).
+    ///
+    /// # Errors
+    /// [`StoreError::WrongDimension`], [`StoreError::BrokenLaw`] (the first law broken).
+    pub fn into_map<const N: usize>(self) -> Result<GMap<N>, StoreError> {
+        let map = self.map.to_gmap_raw::<N>()?;
+        map.validate()?;
+        Ok(map)
+    }
+
+    /// The body, required to satisfy every law of the map and of conservation. O(darts).
+    ///
+    /// # Errors
+    /// [`StoreError::NoMechanics`], [`StoreError::WrongDimension`], [`StoreError::BrokenLaw`],
+    /// [`StoreError::Conservation`].
+    pub fn into_body(self) -> Result<Body, StoreError> {
+        let raw_mech = self.mechanics.ok_or(StoreError::NoMechanics)?;
+        let map = self.map.to_gmap_raw::<3>()?;
+        map.validate()?;
+        let mech = raw_mech.to_mechanics();
+        crate::mechanics::check_conservation(&map, &mech)?;
+        Ok(Body::new(map, mech))
+    }
+}
+
+/// Encodes a document in one form. O(size).
+///
+/// # Errors
+/// [`StoreError::Unrepresentable`] when an attribute is NaN or infinite (it could not be read back).
+pub fn encode(doc: &Document, format: Format) -> Result<Vec<u8>, StoreError> {
+    if let Some(m) = &doc.mechanics {
+        m.check_finite().map_err(|what| StoreError::Unrepresentable { what })?;
+    }
+    Ok(match format {
+        Format::Text => text::encode(doc).into_bytes(),
+        Format::Binary => binary::encode(doc),
+    })
+}
+
+/// Decodes either form (told apart by the magic) into a raw document, checking its structure but
+/// not the laws. O(size).
+///
+/// # Errors
+/// Every structural [`StoreError`] variant, with the line or byte offset; never panics and never
+/// allocates more than the data present justifies.
+pub fn decode(bytes: &[u8]) -> Result<Document, StoreError> {
+    if bytes.starts_with(&BINARY_MAGIC) {
+        binary::decode(bytes)
+    } else if bytes.starts_with(TEXT_MAGIC.as_bytes()) {
+        text::decode(bytes)
+    } else {
+        let head = &bytes[..bytes.len().min(16)];
+        Err(StoreError::BadMagic { found: head.escape_ascii().to_string() })
+    }
+}
+
+/// Reads and decodes a file (raw: laws unchecked). O(size).
+///
+/// # Errors
+/// [`StoreError::Io`] and the errors of [`decode`].
+pub fn read_document(path: &Path) -> Result<Document, StoreError> {
+    let bytes = std::fs::read(path).map_err(|source| StoreError::Io { path: path.to_path_buf(), source })?;
+    decode(&bytes)
+}
+
+/// Loads a map that satisfies every law. O(size + darts · n²).
+///
+/// # Errors
+/// As [`read_document`] and [`Document::into_map`].
+pub fn load_map<const N: usize>(path: &Path) -> Result<GMap<N>, StoreError> {
+    read_document(path)?.into_map()
+}
+
+/// Loads a body whose map and attributes satisfy every law. O(size + darts).
+///
+/// # Errors
+/// As [`read_document`] and [`Document::into_body`].
+pub fn load_body(path: &Path) -> Result<Body, StoreError> {
+    read_document(path)?.into_body()
+}
+
+/// Saves a map in `format`, atomically. O(capacity · n).
+///
+/// # Errors
+/// As [`save_document`].
+pub fn save_map<const N: usize>(map: &GMap<N>, path: &Path, format: Format) -> Result<(), StoreError> {
+    save_document(&Document::from_map(map), path, format)
+}
+
+/// Saves a body in `format`, atomically. O(capacity + cells).
+///
+/// # Errors
+/// As [`save_document`].
+pub fn save_body(body: &Body, path: &Path, format: Format) -> Result<(), StoreError> {
+    save_document(&Document::from_body(body), path, format)
+}
+
+/// Encodes `doc` and writes it atomically: a temporary file in the same directory, written,
+/// flushed and fsynced, renamed onto `path`, then the directory fsynced (best effort). On any
+/// error the temporary file is removed and an existing `path` is left untouched. O(size).
+///
+/// # Errors
+/// [`StoreError::Unrepresentable`] (see [`encode`]); [`StoreError::Io`] naming the file the
+/// system refused.
+pub fn save_document(doc: &Document, path: &Path, format: Format) -> Result<(), StoreError> {
+    let bytes = encode(doc, format)?;
+    write_atomically(path, &bytes)
+}
+
+/// Writes `bytes` to `path` through a temporary file and a rename (see [`save_document`]).
+///
+/// # Errors
+/// [`StoreError::Io`].
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), StoreError> {
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "map".into());
+    static COUNTER: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let serial = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let tmp = dir.join(format!(".{name}.tmp-{}-{serial}", std::process::id()));
+    let io = |p: &Path| {
+        let p = p.to_path_buf();
+        move |source| StoreError::Io { path: p, source }
+    };
+    let result = (|| {
+        let mut file = std::fs::OpenOptions::new().write(true).create_new(true).open(&tmp).map_err(io(&tmp))?;
+        file.write_all(bytes).map_err(io(&tmp))?;
+        file.flush().map_err(io(&tmp))?;
+        file.sync_all().map_err(io(&tmp))?;
+        drop(file);
+        std::fs::rename(&tmp, path).map_err(io(path))
+    })();
+    if result.is_err() {
+        // The temporary file may not exist (creation failed); nothing else to undo.
+        let _ = std::fs::remove_file(&tmp);
+        return result;
+    }
+    // Persist the rename itself; not every platform lets a directory be opened and synced.
+    if let Ok(d) = std::fs::File::open(&dir) {
+        let _ = d.sync_all();
+    }
+    Ok(())
+}

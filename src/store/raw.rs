@@ -1,0 +1,247 @@
+//! The raw arrays a file holds, and their conversion from and to the kernel's types.
+
+use crate::embedding::CellArray;
+use crate::mechanics::{Material, Mechanics, Vec3};
+use crate::{DartId, GMap};
+
+use super::StoreError;
+
+/// The allocator of one cell dimension: ids `0..next` were handed out, those in `free` are dead
+/// (the last one is reused first).
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct IdAllocRecord {
+    /// One past the largest id ever handed out.
+    pub next: u32,
+    /// Dead ids, in reuse order.
+    pub free: Vec<u32>,
+}
+
+/// Every slot of a map, live or dead: what a file stores.
+///
+/// Row d of `alpha` / `cell` is `[d·(n+1), (d+1)·(n+1))`. A dead slot (listed in `free_darts`)
+/// has `alpha = d` and `cell = u32::MAX` in every column.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RawMap {
+    /// The dimension n.
+    pub dimension: usize,
+    /// Number of dart slots.
+    pub capacity: u32,
+    /// αi of every slot, row-major.
+    pub alpha: Vec<u32>,
+    /// The i-cell id of every slot, row-major.
+    pub cell: Vec<u32>,
+    /// Dead slots, in reuse order (the last one is reused first).
+    pub free_darts: Vec<u32>,
+    /// One allocator per cell dimension 0..=n.
+    pub ids: Vec<IdAllocRecord>,
+}
+
+/// The unset cell id of a dead slot.
+pub(crate) const UNSET: u32 = u32::MAX;
+
+impl RawMap {
+    /// Copies every slot of `map`. O(capacity · n).
+    pub fn from_map<const N: usize>(map: &GMap<N>) -> Self {
+        let cap = map.capacity();
+        let mut alpha = Vec::with_capacity(cap * (N + 1));
+        let mut cell = Vec::with_capacity(cap * (N + 1));
+        for d in 0..cap as u32 {
+            let dart = DartId(d);
+            let live = map.contains(dart);
+            for i in 0..=N {
+                alpha.push(if live { map.alpha_dyn(i, dart).0 } else { d });
+                cell.push(if live { map.cell_id(i, dart).0 } else { UNSET });
+            }
+        }
+        let ids = (0..=N)
+            .map(|i| {
+                let (next, free) = map.id_alloc_raw(i);
+                IdAllocRecord { next, free: free.to_vec() }
+            })
+            .collect();
+        RawMap { dimension: N, capacity: cap as u32, alpha, cell, free_darts: map.free_dart_slots_raw().to_vec(), ids }
+    }
+
+    /// Number of involutions, n + 1.
+    pub fn alphas(&self) -> usize {
+        self.dimension + 1
+    }
+
+    /// Liveness of every slot (false for the slots of `free_darts`). O(capacity).
+    pub fn live(&self) -> Vec<bool> {
+        let mut live = vec![true; self.capacity as usize];
+        for &d in &self.free_darts {
+            live[d as usize] = false;
+        }
+        live
+    }
+
+    /// αi of slot d. O(1). Panics if d or i is out of range (the decoder guarantees neither is).
+    pub fn alpha(&self, i: usize, d: u32) -> u32 {
+        self.alpha[d as usize * self.alphas() + i]
+    }
+
+    /// The i-cell id of slot d. O(1).
+    pub fn cell(&self, i: usize, d: u32) -> u32 {
+        self.cell[d as usize * self.alphas() + i]
+    }
+
+    /// Rebuilds the map exactly, with no law checked (the crate-private raw layer). O(capacity · n).
+    ///
+    /// # Errors
+    /// [`StoreError::WrongDimension`] when the file's dimension is not `N`.
+    pub fn to_gmap_raw<const N: usize>(&self) -> Result<GMap<N>, StoreError> {
+        if self.dimension != N {
+            return Err(StoreError::WrongDimension { found: self.dimension, expected: N });
+        }
+        let mut map = GMap::<N>::new();
+        map.alloc_darts_raw(self.capacity as usize);
+        let live = self.live();
+        // One-sided writes: a broken file stays broken (no partner row is touched).
+        for d in (0..self.capacity).filter(|&d| live[d as usize]) {
+            for i in 0..=N {
+                map.set_alpha_raw(i, DartId(d), DartId(self.alpha(i, d)));
+                map.set_cell_raw(i, DartId(d), self.cell(i, d));
+            }
+        }
+        for &d in &self.free_darts {
+            map.kill_dart_raw(DartId(d));
+        }
+        for (i, rec) in self.ids.iter().enumerate() {
+            map.set_id_alloc_raw(i, rec.next, rec.free.clone());
+        }
+        Ok(map)
+    }
+}
+
+/// The attributes of one vertex id.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct VertexRecord {
+    /// Rest position.
+    pub rest: Vec3,
+    /// Current position.
+    pub position: Vec3,
+    /// Current velocity.
+    pub velocity: Vec3,
+    /// Last force accumulator.
+    pub force: Vec3,
+    /// Mass m_v.
+    pub mass: f64,
+    /// Ambient viscosity γ_v.
+    pub viscosity: f64,
+    /// Fixed vertex.
+    pub pinned: bool,
+}
+
+/// Every mechanical attribute of a body, one record per cell id (live or dead).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct RawMechanics {
+    /// Density ρ, Young's modulus E, damping β, viscosity ν.
+    pub material: [f64; 4],
+    /// Per vertex id.
+    pub vertices: Vec<VertexRecord>,
+    /// Per edge id: rest length, stiffness, damping.
+    pub edges: Vec<[f64; 3]>,
+    /// Per face id: boundary flag and outward normal.
+    pub faces: Vec<(bool, Vec3)>,
+    /// Per volume id: rest volume, mass, Young's modulus.
+    pub volumes: Vec<[f64; 3]>,
+}
+
+/// Copies `len` values of a cell array, the default past its end (arrays of one dimension are
+/// grown together, so this only pads arrays a caller shortened by hand).
+fn column<T: Copy + Default>(a: &CellArray<T>, len: usize) -> impl Iterator<Item = T> + '_ {
+    (0..len).map(move |k| a.as_slice().get(k).copied().unwrap_or_default())
+}
+
+impl RawMechanics {
+    /// Copies every attribute. O(cells).
+    pub fn from_mechanics(m: &Mechanics) -> Self {
+        let Material { density, young, damping, viscosity } = m.material;
+        let nv = m.vertex_mass.len().max(m.position.len());
+        let mut vertices: Vec<VertexRecord> = Vec::with_capacity(nv);
+        let cols = (
+            column(&m.rest_position, nv),
+            column(&m.position, nv),
+            column(&m.velocity, nv),
+            column(&m.force, nv),
+            column(&m.vertex_mass, nv),
+            column(&m.vertex_viscosity, nv),
+            column(&m.pinned, nv),
+        );
+        let (r, p, v, f, ma, vi, pi) = cols;
+        for ((((((rest, position), velocity), force), mass), visc), pinned) in
+            r.zip(p).zip(v).zip(f).zip(ma).zip(vi).zip(pi)
+        {
+            vertices.push(VertexRecord { rest, position, velocity, force, mass, viscosity: visc, pinned });
+        }
+        let ne = m.edge_stiffness.len();
+        let edges = column(&m.edge_rest_length, ne)
+            .zip(column(&m.edge_stiffness, ne))
+            .zip(column(&m.edge_damping, ne))
+            .map(|((l, k), c)| [l, k, c])
+            .collect();
+        let nf = m.face_normal.len();
+        let faces = column(&m.face_boundary, nf).zip(column(&m.face_normal, nf)).collect();
+        let nt = m.tet_mass.len();
+        let volumes = column(&m.tet_rest_volume, nt)
+            .zip(column(&m.tet_mass, nt))
+            .zip(column(&m.tet_young, nt))
+            .map(|((v, ma), e)| [v, ma, e])
+            .collect();
+        RawMechanics { material: [density, young, damping, viscosity], vertices, edges, faces, volumes }
+    }
+
+    /// Rebuilds the attributes exactly (no law checked). O(cells).
+    pub fn to_mechanics(&self) -> Mechanics {
+        let [density, young, damping, viscosity] = self.material;
+        let vs = &self.vertices;
+        let col = |f: &dyn Fn(&VertexRecord) -> Vec3| CellArray::from_vec(vs.iter().map(f).collect());
+        let scalar = |f: &dyn Fn(&VertexRecord) -> f64| CellArray::from_vec(vs.iter().map(f).collect());
+        let edge = |k: usize| CellArray::from_vec(self.edges.iter().map(|e| e[k]).collect());
+        let tet = |k: usize| CellArray::from_vec(self.volumes.iter().map(|t| t[k]).collect());
+        Mechanics {
+            material: Material { density, young, damping, viscosity },
+            tet_rest_volume: tet(0),
+            tet_mass: tet(1),
+            tet_young: tet(2),
+            edge_rest_length: edge(0),
+            edge_stiffness: edge(1),
+            edge_damping: edge(2),
+            face_boundary: CellArray::from_vec(self.faces.iter().map(|f| f.0).collect()),
+            face_normal: CellArray::from_vec(self.faces.iter().map(|f| f.1).collect()),
+            vertex_mass: scalar(&|v| v.mass),
+            vertex_viscosity: scalar(&|v| v.viscosity),
+            rest_position: col(&|v| v.rest),
+            position: col(&|v| v.position),
+            velocity: col(&|v| v.velocity),
+            force: col(&|v| v.force),
+            pinned: CellArray::from_vec(vs.iter().map(|v| v.pinned).collect()),
+        }
+    }
+
+    /// `Err(description)` naming the first NaN or infinite value. O(cells).
+    pub fn check_finite(&self) -> Result<(), String> {
+        let bad = |what: &str, k: usize| Err(format!("{what} of record {k} is not finite"));
+        if self.material.iter().any(|x| !x.is_finite()) {
+            return bad("material", 0);
+        }
+        for (k, v) in self.vertices.iter().enumerate() {
+            let all =
+                v.rest.iter().chain(&v.position).chain(&v.velocity).chain(&v.force).chain([&v.mass, &v.viscosity]);
+            if all.into_iter().any(|x| !x.is_finite()) {
+                return bad("a vertex attribute", k);
+            }
+        }
+        if let Some(k) = self.edges.iter().position(|e| e.iter().any(|x| !x.is_finite())) {
+            return bad("an edge attribute", k);
+        }
+        if let Some(k) = self.faces.iter().position(|f| f.1.iter().any(|x| !x.is_finite())) {
+            return bad("a face normal", k);
+        }
+        if let Some(k) = self.volumes.iter().position(|t| t.iter().any(|x| !x.is_finite())) {
+            return bad("a volume attribute", k);
+        }
+        Ok(())
+    }
+}

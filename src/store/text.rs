@@ -1,0 +1,355 @@
+//! The text form `.tmap` (grammar in `docs/FILE_FORMAT.md`).
+
+use std::fmt::Write as _;
+
+use super::raw::{IdAllocRecord, RawMap, RawMechanics, VertexRecord, UNSET};
+use super::{structure, Document, StoreError, Where, MAX_DIMENSION, TEXT_MAGIC, VERSION};
+
+/// Writes the document. Floats use Rust's shortest round-trip notation (`{:?}`). O(size).
+pub(super) fn encode(doc: &Document) -> String {
+    let m = &doc.map;
+    let n1 = m.alphas();
+    let mut s = String::new();
+    let live = m.live();
+    // `write!` into a String cannot fail.
+    let _ = writeln!(s, "{TEXT_MAGIC} {VERSION} {}", m.dimension);
+    let _ = writeln!(s, "darts {} {}", m.capacity, m.capacity as usize - m.free_darts.len());
+    for d in (0..m.capacity).filter(|&d| live[d as usize]) {
+        let row = d as usize * n1..(d as usize + 1) * n1;
+        let _ = write!(s, "{d}");
+        m.alpha[row.clone()].iter().for_each(|a| {
+            let _ = write!(s, " {a}");
+        });
+        s.push_str(" |");
+        m.cell[row].iter().for_each(|c| {
+            let _ = write!(s, " {c}");
+        });
+        s.push('\n');
+    }
+    let _ = writeln!(s, "free-darts {}{}", m.free_darts.len(), list(&m.free_darts));
+    for (i, rec) in m.ids.iter().enumerate() {
+        let _ = writeln!(s, "cell-ids {i} {} {}{}", rec.next, rec.free.len(), list(&rec.free));
+    }
+    if let Some(mech) = &doc.mechanics {
+        encode_mechanics(&mut s, mech);
+    }
+    s.push_str("end\n");
+    s
+}
+
+fn list(ids: &[u32]) -> String {
+    ids.iter().fold(String::new(), |mut acc, id| {
+        let _ = write!(acc, " {id}");
+        acc
+    })
+}
+
+fn floats(s: &mut String, xs: &[f64]) {
+    for x in xs {
+        let _ = write!(s, " {x:?}");
+    }
+}
+
+fn encode_mechanics(s: &mut String, m: &RawMechanics) {
+    let (nv, ne, nf, nt) = (m.vertices.len(), m.edges.len(), m.faces.len(), m.volumes.len());
+    let _ = writeln!(s, "mechanics {nv} {ne} {nf} {nt}");
+    s.push_str("material");
+    floats(s, &m.material);
+    s.push('\n');
+    for (k, v) in m.vertices.iter().enumerate() {
+        let _ = write!(s, "v {k}");
+        for xs in [&v.rest, &v.position, &v.velocity, &v.force] {
+            floats(s, xs);
+        }
+        floats(s, &[v.mass, v.viscosity]);
+        let _ = writeln!(s, " {}", u8::from(v.pinned));
+    }
+    for (k, e) in m.edges.iter().enumerate() {
+        let _ = write!(s, "e {k}");
+        floats(s, e);
+        s.push('\n');
+    }
+    for (k, (boundary, normal)) in m.faces.iter().enumerate() {
+        let _ = write!(s, "f {k} {}", u8::from(*boundary));
+        floats(s, normal);
+        s.push('\n');
+    }
+    for (k, t) in m.volumes.iter().enumerate() {
+        let _ = write!(s, "t {k}");
+        floats(s, t);
+        s.push('\n');
+    }
+}
+
+/// The significant lines of a text file (blank lines and `#` comments skipped), with numbers.
+struct Lines<'a> {
+    lines: Vec<(usize, &'a str)>,
+    pos: usize,
+    /// Line number just past the last line (for "truncated" errors).
+    end_line: usize,
+}
+
+impl<'a> Lines<'a> {
+    fn new(text: &'a str) -> Self {
+        let mut end_line = 1;
+        let mut lines = Vec::new();
+        for (k, line) in text.lines().enumerate() {
+            end_line = k + 2;
+            let t = line.trim();
+            if !t.is_empty() && !t.starts_with('#') {
+                lines.push((k + 1, t));
+            }
+        }
+        Lines { lines, pos: 0, end_line }
+    }
+
+    fn remaining(&self) -> usize {
+        self.lines.len() - self.pos
+    }
+
+    /// The next line split into tokens, whose first token must be `keyword` (unless empty).
+    fn next(&mut self, keyword: &str, expected: &str) -> Result<(usize, Vec<&'a str>), StoreError> {
+        let Some(&(no, line)) = self.lines.get(self.pos) else {
+            return Err(StoreError::Truncated { at: Where::Line(self.end_line), expected: expected.into() });
+        };
+        self.pos += 1;
+        let tokens: Vec<&str> = line.split_whitespace().collect();
+        if !keyword.is_empty() && tokens.first() != Some(&keyword) {
+            return Err(syntax(no, format!("expected {expected}, found {:?}", first_chars(line))));
+        }
+        Ok((no, tokens))
+    }
+}
+
+fn first_chars(line: &str) -> String {
+    line.chars().take(40).collect()
+}
+
+fn syntax(line: usize, message: String) -> StoreError {
+    StoreError::Syntax { at: Where::Line(line), message }
+}
+
+fn int(tok: &str, line: usize, what: &str) -> Result<u64, StoreError> {
+    tok.parse::<u64>().map_err(|_| syntax(line, format!("{what}: {tok:?} is not a non-negative integer")))
+}
+
+fn int32(tok: &str, line: usize, what: &str) -> Result<u32, StoreError> {
+    let v = int(tok, line, what)?;
+    u32::try_from(v).map_err(|_| syntax(line, format!("{what}: {v} does not fit in 32 bits")))
+}
+
+fn float(tok: &str, line: usize, field: &'static str, index: usize) -> Result<f64, StoreError> {
+    let x = tok.parse::<f64>().map_err(|_| syntax(line, format!("{field}: {tok:?} is not a number")))?;
+    if x.is_finite() {
+        Ok(x)
+    } else {
+        Err(StoreError::NonFinite { at: Where::Line(line), field, index })
+    }
+}
+
+fn arity(tokens: &[&str], n: usize, line: usize, what: &str) -> Result<(), StoreError> {
+    if tokens.len() == n {
+        Ok(())
+    } else {
+        Err(syntax(line, format!("{what}: expected {n} fields, found {}", tokens.len())))
+    }
+}
+
+/// Parses the text form into a raw document with its structure checked.
+pub(super) fn decode(bytes: &[u8]) -> Result<Document, StoreError> {
+    let text = std::str::from_utf8(bytes).map_err(|e| {
+        let line = bytes[..e.valid_up_to()].iter().filter(|&&b| b == b'\n').count() + 1;
+        syntax(line, "the text is not valid UTF-8".into())
+    })?;
+    let mut lines = Lines::new(text);
+    let map = decode_map(&mut lines)?;
+    let (no, head) = lines.next("", "\"mechanics\" or \"end\"")?;
+    let mechanics = match head.first() {
+        Some(&"mechanics") => Some(decode_mechanics(&mut lines, no, &head)?),
+        _ => {
+            lines.pos -= 1;
+            None
+        }
+    };
+    let (no, end) = lines.next("end", "\"end\"")?;
+    arity(&end, 1, no, "end")?;
+    if let Some(&(extra, _)) = lines.lines.get(lines.pos) {
+        return Err(StoreError::TrailingData { at: Where::Line(extra) });
+    }
+    if !text.ends_with('\n') {
+        return Err(StoreError::Truncated { at: Where::Line(no), expected: "a newline after \"end\"".into() });
+    }
+    Ok(Document { map, mechanics })
+}
+
+fn decode_header(lines: &mut Lines<'_>) -> Result<usize, StoreError> {
+    let (no, h) = lines.next(TEXT_MAGIC, "the header")?;
+    if h.len() < 2 {
+        return Err(StoreError::Truncated { at: Where::Line(no), expected: "the format version".into() });
+    }
+    let version = int(h[1], no, "version")?;
+    if version != u64::from(VERSION) {
+        return Err(StoreError::UnsupportedVersion { at: Where::Line(no), found: version });
+    }
+    arity(&h, 3, no, "header")?;
+    let dim = int(h[2], no, "dimension")?;
+    if dim == 0 || dim > MAX_DIMENSION as u64 {
+        return Err(StoreError::BadDimension { at: Where::Line(no), found: dim });
+    }
+    Ok(dim as usize)
+}
+
+fn decode_map(lines: &mut Lines<'_>) -> Result<RawMap, StoreError> {
+    let dim = decode_header(lines)?;
+    let n1 = dim + 1;
+    let (no, h) = lines.next("darts", "\"darts CAPACITY LIVE\"")?;
+    arity(&h, 3, no, "darts")?;
+    let capacity = int32(h[1], no, "capacity")?;
+    let live_count = int(h[2], no, "live darts")?;
+    if live_count > u64::from(capacity) || live_count > lines.remaining() as u64 {
+        let limit = u64::from(capacity).min(lines.remaining() as u64);
+        return Err(StoreError::BadCount { at: Where::Line(no), what: "live darts", count: live_count, limit });
+    }
+    let dead = u64::from(capacity) - live_count;
+    // Every dead slot is a token of the free-darts line: bounded by the file size.
+    let limit = (lines.lines.iter().map(|l| l.1.len()).sum::<usize>() / 2) as u64;
+    if capacity == UNSET || dead > limit {
+        return Err(StoreError::BadCount { at: Where::Line(no), what: "dead dart slots", count: dead, limit });
+    }
+    let cap = capacity as usize;
+    let mut alpha: Vec<u32> = (0..cap as u32).flat_map(|d| std::iter::repeat_n(d, n1)).collect();
+    let mut cell = vec![UNSET; cap * n1];
+    let mut prev: Option<u32> = None;
+    for _ in 0..live_count {
+        let (no, t) = lines.next("", "a dart line")?;
+        arity(&t, 2 * n1 + 2, no, "dart line")?;
+        let d = int(t[0], no, "dart id")?;
+        if d >= u64::from(capacity) {
+            return Err(StoreError::DartOutOfRange { at: Where::Line(no), dart: d, capacity: capacity.into() });
+        }
+        let d = d as u32;
+        if prev.is_some_and(|p| d <= p) {
+            return Err(StoreError::Inconsistent {
+                at: Where::Line(no),
+                message: format!("dart {d} is not after dart {} (ids must increase)", prev.unwrap_or(0)),
+            });
+        }
+        prev = Some(d);
+        if t[n1 + 1] != "|" {
+            return Err(syntax(no, format!("expected \"|\" between links and cell ids, found {:?}", t[n1 + 1])));
+        }
+        for i in 0..n1 {
+            let a = int(t[1 + i], no, "alpha link")?;
+            if a >= u64::from(capacity) {
+                return Err(StoreError::DartOutOfRange { at: Where::Line(no), dart: a, capacity: capacity.into() });
+            }
+            alpha[d as usize * n1 + i] = a as u32;
+            cell[d as usize * n1 + i] = int32(t[n1 + 2 + i], no, "cell id")?;
+        }
+    }
+    let (no, f) = lines.next("free-darts", "\"free-darts COUNT IDS…\"")?;
+    let free_darts = id_list(&f, 1, no, "free-darts")?;
+    if free_darts.len() as u64 != dead {
+        let what = "free dart slots (capacity − live)";
+        return Err(StoreError::BadCount { at: Where::Line(no), what, count: free_darts.len() as u64, limit: dead });
+    }
+    let mut ids = Vec::with_capacity(n1);
+    for i in 0..n1 {
+        let (no, c) = lines.next("cell-ids", "\"cell-ids DIM NEXT COUNT IDS…\"")?;
+        if c.len() < 3 || int(c[1], no, "cell dimension")? != i as u64 {
+            return Err(syntax(no, format!("expected \"cell-ids {i} NEXT COUNT IDS…\"")));
+        }
+        let next = int32(c[2], no, "next cell id")?;
+        let free = id_list(&c, 3, no, "cell-ids")?;
+        ids.push(IdAllocRecord { next, free });
+    }
+    let raw = RawMap { dimension: dim, capacity, alpha, cell, free_darts, ids };
+    structure::check(&raw, Where::Line(no))?;
+    Ok(raw)
+}
+
+/// `COUNT IDS…` starting at token `start`.
+fn id_list(t: &[&str], start: usize, no: usize, what: &str) -> Result<Vec<u32>, StoreError> {
+    let Some(count) = t.get(start) else {
+        return Err(syntax(no, format!("{what}: missing count")));
+    };
+    let count = int(count, no, what)?;
+    if count != (t.len() - start - 1) as u64 {
+        return Err(syntax(no, format!("{what}: count {count} but {} ids follow", t.len() - start - 1)));
+    }
+    t[start + 1..].iter().map(|tok| int32(tok, no, what)).collect()
+}
+
+fn decode_mechanics(lines: &mut Lines<'_>, no: usize, head: &[&str]) -> Result<RawMechanics, StoreError> {
+    arity(head, 5, no, "mechanics")?;
+    let mut counts = [0usize; 4];
+    for (k, c) in counts.iter_mut().enumerate() {
+        let v = int(head[1 + k], no, "record count")?;
+        if v > lines.remaining() as u64 {
+            let limit = lines.remaining() as u64;
+            return Err(StoreError::BadCount { at: Where::Line(no), what: "mechanics records", count: v, limit });
+        }
+        *c = v as usize;
+    }
+    let (no, mat) = lines.next("material", "\"material ρ E β ν\"")?;
+    arity(&mat, 5, no, "material")?;
+    let mut material = [0.0; 4];
+    for (k, x) in material.iter_mut().enumerate() {
+        *x = float(mat[1 + k], no, "material", 0)?;
+    }
+    let mut m = RawMechanics { material, ..RawMechanics::default() };
+    for k in 0..counts[0] {
+        let (no, t) = record(lines, "v", k, 16)?;
+        let xs = floats_of(&t[2..16], no, "vertex attribute", k)?;
+        let v3 = |o: usize| [xs[o], xs[o + 1], xs[o + 2]];
+        let pinned = flag(t[16], no)?;
+        m.vertices.push(VertexRecord {
+            rest: v3(0),
+            position: v3(3),
+            velocity: v3(6),
+            force: v3(9),
+            mass: xs[12],
+            viscosity: xs[13],
+            pinned,
+        });
+    }
+    for k in 0..counts[1] {
+        let (no, t) = record(lines, "e", k, 4)?;
+        let xs = floats_of(&t[2..], no, "edge attribute", k)?;
+        m.edges.push([xs[0], xs[1], xs[2]]);
+    }
+    for k in 0..counts[2] {
+        let (no, t) = record(lines, "f", k, 5)?;
+        let boundary = flag(t[2], no)?;
+        let xs = floats_of(&t[3..], no, "face normal", k)?;
+        m.faces.push((boundary, [xs[0], xs[1], xs[2]]));
+    }
+    for k in 0..counts[3] {
+        let (no, t) = record(lines, "t", k, 4)?;
+        let xs = floats_of(&t[2..], no, "volume attribute", k)?;
+        m.volumes.push([xs[0], xs[1], xs[2]]);
+    }
+    Ok(m)
+}
+
+/// A record line `KIND k x…` with `fields` values after the kind.
+fn record<'a>(lines: &mut Lines<'a>, kind: &str, k: usize, fields: usize) -> Result<(usize, Vec<&'a str>), StoreError> {
+    let (no, t) = lines.next(kind, &format!("record \"{kind} {k} …\""))?;
+    arity(&t, fields + 1, no, kind)?;
+    if int(t[1], no, "record id")? != k as u64 {
+        return Err(StoreError::Inconsistent { at: Where::Line(no), message: format!("expected record {kind} {k}") });
+    }
+    Ok((no, t))
+}
+
+fn floats_of(t: &[&str], no: usize, field: &'static str, k: usize) -> Result<Vec<f64>, StoreError> {
+    t.iter().map(|tok| float(tok, no, field, k)).collect()
+}
+
+fn flag(tok: &str, no: usize) -> Result<bool, StoreError> {
+    match tok {
+        "0" => Ok(false),
+        "1" => Ok(true),
+        _ => Err(syntax(no, format!("expected a flag 0 or 1, found {tok:?}"))),
+    }
+}

@@ -1,0 +1,269 @@
+//! Bad files give clear errors, never panics: truncations, byte flips, wrong magic or version,
+//! out-of-range darts, NaN, huge counts; a hand-broken map is listed by `check` with the right dart
+//! and law; a failed save leaves the old file intact.
+
+use std::process::Command;
+
+use proptest::prelude::*;
+use topomech::gmap::{InvariantViolation, Law};
+use topomech::mechanics::{Body, Material};
+use topomech::store::{self, Document, Finding, Format, StoreError};
+use topomech::{DartId, GMap};
+
+fn small_body() -> Body {
+    let (points, tets) = topomech::generate::kuhn_cube(1);
+    Body::from_tets(&points, &tets, Material::default()).unwrap().0
+}
+
+fn two_tets() -> GMap<3> {
+    GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap().0
+}
+
+/// FNV-1a 64, written again from the format document (not the library's code).
+fn fnv(bytes: &[u8]) -> u64 {
+    let mut h: u64 = 0xcbf29ce484222325;
+    for &b in bytes {
+        h ^= b as u64;
+        h = h.wrapping_mul(0x100000001b3);
+    }
+    h
+}
+
+/// Rewrites the trailing checksum after an edit, so the edit itself is what the loader sees.
+fn reseal(bytes: &mut [u8]) {
+    let n = bytes.len() - 8;
+    let sum = fnv(&bytes[..n]);
+    bytes[n..].copy_from_slice(&sum.to_le_bytes());
+}
+
+#[test]
+fn every_truncation_errors_cleanly() {
+    let doc = Document::from_body(&small_body());
+    for format in [Format::Text, Format::Binary] {
+        let bytes = store::encode(&doc, format).unwrap();
+        for cut in 0..bytes.len() {
+            let err = store::decode(&bytes[..cut]).expect_err("a strict prefix must not decode");
+            assert!(!err.to_string().is_empty());
+        }
+        assert!(store::decode(&bytes).is_ok());
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+    #[test]
+    fn byte_flips_never_panic(pos in any::<prop::sample::Index>(), bits in 1u8..=255, binary in any::<bool>()) {
+        let format = if binary { Format::Binary } else { Format::Text };
+        let mut bytes = store::encode(&Document::from_map(&two_tets()), format).unwrap();
+        let k = pos.index(bytes.len());
+        bytes[k] ^= bits;
+        match store::decode(&bytes) {
+            // A text flip may still parse (a digit changed): then check must list or accept it.
+            Ok(doc) => {
+                prop_assert!(!binary, "a flipped binary file decoded: the checksum missed it");
+                let report = store::check_all_laws(&doc, 50);
+                prop_assert_eq!(report.valid, doc.clone().into_map::<3>().is_ok());
+                prop_assert_eq!(report.valid, report.findings.is_empty());
+            }
+            Err(e) => prop_assert!(!e.to_string().is_empty()),
+        }
+    }
+}
+
+#[test]
+fn header_errors_name_what_is_wrong() {
+    let text = store::encode(&Document::from_map(&two_tets()), Format::Text).unwrap();
+    let text = String::from_utf8(text).unwrap();
+    let e = store::decode(b"solid cube\nfacet normal").unwrap_err();
+    assert!(matches!(e, StoreError::BadMagic { .. }), "{e}");
+    let e = store::decode(text.replacen("topomech-gmap 1 3", "topomech-gmap 2 3", 1).as_bytes()).unwrap_err();
+    assert!(matches!(e, StoreError::UnsupportedVersion { found: 2, .. }), "{e}");
+    assert!(e.to_string().contains("line 1"), "{e}");
+    let e = store::decode(text.replacen("topomech-gmap 1 3", "topomech-gmap 1 9", 1).as_bytes()).unwrap_err();
+    assert!(matches!(e, StoreError::BadDimension { found: 9, .. }), "{e}");
+    let e = store::decode(text.as_bytes()).unwrap().into_map::<2>().unwrap_err();
+    assert!(matches!(e, StoreError::WrongDimension { found: 3, expected: 2 }), "{e}");
+
+    let mut bin = store::encode(&Document::from_map(&two_tets()), Format::Binary).unwrap();
+    bin[8] = 7;
+    reseal(&mut bin);
+    let e = store::decode(&bin).unwrap_err();
+    assert!(matches!(e, StoreError::UnsupportedVersion { found: 7, .. }), "{e}");
+    assert!(e.to_string().contains("byte 8"), "{e}");
+}
+
+#[test]
+fn binary_corruption_is_a_checksum_error() {
+    let mut bin = store::encode(&Document::from_map(&two_tets()), Format::Binary).unwrap();
+    let k = bin.len() / 2;
+    bin[k] ^= 0x10;
+    assert!(matches!(store::decode(&bin).unwrap_err(), StoreError::Checksum { .. }));
+}
+
+#[test]
+fn huge_counts_are_refused_before_allocating() {
+    let mut bin = store::encode(&Document::from_map(&two_tets()), Format::Binary).unwrap();
+    bin[28..32].copy_from_slice(&(u32::MAX - 2).to_le_bytes()); // dart capacity
+    reseal(&mut bin);
+    let e = store::decode(&bin).unwrap_err();
+    assert!(matches!(e, StoreError::BadCount { what: "dart capacity", .. }), "{e}");
+    let text = "topomech-gmap 1 3\ndarts 4000000000 0\nfree-darts 0\nend\n";
+    assert!(matches!(store::decode(text.as_bytes()).unwrap_err(), StoreError::BadCount { .. }));
+    let text =
+        "topomech-gmap 1 1\ndarts 1 1\n0 0 0 | 0 0\nfree-darts 0\ncell-ids 0 4000000000 0\ncell-ids 1 1 0\nend\n";
+    let e = store::decode(text.as_bytes()).unwrap_err();
+    assert!(matches!(e, StoreError::BadCount { .. }), "{e}");
+}
+
+#[test]
+fn out_of_range_dart_and_nan_are_located() {
+    let text =
+        "topomech-gmap 1 1\ndarts 2 2\n0 0 1 | 0 0\n1 1 7 | 1 0\nfree-darts 0\ncell-ids 0 2 0\ncell-ids 1 1 0\nend\n";
+    let e = store::decode(text.as_bytes()).unwrap_err();
+    assert!(matches!(e, StoreError::DartOutOfRange { dart: 7, capacity: 2, .. }), "{e}");
+    assert!(e.to_string().contains("line 4"), "{e}");
+
+    let body = small_body();
+    let text = String::from_utf8(store::encode(&Document::from_body(&body), Format::Text).unwrap()).unwrap();
+    let line = text.lines().position(|l| l.starts_with("e 3 ")).unwrap();
+    let broken: Vec<String> = text
+        .lines()
+        .enumerate()
+        .map(|(k, l)| if k == line { "e 3 NaN 1.0 1.0".to_string() } else { l.to_string() })
+        .collect();
+    let e = store::decode((broken.join("\n") + "\n").as_bytes()).unwrap_err();
+    assert!(matches!(e, StoreError::NonFinite { index: 3, .. }), "{e}");
+    assert!(e.to_string().contains(&format!("line {}", line + 1)), "{e}");
+}
+
+/// The text of `two_tets` with α0 of dart `d` pointed at `to` instead.
+fn swap_alpha0(d: u32, to: u32) -> String {
+    let text = String::from_utf8(store::encode(&Document::from_map(&two_tets()), Format::Text).unwrap()).unwrap();
+    text.lines()
+        .map(|l| {
+            let t: Vec<&str> = l.split_whitespace().collect();
+            if t.first() == Some(&d.to_string().as_str()) && t.get(5) == Some(&"|") {
+                let mut t: Vec<String> = t.iter().map(|s| s.to_string()).collect();
+                t[1] = to.to_string();
+                t.join(" ")
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+        + "\n"
+}
+
+#[test]
+fn a_swapped_link_is_reported_with_its_dart_and_law() {
+    let map = two_tets();
+    let (d, to) = (5u32, 11u32);
+    assert_ne!(map.alpha_dyn(0, DartId(d)), DartId(to));
+    let doc = store::decode(swap_alpha0(d, to).as_bytes()).unwrap();
+    // The normal load refuses the map ...
+    let e = doc.clone().into_map::<3>().unwrap_err();
+    assert!(matches!(e, StoreError::BrokenLaw(_)), "{e}");
+    // ... check lists every law it breaks: the involution at d (α0(d) = to, α0(to) ≠ d) and at
+    // d's old partner (α0(4) = d but α0(d) ≠ 4).
+    let report = store::check_all_laws(&doc, 100);
+    assert!(!report.valid);
+    let involution_at = |x: u32| {
+        report.findings.iter().find_map(|f| match f {
+            Finding::Map(v @ InvariantViolation::NotInvolution { dart, i: 0, image, .. }) if dart.0 == x => {
+                assert_eq!(v.law(), Law::Involution);
+                Some(*image)
+            }
+            _ => None,
+        })
+    };
+    assert_eq!(involution_at(d), Some(DartId(to)));
+    assert_eq!(involution_at(map.alpha_dyn(0, DartId(d)).0), Some(DartId(d)));
+    assert!(report.findings.len() > 1, "only the first violation was listed: {:?}", report.findings);
+}
+
+fn topomech() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_topomech"))
+}
+
+#[test]
+fn check_command_exit_codes_and_json() {
+    let dir = std::env::temp_dir().join(format!("topomech-store-check-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let good = dir.join("good.tmapb");
+    store::save_body(&small_body(), &good, Format::Binary).unwrap();
+    let out = topomech().args(["check", good.to_str().unwrap()]).output().unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stdout));
+
+    let bad = dir.join("bad.tmap");
+    std::fs::write(&bad, swap_alpha0(5, 11)).unwrap();
+    let out = topomech().args(["check", "--json", bad.to_str().unwrap()]).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["valid"], false);
+    let findings = json["findings"].as_array().unwrap();
+    assert!(findings.iter().any(|f| f["law"] == "involution" && f["darts"][0] == 5 && f["darts"][1] == 11));
+
+    let garbage = dir.join("garbage.tmap");
+    std::fs::write(&garbage, "topomech-gmap 1 3\ndarts 3\n").unwrap();
+    let out = topomech().args(["check", garbage.to_str().unwrap()]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("line 2"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn failed_saves_leave_the_old_file_intact() {
+    let dir = std::env::temp_dir().join(format!("topomech-store-atomic-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("body.tmap");
+    let body = small_body();
+    store::save_body(&body, &path, Format::Text).unwrap();
+    let old = std::fs::read(&path).unwrap();
+
+    // An unrepresentable value: refused before anything is written.
+    let mut nan = body.clone();
+    nan.attrs_mut().position.as_mut_slice()[0][0] = f64::NAN;
+    assert!(matches!(store::save_body(&nan, &path, Format::Text), Err(StoreError::Unrepresentable { .. })));
+    assert_eq!(std::fs::read(&path).unwrap(), old);
+
+    // The rename fails (the target is a non-empty directory): the temporary file is cleaned up.
+    let blocker = dir.join("blocker.tmap");
+    std::fs::create_dir_all(blocker.join("inside")).unwrap();
+    assert!(matches!(store::save_body(&body, &blocker, Format::Text), Err(StoreError::Io { .. })));
+    assert!(blocker.join("inside").is_dir());
+
+    // A directory that cannot be written (only effective when not running as root).
+    let ro = dir.join("ro");
+    std::fs::create_dir_all(&ro).unwrap();
+    let ro_path = ro.join("body.tmap");
+    store::save_body(&body, &ro_path, Format::Text).unwrap();
+    let ro_old = std::fs::read(&ro_path).unwrap();
+    set_mode(&ro, 0o555);
+    let probe_ok = std::fs::write(ro.join("probe"), b"x").is_ok();
+    let mut moved = small_body();
+    moved.attrs_mut().position.as_mut_slice()[0][0] += 1.0;
+    let result = store::save_body(&moved, &ro_path, Format::Text);
+    if !probe_ok {
+        assert!(matches!(result, Err(StoreError::Io { .. })), "{result:?}");
+        assert_eq!(std::fs::read(&ro_path).unwrap(), ro_old);
+    }
+    set_mode(&ro, 0o755);
+
+    let leftovers: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains(".tmp-"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[cfg(unix)]
+fn set_mode(p: &std::path::Path, mode: u32) {
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::set_permissions(p, std::fs::Permissions::from_mode(mode)).unwrap();
+}
+
+#[cfg(not(unix))]
+fn set_mode(_: &std::path::Path, _: u32) {}

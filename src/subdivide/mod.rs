@@ -22,6 +22,7 @@
 //! μt on volumes of the finest level; dart levels ≤ max level.
 
 mod ops;
+mod tet;
 mod tri;
 
 use crate::gmap::{AlphaMask, DartId, GMap, InvariantViolation};
@@ -88,6 +89,21 @@ pub enum SubdivideError {
     /// The operation exists for these dimensions only (faces: n ∈ {2, 3}).
     #[error("this operation is not defined for {0}-G-maps")]
     WrongDimension(usize),
+    /// The volume, at its own level μt, is not a tetrahedron (four corners of three faces each).
+    #[error("the volume of {dart} has {corners} corners at its own level, not 4")]
+    NotATetrahedron {
+        /// A dart of the volume.
+        dart: DartId,
+        /// Corners found.
+        corners: usize,
+    },
+    /// A face of the tetrahedron was refined beyond one 1→4 step, or an inner edge of one of its
+    /// split faces carries an inserted vertex (tetrahedron 1→8 does not support this yet).
+    #[error("a face of the tetrahedron at {dart} is refined beyond one 1→4 step")]
+    FaceRefinedTooFar {
+        /// A dart of the offending face (or of the volume when the face count is wrong).
+        dart: DartId,
+    },
     /// The edge has an α0-free dart: it has no second vertex to split between.
     #[error("the edge of {0} is open (α0-free)")]
     OpenEdge(DartId),

@@ -19,9 +19,9 @@ use crate::gmap::{AlphaMask, DartId};
 /// One side of a triangle face: the corner dart it starts from and its inserted (flat) vertices
 /// in order, each as (dart on the incoming half, dart on the outgoing half).
 #[derive(Clone, Debug)]
-struct Side {
-    start: DartId,
-    flats: Vec<(DartId, DartId)>,
+pub(super) struct Side {
+    pub(super) start: DartId,
+    pub(super) flats: Vec<(DartId, DartId)>,
 }
 
 impl<const N: usize> LeveledMap<N> {
@@ -123,8 +123,14 @@ impl<const N: usize> LeveledMap<N> {
         self.insert_edge_2d(m_out[0], m_in[1]);
         let (e, f) = self.insert_edge_2d(m_out[1], m_in[2]);
         let center = if self.map.same_orbit(f, sides[2].start, AlphaMask::of(&[0, 1])) { e } else { f };
+        // The midpoints are corners of the children on both sides of the face (in 3D the
+        // α3-mirror darts at the midpoints were created flat too).
         for &x in m_in.iter().chain(&m_out) {
             self.flat[x.index()] = false;
+            if N >= 3 {
+                let y = self.map.alpha_dyn(3, x);
+                self.flat[y.index()] = false;
+            }
         }
         let children = [sides[0].start, sides[1].start, sides[2].start, center];
         for c in children {
@@ -135,7 +141,7 @@ impl<const N: usize> LeveledMap<N> {
     }
 
     /// The three sides of the triangle face of `d`, from a corner. O(face).
-    fn triangle_sides(&self, d: DartId) -> Result<Vec<Side>, SubdivideError> {
+    pub(super) fn triangle_sides(&self, d: DartId) -> Result<Vec<Side>, SubdivideError> {
         let face = self.map.orbit(d, AlphaMask::of(&[0, 1]));
         let corner = face.iter().copied().find(|&x| !self.flat[x.index()]);
         let corner = corner.ok_or(SubdivideError::NotATriangle { dart: d, corners: 0 })?;

@@ -171,7 +171,7 @@ impl<const N: usize> GMap<N> {
         for alloc in &self.ids {
             let mut set = VisitBits::new(alloc.next as usize);
             let freed = alloc.free.iter().filter(|&&id| id < alloc.next && set.insert(id)).count();
-            dead.push(set);
+            dead.push((freed > 0).then_some(set));
             live.push(alloc.next as usize - freed);
         }
         let mut used: Vec<VisitBits> = self.ids.iter().map(|a| VisitBits::new(a.next as usize)).collect();
@@ -195,27 +195,41 @@ impl<const N: usize> GMap<N> {
 
     /// The involution, quasi-manifold and constant-live-id laws at dart slot d, reading its row
     /// and its neighbours' rows once. Same verdict as `check_dart_links` + `check_dart_cells`.
+    /// `dead[dim]` is `None` when dimension dim has no freed id. Violations are accumulated in
+    /// one flag rather than returned early, so the common (valid) path has no data-dependent
+    /// branch besides the range test that guards indexing.
     #[inline]
-    fn dart_laws_hold(&self, d: u32, dead: &[VisitBits]) -> bool {
-        let links = self.alpha_row(d);
-        let cells = self.cell_row(d);
+    fn dart_laws_hold(&self, d: u32, dead: &[Option<VisitBits>]) -> bool {
+        let capacity = self.capacity();
+        let base = d as usize * (N + 1);
+        let links = &self.alpha[base..base + N + 1];
+        let cells = &self.cell[base..base + N + 1];
+        let mut bad = false;
         for (i, &e) in links.iter().enumerate() {
-            if !self.contains(DartId(e)) || self.alpha_row(e)[i] != d {
+            if e as usize >= capacity {
                 return false;
             }
-            let other = self.cell_row(e);
-            if (0..=N).any(|dim| dim != i && other[dim] != cells[dim]) {
-                return false;
+            let alive = self.alive[e as usize >> 6] >> (e & 63) & 1 == 1;
+            let other = e as usize * (N + 1);
+            bad |= !alive | (self.alpha[other + i] != d);
+            let other_cells = &self.cell[other..other + N + 1];
+            for dim in 0..=N {
+                bad |= (dim != i) & (other_cells[dim] != cells[dim]);
             }
         }
         for i in 0..=N {
             for j in i + 2..=N {
-                if self.alpha_row(links[j])[i] != self.alpha_row(links[i])[j] {
-                    return false;
-                }
+                bad |= self.alpha[links[j] as usize * (N + 1) + i] != self.alpha[links[i] as usize * (N + 1) + j];
             }
         }
-        (0..=N).all(|dim| cells[dim] < self.ids[dim].next && !dead[dim].contains(cells[dim]))
+        for dim in 0..=N {
+            let id = cells[dim];
+            bad |= id >= self.ids[dim].next;
+            if let Some(dead) = &dead[dim] {
+                bad |= dead.contains(id);
+            }
+        }
+        !bad
     }
 
     /// Checks the local laws (involution, quasi-manifold, constant cell ids) at the given darts

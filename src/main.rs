@@ -6,6 +6,7 @@
 //! topomech info MESH [--json]    characteristics of a mesh file
 //! topomech simulate MESH …       mass/spring simulation (see --help)
 //! topomech bench step MESH       map-driven vs flat-array step time
+//! topomech refine MESH …         adaptive 1→8 refinement around a point (see --help)
 //! ```
 //!
 //! Exit status 0 on success, 1 with one line `topomech: error: …` on stderr when the input is bad
@@ -49,6 +50,8 @@ enum Command {
     Remove(cli::cut::RemoveArgs),
     /// Simulate a hanging body that tears where its stress exceeds a threshold.
     Tear(cli::cut::TearArgs),
+    /// Refine the tets meeting a ball 1→8, level by level, sharing their masses (seed 004).
+    Refine(cli::refine::RefineArgs),
     /// Validate a `.tmap`/`.tmapb` map file and list each broken law (exit 0 valid, 1 broken, 2 unreadable).
     Check(cli::check::CheckArgs),
 }
@@ -65,6 +68,7 @@ impl Command {
             Command::Remove(args) => cli::cut::run_remove(args),
             Command::Tear(args) => cli::cut::run_tear(args),
             Command::Check(args) => cli::check::run(args),
+            Command::Refine(args) => cli::refine::run(args),
         }
     }
 }

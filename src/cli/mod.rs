@@ -10,6 +10,7 @@ pub mod check;
 pub mod cut;
 pub mod demo;
 pub mod info;
+pub mod refine;
 pub mod simulate;
 
 use std::io::Write;

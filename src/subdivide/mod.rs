@@ -22,8 +22,11 @@
 //! μt on volumes of the finest level; dart levels ≤ max level.
 
 mod ops;
+mod region;
 mod tet;
 mod tri;
+
+pub use region::{tet_distance, Refinement, TetMasses};
 
 use crate::gmap::{AlphaMask, DartId, GMap, InvariantViolation};
 

@@ -108,7 +108,7 @@ impl LeveledMap<3> {
 
     /// The vertex ids of the four corners of the volume of `d` at its own level `lt`: the
     /// vertices with three faces around them inside the volume of G_lt (flat vertices have two).
-    fn tet_corners(&self, d: DartId, lt: u8) -> Result<[u32; 4], SubdivideError> {
+    pub(super) fn tet_corners(&self, d: DartId, lt: u8) -> Result<[u32; 4], SubdivideError> {
         let volume = self.map.orbit(d, AlphaMask::of(&[0, 1, 2]));
         if let Some(&x) = volume.iter().find(|&&x| (0..3).any(|j| self.map.is_free(j, x))) {
             return Err(SubdivideError::OpenEdge(x));

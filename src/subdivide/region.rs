@@ -1,0 +1,273 @@
+//! Refinement driven by a region, with tet masses carried to the children (seed 004's use case:
+//! refine the incision zone before cutting; issue 5, "mechanics coupling").
+//!
+//! # Zone
+//! A tetrahedron is *in the zone* of the ball B(c, r) when its closed point set meets the ball:
+//! dist(c, T) ≤ r, computed exactly (0 inside T, else the distance to the nearest face).
+//!
+//! # Order
+//! [`LeveledMap::refine_around`] works level by level: at level L it subdivides 1→8 every tet of
+//! the finest map with μt = L − 1 that is in the zone. All level-L operations end before any
+//! level-(L+1) one, so every face a subdivided tet sees is either unsplit or split once (the
+//! support of [`LeveledMap::subdivide_tet`]), and a coarser tet outside the zone is never touched
+//! again (its faces on the zone side may carry several levels; that is the adaptive picture).
+//!
+//! # Mass rule
+//! [`TetMasses`] holds one mass per volume id. When a tet of mass m is split into children of rest
+//! volumes V_1..V_8, child k gets m · V_k / ΣV (the last one m minus the others), so Σ m_k = m up to
+//! one rounding. Vertex masses are derived, never stored: m_v = Σ_{tets t ∋ v} m_t / 4 (seed 000,
+//! §3.1), so Σ_v m_v = Σ_t m_t holds by construction.
+
+use super::{LeveledMap, SubdivideError};
+use crate::gmap::{CellId, DartId};
+
+/// One mass per volume id of a [`LeveledMap<3>`] (index = volume cell id).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TetMasses {
+    /// `mass[t]`: the mass of volume t (0 for ids no volume uses).
+    pub mass: Vec<f64>,
+}
+
+/// What [`LeveledMap::refine_around`] did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Refinement {
+    /// Tets subdivided at each level (index 0 unused, always 0).
+    pub subdivided_per_level: Vec<usize>,
+    /// Σ tet mass before.
+    pub total_mass_before: f64,
+    /// Σ tet mass after.
+    pub total_mass_after: f64,
+}
+
+impl TetMasses {
+    /// Masses ρ · |V_t| from the positions of the map's vertices. O(darts).
+    ///
+    /// Errors: [`SubdivideError::NotATetrahedron`] if a volume does not have 4 vertices.
+    pub fn from_density(m: &LeveledMap<3>, density: f64) -> Result<Self, SubdivideError> {
+        let map = m.map();
+        let mut mass = vec![0.0; map.cell_id_bound(3)];
+        for d in map.one_dart_per_cell(3) {
+            mass[map.cell_id(3, d).index()] = density * m.tet_volume(d)?.abs();
+        }
+        Ok(TetMasses { mass })
+    }
+
+    /// Σ of the tet masses of the live volumes. O(darts).
+    pub fn total(&self, m: &LeveledMap<3>) -> f64 {
+        let map = m.map();
+        map.one_dart_per_cell(3).into_iter().map(|d| self.mass[map.cell_id(3, d).index()]).sum()
+    }
+
+    /// Vertex masses m_v = Σ_{t ∋ v} m_t / 4, indexed by vertex id. O(darts).
+    pub fn vertex_masses(&self, m: &LeveledMap<3>) -> Result<Vec<f64>, SubdivideError> {
+        let map = m.map();
+        let mut out = vec![0.0; map.cell_id_bound(0)];
+        for d in map.one_dart_per_cell(3) {
+            let share = self.mass[map.cell_id(3, d).index()] / 4.0;
+            for v in m.tet_vertices(d)? {
+                out[v as usize] += share;
+            }
+        }
+        Ok(out)
+    }
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+/// Distance from `p` to the segment [a, b]. O(1).
+fn segment_distance(p: [f64; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
+    let ab = sub(b, a);
+    let len2 = dot(ab, ab);
+    let t = if len2 > 0.0 { (dot(sub(p, a), ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
+    let q = [a[0] + t * ab[0], a[1] + t * ab[1], a[2] + t * ab[2]];
+    dot(sub(p, q), sub(p, q)).sqrt()
+}
+
+/// Distance from `p` to the closed triangle (a, b, c): the distance to its plane when the
+/// projection falls inside, else the distance to the nearest side. O(1).
+fn triangle_distance(p: [f64; 3], [a, b, c]: [[f64; 3]; 3]) -> f64 {
+    let n = cross(sub(b, a), sub(c, a));
+    let nn = dot(n, n);
+    if nn > 0.0 {
+        let h = dot(sub(p, a), n) / nn;
+        let q = [p[0] - h * n[0], p[1] - h * n[1], p[2] - h * n[2]];
+        let inside = [(a, b), (b, c), (c, a)].iter().all(|&(x, y)| dot(cross(sub(y, x), sub(q, x)), n) >= 0.0);
+        if inside {
+            return h.abs() * nn.sqrt();
+        }
+    }
+    segment_distance(p, a, b).min(segment_distance(p, b, c)).min(segment_distance(p, c, a))
+}
+
+/// Distance from `p` to the closed tetrahedron with corners `t`: 0 inside, else the distance to
+/// the nearest face. O(1).
+pub fn tet_distance(p: [f64; 3], t: [[f64; 3]; 4]) -> f64 {
+    let faces = [[t[1], t[2], t[3]], [t[0], t[3], t[2]], [t[0], t[1], t[3]], [t[0], t[2], t[1]]];
+    let vol = crate::mesh::signed_volume(t[0], t[1], t[2], t[3]);
+    let same_side = |f: &[[f64; 3]; 3]| crate::mesh::signed_volume(f[0], f[1], f[2], p) * vol >= 0.0;
+    if vol != 0.0 && faces.iter().all(same_side) {
+        return 0.0;
+    }
+    faces.iter().map(|&f| triangle_distance(p, f)).fold(f64::INFINITY, f64::min)
+}
+
+impl LeveledMap<3> {
+    /// The four corner vertex ids of the tet of `d` at its own level μt, in increasing order (a
+    /// tet outside a refined zone may carry inserted vertices of its neighbours on its sides in
+    /// the finest map; they are not corners). O(volume).
+    ///
+    /// Errors: [`SubdivideError::NotATetrahedron`] when the volume at its level is not a tet,
+    /// [`SubdivideError::OpenEdge`] when it is not closed.
+    pub fn tet_vertices(&self, d: DartId) -> Result<[u32; 4], SubdivideError> {
+        let mut corners = self.tet_corners(d, self.mu[d.index()].tet)?;
+        corners.sort_unstable();
+        Ok(corners)
+    }
+
+    /// Signed volume of the tet of `d` from the stored positions (vertex ids in increasing
+    /// order). O(volume).
+    pub fn tet_volume(&self, d: DartId) -> Result<f64, SubdivideError> {
+        let p = self.tet_vertices(d)?.map(|v| self.vertex_position(v));
+        Ok(crate::mesh::signed_volume(p[0], p[1], p[2], p[3]))
+    }
+
+    fn vertex_position(&self, v: u32) -> [f64; 3] {
+        self.points.get(v as usize).copied().unwrap_or([0.0; 3])
+    }
+
+    /// Whether the tet of `d` meets the closed ball B(center, radius). O(volume).
+    pub fn tet_in_ball(&self, d: DartId, center: [f64; 3], radius: f64) -> Result<bool, SubdivideError> {
+        let p = self.tet_vertices(d)?.map(|v| self.vertex_position(v));
+        Ok(tet_distance(center, p) <= radius)
+    }
+
+    /// Subdivides the tet of `d` 1→8 at `level` (see [`Self::subdivide_tet`]) and shares its mass
+    /// among the children in proportion to their rest volumes (module docs). O(volume + touched).
+    ///
+    /// Errors: those of [`Self::subdivide_tet`]; the map and the masses are unchanged on error.
+    pub fn subdivide_tet_with_mass(
+        &mut self,
+        d: DartId,
+        level: u8,
+        masses: &mut TetMasses,
+    ) -> Result<[DartId; 8], SubdivideError> {
+        let parent = masses.mass.get(self.map.cell_id(3, d).index()).copied().unwrap_or(0.0);
+        let children = self.subdivide_tet(d, level)?;
+        let volumes: Vec<f64> = children.iter().map(|&c| self.tet_volume(c).map(f64::abs)).collect::<Result<_, _>>()?;
+        let total: f64 = volumes.iter().sum();
+        masses.mass.resize(self.map.cell_id_bound(3).max(masses.mass.len()), 0.0);
+        let mut given = 0.0;
+        for (k, &c) in children.iter().enumerate() {
+            let share = if k + 1 == children.len() {
+                parent - given
+            } else if total > 0.0 {
+                parent * volumes[k] / total
+            } else {
+                parent / children.len() as f64
+            };
+            given += share;
+            masses.mass[self.map.cell_id(3, c).index()] = share;
+        }
+        Ok(children)
+    }
+
+    /// Refines the zone of the ball B(center, radius) up to level `levels` (module docs): for
+    /// L = max(1, k)..=levels, every tet with μt = L − 1 meeting the ball is subdivided at level L,
+    /// its mass shared by [`Self::subdivide_tet_with_mass`]. Returns the count per level and the
+    /// mass totals. O(Σ_L (volumes + refined · touched)).
+    ///
+    /// Errors: those of [`Self::subdivide_tet`] (the map keeps the operations done before it);
+    /// [`SubdivideError::LevelTooHigh`] for `levels` above [`super::MAX_LEVEL`].
+    ///
+    /// ```
+    /// use topomech::subdivide::{LeveledMap, TetMasses};
+    /// use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let points = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mut m = LeveledMap::new(map, points);
+    /// let mut masses = TetMasses::from_density(&m, 6.0).unwrap();
+    /// let r = m.refine_around([0.1, 0.1, 0.1], 10.0, 2, &mut masses).unwrap();
+    /// assert_eq!(r.subdivided_per_level, vec![0, 1, 8]);
+    /// assert_eq!(m.map().count_cells().0[3], 64);
+    /// assert!((r.total_mass_after - 1.0).abs() < 1e-12);
+    /// ```
+    pub fn refine_around(
+        &mut self,
+        center: [f64; 3],
+        radius: f64,
+        levels: u8,
+        masses: &mut TetMasses,
+    ) -> Result<Refinement, SubdivideError> {
+        self.check_op_level(levels)?;
+        let before = masses.total(self);
+        let mut per_level = vec![0; levels as usize + 1];
+        for level in self.max_level.max(1)..=levels {
+            let zone = self.zone_tets(level - 1, center, radius)?;
+            for d in zone {
+                self.subdivide_tet_with_mass(d, level, masses)?;
+                per_level[level as usize] += 1;
+            }
+        }
+        Ok(Refinement {
+            subdivided_per_level: per_level,
+            total_mass_before: before,
+            total_mass_after: masses.total(self),
+        })
+    }
+
+    /// One dart of every tet with μt = `lt` meeting the ball. O(darts).
+    fn zone_tets(&self, lt: u8, center: [f64; 3], radius: f64) -> Result<Vec<DartId>, SubdivideError> {
+        let mut out = Vec::new();
+        for d in self.map.one_dart_per_cell(3) {
+            if self.mu[d.index()].tet == lt && self.tet_in_ball(d, center, radius)? {
+                out.push(d);
+            }
+        }
+        Ok(out)
+    }
+
+    /// The tets of the finest map as vertex quadruples (positive orientation) with their μt, for
+    /// output. O(darts).
+    pub fn finest_tets(&self) -> Result<Vec<([u32; 4], u8, CellId)>, SubdivideError> {
+        let mut out = Vec::new();
+        for d in self.map.one_dart_per_cell(3) {
+            let mut t = self.tet_vertices(d)?;
+            let p = t.map(|v| self.vertex_position(v));
+            if crate::mesh::signed_volume(p[0], p[1], p[2], p[3]) < 0.0 {
+                t.swap(2, 3);
+            }
+            out.push((t, self.mu[d.index()].tet, self.map.cell_id(3, d)));
+        }
+        Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const UNIT: [[f64; 3]; 4] = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+
+    #[test]
+    fn tet_distance_is_zero_inside_and_euclidean_outside() {
+        assert_eq!(tet_distance([0.1, 0.1, 0.1], UNIT), 0.0);
+        assert!((tet_distance([-2.0, 0.0, 0.0], UNIT) - 2.0).abs() < 1e-15);
+        // Nearest point of the slanted face x + y + z = 1 from (1, 1, 1): distance 2/√3.
+        assert!((tet_distance([1.0, 1.0, 1.0], UNIT) - 2.0 / 3f64.sqrt()).abs() < 1e-12);
+        // Nearest feature an edge: from (-1, -1, 0.5) to the z-axis edge, √2.
+        assert!((tet_distance([-1.0, -1.0, 0.5], UNIT) - 2f64.sqrt()).abs() < 1e-12);
+        // Orientation of the corners does not matter.
+        let flipped = [UNIT[0], UNIT[2], UNIT[1], UNIT[3]];
+        assert_eq!(tet_distance([0.1, 0.1, 0.1], flipped), 0.0);
+    }
+}

@@ -1,0 +1,179 @@
+//! Refinement driven by a ball (`LeveledMap::refine_around`, issue 5) and the `topomech refine`
+//! command. Laws checked after every refinement:
+//! - every law of the leveled map (`check_all`: finest map valid, μt ≤ μf ≤ μa, every level valid);
+//! - zone law: every tet of the finest map that meets the ball has μt = L (a tet meeting it at a
+//!   lower level would have been refined at the next level); tets far from the ball keep μt = 0;
+//! - mass laws: Σ tet masses unchanged; Σ vertex masses = Σ tet masses; every tet's mass equals
+//!   ρ · its volume (children share the parent's mass by volume and midpoint subdivision divides
+//!   volume exactly);
+//! - the Euler characteristic of every extracted level equals that of level 0.
+
+use std::process::Command;
+
+use proptest::prelude::*;
+use topomech::generate::kuhn_cube;
+use topomech::subdivide::{tet_distance, LeveledMap, SubdivideError, TetMasses};
+use topomech::GMap;
+
+const RHO: f64 = 3.0;
+
+fn cube(k: usize) -> LeveledMap<3> {
+    let (points, tets) = kuhn_cube(k);
+    let (map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+    LeveledMap::new(map, points)
+}
+
+fn check_laws(m: &LeveledMap<3>, masses: &TetMasses, center: [f64; 3], radius: f64, levels: u8, mass0: f64) {
+    m.check_all().unwrap();
+    let chi0 = m.level(0).unwrap().map.euler_characteristic();
+    for i in 0..=m.max_level() {
+        assert_eq!(m.level(i).unwrap().map.euler_characteristic(), chi0, "level {i}");
+    }
+    let map = m.map();
+    for d in map.one_dart_per_cell(3) {
+        let corners = m.tet_vertices(d).unwrap().map(|v| m.points()[v as usize]);
+        let dist = tet_distance(center, corners);
+        let mu = m.mu(d).tet;
+        if dist <= radius {
+            assert_eq!(mu, levels, "a tet meeting the ball (distance {dist}) stayed at level {mu}");
+        }
+        let expected = RHO * m.tet_volume(d).unwrap().abs();
+        let got = masses.mass[map.cell_id(3, d).index()];
+        assert!((got - expected).abs() <= 1e-12 * mass0, "tet of {d}: mass {got}, ρ·V = {expected}");
+    }
+    let total = masses.total(m);
+    assert!((total - mass0).abs() <= 1e-12 * mass0, "Σ tet mass {total} ≠ {mass0}");
+    let vertex_total: f64 = masses.vertex_masses(m).unwrap().iter().sum();
+    assert!((vertex_total - total).abs() <= 1e-12 * mass0, "Σ vertex mass {vertex_total} ≠ {total}");
+}
+
+#[test]
+fn one_tet_to_level_two_has_64_tets_and_keeps_its_mass() {
+    let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    let mut m = LeveledMap::new(map, vec![[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.0]]);
+    let mut masses = TetMasses::from_density(&m, RHO).unwrap();
+    let mass0 = masses.total(&m);
+    assert!((mass0 - RHO * 8.0 / 6.0).abs() < 1e-12);
+    let r = m.refine_around([0.5, 0.5, 0.5], 10.0, 2, &mut masses).unwrap();
+    assert_eq!(r.subdivided_per_level, vec![0, 1, 8]);
+    let per_level: Vec<usize> = (0..=2).map(|i| m.level(i).unwrap().map.count_cells().0[3]).collect();
+    assert_eq!(per_level, vec![1, 8, 64]);
+    check_laws(&m, &masses, [0.5, 0.5, 0.5], 10.0, 2, mass0);
+}
+
+#[test]
+fn a_corner_zone_of_a_cube_refines_only_near_the_corner() {
+    let mut m = cube(3);
+    let mut masses = TetMasses::from_density(&m, RHO).unwrap();
+    let mass0 = masses.total(&m);
+    // kuhn_cube(3) spans [0, 3]³ in unit cells.
+    let (center, radius) = ([0.0, 0.0, 0.0], 0.2);
+    let r = m.refine_around(center, radius, 3, &mut masses).unwrap();
+    assert!(r.subdivided_per_level[1] > 0 && r.subdivided_per_level[3] > 0, "{r:?}");
+    check_laws(&m, &masses, center, radius, 3, mass0);
+    // The opposite corner is far away: its tets are untouched.
+    let far = m.map().one_dart_per_cell(3).into_iter().filter(|&d| {
+        let c = m.tet_vertices(d).unwrap().map(|v| m.points()[v as usize]);
+        tet_distance([3.0, 3.0, 3.0], c) == 0.0
+    });
+    for d in far {
+        assert_eq!(m.mu(d).tet, 0);
+    }
+}
+
+#[test]
+fn refinement_continues_from_the_current_level_and_refuses_going_back() {
+    let mut m = cube(2);
+    let mut masses = TetMasses::from_density(&m, RHO).unwrap();
+    let mass0 = masses.total(&m);
+    m.refine_around([1.0, 1.0, 1.0], 0.2, 2, &mut masses).unwrap();
+    // A second zone at the same top level: only level-1 tets there can be refined at level 2.
+    m.refine_around([0.8, 0.8, 0.8], 0.5, 2, &mut masses).unwrap();
+    m.check_all().unwrap();
+    assert!((masses.total(&m) - mass0).abs() <= 1e-12 * mass0);
+    let before = m.map().dart_count();
+    let err = m.refine_around([0.5, 0.5, 0.5], 1.0, 1, &mut masses).unwrap_err();
+    assert!(matches!(err, SubdivideError::LevelBelowMax { level: 1, max_level: 2 }), "{err:?}");
+    assert_eq!(m.map().dart_count(), before, "a refused refinement changes nothing");
+    let err = m.refine_around([0.5, 0.5, 0.5], 1.0, 251, &mut masses).unwrap_err();
+    assert!(matches!(err, SubdivideError::LevelTooHigh(251)), "{err:?}");
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+    #[test]
+    fn random_zones_keep_every_law(
+        k in 1usize..=2,
+        c in prop::array::uniform3(-0.5f64..2.5),
+        radius in 0.0f64..1.0,
+        levels in 1u8..=2,
+    ) {
+        let mut m = cube(k);
+        let mut masses = TetMasses::from_density(&m, RHO).unwrap();
+        let mass0 = masses.total(&m);
+        m.refine_around(c, radius, levels, &mut masses).unwrap();
+        check_laws(&m, &masses, c, radius, levels, mass0);
+    }
+}
+
+const BIN: &str = env!("CARGO_BIN_EXE_topomech");
+
+fn liver() -> String {
+    format!("{}/data/liver_547_v22.msh", env!("CARGO_MANIFEST_DIR"))
+}
+
+#[test]
+fn the_refine_command_reports_the_documented_json() {
+    let out = Command::new(BIN)
+        .args(["refine", &liver(), "--around", "-2.2,3.2,0.6", "--radius", "0.4", "--levels", "2", "--json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    for key in [
+        "volumes",
+        "darts",
+        "tets_per_level",
+        "valid",
+        "mu_order_ok",
+        "levels_valid",
+        "total_mass_before",
+        "total_mass_after",
+        "refine_ms",
+    ] {
+        assert!(v.get(key).is_some(), "missing key {key} in {v}");
+    }
+    let per_level: Vec<u64> = v["tets_per_level"].as_array().unwrap().iter().map(|x| x.as_u64().unwrap()).collect();
+    assert_eq!(per_level.len(), 3);
+    assert_eq!(per_level[0], 1852);
+    assert!(per_level[0] < per_level[1] && per_level[1] < per_level[2], "{per_level:?}");
+    assert_eq!(v["volumes"].as_u64().unwrap(), per_level[2]);
+    assert!(
+        v["valid"].as_bool().unwrap() && v["mu_order_ok"].as_bool().unwrap() && v["levels_valid"].as_bool().unwrap()
+    );
+    let (a, b) = (v["total_mass_before"].as_f64().unwrap(), v["total_mass_after"].as_f64().unwrap());
+    assert!((a - b).abs() <= 1e-12 * a, "{a} vs {b}");
+}
+
+#[test]
+fn the_refine_command_rejects_bad_arguments_with_a_message() {
+    for (args, needle) in [
+        (vec!["--around", "0,0,0", "--radius", "-1"], "--radius"),
+        (vec!["--around", "0,0,0", "--radius", "NaN"], "--radius"),
+        (vec!["--around", "0,nan,0", "--radius", "1"], "not finite"),
+        (vec!["--around", "0,0", "--radius", "1"], "X,Y,Z"),
+    ] {
+        let liver = liver();
+        let mut all = vec!["refine", liver.as_str()];
+        all.extend(args.iter().copied());
+        let out = Command::new(BIN).args(&all).output().unwrap();
+        assert!(!out.status.success(), "{all:?} succeeded");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(needle), "{all:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+    let out =
+        Command::new(BIN).args(["refine", "/no/such.msh", "--around", "0,0,0", "--radius", "1"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("/no/such.msh"));
+}

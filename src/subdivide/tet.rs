@@ -371,6 +371,7 @@ impl LeveledMap<3> {
     /// and edges (both sides), so μt ≤ μf ≤ μa holds. O(volume · face).
     fn set_tet_levels(&mut self, c: DartId, level: u8) {
         let mut faces_done: FxHashSet<u32> = FxHashSet::default();
+        let mut edges_done: FxHashSet<u32> = FxHashSet::default();
         for x in self.map.orbit(c, AlphaMask::of(&[0, 1, 2])) {
             self.mu[x.index()].tet = level;
             if faces_done.contains(&x.0) {
@@ -379,7 +380,12 @@ impl LeveledMap<3> {
             for y in self.map.orbit(x, AlphaMask::cell(3, 2)) {
                 faces_done.insert(y.0);
                 self.mu[y.index()].face = self.mu[y.index()].face.max(level);
+                if edges_done.contains(&y.0) {
+                    continue;
+                }
+                // Each edge orbit is walked once: its darts in this face side are marked done.
                 for z in self.map.orbit(y, AlphaMask::cell(3, 1)) {
+                    edges_done.insert(z.0);
                     self.mu[z.index()].edge = self.mu[z.index()].edge.max(level);
                 }
             }

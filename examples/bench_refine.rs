@@ -1,0 +1,54 @@
+//! Uniform 1→8 refinement of every tet of the Kuhn cube of size k (the mesh of CGAL's anchor
+//! benchmark, `--red`), with levels and the tet masses shared among the children, timed as CPU
+//! time per tet. Prints one line and one JSON object.
+//!
+//!     cargo run --release --example bench_refine -- 10
+//!
+//! Pair it with `target/cgal_bench K --red --no-subdiv3d` in the same run (see docs/BENCHMARKS.md).
+
+use std::time::Instant;
+
+use topomech::generate::kuhn_cube;
+use topomech::subdivide::{LeveledMap, TetMasses};
+use topomech::GMap;
+
+/// The thread's user + system CPU time in seconds (10 ms ticks), or `None` where /proc is missing.
+fn thread_cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/thread-self/stat").ok()?;
+    let after_name = &stat[stat.rfind(')')? + 1..];
+    let fields: Vec<&str> = after_name.split_whitespace().collect();
+    let utime: f64 = fields.get(11)?.parse().ok()?;
+    let stime: f64 = fields.get(12)?.parse().ok()?;
+    Some((utime + stime) / 100.0)
+}
+
+fn main() {
+    let k: usize = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(10);
+    let (points, tets) = kuhn_cube(k);
+    let (map, _) = GMap::<3>::from_tets(points.len(), &tets).expect("the Kuhn cube builds");
+    let mut m = LeveledMap::new(map, points);
+    let mut masses = TetMasses::from_density(&m, 1.0).expect("tets");
+    let (cpu0, wall0) = (thread_cpu_seconds(), Instant::now());
+    let r = m.refine_around([0.0; 3], f64::MAX, 1, &mut masses).expect("uniform refinement");
+    let (cpu1, wall) = (thread_cpu_seconds(), wall0.elapsed().as_secs_f64());
+    let cpu = match (cpu0, cpu1) {
+        (Some(a), Some(b)) => b - a,
+        _ => wall,
+    };
+    let n = tets.len() as f64;
+    m.check_all().expect("every law holds after the refinement");
+    let rel = (r.total_mass_after - r.total_mass_before).abs() / r.total_mass_before;
+    println!(
+        "[refine] k={k} tets={} -> {}: {:.1} us/tet CPU ({:.1} us/tet wall), mass residual {rel:.1e}",
+        tets.len(),
+        m.map().count_cells().0[3],
+        1e6 * cpu / n,
+        1e6 * wall / n
+    );
+    println!(
+        "{{\"k\":{k},\"tets\":{},\"us_per_tet_cpu\":{:.3},\"us_per_tet_wall\":{:.3},\"mass_residual\":{rel:e}}}",
+        tets.len(),
+        1e6 * cpu / n,
+        1e6 * wall / n
+    );
+}

@@ -44,5 +44,8 @@ pub mod store;
 pub mod subdivide;
 pub mod vtk;
 
+#[doc = include_str!("../docs/TUTORIAL.md")]
+pub mod tutorial {}
+
 pub use build::{BuildError, BuildReport};
 pub use gmap::{AlphaMask, CellId, DartId, GMap, InvariantViolation};

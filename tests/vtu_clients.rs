@@ -50,7 +50,7 @@ fn scratch(name: &str) -> PathBuf {
 
 /// The built-in liver cut in two by a plane through its middle: a body whose vertices were
 /// split, so the file has more points than the input mesh.
-fn cut_liver() -> (Vec<[f64; 3]>, Vec<[u32; 4]>) {
+fn cut_liver() -> Mesh {
     let loaded = load::load_builtin().unwrap();
     let (mut body, _) = Body::from_tets(&loaded.mesh.points, &loaded.mesh.tets, Material::default()).unwrap();
     let plane = Plane { point: [-1.5, 3.0, 0.6], normal: [1.0, 0.2, 0.1] };
@@ -104,7 +104,10 @@ d = servermanager.Fetch(one)
 print(json.dumps({"steps": steps, "frames": frames, "single": [d.GetNumberOfPoints(), d.GetNumberOfCells()]}))
 "#;
 
-fn write_series(dir: &Path, frames: &[(Vec<[f64; 3]>, Vec<[u32; 4]>)]) -> PathBuf {
+/// Points and tets of one frame.
+type Mesh = (Vec<[f64; 3]>, Vec<[u32; 4]>);
+
+fn write_series(dir: &Path, frames: &[Mesh]) -> PathBuf {
     let mut series = Series::new(dir, "frames").unwrap();
     for (k, (points, tets)) in frames.iter().enumerate() {
         series.push(0.5 * k as f64, &Frame { points, tets, vectors: Vec::new() }).unwrap();
@@ -129,7 +132,7 @@ fn pvpython_reads_back_a_series_and_a_frame() {
     let json_line = text.lines().rev().find(|l| l.starts_with('{')).expect("pvpython printed the JSON line");
     let v: serde_json::Value = serde_json::from_str(json_line).unwrap();
     assert_eq!(v["steps"], serde_json::json!([0.0, 0.5]));
-    let expect = |(p, t): &(Vec<[f64; 3]>, Vec<[u32; 4]>)| serde_json::json!([p.len(), t.len(), 10]);
+    let expect = |(p, t): &Mesh| serde_json::json!([p.len(), t.len(), 10]);
     assert_eq!(v["frames"], serde_json::json!([expect(&before), expect(&after)]));
     assert_eq!(v["single"], serde_json::json!([after.0.len(), after.1.len()]));
 }

@@ -21,6 +21,7 @@
 //! μt ≤ μf ≤ μa for every dart (Theorem 1 and its corollary); μa constant on edges, μf on faces,
 //! μt on volumes of the finest level; dart levels ≤ max level.
 
+pub mod fuzz;
 mod ops;
 mod region;
 mod tet;

@@ -1,0 +1,265 @@
+//! Random subdivision sequences decoded from bytes: the body of the cargo-fuzz target
+//! `fuzz/fuzz_targets/subdivide.rs`, of the proptest suite `tests/subdivide_fuzz.rs` and of the
+//! replay of the committed corpus `fuzz/corpus/subdivide/` on stable (one decoder, three engines).
+//!
+//! # Decoding
+//! Byte 0 picks the mesh: a 2×2 triangle grid (2-G-map), the Kuhn cube k = 1 (6 tets) or one
+//! tetrahedron (3-G-maps). Then every 3 bytes make one [`Op`]: byte a picks the kind (a % 4: edge
+//! split, triangle 1→4, tet 1→8, refinement around a ball; the two last are 3D only and become a
+//! triangle split in 2D), bit 7 of a whether the level goes up by one; bytes b, c pick the dart
+//! (any live dart, `(b·256 + c) mod darts`) or, for a ball, its centre and radius. Levels stay
+//! ≤ [`MAX_FUZZ_LEVEL`]; the map stops growing at [`MAX_DARTS`] darts.
+//!
+//! # Laws checked after every op (a failure is a bug in topomech)
+//! - accepted op: [`LeveledMap::check_all`] (finest map valid, μt ≤ μf ≤ μa, every level a valid
+//!   G-map); level k isomorphic to the finest map; the Euler characteristic of every level equals
+//!   that of the input; a refinement around a ball keeps Σ tet mass and leaves every tet meeting
+//!   the ball at the top level;
+//! - refused op: only the documented refusals (`AlreadyAtLevel`, `NotATriangle`,
+//!   `NotATetrahedron`, `FaceRefinedTooFar`, `OpenEdge`), and the map is unchanged (same darts,
+//!   isomorphic, same maximum level).
+
+use super::{tet_distance, LeveledMap, SubdivideError, TetMasses};
+use crate::generate::{grid_triangles, kuhn_cube};
+use crate::gmap::{DartId, GMap};
+
+/// Highest level an op may reach.
+pub const MAX_FUZZ_LEVEL: u8 = 3;
+/// The map is not refined further once it has this many darts.
+pub const MAX_DARTS: usize = 5_000;
+
+/// The mesh an input starts from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mesh {
+    /// `grid_triangles(2)`: 8 triangles (2D).
+    Grid,
+    /// `kuhn_cube(1)`: 6 tets.
+    Cube,
+    /// One tetrahedron.
+    Tet,
+}
+
+/// One decoded operation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Op {
+    /// `split_edge` of the edge of dart pick % darts.
+    SplitEdge {
+        /// Dart selector.
+        pick: u16,
+        /// Level one above the current maximum.
+        up: bool,
+    },
+    /// `subdivide_triangle`.
+    Triangle {
+        /// Dart selector.
+        pick: u16,
+        /// Level one above the current maximum.
+        up: bool,
+    },
+    /// `subdivide_tet` (3D).
+    Tet {
+        /// Dart selector.
+        pick: u16,
+        /// Level one above the current maximum.
+        up: bool,
+    },
+    /// `refine_around` a ball to one level above the current maximum (3D).
+    Around {
+        /// Centre selector: each coordinate is (byte / 255) in the unit cube.
+        center: [u8; 2],
+        /// Radius selector: byte / 255.
+        radius: u8,
+    },
+}
+
+/// What [`run_bytes`] did.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Report {
+    /// Operations accepted.
+    pub applied: usize,
+    /// Operations refused with a documented error.
+    pub refused: usize,
+    /// Maximum level reached.
+    pub max_level: u8,
+    /// Darts at the end.
+    pub darts: usize,
+}
+
+/// Decodes bytes into a mesh and operations (see the [module docs](self)). Never fails.
+pub fn decode(bytes: &[u8]) -> (Mesh, Vec<Op>) {
+    let mesh = match bytes.first().map_or(0, |b| b % 3) {
+        0 => Mesh::Grid,
+        1 => Mesh::Cube,
+        _ => Mesh::Tet,
+    };
+    let ops = bytes.get(1..).unwrap_or(&[]).chunks_exact(3).map(|c| decode_op(c[0], c[1], c[2])).collect();
+    (mesh, ops)
+}
+
+fn decode_op(a: u8, b: u8, c: u8) -> Op {
+    let (pick, up) = (u16::from_be_bytes([b, c]), a & 0x80 != 0);
+    match a % 4 {
+        0 => Op::SplitEdge { pick, up },
+        1 => Op::Triangle { pick, up },
+        2 => Op::Tet { pick, up },
+        _ => Op::Around { center: [b, c], radius: a.rotate_right(2) },
+    }
+}
+
+/// Decodes and runs `bytes`, checking every law after every op.
+///
+/// # Errors
+/// A message naming the op index and the law that broke (a bug in topomech).
+pub fn run_bytes(bytes: &[u8]) -> Result<Report, String> {
+    let (mesh, ops) = decode(bytes);
+    match mesh {
+        Mesh::Grid => {
+            let (points, tris) = grid_triangles(2);
+            let (map, _) = GMap::<2>::from_triangles(points.len(), &tris).map_err(|e| e.to_string())?;
+            run(LeveledMap::new(map, points), &ops, apply_2d)
+        }
+        Mesh::Cube | Mesh::Tet => {
+            let (points, tets) = if mesh == Mesh::Cube {
+                kuhn_cube(1)
+            } else {
+                (vec![[0.0, 0.0, 0.0], [1.0, 0.1, 0.0], [0.2, 1.0, 0.1], [0.1, 0.3, 1.0]], vec![[0, 1, 2, 3]])
+            };
+            let (map, _) = GMap::<3>::from_tets(points.len(), &tets).map_err(|e| e.to_string())?;
+            run(LeveledMap::new(map, points), &ops, apply_3d)
+        }
+    }
+}
+
+type Apply<const N: usize> = fn(&mut LeveledMap<N>, Op) -> Result<Result<(), SubdivideError>, String>;
+
+fn run<const N: usize>(mut m: LeveledMap<N>, ops: &[Op], apply: Apply<N>) -> Result<Report, String> {
+    let chi = m.map().euler_characteristic();
+    let mut report = Report::default();
+    for (k, &op) in ops.iter().enumerate() {
+        if m.map().dart_count() >= MAX_DARTS {
+            break;
+        }
+        let before = m.clone();
+        match apply(&mut m, op).map_err(|e| format!("op {k} {op:?}: {e}"))? {
+            Ok(()) => {
+                report.applied += 1;
+                check_accepted(&m, chi).map_err(|e| format!("op {k} {op:?} accepted: {e}"))?;
+            }
+            Err(e) => {
+                report.refused += 1;
+                check_refused(&before, &m, &e).map_err(|msg| format!("op {k} {op:?} refused ({e}): {msg}"))?;
+            }
+        }
+    }
+    report.max_level = m.max_level();
+    report.darts = m.map().dart_count();
+    Ok(report)
+}
+
+fn level_of<const N: usize>(m: &LeveledMap<N>, up: bool) -> u8 {
+    let top = m.max_level();
+    if up && top < MAX_FUZZ_LEVEL {
+        top + 1
+    } else {
+        top
+    }
+}
+
+fn pick_dart<const N: usize>(m: &LeveledMap<N>, pick: u16) -> DartId {
+    let n = m.map().dart_count().max(1);
+    m.map().darts().nth(pick as usize % n).expect("a live dart")
+}
+
+fn apply_2d(m: &mut LeveledMap<2>, op: Op) -> Result<Result<(), SubdivideError>, String> {
+    Ok(match op {
+        Op::SplitEdge { pick, up } => m.split_edge(pick_dart(m, pick), level_of(m, up)).map(drop),
+        Op::Triangle { pick, up } | Op::Tet { pick, up } => {
+            m.subdivide_triangle(pick_dart(m, pick), level_of(m, up)).map(drop)
+        }
+        Op::Around { center, radius } => {
+            let pick = u16::from_be_bytes(center) ^ u16::from(radius);
+            m.subdivide_triangle(pick_dart(m, pick), level_of(m, true)).map(drop)
+        }
+    })
+}
+
+fn apply_3d(m: &mut LeveledMap<3>, op: Op) -> Result<Result<(), SubdivideError>, String> {
+    Ok(match op {
+        Op::SplitEdge { pick, up } => m.split_edge(pick_dart(m, pick), level_of(m, up)).map(drop),
+        Op::Triangle { pick, up } => m.subdivide_triangle(pick_dart(m, pick), level_of(m, up)).map(drop),
+        Op::Tet { pick, up } => m.subdivide_tet(pick_dart(m, pick), level_of(m, up)).map(drop),
+        Op::Around { center, radius } => return around(m, center, radius),
+    })
+}
+
+/// `refine_around` with the mass and zone laws checked. Tets created by hand-ordered ops may not
+/// be refinable by a ball (`FaceRefinedTooFar` after a face was split twice): that is a refusal.
+fn around(m: &mut LeveledMap<3>, center: [u8; 2], radius: u8) -> Result<Result<(), SubdivideError>, String> {
+    let c = [f64::from(center[0]) / 255.0, f64::from(center[1]) / 255.0, 0.5];
+    let r = f64::from(radius) / 255.0;
+    let levels = level_of(m, true);
+    let mut masses = TetMasses::from_density(m, 2.0).map_err(|e| format!("masses of the tets: {e}"))?;
+    let before = m.clone();
+    let result = m.refine_around(c, r, levels, &mut masses);
+    if let Err(e) = result {
+        // refine_around keeps the ops done before a refusal; the fuzz checks want all or nothing.
+        *m = before;
+        return Ok(Err(e));
+    }
+    let (total, expected) = (masses.total(m), masses_total(&before)?);
+    if (total - expected).abs() > 1e-12 * expected.max(1.0) {
+        return Err(format!("Σ tet mass {total} after, {expected} before"));
+    }
+    for d in m.map().one_dart_per_cell(3) {
+        let corners = m.tet_vertices(d).map_err(|e| e.to_string())?.map(|v| m.points()[v as usize]);
+        if tet_distance(c, corners) <= r && m.mu(d).tet < levels && m.mu(d).tet + 1 == levels {
+            return Err(format!("the tet of {d} meets the ball but stayed at level {}", m.mu(d).tet));
+        }
+    }
+    Ok(Ok(()))
+}
+
+fn masses_total(m: &LeveledMap<3>) -> Result<f64, String> {
+    let masses = TetMasses::from_density(m, 2.0).map_err(|e| e.to_string())?;
+    Ok(masses.total(m))
+}
+
+fn check_accepted<const N: usize>(m: &LeveledMap<N>, chi: i64) -> Result<(), String> {
+    m.check_all().map_err(|e| e.to_string())?;
+    let top = m.level(m.max_level()).map_err(|e| e.to_string())?;
+    if !top.map.is_isomorphic(m.map()) {
+        return Err("level k is not isomorphic to the finest map".into());
+    }
+    for i in 0..=m.max_level() {
+        let x = m.level(i).map_err(|e| e.to_string())?.map.euler_characteristic();
+        if x != chi {
+            return Err(format!("level {i} has Euler characteristic {x}, the input {chi}"));
+        }
+    }
+    Ok(())
+}
+
+fn check_refused<const N: usize>(
+    before: &LeveledMap<N>,
+    after: &LeveledMap<N>,
+    e: &SubdivideError,
+) -> Result<(), String> {
+    let documented = matches!(
+        e,
+        SubdivideError::AlreadyAtLevel { .. }
+            | SubdivideError::NotATriangle { .. }
+            | SubdivideError::NotATetrahedron { .. }
+            | SubdivideError::FaceRefinedTooFar { .. }
+            | SubdivideError::OpenEdge(_)
+    );
+    if !documented {
+        return Err("not a documented refusal for a live dart at a valid level".into());
+    }
+    let same = before.map().dart_count() == after.map().dart_count()
+        && before.max_level() == after.max_level()
+        && before.map().is_isomorphic(after.map());
+    if !same {
+        return Err("the map changed".into());
+    }
+    after.check_all().map_err(|e| e.to_string())
+}

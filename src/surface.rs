@@ -84,7 +84,7 @@ pub struct Surface {
 /// use topomech::{generate, mechanics::Body, surface};
 ///
 /// let (points, tets) = generate::kuhn_cube(1);
-/// let (body, _) = Body::from_tets(&points, &tets, topomech::cut::material()).unwrap();
+/// let (body, _) = Body::from_tets(&points, &tets, Default::default()).unwrap();
 /// let s = surface::boundary_surface(&body);
 /// assert_eq!((s.positions.len(), s.triangles.len()), (8, 12));
 /// ```

@@ -25,9 +25,19 @@ pub(super) fn draw(image: &mut Image, map: Colormap, lo: f64, hi: f64) {
         }
     }
     frame(image, x0.saturating_sub(1), y0.saturating_sub(1), x1, y1);
-    let label = |v: f64| format!("{v:.2e}");
     text_right(image, &label(hi), x1, y0.saturating_sub(7 * px + 1), px);
     text_right(image, &label(lo), x1, y1 + 2 * px, px);
+}
+
+/// A short label: three significant digits, in scientific notation outside [0.01, 10⁴).
+fn label(v: f64) -> String {
+    let a = v.abs();
+    if a == 0.0 || (0.01..10_000.0).contains(&a) {
+        let decimals = if a == 0.0 { 0 } else { (2 - a.log10().floor() as i32).max(0) as usize };
+        format!("{v:.decimals$}")
+    } else {
+        format!("{v:.2e}")
+    }
 }
 
 fn frame(image: &mut Image, x0: u32, y0: u32, x1: u32, y1: u32) {

@@ -45,7 +45,7 @@ impl View {
     }
 
     /// Camera coordinates: (right, up, depth in front of the eye).
-    fn to_camera(&self, p: Vec3) -> Vec3 {
+    fn camera_coords(&self, p: Vec3) -> Vec3 {
         let d = sub(p, self.eye);
         [dot(d, self.right), dot(d, self.up), dot(d, self.forward)]
     }
@@ -72,7 +72,7 @@ impl<'a> Target<'a> {
     /// projected, and filled where it is nearer than what is there (ties keep the earlier
     /// triangle). O(pixels of its clamped screen bounding box).
     pub(crate) fn draw(&mut self, view: &View, tri: [Vec3; 3], color: [u8; 3]) {
-        let cam = tri.map(|p| view.to_camera(p));
+        let cam = tri.map(|p| view.camera_coords(p));
         let poly = clip_near(cam, view.near);
         let (w, h) = (self.image.width as f64, self.image.height as f64);
         let project = |c: Vec3| {

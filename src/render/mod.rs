@@ -221,7 +221,8 @@ impl Image {
         (x < self.width && y < self.height).then(|| 3 * (y as usize * self.width as usize + x as usize))
     }
 
-    /// The image as a PNG file (8-bit RGB, no interlace, adaptive row filters, one IDAT).
+    /// The image as a PNG file (8-bit RGB, no interlace, adaptive row filters, IDAT chunks of at
+    /// most 1 MiB).
     /// O(pixels).
     ///
     /// # Errors

@@ -84,10 +84,15 @@ pub(crate) fn encode_rgb(width: u32, height: u32, rgb: &[u8]) -> Vec<u8> {
     ihdr.extend_from_slice(&height.to_be_bytes());
     ihdr.extend_from_slice(&[8, 2, 0, 0, 0]); // depth 8, RGB, deflate, adaptive filters, no interlace
     chunk(&mut out, b"IHDR", &ihdr);
-    chunk(&mut out, b"IDAT", &zlib_compress(&filter_rows(width as usize, rgb)));
+    // Several IDAT chunks of at most 1 MiB each: a chunk length must stay below 2³¹.
+    for part in zlib_compress(&filter_rows(width as usize, rgb)).chunks(IDAT_MAX) {
+        chunk(&mut out, b"IDAT", part);
+    }
     chunk(&mut out, b"IEND", &[]);
     out
 }
+
+const IDAT_MAX: usize = 1 << 20;
 
 fn chunk(out: &mut Vec<u8>, kind: &[u8; 4], data: &[u8]) {
     out.extend_from_slice(&(data.len() as u32).to_be_bytes());

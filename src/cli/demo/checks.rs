@@ -104,3 +104,46 @@ impl Checker {
         Ok(self.last)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use topomech::{cut, generate};
+
+    fn cube() -> Body {
+        let (points, tets) = generate::kuhn_cube(2);
+        Body::from_tets(&points, &tets, cut::ops::material()).unwrap().0
+    }
+
+    #[test]
+    fn a_fresh_body_passes_the_four_checks() {
+        let body = cube();
+        let mut checker = Checker::new(&body);
+        assert!((checker.initial_mass - 1.7 * 8.0).abs() < 1e-12, "ρ · volume");
+        let r = checker.check(&body, "test", 0).unwrap();
+        assert_eq!(checker.passed, 4);
+        assert_eq!(r, Residuals { mass: 0.0, stiffness: 0.0 });
+    }
+
+    #[test]
+    fn a_removal_is_balanced_by_what_it_reports() {
+        let mut body = cube();
+        let mut checker = Checker::new(&body);
+        let r = cut::remove_volume(&mut body, topomech::CellId(5)).unwrap();
+        assert!(matches!(checker.check(&body, "removal", 1), Err(DemoError::Balance { quantity: "total mass", .. })));
+        checker.removed(r.removed_mass, r.removed_stiffness);
+        let res = checker.check(&body, "removal", 1).unwrap();
+        assert!(res.mass.abs() <= TOLERANCE && res.stiffness.abs() <= TOLERANCE, "{res:?}");
+    }
+
+    #[test]
+    fn an_unbalanced_account_stops_with_the_stage_and_quantity() {
+        let body = cube();
+        let mut checker = Checker::new(&body);
+        checker.removed(0.0, 1.0);
+        let err = checker.check(&body, "tear", 7).unwrap_err();
+        let msg = err.to_string();
+        assert!(msg.contains("stage tear, step 7") && msg.contains("total stiffness"), "{msg}");
+        assert_eq!(checker.passed, 3, "validity, conservation and mass passed before");
+    }
+}

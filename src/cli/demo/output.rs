@@ -40,16 +40,15 @@ pub const WIDTH: u32 = 800;
 pub const HEIGHT: u32 = 600;
 
 /// The fixed camera: it frames the rest shape's box, extended below by a third of the longest
-/// extent so the sagging body stays in view, looking across the longest axis from slightly above
-/// (the incision is on top). O(1).
+/// extent so the sagging body stays in view, looking across the longest axis (along −y for the
+/// liver, so its pinned end is on the right) from slightly above. O(1).
 pub fn camera(c: &SceneConfig) -> Camera {
     let (mut lo, hi) = (c.lo, c.hi);
     lo[c.up_axis] -= c.extent() / 3.0;
     let side = 3 - c.long_axis - c.up_axis;
     let mut view = [0.0; 3];
-    view[side] = 1.0;
-    view[c.up_axis] = -0.6;
-    view[c.long_axis] = 0.25;
+    view[side] = -1.0;
+    view[c.up_axis] = -0.3;
     Camera::fit(lo, hi, view)
 }
 

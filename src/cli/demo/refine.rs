@@ -124,3 +124,41 @@ fn dot(a: Vec3, b: Vec3) -> f64 {
 fn cross(a: Vec3, b: Vec3) -> Vec3 {
     [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use topomech::{cut, generate};
+
+    fn cube() -> Body {
+        let (points, tets) = generate::kuhn_cube(2);
+        Body::from_tets(&points, &tets, cut::ops::material()).unwrap().0
+    }
+
+    #[test]
+    fn refining_some_tets_keeps_the_enclosed_volume_and_marks_their_level() {
+        let body = cube();
+        let before = topomech::surface::boundary_surface(&body);
+        let tets: Vec<CellId> = (0..12).map(CellId).collect();
+        let mut run = StageRun::default();
+        let (lm, checks) = refine(&body, &tets, &mut run, &ProgressBar::hidden()).unwrap();
+        assert_eq!((run.operations, checks), (12, 2));
+        assert_eq!(lm.map().count_cells().0[3], 48 + 7 * 12, "1→8 per refined tet");
+        let (after, levels) = refined_surface(&lm);
+        assert_eq!(levels.len(), after.triangles.len());
+        assert!((after.enclosed_volume() - before.enclosed_volume()).abs() < 1e-12, "same solid");
+        assert!((after.enclosed_volume() - 8.0).abs() < 1e-12);
+        assert!(levels.contains(&0) && levels.contains(&LEVEL), "both levels show on the boundary");
+        assert!(after.triangles.len() > before.triangles.len());
+    }
+
+    #[test]
+    fn an_unrefined_map_gives_back_the_body_surface() {
+        let body = cube();
+        let (lm, _) = refine(&body, &[], &mut StageRun::default(), &ProgressBar::hidden()).unwrap();
+        let (s, levels) = refined_surface(&lm);
+        assert_eq!(s.triangles.len(), 12 * 4, "12k² boundary faces for k = 2");
+        assert!(levels.iter().all(|&l| l == 0));
+        assert!((s.enclosed_volume() - 8.0).abs() < 1e-12);
+    }
+}

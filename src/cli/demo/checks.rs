@@ -7,6 +7,10 @@
 //!   stiffness  Σ_e k_e + removed stiffness  = K0     (relative residual |Δ| / K0 ≤ TOLERANCE)
 //! ```
 //!
+//! A simulation step writes only positions and velocities, which none of these laws read (they
+//! use rest positions), so the demo checks after every topological operation and at every frame,
+//! not after every step.
+//!
 //! Cutting and tearing only dissociate (m = m1 + m2, k = k1 + k2), so both sums stay; a removal
 //! takes exactly its tet's mass and stiffness contributions away, which [`Checker::removed`]
 //! records.

@@ -204,9 +204,10 @@ struct Played {
     threshold: f64,
 }
 
-/// The progress bar over all steps, on stderr, hidden when stderr is not a terminal.
+/// The progress bar over all steps, on stderr; hidden with `--json` or when stdout or stderr is
+/// not a terminal (a log or a test).
 fn progress_bar(len: u64, json: bool) -> ProgressBar {
-    if json || !std::io::stderr().is_terminal() {
+    if json || !std::io::stdout().is_terminal() || !std::io::stderr().is_terminal() {
         return ProgressBar::hidden();
     }
     let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
@@ -232,7 +233,7 @@ fn play(args: &DemoArgs, loaded: &Loaded, log: &mut dyn Write) -> Result<Played,
     let mut sag = StageRun { name: "sag", ..StageRun::default() };
     bar.set_message("sag");
     scene.simulate(&mut sag, n, None, &mut output, &bar)?;
-    finish_stage(log, &scene, &sag, &mut rows, "1/5", format!("{n} steps under gravity"))?;
+    finish_stage(log, &scene, &sag, &mut rows, "1/5", format!("{} under gravity", plural(n, "step")))?;
     output.set_stress_scale(rows.last().and_then(|r| r.max_stress).unwrap_or(0.0));
     output.stress_picture("1_sag.png", &scene)?;
 
@@ -240,7 +241,7 @@ fn play(args: &DemoArgs, loaded: &Loaded, log: &mut dyn Write) -> Result<Played,
     bar.set_message("incision");
     scene.incise(&mut incision)?;
     scene.simulate(&mut incision, n / 2, None, &mut output, &bar)?;
-    let what = format!("{} faces cut, then {} steps", incision.cut_faces, incision.steps);
+    let what = format!("{} cut, then {}", plural(incision.cut_faces as u64, "face"), plural(incision.steps, "step"));
     finish_stage(log, &scene, &incision, &mut rows, "2/5", what)?;
     output.stress_picture("2_incision.png", &scene)?;
 
@@ -248,7 +249,8 @@ fn play(args: &DemoArgs, loaded: &Loaded, log: &mut dyn Write) -> Result<Played,
     let mut tear = StageRun { name: "tear", ..StageRun::default() };
     bar.set_message("tear");
     scene.simulate(&mut tear, n / 2, Some(threshold), &mut output, &bar)?;
-    let what = format!("{} vertices torn above {threshold:.4e} ({} faces)", tear.operations, tear.cut_faces);
+    let torn = if tear.operations == 1 { "1 vertex".to_string() } else { format!("{} vertices", tear.operations) };
+    let what = format!("{torn} torn above {threshold:.4e} ({})", plural(tear.cut_faces as u64, "face"));
     finish_stage(log, &scene, &tear, &mut rows, "3/5", what)?;
     output.stress_picture("3_tear.png", &scene)?;
 
@@ -256,7 +258,11 @@ fn play(args: &DemoArgs, loaded: &Loaded, log: &mut dyn Write) -> Result<Played,
     bar.set_message("removal");
     scene.remove_ball(&mut removal)?;
     scene.simulate(&mut removal, n / 4, None, &mut output, &bar)?;
-    let what = format!("{} tets removed at the free tip, then {} steps", removal.operations, removal.steps);
+    let what = format!(
+        "{} removed at the free tip, then {}",
+        plural(removal.operations as u64, "tet"),
+        plural(removal.steps, "step")
+    );
     finish_stage(log, &scene, &removal, &mut rows, "4/5", what)?;
     output.stress_picture("4_removal.png", &scene)?;
     output.obj("surface.obj", &surface::boundary_surface(&scene.body))?;
@@ -276,6 +282,14 @@ fn play(args: &DemoArgs, loaded: &Loaded, log: &mut dyn Write) -> Result<Played,
     output.picture("5_refined.png", &refined, &shading)?;
     write_refinement(log, &lm, &refinement, scene.checker.passed)?;
     Ok(Played { scene, rows, output, threshold })
+}
+
+/// "1 step", "3 steps".
+fn plural(n: u64, noun: &str) -> String {
+    match n {
+        1 => format!("1 {noun}"),
+        n => format!("{n} {noun}s"),
+    }
 }
 
 fn write_setup(out: &mut dyn Write, scene: &Scene) -> std::io::Result<()> {

@@ -40,8 +40,10 @@ pub mod load;
 pub mod mechanics;
 pub mod mesh;
 pub mod ops;
+pub mod render;
 pub mod store;
 pub mod subdivide;
+pub mod surface;
 pub mod vtk;
 
 #[doc = include_str!("../docs/TUTORIAL.md")]

@@ -1,8 +1,8 @@
 //! `topomech`: build n-G-maps from tetrahedral meshes and report what they are.
 //!
 //! ```text
-//! topomech                       demo on the built-in liver mesh (no files needed)
-//! topomech demo [--json]         the same
+//! topomech                       surgical demo scene on the built-in liver mesh, writes out/
+//! topomech demo [--mesh F] …     the same (--out DIR, --steps N, --json)
 //! topomech info MESH [--json]    characteristics of a mesh file
 //! topomech simulate MESH …       mass/spring simulation (see --help)
 //! topomech bench step MESH       map-driven vs flat-array step time
@@ -34,7 +34,7 @@ struct Cli {
 /// `pub mod x;` in `src/cli/mod.rs` with `pub fn run(args: XArgs) -> Result<(), CliError>`.
 #[derive(Debug, Subcommand)]
 enum Command {
-    /// Build the built-in liver mesh, validate it, print its characteristics (the default).
+    /// The surgical scene on the built-in liver (or --mesh): sag, incision, tear, removal, refinement (the default).
     Demo(cli::demo::DemoArgs),
     /// Load a mesh file into a 3-G-map and print its characteristics.
     Info(cli::info::InfoArgs),

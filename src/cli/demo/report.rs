@@ -1,0 +1,209 @@
+//! The demo's summary: one row per stage (cells per dimension, boundary, components, mass and
+//! stiffness balances, step time), printed as a table or as one JSON object.
+
+use std::io::Write;
+
+use topomech::cut;
+use topomech::gmap::GMap;
+use topomech::mechanics::Vec3;
+use topomech::subdivide::LeveledMap;
+
+use super::checks::{total_mass, total_stiffness};
+use super::scene::{Scene, StageRun};
+use crate::cli::simulate::median;
+use crate::cli::InfoJson;
+
+/// One stage of the summary (JSON keys in this order). Mass fields are `None` for the
+/// geometry-only refinement.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct StageRow {
+    /// Stage name: rest, sag, incision, tear, removal, refinement.
+    pub stage: &'static str,
+    /// 0-cells.
+    pub vertices: usize,
+    /// 1-cells.
+    pub edges: usize,
+    /// 2-cells.
+    pub faces: usize,
+    /// 3-cells.
+    pub volumes: usize,
+    /// α3-free faces.
+    pub boundary_faces: usize,
+    /// Connected components.
+    pub components: usize,
+    /// Σ_v m_v.
+    pub total_mass: Option<f64>,
+    /// Mass removed with tets so far.
+    pub removed_mass: Option<f64>,
+    /// (Σ m_v + removed − M0) / M0.
+    pub mass_residual: Option<f64>,
+    /// Σ_e k_e.
+    pub stiffness_sum: Option<f64>,
+    /// (Σ k_e + removed − K0) / K0.
+    pub stiffness_residual: Option<f64>,
+    /// Time steps of the stage.
+    pub steps: u64,
+    /// Median wall time of a step (a subdivision for the refinement) in µs.
+    pub step_us_median: f64,
+    /// Faces cut, vertices torn, tets removed or tets refined.
+    pub operations: usize,
+    /// Faces dissociated.
+    pub cut_faces: usize,
+    /// Wall time of the stage's topological operations in ms.
+    pub operation_ms: f64,
+    /// Largest principal tensile stress of a vertex at the end of the stage.
+    pub max_stress: Option<f64>,
+    /// Largest distance of a vertex from its rest position.
+    pub max_displacement: Option<f64>,
+    /// Checks passed since the start (cumulative).
+    pub checks_passed: usize,
+}
+
+fn counts_row(stage: &'static str, map: &GMap<3>, run: &StageRun) -> StageRow {
+    let c = map.count_cells().0;
+    let mut times = run.step_us.clone();
+    StageRow {
+        stage,
+        vertices: c[0],
+        edges: c[1],
+        faces: c[2],
+        volumes: c[3],
+        boundary_faces: map.boundary_cell_count(),
+        components: map.components().len(),
+        total_mass: None,
+        removed_mass: None,
+        mass_residual: None,
+        stiffness_sum: None,
+        stiffness_residual: None,
+        steps: run.steps,
+        step_us_median: median(&mut times),
+        operations: run.operations,
+        cut_faces: run.cut_faces,
+        operation_ms: run.operation_us / 1e3,
+        max_stress: None,
+        max_displacement: None,
+        checks_passed: 0,
+    }
+}
+
+/// The row of a mechanical stage, from the scene as the stage left it. O(darts).
+pub fn scene_row(scene: &Scene, run: &StageRun) -> StageRow {
+    let body = &scene.body;
+    let ch = &scene.checker;
+    let stress = cut::principal_stress(body, &scene.sim);
+    StageRow {
+        total_mass: Some(total_mass(body)),
+        removed_mass: Some(ch.removed_mass),
+        mass_residual: Some(ch.last.mass),
+        stiffness_sum: Some(total_stiffness(body)),
+        stiffness_residual: Some(ch.last.stiffness),
+        max_stress: Some(stress.iter().map(|s| s.magnitude).fold(0.0, f64::max)),
+        max_displacement: Some(scene.sim.max_displacement(body)),
+        checks_passed: ch.passed,
+        ..counts_row(run.name, body.map(), run)
+    }
+}
+
+/// The row of the refinement (no mechanics). O(darts).
+pub fn refined_row(lm: &LeveledMap<3>, run: &StageRun, checks_passed: usize) -> StageRow {
+    StageRow { checks_passed, ..counts_row(run.name, lm.map(), run) }
+}
+
+/// The parameters and files of the run, for the JSON summary.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct SceneJson {
+    /// Sag steps.
+    pub sag_steps: u64,
+    /// Time step.
+    pub dt: f64,
+    /// The integrator.
+    pub integrator: &'static str,
+    /// Gravity.
+    pub gravity: Vec3,
+    /// Young's modulus.
+    pub young: f64,
+    /// Density.
+    pub density: f64,
+    /// Ambient viscosity.
+    pub viscosity: f64,
+    /// Pinned vertices.
+    pub pinned: usize,
+    /// Tear threshold (a force).
+    pub tear_threshold: f64,
+}
+
+/// The files written, as paths.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct FilesJson {
+    /// The output directory.
+    pub dir: String,
+    /// The ParaView series.
+    pub pvd: String,
+    /// Its frames.
+    pub vtu: Vec<String>,
+    /// The OBJ surfaces (the final body's first).
+    pub obj: Vec<String>,
+    /// The pictures.
+    pub png: Vec<String>,
+}
+
+/// The JSON summary of `topomech demo --json` (exactly these keys, in this order).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct DemoJson {
+    /// The mesh's name or path.
+    pub mesh_name: String,
+    /// `topomech info --json` of the mesh (what `demo --json` printed before the scene).
+    pub mesh: InfoJson,
+    /// Parameters.
+    pub scene: SceneJson,
+    /// One row per stage.
+    pub stages: Vec<StageRow>,
+    /// Checks passed in all.
+    pub checks_passed: usize,
+    /// Whether every check passed (a failed check stops the demo with exit status 1).
+    pub all_checks_passed: bool,
+    /// Σ m_v of the initial body.
+    pub initial_mass: f64,
+    /// Σ m_v at the end.
+    pub final_mass: f64,
+    /// Mass removed.
+    pub removed_mass: f64,
+    /// Whether the mechanics follows the refinement (not yet: geometry only).
+    pub refinement_mechanics: bool,
+    /// Output files.
+    pub files: FilesJson,
+    /// Wall time of the whole run in ms.
+    pub wall_ms: f64,
+}
+
+fn opt(v: Option<f64>, f: impl Fn(f64) -> String) -> String {
+    v.map_or_else(|| "-".to_string(), f)
+}
+
+/// The summary table. O(stages).
+pub fn write_table(out: &mut dyn Write, rows: &[StageRow]) -> std::io::Result<()> {
+    writeln!(
+        out,
+        "  {:<11}{:>6}{:>7}{:>7}{:>7}{:>6}{:>5}{:>13}{:>10}{:>10}{:>7}{:>9}",
+        "stage", "V", "E", "F", "T", "bnd", "cmp", "total mass", "Δm/M0", "Δk/K0", "steps", "step µs"
+    )?;
+    for r in rows {
+        writeln!(
+            out,
+            "  {:<11}{:>6}{:>7}{:>7}{:>7}{:>6}{:>5}{:>13}{:>10}{:>10}{:>7}{:>9}",
+            r.stage,
+            r.vertices,
+            r.edges,
+            r.faces,
+            r.volumes,
+            r.boundary_faces,
+            r.components,
+            opt(r.total_mass, |m| format!("{m:.6}")),
+            opt(r.mass_residual, |x| format!("{x:.1e}")),
+            opt(r.stiffness_residual, |x| format!("{x:.1e}")),
+            r.steps,
+            if r.step_us_median > 0.0 { format!("{:.1}", r.step_us_median) } else { "-".to_string() },
+        )?;
+    }
+    Ok(())
+}

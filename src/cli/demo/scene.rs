@@ -1,0 +1,356 @@
+//! The surgical scene: a body pinned at one end of its longest axis, sagging under gravity, then
+//! cut, torn and trimmed, with every operation checked ([`Checker`]) and every stage recorded.
+//!
+//! ```text
+//!   pinned end                          free end
+//!   |##|------------------ | ------------------\
+//!   |##|                   | incision           \   ← removal ball at the free tip
+//!   |##|                   |(upper part only)   /
+//!   |##|-----------------------------------------/        gravity ↓ (−up)
+//! ```
+//!
+//! The incision is the face separation of `cut::incise_plane` (a face is cut when the centroids
+//! of its two tets lie on opposite sides of the plane) restricted to the faces whose centroid lies
+//! in the upper part of the body near the plane, so the body stays in one piece, as a scalpel
+//! stroke does; a whole-plane cut would drop the free half.
+
+use std::time::Instant;
+
+use indicatif::ProgressBar;
+use topomech::cut::{self, Plane};
+use topomech::mechanics::{Body, Integrator, Material, PinSpec, Simulation, StepConfig, TouchedCells, Vec3};
+use topomech::{AlphaMask, CellId, DartId};
+
+use super::checks::Checker;
+use super::output::Output;
+use super::DemoError;
+
+/// Fraction of the longest extent pinned at its low end.
+pub const PIN_FRACTION: f64 = 0.12;
+/// Position of the incision plane along the longest axis, as a fraction of the extent from the
+/// pinned end.
+pub const INCISION_AT: f64 = 0.55;
+/// Depth of the incision as a fraction of the body's height near the plane.
+pub const INCISION_DEPTH: f64 = 0.6;
+/// The tear threshold as a fraction of the largest vertex stress when the tear stage starts.
+pub const TEAR_FRACTION: f64 = 0.8;
+/// Vertices torn per step at most, and in the whole tear stage at most.
+pub const TEAR_PER_STEP: usize = 2;
+/// See [`TEAR_PER_STEP`].
+pub const TEAR_MAX: usize = 16;
+/// Radius of the removal ball as a fraction of the longest extent.
+pub const REMOVAL_RADIUS: f64 = 0.12;
+/// Young's modulus per unit weight and length, E = this · ρ · |g| · extent: with it the body sags
+/// by about a fifth of its length whatever its units (E = 1000 for the built-in liver).
+pub const YOUNG_PER_WEIGHT: f64 = 16.0;
+/// Gravity acceleration.
+pub const GRAVITY: f64 = 9.81;
+/// Ambient viscosity ν (1/s): damps the sag to rest within about two seconds of simulated time.
+pub const VISCOSITY: f64 = 5.0;
+/// Largest time step; smaller when the mesh's highest frequency needs it (dt ≤ 1/ω_max).
+pub const MAX_DT: f64 = 1e-3;
+
+/// The fixed parameters of a scene, derived from the rest shape.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneConfig {
+    /// Sag steps (the other stages scale with it).
+    pub steps: u64,
+    /// Time step.
+    pub dt: f64,
+    /// The axis of the longest extent (0 = x, 1 = y, 2 = z).
+    pub long_axis: usize,
+    /// The axis opposite to gravity.
+    pub up_axis: usize,
+    /// Gravity vector.
+    pub gravity: Vec3,
+    /// The material.
+    pub material: Material,
+    /// Rest bounding box.
+    pub lo: Vec3,
+    /// See `lo`.
+    pub hi: Vec3,
+    /// Vertices with rest coordinate ≤ this along `long_axis` are pinned.
+    pub pin_limit: f64,
+    /// How many vertices are pinned.
+    pub pinned: usize,
+}
+
+impl SceneConfig {
+    /// The longest extent of the rest shape. O(1).
+    pub fn extent(&self) -> f64 {
+        self.hi[self.long_axis] - self.lo[self.long_axis]
+    }
+}
+
+/// What one stage did, besides the state it leaves.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StageRun {
+    /// Stage name.
+    pub name: &'static str,
+    /// Time steps made.
+    pub steps: u64,
+    /// Wall time of each step (or each refinement operation) in µs.
+    pub step_us: Vec<f64>,
+    /// Operations made: faces cut, vertices torn, tets removed, tets refined.
+    pub operations: usize,
+    /// Faces dissociated by the stage.
+    pub cut_faces: usize,
+    /// Wall time of the topological operation(s) in µs.
+    pub operation_us: f64,
+}
+
+/// A body, its simulation and its checker. See the [module docs](self).
+pub struct Scene {
+    /// The body.
+    pub body: Body,
+    /// Its simulation (projection and stepper).
+    pub sim: Simulation,
+    /// The checks run so far.
+    pub checker: Checker,
+    /// The parameters.
+    pub config: SceneConfig,
+    /// Simulated time so far.
+    pub time: f64,
+    /// The tets beside the incision (volume ids, both sides).
+    pub incision_tets: Vec<CellId>,
+    /// The incision plane.
+    pub plane: Option<Plane>,
+}
+
+fn bounds(points: &[Vec3]) -> (Vec3, Vec3) {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in points {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    (lo, hi)
+}
+
+impl Scene {
+    /// Builds the body of `points`/`tets`, pins its low end along the longest axis and prepares a
+    /// symplectic Euler simulation with dt = min([`MAX_DT`], 1/ω_max). O(T log T).
+    ///
+    /// # Errors
+    /// [`DemoError::Model`] (a degenerate tet, a bad point), [`DemoError::Sim`].
+    pub fn new(points: &[Vec3], tets: &[[u32; 4]], steps: u64) -> Result<Self, DemoError> {
+        let (lo, hi) = bounds(points);
+        let ext = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
+        let long_axis = (0..3).fold(0, |a, k| if ext[k] > ext[a] { k } else { a });
+        let up_axis = if long_axis == 2 { 0 } else { 2 };
+        let mut gravity = [0.0; 3];
+        gravity[up_axis] = -GRAVITY;
+        let density = Material::default().density;
+        let young = YOUNG_PER_WEIGHT * density * GRAVITY * ext[long_axis];
+        let material = Material { density, young, viscosity: VISCOSITY, ..Material::default() };
+        let (mut body, _) = Body::from_tets(points, tets, material).map_err(DemoError::Model)?;
+        let pin_limit = lo[long_axis] + PIN_FRACTION * ext[long_axis];
+        let pins = PinSpec { ids: Vec::new(), below: Some((long_axis, pin_limit)), inside: None };
+        body.attrs_mut().pin_where(|id, p| pins.pins(id, p));
+        let live = topomech::mechanics::Mechanics::live_vertices(body.map());
+        let pinned = body.attrs().pinned.as_slice().iter().zip(&live).filter(|(&p, &l)| p && l).count();
+        let probe = Simulation::new(&mut body, gravity, StepConfig::new(Integrator::Symplectic, MAX_DT))
+            .map_err(|source| DemoError::Sim { stage: "setup", source })?;
+        let omega = probe.projection.system.omega_max();
+        let dt = if omega > 0.0 { MAX_DT.min(1.0 / omega) } else { MAX_DT };
+        let sim = Simulation::new(&mut body, gravity, StepConfig::new(Integrator::Symplectic, dt))
+            .map_err(|source| DemoError::Sim { stage: "setup", source })?;
+        let config = SceneConfig { steps, dt, long_axis, up_axis, gravity, material, lo, hi, pin_limit, pinned };
+        let checker = Checker::new(&body);
+        Ok(Scene { body, sim, checker, config, time: 0.0, incision_tets: Vec::new(), plane: None })
+    }
+
+    /// Runs `steps` steps, checking and writing a frame every `steps / 10` steps and at the end;
+    /// with `tear = Some(threshold)` a [`cut::tear_step`] follows each step (until [`TEAR_MAX`]
+    /// vertices are torn) and every tear is checked. O(steps · (springs + slots)) + checks.
+    ///
+    /// # Errors
+    /// [`DemoError::Sim`] on blow-up, [`DemoError::Cut`], or a failed check.
+    pub fn simulate(
+        &mut self,
+        run: &mut StageRun,
+        steps: u64,
+        tear: Option<f64>,
+        out: &mut Output,
+        bar: &ProgressBar,
+    ) -> Result<(), DemoError> {
+        let stage = run.name;
+        let every = (steps / 10).max(1);
+        for step in 1..=steps {
+            let t = Instant::now();
+            self.sim.step(&mut self.body).map_err(|source| DemoError::Sim { stage, source })?;
+            run.step_us.push(t.elapsed().as_secs_f64() * 1e6);
+            self.time += self.config.dt;
+            run.steps += 1;
+            if let Some(threshold) = tear.filter(|_| run.operations < TEAR_MAX) {
+                let t = Instant::now();
+                let room = TEAR_PER_STEP.min(TEAR_MAX - run.operations);
+                let torn = cut::tear_step(&mut self.body, &mut self.sim, threshold, room)
+                    .map_err(|source| DemoError::Cut { stage, source })?;
+                run.operation_us += t.elapsed().as_secs_f64() * 1e6;
+                // A vertex with no inner face around it has an empty fan: nothing was torn.
+                let real = torn.tears.iter().filter(|t| !t.dissociations.is_empty()).count();
+                if real > 0 {
+                    run.operations += real;
+                    run.cut_faces += torn.tears.iter().map(|t| t.dissociations.len()).sum::<usize>();
+                    self.checker.check(&self.body, stage, run.steps)?;
+                }
+            }
+            if step % every == 0 || step == steps {
+                self.checker.check(&self.body, stage, run.steps)?;
+                out.frame(self)?;
+            }
+            bar.inc(1);
+        }
+        Ok(())
+    }
+
+    /// The incision (see the [module docs](self)): the plane normal to the longest axis at
+    /// [`INCISION_AT`] of the extent, cutting the faces whose centroid lies in the top
+    /// [`INCISION_DEPTH`] of the body's height near the plane. Checks the result. O(darts) plus
+    /// one dissociation per cut face.
+    ///
+    /// # Errors
+    /// [`DemoError::Cut`], [`DemoError::Sim`], a failed check.
+    pub fn incise(&mut self, run: &mut StageRun) -> Result<(), DemoError> {
+        let stage = run.name;
+        let (a, up) = (self.config.long_axis, self.config.up_axis);
+        let mut point = [0.0; 3];
+        point[a] = self.config.lo[a] + INCISION_AT * self.config.extent();
+        let mut normal = [0.0; 3];
+        normal[a] = 1.0;
+        let plane = Plane { point, normal };
+        let t = Instant::now();
+        let faces = self.incision_faces(&plane, a, up);
+        let mut touched = TouchedCells::default();
+        for d in faces {
+            let map = self.body.map();
+            let pair = [map.cell_id(3, d), map.cell_id(3, map.alpha::<3>(d))];
+            let dis = cut::dissociate_face(&mut self.body, d).map_err(|source| DemoError::Cut { stage, source })?;
+            touched.extend(dis.touched);
+            self.incision_tets.extend(pair);
+            run.cut_faces += 1;
+        }
+        self.incision_tets.sort_unstable();
+        self.incision_tets.dedup();
+        self.sim.update(&mut self.body, &touched).map_err(|source| DemoError::Sim { stage, source })?;
+        run.operation_us += t.elapsed().as_secs_f64() * 1e6;
+        run.operations = run.cut_faces;
+        self.plane = Some(plane);
+        self.checker.check(&self.body, stage, run.steps)?;
+        Ok(())
+    }
+
+    /// The inner faces across `plane` (tet centroids on opposite sides, as `incise_plane`) whose
+    /// centroid is above the cut depth. O(darts).
+    fn incision_faces(&self, plane: &Plane, a: usize, up: usize) -> Vec<DartId> {
+        let (map, x) = (self.body.map(), &self.body.attrs().position);
+        let near = 0.1 * self.config.extent();
+        let (mut top, mut bottom) = (f64::NEG_INFINITY, f64::INFINITY);
+        for d in map.one_dart_per_cell(0) {
+            let p = x[map.vertex_id(d)];
+            if (p[a] - plane.point[a]).abs() <= near {
+                top = top.max(p[up]);
+                bottom = bottom.min(p[up]);
+            }
+        }
+        let depth = top - INCISION_DEPTH * (top - bottom);
+        let side = cut::tet_sides(&self.body, plane);
+        map.one_dart_per_cell(2)
+            .into_iter()
+            .filter(|&d| {
+                let other = map.alpha::<3>(d);
+                other != d
+                    && side[map.cell_id(3, d).index()] != side[map.cell_id(3, other).index()]
+                    && self.face_centroid(d)[up] >= depth
+            })
+            .collect()
+    }
+
+    /// Mean current position of the vertices of the face of `d`. O(face).
+    pub fn face_centroid(&self, d: DartId) -> Vec3 {
+        let map = self.body.map();
+        let mut ids: Vec<CellId> = map.orbit(d, AlphaMask::of(&[0, 1])).into_iter().map(|x| map.vertex_id(x)).collect();
+        ids.sort_unstable();
+        ids.dedup();
+        centroid(ids.iter().map(|&v| self.body.attrs().position[v]))
+    }
+
+    /// The tear threshold: [`TEAR_FRACTION`] of the largest vertex stress now. O(springs + slots).
+    pub fn tear_threshold(&self) -> f64 {
+        let stress = cut::principal_stress(&self.body, &self.sim);
+        TEAR_FRACTION * stress.iter().map(|s| s.magnitude).fold(0.0, f64::max)
+    }
+
+    /// Removes the tets whose centroid (current positions) lies within [`REMOVAL_RADIUS`] of the
+    /// extent from the free tip (the live vertex farthest along the longest axis), records the
+    /// mass and stiffness that left, lets the simulation follow and checks. O(darts) per removal.
+    ///
+    /// # Errors
+    /// [`DemoError::Cut`], [`DemoError::Sim`], a failed check.
+    pub fn remove_ball(&mut self, run: &mut StageRun) -> Result<(), DemoError> {
+        let stage = run.name;
+        let t = Instant::now();
+        let victims = self.tets_in_ball(self.free_tip(), REMOVAL_RADIUS * self.config.extent());
+        let mut touched = TouchedCells::default();
+        for id in victims {
+            let r = cut::remove_volume(&mut self.body, id).map_err(|source| DemoError::Cut { stage, source })?;
+            self.checker.removed(r.removed_mass, r.removed_stiffness);
+            run.cut_faces += r.dissociations.len();
+            run.operations += 1;
+            touched.extend(r.touched);
+        }
+        self.incision_tets.retain(|&t| topomech::cut::volume_dart(&self.body, t).is_some());
+        self.sim.update(&mut self.body, &touched).map_err(|source| DemoError::Sim { stage, source })?;
+        run.operation_us += t.elapsed().as_secs_f64() * 1e6;
+        self.checker.check(&self.body, stage, run.steps)?;
+        Ok(())
+    }
+
+    /// Current position of the live vertex farthest along the longest axis. O(darts).
+    fn free_tip(&self) -> Vec3 {
+        let (map, x) = (self.body.map(), &self.body.attrs().position);
+        let a = self.config.long_axis;
+        map.one_dart_per_cell(0).into_iter().map(|d| x[map.vertex_id(d)]).fold(self.config.lo, |best, p| {
+            if p[a] > best[a] {
+                p
+            } else {
+                best
+            }
+        })
+    }
+
+    /// Volume ids whose centroid (current positions) is within `r` of `c`. O(darts).
+    fn tets_in_ball(&self, c: Vec3, r: f64) -> Vec<CellId> {
+        let (map, x) = (self.body.map(), &self.body.attrs().position);
+        let mut out = Vec::new();
+        for d in map.one_dart_per_cell(3) {
+            let mut ids: Vec<CellId> = map.cell_darts(3, d).into_iter().map(|y| map.vertex_id(y)).collect();
+            ids.sort_unstable();
+            ids.dedup();
+            let g = centroid(ids.iter().map(|&v| x[v]));
+            if (0..3).map(|k| (g[k] - c[k]).powi(2)).sum::<f64>() <= r * r {
+                out.push(map.cell_id(3, d));
+            }
+        }
+        out.sort_unstable();
+        out
+    }
+}
+
+/// The mean of `points` (the origin for none). O(points).
+pub fn centroid(points: impl Iterator<Item = Vec3>) -> Vec3 {
+    let (mut sum, mut n) = ([0.0; 3], 0usize);
+    for p in points {
+        for k in 0..3 {
+            sum[k] += p[k];
+        }
+        n += 1;
+    }
+    if n == 0 {
+        return sum;
+    }
+    sum.map(|s| s / n as f64)
+}

@@ -1,0 +1,421 @@
+//! Software rendering of a boundary [`Surface`] to a PNG picture, with no GPU and no display.
+//!
+//! A fixed pinhole [`Camera`] (perspective, vertical field of view) looks at the surface; every
+//! triangle is clipped against a near plane, projected and filled at pixel centres into an
+//! [`Image`] with a depth buffer, so the nearest surface wins whatever the drawing order. Each
+//! triangle gets one colour ([`Shading`]: flat, per-triangle RGB, or a per-triangle scalar such as
+//! stress or subdivision level through a [`Colormap`]) times a Lambert factor for a headlight at
+//! the eye plus an ambient term. Both sides of a triangle are lit, so the two faces of a cut show;
+//! a back side is drawn slightly darker. An optional legend bar shows the colormap with its
+//! minimum and maximum. [`Image::encode_png`] writes the result with the encoder of [`png`]
+//! (written here: CRC-32, Adler-32, DEFLATE with fixed Huffman codes and LZ77).
+//!
+//! Everything is single-threaded f64 arithmetic in a fixed order, so the same input gives the
+//! same bytes. Cost of [`render`]: O(width · height + Σ over triangles of their clamped screen
+//! bounding box).
+//!
+//! ```
+//! use topomech::{generate, render, surface};
+//!
+//! let (points, tets) = generate::kuhn_cube(2);
+//! let s = surface::boundary_surface_of_tets(&points, &tets).unwrap();
+//! let (lo, hi) = s.bounds().unwrap();
+//! let camera = render::Camera::fit(lo, hi, [-1.0, -2.0, -1.5]);
+//! let image = render::render(&s, &render::Shading::Flat([200, 120, 100]), &camera, 64, 48).unwrap();
+//! assert_ne!(image.pixel(32, 24), Some(render::Style::default().background)); // the cube is in the middle
+//! assert!(image.encode_png().unwrap().starts_with(b"\x89PNG"));
+//! ```
+
+mod colormap;
+mod legend;
+pub mod png;
+mod raster;
+
+use std::path::{Path, PathBuf};
+
+pub use colormap::Colormap;
+
+use crate::mechanics::Vec3;
+use crate::surface::Surface;
+use raster::{cross, dot, norm, sub, Target, View};
+
+/// The largest image [`render`] accepts, in pixels (a bound on the buffers it allocates).
+pub const MAX_PIXELS: u64 = 1 << 26;
+
+/// Errors of the renderer and of the PNG writer.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    /// A zero or too large image size.
+    #[error("image size {width}x{height} is not allowed (both must be positive, at most {MAX_PIXELS} pixels)")]
+    BadSize {
+        /// Asked width.
+        width: u32,
+        /// Asked height.
+        height: u32,
+    },
+    /// The camera does not define a view.
+    #[error("bad camera {camera:?}: {reason}")]
+    BadCamera {
+        /// The camera.
+        camera: Camera,
+        /// What is wrong with it.
+        reason: &'static str,
+    },
+    /// A surface vertex has a NaN or infinite coordinate.
+    #[error("surface vertex {vertex} (vertex id {id}) has a non-finite position {position:?}")]
+    NonFinitePosition {
+        /// Index of the vertex in the surface.
+        vertex: usize,
+        /// Its vertex cell id (`Surface::vertex_ids`), or `u32::MAX` if the surface has none.
+        id: u32,
+        /// The position.
+        position: Vec3,
+    },
+    /// A triangle refers to a vertex that the surface does not have.
+    #[error("triangle {triangle} refers to vertex {index}, but the surface has {vertices} vertices")]
+    BadTriangle {
+        /// The triangle's index.
+        triangle: usize,
+        /// The bad vertex index.
+        index: u32,
+        /// The number of vertices.
+        vertices: usize,
+    },
+    /// A per-triangle array does not have one entry per triangle.
+    #[error("{got} per-triangle values for {expected} triangles")]
+    ValueCount {
+        /// Its length.
+        got: usize,
+        /// The number of triangles.
+        expected: usize,
+    },
+    /// A per-triangle value is NaN or infinite.
+    #[error("the value of triangle {triangle} is {value}, not a finite number")]
+    NonFiniteValue {
+        /// The triangle's index.
+        triangle: usize,
+        /// The value.
+        value: f64,
+    },
+    /// A colour scale whose ends are not finite or are reversed.
+    #[error("colour scale range ({lo}, {hi}) must be finite with lo <= hi")]
+    BadRange {
+        /// Its lower end.
+        lo: f64,
+        /// Its upper end.
+        hi: f64,
+    },
+    /// An image whose pixel buffer does not match its size (the fields are public).
+    #[error("image {width}x{height} has {len} bytes of RGB, expected 3 per pixel")]
+    BadBuffer {
+        /// Width.
+        width: u32,
+        /// Height.
+        height: u32,
+        /// Length of `rgb`.
+        len: usize,
+    },
+    /// The PNG file could not be written (the cause names the file or its temporary sibling).
+    #[error("cannot write the PNG file {}: {source}", .path.display())]
+    Write {
+        /// The file asked for.
+        path: PathBuf,
+        /// The cause.
+        source: crate::store::StoreError,
+    },
+}
+
+/// A pinhole camera: at `eye`, looking at `target`, with `up` pointing up on the picture, and a
+/// vertical field of view of `fov_y_deg` degrees (pixels are square, so the horizontal field of
+/// view follows from the aspect ratio).
+///
+/// Invariant checked by [`render`] (a [`RenderError::BadCamera`] otherwise): finite coordinates,
+/// `eye != target`, `up` not parallel to the view direction, `0 < fov_y_deg < 180`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    /// Centre of projection.
+    pub eye: Vec3,
+    /// The point seen at the centre of the picture.
+    pub target: Vec3,
+    /// A vector whose projection points up on the picture (need not be orthogonal to the view).
+    pub up: Vec3,
+    /// Vertical field of view, in degrees.
+    pub fov_y_deg: f64,
+}
+
+impl Camera {
+    /// The field of view [`Camera::fit`] uses, in degrees.
+    pub const FIT_FOV_Y_DEG: f64 = 30.0;
+
+    /// A camera at `eye` looking at `target`. O(1); checked when used.
+    pub fn looking_at(eye: Vec3, target: Vec3, up: Vec3, fov_y_deg: f64) -> Camera {
+        Camera { eye, target, up, fov_y_deg }
+    }
+
+    /// A camera looking along `view_dir` at the centre of the box `min..max`, far enough that the
+    /// box's bounding sphere fits in the vertical field of view ([`Camera::FIT_FOV_Y_DEG`]) with a
+    /// 5 % margin — and in the horizontal one whenever the picture is at least as wide as high.
+    /// `up` is +z, or +y when `view_dir` is within about 8° of the z axis. Compute it once (e.g.
+    /// from the rest shape) to keep the camera fixed over an animation. O(1).
+    ///
+    /// A zero or non-finite `view_dir` or box gives a camera that [`render`] refuses; a box of
+    /// zero size is framed as if its radius were 1.
+    ///
+    /// ```
+    /// use topomech::render::Camera;
+    ///
+    /// let c = Camera::fit([0.0; 3], [2.0; 3], [0.0, 1.0, 0.0]);
+    /// assert_eq!(c.target, [1.0; 3]);
+    /// assert!(c.eye[1] < 0.0 && c.eye[0] == 1.0 && c.eye[2] == 1.0);
+    /// ```
+    pub fn fit(min: Vec3, max: Vec3, view_dir: Vec3) -> Camera {
+        let target = std::array::from_fn(|k| (min[k] + max[k]) / 2.0);
+        let radius = match norm(sub(max, min)) / 2.0 {
+            r if r > 0.0 => r,
+            _ => 1.0,
+        };
+        let half_fov = (Self::FIT_FOV_Y_DEG / 2.0).to_radians();
+        let distance = 1.05 * radius / half_fov.sin();
+        let len = norm(view_dir);
+        let dir = view_dir.map(|c| c / len);
+        let eye = std::array::from_fn(|k| target[k] - distance * dir[k]);
+        let up = if dir[2].abs() < 0.99 { [0.0, 0.0, 1.0] } else { [0.0, 1.0, 0.0] };
+        Camera { eye, target, up, fov_y_deg: Self::FIT_FOV_Y_DEG }
+    }
+}
+
+/// An 8-bit RGB picture, rows top to bottom.
+///
+/// Invariant (checked by [`Image::encode_png`]): `rgb.len() == 3 · width · height`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Image {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Pixel (x, y) is `rgb[3·(y·width + x)..][..3]`.
+    pub rgb: Vec<u8>,
+}
+
+impl Image {
+    /// A `width` × `height` image filled with `background`. O(pixels).
+    pub fn new(width: u32, height: u32, background: [u8; 3]) -> Image {
+        let n = width as usize * height as usize;
+        Image { width, height, rgb: background.repeat(n) }
+    }
+
+    /// The colour of pixel (x, y), `None` outside the image. O(1).
+    pub fn pixel(&self, x: u32, y: u32) -> Option<[u8; 3]> {
+        let i = self.index(x, y)?;
+        self.rgb.get(i..i + 3).map(|p| [p[0], p[1], p[2]])
+    }
+
+    /// Sets pixel (x, y); does nothing outside the image. O(1).
+    pub fn set_pixel(&mut self, x: u32, y: u32, color: [u8; 3]) {
+        if let Some(p) = self.index(x, y).and_then(|i| self.rgb.get_mut(i..i + 3)) {
+            p.copy_from_slice(&color);
+        }
+    }
+
+    fn index(&self, x: u32, y: u32) -> Option<usize> {
+        (x < self.width && y < self.height).then(|| 3 * (y as usize * self.width as usize + x as usize))
+    }
+
+    /// The image as a PNG file (8-bit RGB, no interlace, adaptive row filters, IDAT chunks of at
+    /// most 1 MiB).
+    /// O(pixels).
+    ///
+    /// # Errors
+    /// [`RenderError::BadSize`] for a zero dimension; [`RenderError::BadBuffer`] when `rgb` does
+    /// not hold 3 bytes per pixel.
+    pub fn encode_png(&self) -> Result<Vec<u8>, RenderError> {
+        if self.width == 0 || self.height == 0 || self.width > i32::MAX as u32 || self.height > i32::MAX as u32 {
+            return Err(RenderError::BadSize { width: self.width, height: self.height });
+        }
+        if self.rgb.len() as u64 != 3 * self.width as u64 * self.height as u64 {
+            return Err(RenderError::BadBuffer { width: self.width, height: self.height, len: self.rgb.len() });
+        }
+        Ok(png::encode_rgb(self.width, self.height, &self.rgb))
+    }
+
+    /// Writes [`Image::encode_png`] to `path` atomically (temporary file, then rename; see
+    /// [`crate::store::write_atomically`]). O(pixels).
+    ///
+    /// # Errors
+    /// As [`Image::encode_png`]; [`RenderError::Write`] naming `path`.
+    pub fn write_png(&self, path: &Path) -> Result<(), RenderError> {
+        let bytes = self.encode_png()?;
+        crate::store::write_atomically(path, &bytes)
+            .map_err(|source| RenderError::Write { path: path.to_path_buf(), source })
+    }
+}
+
+/// How the triangles are coloured (before lighting).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Shading {
+    /// One colour for the whole surface.
+    Flat([u8; 3]),
+    /// One colour per triangle (e.g. a palette indexed by subdivision level).
+    Colors(Vec<[u8; 3]>),
+    /// One scalar per triangle (stress, level, …) through `colormap`, with `range.0` at its start
+    /// and `range.1` at its end (values outside are clamped). Keep `range` fixed over an animation
+    /// so colours compare across frames.
+    PerTriangle {
+        /// One value per triangle.
+        values: Vec<f64>,
+        /// The ends of the scale.
+        range: (f64, f64),
+        /// The colours.
+        colormap: Colormap,
+    },
+}
+
+impl Shading {
+    /// [`Shading::PerTriangle`] with `range` = (min, max) of the finite `values` ((0, 1) if there
+    /// are none). O(values).
+    pub fn by_values(values: Vec<f64>, colormap: Colormap) -> Shading {
+        let finite = values.iter().copied().filter(|v| v.is_finite());
+        let range = finite.fold(None, |r: Option<(f64, f64)>, v| Some(r.map_or((v, v), |(a, b)| (a.min(v), b.max(v)))));
+        Shading::PerTriangle { values, range: range.unwrap_or((0.0, 1.0)), colormap }
+    }
+
+    /// The base colour of each triangle, checked against the surface. O(triangles).
+    fn colors(&self, triangles: usize) -> Result<Vec<[u8; 3]>, RenderError> {
+        let count = |got: usize| {
+            if got == triangles {
+                Ok(())
+            } else {
+                Err(RenderError::ValueCount { got, expected: triangles })
+            }
+        };
+        match self {
+            Shading::Flat(c) => Ok(vec![*c; triangles]),
+            Shading::Colors(colors) => count(colors.len()).map(|()| colors.clone()),
+            Shading::PerTriangle { values, range: (lo, hi), colormap } => {
+                count(values.len())?;
+                if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
+                    return Err(RenderError::BadRange { lo: *lo, hi: *hi });
+                }
+                if let Some((triangle, &value)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+                    return Err(RenderError::NonFiniteValue { triangle, value });
+                }
+                Ok(values.iter().map(|&v| colormap.color_in(v, *lo, *hi)).collect())
+            }
+        }
+    }
+
+    /// The colour scale to show in a legend, if the shading has one.
+    fn scale(&self) -> Option<(Colormap, f64, f64)> {
+        match self {
+            Shading::PerTriangle { range, colormap, .. } => Some((*colormap, range.0, range.1)),
+            _ => None,
+        }
+    }
+}
+
+/// Picture settings besides the camera and the colours.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Style {
+    /// Colour where no triangle is seen.
+    pub background: [u8; 3],
+    /// Share of the light that does not depend on the angle, in [0, 1].
+    pub ambient: f64,
+    /// Draw a colour bar with its minimum and maximum on the right (per-scalar shading only).
+    pub legend: bool,
+}
+
+impl Default for Style {
+    /// White background, ambient 0.3, legend on.
+    fn default() -> Self {
+        Style { background: [255, 255, 255], ambient: 0.3, legend: true }
+    }
+}
+
+/// Renders `surface` as seen by `camera` into a `width` × `height` picture with the default
+/// [`Style`]. See [`render_styled`].
+///
+/// # Errors
+/// As [`render_styled`].
+pub fn render(
+    surface: &Surface,
+    shading: &Shading,
+    camera: &Camera,
+    width: u32,
+    height: u32,
+) -> Result<Image, RenderError> {
+    render_styled(surface, shading, camera, width, height, &Style::default())
+}
+
+/// Renders `surface` as seen by `camera`: z-buffered, each triangle in its [`Shading`] colour
+/// scaled by `ambient + (1 − ambient)·|cos θ|`, θ the angle between its normal and the direction
+/// to the eye (a headlight), times 0.8 on its back side; a triangle behind the eye is clipped at
+/// a near plane 10⁻⁴·|target − eye| in front of it. With `style.legend` and per-scalar shading, a
+/// colour bar with the range's ends is drawn on the right.
+///
+/// Cost: O(width · height + triangles + Σ clamped screen bounding boxes).
+///
+/// # Errors
+/// [`RenderError::BadSize`], [`RenderError::BadCamera`], [`RenderError::BadTriangle`],
+/// [`RenderError::NonFinitePosition`], and for the shading [`RenderError::ValueCount`],
+/// [`RenderError::BadRange`], [`RenderError::NonFiniteValue`]. Nothing is drawn on error.
+pub fn render_styled(
+    surface: &Surface,
+    shading: &Shading,
+    camera: &Camera,
+    width: u32,
+    height: u32,
+    style: &Style,
+) -> Result<Image, RenderError> {
+    if width == 0 || height == 0 || width as u64 * height as u64 > MAX_PIXELS {
+        return Err(RenderError::BadSize { width, height });
+    }
+    let view = View::new(camera)?;
+    check_surface(surface)?;
+    let colors = shading.colors(surface.triangles.len())?;
+    let mut image = Image::new(width, height, style.background);
+    let ambient = if style.ambient.is_finite() { style.ambient.clamp(0.0, 1.0) } else { 0.3 };
+    let mut target = Target::new(&mut image);
+    for (tri, &base) in surface.triangles.iter().zip(&colors) {
+        let p = tri.map(|i| surface.positions[i as usize]);
+        let light = ambient + (1.0 - ambient) * headlight(p, view.eye());
+        target.draw(&view, p, base.map(|c| (c as f64 * light).round().clamp(0.0, 255.0) as u8));
+    }
+    if let (true, Some((map, lo, hi))) = (style.legend, shading.scale()) {
+        legend::draw(&mut image, map, lo, hi);
+    }
+    Ok(image)
+}
+
+/// |cos θ| between the triangle's normal and the direction to the eye, times 0.8 when the eye
+/// sees its back; 0 for a degenerate triangle.
+fn headlight(p: [Vec3; 3], eye: Vec3) -> f64 {
+    let n = cross(sub(p[1], p[0]), sub(p[2], p[0]));
+    let centroid = std::array::from_fn(|k| (p[0][k] + p[1][k] + p[2][k]) / 3.0);
+    let to_eye = sub(eye, centroid);
+    let denom = norm(n) * norm(to_eye);
+    if denom == 0.0 || !denom.is_finite() {
+        return 0.0;
+    }
+    let cos = dot(n, to_eye) / denom;
+    if cos >= 0.0 {
+        cos
+    } else {
+        -0.8 * cos
+    }
+}
+
+fn check_surface(surface: &Surface) -> Result<(), RenderError> {
+    let vertices = surface.positions.len();
+    for (triangle, tri) in surface.triangles.iter().enumerate() {
+        if let Some(&index) = tri.iter().find(|&&i| i as usize >= vertices) {
+            return Err(RenderError::BadTriangle { triangle, index, vertices });
+        }
+    }
+    if let Some((vertex, &position)) =
+        surface.positions.iter().enumerate().find(|(_, p)| p.iter().any(|c| !c.is_finite()))
+    {
+        let id = surface.vertex_ids.get(vertex).copied().unwrap_or(u32::MAX);
+        return Err(RenderError::NonFinitePosition { vertex, id, position });
+    }
+    Ok(())
+}

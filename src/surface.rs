@@ -1,0 +1,302 @@
+//! The boundary surface of a body or of a tetrahedral mesh, as an indexed triangle mesh.
+//!
+//! In a 3-G-map the boundary is made of the α3-free darts (seed 000, §2: "αn-free darts form the
+//! boundary"); each boundary face orbit ⟨α0, α1⟩ is one triangle. [`boundary_surface`] reads it
+//! from a [`Body`] at its current positions; [`boundary_surface_of_tets`] finds it in a plain
+//! tetrahedron list (the faces used by exactly one tet), for meshes without a map, such as the
+//! geometry of a subdivided level.
+//!
+//! A [`Surface`] is what the software renderer ([`crate::render`]) draws and what
+//! [`Surface::to_obj`] writes as a Wavefront OBJ file.
+//!
+//! ```
+//! use topomech::{generate, surface};
+//!
+//! let (points, tets) = generate::kuhn_cube(2);
+//! let s = surface::boundary_surface_of_tets(&points, &tets).unwrap();
+//! assert_eq!(s.triangles.len(), 2 * 6 * 2 * 2); // two triangles per unit square of each side
+//! assert!((s.enclosed_volume() - 8.0).abs() < 1e-12);
+//! ```
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use rustc_hash::FxHashMap;
+
+use crate::mechanics::{Body, Vec3};
+use crate::DartId;
+
+/// Errors of the surface extraction and of the OBJ writer.
+#[derive(Debug, thiserror::Error)]
+pub enum SurfaceError {
+    /// A tetrahedron refers to a point index outside the point array.
+    #[error("tet {tet} refers to point {point}, but there are only {points} points")]
+    PointOutOfRange {
+        /// The tet's index.
+        tet: usize,
+        /// The bad point index.
+        point: u32,
+        /// The number of points.
+        points: usize,
+    },
+    /// The OBJ file could not be written (the cause names the file or its temporary sibling).
+    #[error("cannot write the surface OBJ file {}: {source}", .path.display())]
+    Write {
+        /// The file asked for.
+        path: PathBuf,
+        /// The cause.
+        source: crate::store::StoreError,
+    },
+}
+
+/// An indexed triangle mesh: the boundary of a solid.
+///
+/// Invariants (kept by the constructors of this module): every index of `triangles` is
+/// `< positions.len()`; every surface vertex is used by some triangle (the vertex array is
+/// compacted); `vertex_ids.len() == positions.len()` and `face_volumes.len() == triangles.len()`;
+/// each triangle is oriented outward, i.e. its normal (b − a) × (c − a) points away from the
+/// fourth vertex of the tetrahedron behind it (measured at rest for a body).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Surface {
+    /// Position of each surface vertex.
+    pub positions: Vec<Vec3>,
+    /// Triangles as three indices into `positions`, counter-clockwise seen from outside.
+    pub triangles: Vec<[u32; 3]>,
+    /// For surface vertex i, the vertex cell id in the body (or the point index in the point
+    /// array for [`boundary_surface_of_tets`]).
+    pub vertex_ids: Vec<u32>,
+    /// For triangle t, the volume cell id of the tetrahedron behind it (or the tet index).
+    pub face_volumes: Vec<u32>,
+}
+
+/// The boundary surface of `body`: one triangle per α3-free face orbit, at the body's current
+/// vertex positions, in face id order.
+///
+/// Each triangle is oriented away from the fourth vertex of its tetrahedron, measured on the rest
+/// positions (so the orientation is that of the material and does not flip when a tet is
+/// inverted by a large deformation); a tet that is flat at rest is oriented on the current
+/// positions instead. After a face dissociation both sides of the cut are boundary faces, so the
+/// surface grows by two triangles per dissociated face.
+///
+/// Cost: O(darts) (one pass to pick a dart per face, O(1) per boundary face after that).
+///
+/// ```
+/// use topomech::{generate, mechanics::Body, surface};
+///
+/// let (points, tets) = generate::kuhn_cube(1);
+/// let (body, _) = Body::from_tets(&points, &tets, Default::default()).unwrap();
+/// let s = surface::boundary_surface(&body);
+/// assert_eq!((s.positions.len(), s.triangles.len()), (8, 12));
+/// ```
+pub fn boundary_surface(body: &Body) -> Surface {
+    let map = body.map();
+    let attrs = body.attrs();
+    let mut builder = Builder::new(map.cell_id_bound(0));
+    for d in map.one_dart_per_cell(2) {
+        if !map.is_free(3, d) {
+            continue;
+        }
+        let at = |x: DartId| map.vertex_id(x);
+        let a = at(d);
+        let b = at(map.alpha::<0>(d));
+        let c = at(map.alpha::<0>(map.alpha::<1>(map.alpha::<0>(d))));
+        // α2 stays in the tet (onto the other face through edge ab); α1 then α0 reach its apex.
+        let apex = at(map.alpha::<0>(map.alpha::<1>(map.alpha::<2>(d))));
+        let corners = [a, b, c, apex];
+        let rest = corners.map(|v| attrs.rest_position[v]);
+        let now = corners.map(|v| attrs.position[v]);
+        let side = if apex_side(rest) != 0.0 { apex_side(rest) } else { apex_side(now) };
+        let flip = side > 0.0;
+        let tri = if flip { [a, c, b] } else { [a, b, c] };
+        builder.push(tri.map(|v| (v.0, attrs.position[v])), map.cell_id(3, d).0);
+    }
+    builder.finish()
+}
+
+/// The boundary surface of a tetrahedral mesh: the faces used by exactly one tet, in tet order
+/// then local face order, each oriented away from the tet's fourth point. `vertex_ids` are point
+/// indices and `face_volumes` tet indices. A face shared by three or more tets (not a manifold)
+/// is not a boundary face.
+///
+/// Cost: O(T) expected (one hash of each of the 4T sorted face triples).
+///
+/// # Errors
+/// [`SurfaceError::PointOutOfRange`] naming the first tet with a bad index.
+///
+/// ```
+/// use topomech::surface::boundary_surface_of_tets;
+///
+/// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+/// let s = boundary_surface_of_tets(&points, &[[0, 1, 2, 3]]).unwrap();
+/// assert_eq!(s.triangles.len(), 4);
+/// assert!((s.enclosed_volume() - 1.0 / 6.0).abs() < 1e-15);
+/// assert!(boundary_surface_of_tets(&points, &[[0, 1, 2, 9]]).is_err());
+/// ```
+pub fn boundary_surface_of_tets(points: &[Vec3], tets: &[[u32; 4]]) -> Result<Surface, SurfaceError> {
+    if let Some((tet, &point)) =
+        tets.iter().enumerate().find_map(|(t, tet)| tet.iter().find(|&&p| p as usize >= points.len()).map(|p| (t, p)))
+    {
+        return Err(SurfaceError::PointOutOfRange { tet, point, points: points.len() });
+    }
+    let face = |tet: &[u32; 4], f: usize| -> [u32; 3] {
+        let mut k = 0;
+        let mut out = [0; 3];
+        for (j, &p) in tet.iter().enumerate() {
+            if j != f {
+                out[k] = p;
+                k += 1;
+            }
+        }
+        out
+    };
+    let key = |mut tri: [u32; 3]| {
+        tri.sort_unstable();
+        tri
+    };
+    let mut uses: FxHashMap<[u32; 3], u32> = FxHashMap::default();
+    for tet in tets {
+        for f in 0..4 {
+            *uses.entry(key(face(tet, f))).or_insert(0) += 1;
+        }
+    }
+    let mut builder = Builder::new(points.len());
+    for (t, tet) in tets.iter().enumerate() {
+        for f in 0..4 {
+            let [a, b, c] = face(tet, f);
+            if uses[&key([a, b, c])] != 1 {
+                continue;
+            }
+            let p = |v: u32| points[v as usize];
+            let tri = if apex_side([p(a), p(b), p(c), p(tet[f])]) > 0.0 { [a, c, b] } else { [a, b, c] };
+            builder.push(tri.map(|v| (v, p(v))), t as u32);
+        }
+    }
+    Ok(builder.finish())
+}
+
+/// Sign of the apex `q[3]` relative to the plane of the triangle `q[0..3]` oriented by its normal:
+/// positive when the apex is in front, i.e. the triangle faces inward.
+fn apex_side(q: [Vec3; 4]) -> f64 {
+    let n = cross(sub(q[1], q[0]), sub(q[2], q[0]));
+    let s = dot(n, sub(q[3], q[0]));
+    if s > 0.0 {
+        1.0
+    } else if s < 0.0 {
+        -1.0
+    } else {
+        0.0
+    }
+}
+
+/// Collects triangles over vertex ids and compacts the vertices on the fly.
+struct Builder {
+    index_of: Vec<u32>,
+    surface: Surface,
+}
+
+impl Builder {
+    fn new(id_bound: usize) -> Self {
+        Builder { index_of: vec![u32::MAX; id_bound], surface: Surface::default() }
+    }
+
+    fn push(&mut self, corners: [(u32, Vec3); 3], volume: u32) {
+        let tri = corners.map(|(id, p)| self.vertex(id, p));
+        self.surface.triangles.push(tri);
+        self.surface.face_volumes.push(volume);
+    }
+
+    fn vertex(&mut self, id: u32, p: Vec3) -> u32 {
+        let slot = &mut self.index_of[id as usize];
+        if *slot == u32::MAX {
+            *slot = self.surface.positions.len() as u32;
+            self.surface.positions.push(p);
+            self.surface.vertex_ids.push(id);
+        }
+        *slot
+    }
+
+    fn finish(self) -> Surface {
+        self.surface
+    }
+}
+
+impl Surface {
+    /// The axis-aligned bounding box `(min, max)` of the vertices, or `None` for an empty
+    /// surface. Non-finite coordinates are skipped. O(vertices).
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let mut it = self.positions.iter().filter(|p| p.iter().all(|c| c.is_finite()));
+        let first = *it.next()?;
+        Some(it.fold((first, first), |(lo, hi), p| {
+            (std::array::from_fn(|k| lo[k].min(p[k])), std::array::from_fn(|k| hi[k].max(p[k])))
+        }))
+    }
+
+    /// The signed volume enclosed by the triangles, Σ a·(b × c) / 6 (divergence theorem). For a
+    /// closed, outward-oriented surface it is the volume of the solid; it is independent of the
+    /// origin only when the surface is closed. O(triangles).
+    pub fn enclosed_volume(&self) -> f64 {
+        let p = |i: u32| self.positions[i as usize];
+        self.triangles.iter().map(|&[a, b, c]| dot(p(a), cross(p(b), p(c)))).sum::<f64>() / 6.0
+    }
+
+    /// Total area of the triangles. O(triangles).
+    pub fn area(&self) -> f64 {
+        let p = |i: u32| self.positions[i as usize];
+        self.triangles.iter().map(|&[a, b, c]| norm(cross(sub(p(b), p(a)), sub(p(c), p(a)))) / 2.0).sum()
+    }
+
+    /// The surface as Wavefront OBJ text: a comment header, one `v x y z` line per vertex
+    /// (shortest round-trip decimal form), one `f i j k` line per triangle (1-based indices, in
+    /// the triangle's outward orientation). O(vertices + triangles).
+    ///
+    /// ```
+    /// use topomech::surface::boundary_surface_of_tets;
+    ///
+    /// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let obj = boundary_surface_of_tets(&points, &[[0, 1, 2, 3]]).unwrap().to_obj();
+    /// assert_eq!(obj.lines().filter(|l| l.starts_with("v ")).count(), 4);
+    /// assert_eq!(obj.lines().filter(|l| l.starts_with("f ")).count(), 4);
+    /// ```
+    pub fn to_obj(&self) -> String {
+        let mut s = String::with_capacity(40 * self.positions.len() + 24 * self.triangles.len() + 128);
+        let _ = writeln!(
+            s,
+            "# topomech boundary surface: {} vertices, {} triangles, outward counter-clockwise",
+            self.positions.len(),
+            self.triangles.len()
+        );
+        for p in &self.positions {
+            let _ = writeln!(s, "v {} {} {}", p[0], p[1], p[2]);
+        }
+        for t in &self.triangles {
+            let _ = writeln!(s, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1);
+        }
+        s
+    }
+
+    /// Writes [`Surface::to_obj`] to `path` atomically (a temporary file in the same directory,
+    /// then a rename: see [`crate::store::write_atomically`]). O(vertices + triangles).
+    ///
+    /// # Errors
+    /// [`SurfaceError::Write`] naming `path`.
+    pub fn write_obj(&self, path: &Path) -> Result<(), SurfaceError> {
+        crate::store::write_atomically(path, self.to_obj().as_bytes())
+            .map_err(|source| SurfaceError::Write { path: path.to_path_buf(), source })
+    }
+}
+
+fn sub(a: Vec3, b: Vec3) -> Vec3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn dot(a: Vec3, b: Vec3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn cross(a: Vec3, b: Vec3) -> Vec3 {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+fn norm(a: Vec3) -> f64 {
+    dot(a, a).sqrt()
+}

@@ -76,7 +76,10 @@ fn every_check_passes_and_mass_is_kept_or_accounted_for() {
     assert!((num(&s, "final_mass") + num(&s, "removed_mass") - m0).abs() <= 1e-9 * m0);
     assert_eq!(int(&s, "checks_passed"), int(stage(&s, "refinement"), "checks_passed"));
     assert_eq!(s["mesh"]["vertices"], 547, "the built-in liver");
-    assert_eq!(s["refinement_mechanics"], false, "refinement is geometry-only");
+    assert_eq!(s["refinement_mechanics"], false, "springs do not follow the refinement yet");
+    let refined = stage(&s, "refinement");
+    assert!(num(refined, "mass_residual").abs() <= 1e-9, "the children share their parents' masses");
+    assert!((num(refined, "total_mass") - num(&s, "final_mass")).abs() <= 1e-9 * m0);
 }
 
 #[test]
@@ -158,7 +161,7 @@ fn the_text_report_ends_with_a_table_of_every_stage() {
         assert!(table.lines().any(|l| l.trim_start().starts_with(name)), "{name} row: {table}");
     }
     assert!(report.contains("checks passed"), "{report}");
-    assert!(report.contains("geometry only"), "{report}");
+    assert!(report.contains("springs and the simulation do not follow"), "{report}");
     assert!(dir.join("pictures/scene.pvd").is_file(), "--out is used");
     assert!(!dir.join("out").exists(), "and the default is not");
 }

@@ -4,7 +4,7 @@
 //! A liver (the built-in mesh, or any mesh file) pinned at one end of its longest axis:
 //!
 //! ```text
-//!   rest ─► 1 sag ─► 2 incision ─► 3 tear ─► 4 removal ─► 5 refinement (geometry only)
+//!   rest ─► 1 sag ─► 2 incision ─► 3 tear ─► 4 removal ─► 5 refinement (masses shared, no springs yet)
 //!           N steps   cut + N/2     N/2 steps  ball + N/4   1→8 subdivision of the tets
 //!                     steps         with tears steps        beside the incision, level 1
 //! ```
@@ -270,10 +270,10 @@ fn play(args: &DemoArgs, loaded: &Loaded, log: &mut dyn Write) -> Result<Played,
     let mut refinement = StageRun { name: "refinement", ..StageRun::default() };
     bar.set_message("refinement");
     bar.inc_length(scene.incision_tets.len() as u64);
-    let (lm, checks) = refine::refine(&scene.body, &scene.incision_tets, &mut refinement, &bar)?;
+    let (lm, masses, checks) = refine::refine(&scene.body, &scene.incision_tets, &mut refinement, &bar)?;
     scene.checker.passed += checks;
     bar.finish_and_clear();
-    rows.push(report::refined_row(&lm, &refinement, scene.checker.passed));
+    rows.push(report::refined_row(&lm, &masses, &scene, &refinement));
     let (refined, levels) = refine::refined_surface(&lm);
     output.obj("refined.obj", &refined)?;
     let values = levels.into_iter().map(f64::from).collect();
@@ -352,7 +352,7 @@ fn write_refinement(out: &mut dyn Write, lm: &LeveledMap<3>, run: &StageRun, che
         lm.darts_at_level(refine::LEVEL),
         refine::LEVEL
     )?;
-    writeln!(out, "        (geometry only: the mechanics does not follow subdivision yet)")
+    writeln!(out, "        (tet masses follow the children; springs and the simulation do not follow subdivision yet)")
 }
 
 impl Played {

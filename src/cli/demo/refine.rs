@@ -1,15 +1,17 @@
 //! Refinement of the incision zone (seed 004): the final body's map and current positions wrapped
 //! as level 0 of a [`LeveledMap`], and each tet beside the incision subdivided 1→8 at level 1.
 //!
-//! Geometry only: the mechanics does not follow subdivision yet (no masses or springs for the new
-//! cells), so this stage has no conservation check; it checks the level laws instead
-//! ([`LeveledMap::check_all`]: finest map valid, μt ≤ μf ≤ μa, every level extracted and valid).
+//! Masses follow the subdivision: each child tet takes its parent's mass in proportion to its
+//! volume ([`LeveledMap::subdivide_tet_with_mass`]), and the stage checks that Σ tet mass is
+//! unchanged. Springs do not follow yet (no stiffness for the new edges), so there is no stiffness
+//! balance here; the level laws are checked instead ([`LeveledMap::check_all`]: finest map valid,
+//! μt ≤ μf ≤ μa, every level extracted and valid).
 
 use std::time::Instant;
 
 use indicatif::ProgressBar;
 use topomech::mechanics::{Body, Vec3};
-use topomech::subdivide::LeveledMap;
+use topomech::subdivide::{LeveledMap, TetMasses};
 use topomech::surface::Surface;
 use topomech::{AlphaMask, CellId, DartId, GMap};
 
@@ -19,26 +21,33 @@ use super::DemoError;
 /// The level the incision zone is refined to.
 pub const LEVEL: u8 = 1;
 
-/// Wraps `body` (map and current positions) as level 0 and subdivides the live tets among `tets`
-/// at [`LEVEL`], then checks every level law. Returns the leveled map and the checks passed.
+/// Wraps `body` (map, current positions, tet masses) as level 0 and subdivides the live tets
+/// among `tets` at [`LEVEL`], sharing their masses, then checks every level law and the mass
+/// balance. Returns the leveled map, the tet masses and the checks passed.
 /// O(tets · darts) to find the tets plus the subdivisions and O(capacity · n²) for the check.
 ///
 /// # Errors
-/// [`DemoError::Subdivide`] naming the tet, [`DemoError::Levels`] when a level law fails.
+/// [`DemoError::Subdivide`] naming the tet, [`DemoError::Levels`] when a level law fails,
+/// [`DemoError::Balance`] when Σ tet mass changed by more than the tolerance.
 pub fn refine(
     body: &Body,
     tets: &[CellId],
     run: &mut StageRun,
     bar: &ProgressBar,
-) -> Result<(LeveledMap<3>, usize), DemoError> {
+) -> Result<(LeveledMap<3>, TetMasses, usize), DemoError> {
     let points = body.attrs().position.as_slice().to_vec();
     let mut lm = LeveledMap::new(body.map().clone(), points);
+    // The leveled map starts as a copy of the body's map: same volume ids, so the same masses.
+    let mut masses =
+        TetMasses { mass: (0..body.map().cell_id_bound(3)).map(|t| body.attrs().tet_mass(CellId(t as u32))).collect() };
+    let before = masses.total(&lm);
     let t0 = Instant::now();
     for &t in tets {
         let found = lm.map().darts().find(|&d| lm.map().cell_id(3, d) == t && lm.mu(d).tet < LEVEL);
         if let Some(d) = found {
             let t1 = Instant::now();
-            lm.subdivide_tet(d, LEVEL).map_err(|source| DemoError::Subdivide { tet: t, source })?;
+            lm.subdivide_tet_with_mass(d, LEVEL, &mut masses)
+                .map_err(|source| DemoError::Subdivide { tet: t, source })?;
             run.step_us.push(t1.elapsed().as_secs_f64() * 1e6);
             run.operations += 1;
         }
@@ -46,7 +55,11 @@ pub fn refine(
     }
     run.operation_us = t0.elapsed().as_secs_f64() * 1e6;
     lm.check_all().map_err(DemoError::Levels)?;
-    Ok((lm, 2))
+    let residual = (masses.total(&lm) - before) / before;
+    if residual.abs() > super::checks::TOLERANCE {
+        return Err(DemoError::Balance { stage: "refinement", step: 0, quantity: "mass", residual });
+    }
+    Ok((lm, masses, 3))
 }
 
 /// The boundary of the finest level as triangles: every α3-free face, its vertex cycle walked by

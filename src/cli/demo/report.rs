@@ -6,15 +6,15 @@ use std::io::Write;
 use topomech::cut;
 use topomech::gmap::GMap;
 use topomech::mechanics::Vec3;
-use topomech::subdivide::LeveledMap;
+use topomech::subdivide::{LeveledMap, TetMasses};
 
 use super::checks::{total_mass, total_stiffness};
 use super::scene::{Scene, StageRun};
 use crate::cli::simulate::median;
 use crate::cli::InfoJson;
 
-/// One stage of the summary (JSON keys in this order). Mass fields are `None` for the
-/// geometry-only refinement.
+/// One stage of the summary (JSON keys in this order). Stiffness fields are `None` for the
+/// refinement (springs do not follow subdivision yet); its mass is Σ tet mass of the finest level.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct StageRow {
     /// Stage name: rest, sag, incision, tear, removal, refinement.
@@ -104,9 +104,18 @@ pub fn scene_row(scene: &Scene, run: &StageRun) -> StageRow {
     }
 }
 
-/// The row of the refinement (no mechanics). O(darts).
-pub fn refined_row(lm: &LeveledMap<3>, run: &StageRun, checks_passed: usize) -> StageRow {
-    StageRow { checks_passed, ..counts_row(run.name, lm.map(), run) }
+/// The row of the refinement: cell counts of the finest level and Σ tet mass (the children share
+/// their parents' masses); no springs yet, so no stiffness. O(darts).
+pub fn refined_row(lm: &LeveledMap<3>, masses: &TetMasses, scene: &Scene, run: &StageRun) -> StageRow {
+    let ch = &scene.checker;
+    let total = masses.total(lm);
+    StageRow {
+        total_mass: Some(total),
+        removed_mass: Some(ch.removed_mass),
+        mass_residual: Some((total + ch.removed_mass - ch.initial_mass) / ch.initial_mass),
+        checks_passed: ch.passed,
+        ..counts_row(run.name, lm.map(), run)
+    }
 }
 
 /// The parameters and files of the run, for the JSON summary.
@@ -168,7 +177,8 @@ pub struct DemoJson {
     pub final_mass: f64,
     /// Mass removed.
     pub removed_mass: f64,
-    /// Whether the mechanics follows the refinement (not yet: geometry only).
+    /// Whether the whole mechanics (springs, simulation) follows the refinement (not yet: only the
+    /// tet masses do).
     pub refinement_mechanics: bool,
     /// Output files.
     pub files: FilesJson,

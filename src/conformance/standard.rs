@@ -4,7 +4,7 @@
 //! |---|---|---|
 //! | `single_tet_remove` | 1 tet, inline | removal down to the empty body; removing again is refused |
 //! | `two_tets_dissociate` | 2 tets, inline | one dissociation: 1 → 2 components; again is refused |
-//! | `helix_remove_middle` | 3 tets in a twisted chain, inline | a removal that leaves two tets touching along an edge only: 2 components, pinched edge |
+//! | `chain_remove_middle` | 3 tets in a chain, inline | a removal that leaves two tets touching along an edge only: 2 components, pinched edge |
 //! | `kuhn2_incise_planes` | Kuhn cube k = 2, inline | incisions by an axis plane (2 halves), then an oblique one |
 //! | `kuhn2_edge_then_vertex_split` | Kuhn cube k = 2, inline | a dissociation that splits an edge only, then one that splits a vertex; Σ k constant (k = k1 + k2) |
 //! | `kuhn2_tear_center` | Kuhn cube k = 2, generated | tearing the centre vertex, then a removal |
@@ -22,7 +22,7 @@ use super::ConformanceError;
 /// The recipes of the standard set, in file-name order. O(k³) for the cube meshes.
 pub fn recipes() -> Vec<Recipe> {
     vec![
-        helix_remove_middle(),
+        chain_remove_middle(),
         jittered_cube_shared_sequence(),
         kuhn2_edge_then_vertex_split(),
         kuhn2_incise_planes(),
@@ -86,15 +86,22 @@ fn two_tets_dissociate() -> Recipe {
     )
 }
 
-fn helix_remove_middle() -> Recipe {
-    let points: Vec<[f64; 3]> =
-        (0..6).map(|i| [(1.1 * i as f64).cos(), (1.1 * i as f64).sin(), 0.4 * i as f64]).collect();
+fn chain_remove_middle() -> Recipe {
+    // t0 = {0,1,2,3}, t1 = {1,2,3,4}, t2 = {2,3,4,5}; point 5 lies across the face {2,3,4} from 1.
+    let points = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [1.0, 1.0, 1.0],
+        [0.0, 1.5, 1.5],
+    ];
     recipe(
-        "helix_remove_middle",
-        "Six points on a helix, three tets in a chain (each shares a face with the next; the first and the \
-         last share only the edge {2,3}). Step 0 removes the middle tet: two components remain that touch \
-         along that edge only, so in the map points 2 and 3 and the edge {2,3} each become two cells \
-         (connectivity is through faces). Mass and Σ stiffness drop by exactly the removed tet's share.",
+        "chain_remove_middle",
+        "Three tets in a chain (each shares a face with the next; the first and the last share only the \
+         edge {2,3}). Step 0 removes the middle tet: two components remain that touch along that edge only, \
+         so in the map points 2 and 3 and the edge {2,3} each become two cells (connectivity is through \
+         faces). Mass and Σ stiffness drop by exactly the removed tet's share.",
         inline((points, vec![[0, 1, 2, 3], [1, 2, 3, 4], [2, 3, 4, 5]])),
         Ops::Listed(vec![Op::Remove { tet: 1 }]),
     )

@@ -67,7 +67,10 @@ fn generation_reproduces_the_committed_files_exactly() {
 }
 
 /// Every way of altering one expected number, applied to step `k` (None = initial).
-fn mutations() -> Vec<(&'static str, fn(&mut Expect))> {
+/// A field name and a way to alter it.
+type Mutation = (&'static str, fn(&mut Expect));
+
+fn mutations() -> Vec<Mutation> {
     vec![
         ("total_mass", |e| e.total_mass = e.total_mass * (1.0 + 1e-6) + 1e-6),
         ("total_stiffness", |e| e.total_stiffness = e.total_stiffness * (1.0 - 1e-6) - 1e-6),
@@ -185,7 +188,8 @@ fn operations_naming_what_the_mesh_lacks_are_rejected() {
 fn tet_volume(p: &[[f64; 3]], t: &[u32; 4]) -> f64 {
     let [a, b, c, d] = t.map(|i| p[i as usize]);
     let (u, v, w) = ([0, 1, 2].map(|k| b[k] - a[k]), [0, 1, 2].map(|k| c[k] - a[k]), [0, 1, 2].map(|k| d[k] - a[k]));
-    let det = u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) + u[2] * (v[0] * w[1] - v[1] * w[0]);
+    let det =
+        u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) + u[2] * (v[0] * w[1] - v[1] * w[0]);
     (det / 6.0).abs()
 }
 
@@ -203,7 +207,10 @@ fn tet_share(p: &[[f64; 3]], t: &[u32; 4], density: f64, young: f64) -> (f64, f6
     (density * v, k)
 }
 
-fn inline_mesh(v: &Vector) -> Option<(Vec<[f64; 3]>, Vec<[u32; 4]>)> {
+/// Points and tets.
+type Mesh = (Vec<[f64; 3]>, Vec<[u32; 4]>);
+
+fn inline_mesh(v: &Vector) -> Option<Mesh> {
     match &v.mesh {
         MeshSpec::Inline { points, tets } => Some((points.clone(), tets.clone())),
         MeshSpec::KuhnCube { k } => Some(kuhn_cube(*k)),

@@ -172,7 +172,8 @@ fn check_header(v: &Vector) -> Result<(), ConformanceError> {
         return Err(invalid(format!("tolerance {} must be finite and ≥ 0", v.tolerance)));
     }
     let m = v.material;
-    for (name, value) in [("density", m.density), ("young", m.young), ("damping", m.damping), ("viscosity", m.viscosity)]
+    for (name, value) in
+        [("density", m.density), ("young", m.young), ("damping", m.damping), ("viscosity", m.viscosity)]
     {
         if !(value.is_finite() && value >= 0.0) {
             return Err(invalid(format!("material {name} = {value} must be finite and ≥ 0")));
@@ -205,9 +206,10 @@ fn compare(v: &Vector, step: Option<usize>, want: &Expect, got: &Expect) -> Resu
     exact!(boundary_faces);
     exact!(components);
     exact!(euler);
-    for (field, a, b) in
-        [("total_mass", want.total_mass, got.total_mass), ("total_stiffness", want.total_stiffness, got.total_stiffness)]
-    {
+    for (field, a, b) in [
+        ("total_mass", want.total_mass, got.total_mass),
+        ("total_stiffness", want.total_stiffness, got.total_stiffness),
+    ] {
         if !close(a, b) {
             return Err(fail(field, a.to_string(), b.to_string()));
         }
@@ -272,7 +274,11 @@ impl Runner {
     /// Input tet `t`, or a bad-op error naming the range.
     fn tet(&self, step: usize, t: u32) -> Result<[u32; 4], ConformanceError> {
         let n = self.oracle.tets.len();
-        self.oracle.tets.get(t as usize).copied().ok_or_else(|| self.bad(step, format!("tet {t} is out of range (the mesh has {n} tets)")))
+        self.oracle
+            .tets
+            .get(t as usize)
+            .copied()
+            .ok_or_else(|| self.bad(step, format!("tet {t} is out of range (the mesh has {n} tets)")))
     }
 
     /// The live dart 24t + k of input tet t (the builder's numbering, `docs/ARCHITECTURE.md`),
@@ -322,11 +328,21 @@ impl Runner {
         let f = a.iter().position(|p| !face.contains(p)).expect("a tet has one corner off each of its faces");
         let d = self.dart(tets[0], 6 * f).expect("tet checked live above");
         match cut::dissociate_face(&mut self.body, d) {
-            Err(CutError::BoundaryFace { .. }) => Ok(Outcome { refused: Some(Refusal::BoundaryFace), dissociated: vec![] }),
+            Err(CutError::BoundaryFace { .. }) => {
+                Ok(Outcome { refused: Some(Refusal::BoundaryFace), dissociated: vec![] })
+            }
             Err(e) => Err(self.law(Some(step), format!("dissociating {tets:?}: {e}"))),
             Ok(dis) => {
                 if self.tet_of(dis.opposite) != tets[1] {
-                    return Err(self.law(Some(step), format!("face {face:?} of tet {} was glued to tet {}, not {}", tets[0], self.tet_of(dis.opposite), tets[1])));
+                    return Err(self.law(
+                        Some(step),
+                        format!(
+                            "face {face:?} of tet {} was glued to tet {}, not {}",
+                            tets[0],
+                            self.tet_of(dis.opposite),
+                            tets[1]
+                        ),
+                    ));
                 }
                 self.oracle.cut.insert(face);
                 Ok(Outcome { refused: None, dissociated: vec![tets] })
@@ -351,7 +367,8 @@ impl Runner {
             CutError::BadPlane { .. } => self.bad(step, e.to_string()),
             e => self.law(Some(step), e.to_string()),
         })?;
-        let pairs = inc.dissociations.iter().map(|dis| pair(self.tet_of(dis.dart), self.tet_of(dis.opposite))).collect();
+        let pairs =
+            inc.dissociations.iter().map(|dis| pair(self.tet_of(dis.dart), self.tet_of(dis.opposite))).collect();
         self.record_cut(step, sorted(pairs))
     }
 
@@ -384,7 +401,8 @@ impl Runner {
     fn record_cut(&mut self, step: usize, pairs: Vec<[u32; 2]>) -> Result<Outcome, ConformanceError> {
         for &[a, b] in &pairs {
             let face = common(&self.oracle.tets[a as usize], &self.oracle.tets[b as usize]);
-            let face: [u32; 3] = face.try_into().map_err(|f| self.law(Some(step), format!("tets {a}, {b} share {f:?}, not a face")))?;
+            let face: [u32; 3] =
+                face.try_into().map_err(|f| self.law(Some(step), format!("tets {a}, {b} share {f:?}, not a face")))?;
             self.oracle.cut.insert(face);
         }
         Ok(Outcome { refused: None, dissociated: pairs })
@@ -414,7 +432,12 @@ impl Runner {
             .fold(f64::INFINITY, f64::min);
         let margin = PLANE_MARGIN * diagonal;
         if distance < margin {
-            return Err(ConformanceError::AmbiguousPlane { vector: self.name.clone(), step: Some(step), distance, margin });
+            return Err(ConformanceError::AmbiguousPlane {
+                vector: self.name.clone(),
+                step: Some(step),
+                distance,
+                margin,
+            });
         }
         Ok(())
     }
@@ -429,7 +452,10 @@ impl Runner {
         if got != (cells.to_vec(), boundary, comps) {
             return Err(self.law(
                 step,
-                format!("map (cells, boundary faces, components) {got:?}, union-find model {:?}", (cells, boundary, comps)),
+                format!(
+                    "map (cells, boundary faces, components) {got:?}, union-find model {:?}",
+                    (cells, boundary, comps)
+                ),
             ));
         }
         Ok(())
@@ -470,8 +496,11 @@ impl Runner {
             }
             shared::Op::DissociateBoundary(k) => {
                 let glued: Vec<[u32; 3]> = o.glued().into_iter().map(|(f, _)| f).collect();
-                let free: Vec<[u32; 3]> =
-                    live.iter().flat_map(|&t| (0..4).map(move |f| o.triple(t, f))).filter(|f| !glued.contains(f)).collect();
+                let free: Vec<[u32; 3]> = live
+                    .iter()
+                    .flat_map(|&t| (0..4).map(move |f| o.triple(t, f)))
+                    .filter(|f| !glued.contains(f))
+                    .collect();
                 let face = *free.get(k % free.len().max(1))?;
                 let [(a, _), (b, _)] = *o.inner.get(&face)?;
                 Some(Op::Dissociate { tets: pair(a as u32, b as u32), face })

@@ -88,14 +88,8 @@ fn two_tets_dissociate() -> Recipe {
 
 fn chain_remove_middle() -> Recipe {
     // t0 = {0,1,2,3}, t1 = {1,2,3,4}, t2 = {2,3,4,5}; point 5 lies across the face {2,3,4} from 1.
-    let points = vec![
-        [0.0, 0.0, 0.0],
-        [1.0, 0.0, 0.0],
-        [0.0, 1.0, 0.0],
-        [0.0, 0.0, 1.0],
-        [1.0, 1.0, 1.0],
-        [0.0, 1.5, 1.5],
-    ];
+    let points =
+        vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 1.0], [0.0, 1.5, 1.5]];
     recipe(
         "chain_remove_middle",
         "Three tets in a chain (each shares a face with the next; the first and the last share only the \
@@ -171,14 +165,36 @@ fn jittered_cube_shared_sequence() -> Recipe {
 
 fn liver_short_sequence() -> Recipe {
     let bytes = vec![
-        0, 0, // mesh bytes of the shared generator (ignored: the mesh is the liver)
-        0, 100, 0, 0, // dissociate the 100th glued face
-        1, 0xd0, 7, 0, // dissociate the 2000th
-        7, 37, 0, 0, // remove a tet
-        9, 0, 0, 0, // remove it again (refused)
-        10, 250, 0, 0b1001_1101, // incise through (near) a tet's centroid
-        11, 0x09, 3, 0b0101_0110, // tear a vertex
-        3, 44, 1, 0, // dissociate the 300th glued face
+        0,
+        0, // mesh bytes of the shared generator (ignored: the mesh is the liver)
+        0,
+        100,
+        0,
+        0, // dissociate the 100th glued face
+        1,
+        0xd0,
+        7,
+        0, // dissociate the 2000th
+        7,
+        37,
+        0,
+        0, // remove a tet
+        9,
+        0,
+        0,
+        0, // remove it again (refused)
+        10,
+        250,
+        0,
+        0b1001_1101, // incise through (near) a tet's centroid
+        11,
+        0x09,
+        3,
+        0b0101_0110, // tear a vertex
+        3,
+        44,
+        1,
+        0, // dissociate the 300th glued face
     ];
     recipe(
         "liver_short_sequence",

@@ -352,3 +352,176 @@ fn cli_generate_writes_the_committed_set() {
     }
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// A second engine that knows nothing of G-maps: the tet list, which tets are alive, and which
+/// inner faces are still glued (docs/CONFORMANCE.md, "The model the vectors describe"). It
+/// replays every committed vector and must find every expected field, which shows the vectors
+/// can be used by an engine built another way.
+struct TetListEngine {
+    points: Vec<[f64; 3]>,
+    tets: Vec<[u32; 4]>,
+    density: f64,
+    young: f64,
+    alive: Vec<bool>,
+    /// Glued faces by their (sorted) tet pair.
+    glued: std::collections::BTreeSet<[u32; 2]>,
+}
+
+fn find(parent: &mut [usize], mut x: usize) -> usize {
+    while parent[x] != x {
+        parent[x] = parent[parent[x]];
+        x = parent[x];
+    }
+    x
+}
+
+impl TetListEngine {
+    fn new(v: &Vector) -> Self {
+        let (points, tets) = match &v.mesh {
+            MeshSpec::File { path, .. } => {
+                let mesh = topomech::io::read_mesh(&root().join(path)).expect("the vector's mesh file");
+                (mesh.points, mesh.tets)
+            }
+            _ => inline_mesh(v).unwrap(),
+        };
+        let mut by_face: std::collections::HashMap<Vec<u32>, Vec<u32>> = Default::default();
+        for (t, tet) in tets.iter().enumerate() {
+            for skip in 0..4 {
+                let mut f: Vec<u32> = (0..4).filter(|&c| c != skip).map(|c| tet[c]).collect();
+                f.sort_unstable();
+                by_face.entry(f).or_default().push(t as u32);
+            }
+        }
+        let glued =
+            by_face.values().filter(|ts| ts.len() == 2).map(|ts| [ts[0].min(ts[1]), ts[0].max(ts[1])]).collect();
+        let alive = vec![true; tets.len()];
+        TetListEngine { points, tets, density: v.material.density, young: v.material.young, alive, glued }
+    }
+
+    fn centroid(&self, t: u32) -> [f64; 3] {
+        let mut c = [0.0; 3];
+        for p in self.tets[t as usize] {
+            for (c, x) in c.iter_mut().zip(self.points[p as usize]) {
+                *c += x / 4.0;
+            }
+        }
+        c
+    }
+
+    /// Applies `op`; returns (refusal, dissociated pairs).
+    fn apply(&mut self, op: &Op, expect: &Expect) -> (Option<Refusal>, Vec<[u32; 2]>) {
+        match op {
+            Op::Dissociate { tets, .. } if !self.alive[tets[0] as usize] || !self.alive[tets[1] as usize] => {
+                (Some(Refusal::RemovedTet), vec![])
+            }
+            Op::Dissociate { tets, .. } if !self.glued.remove(tets) => (Some(Refusal::BoundaryFace), vec![]),
+            Op::Dissociate { tets, .. } => (None, vec![*tets]),
+            Op::Remove { tet } if !self.alive[*tet as usize] => (Some(Refusal::RemovedTet), vec![]),
+            Op::Remove { tet } => {
+                let cut: Vec<[u32; 2]> = self.glued.iter().filter(|p| p.contains(tet)).copied().collect();
+                cut.iter().for_each(|p| {
+                    self.glued.remove(p);
+                });
+                self.alive[*tet as usize] = false;
+                (None, cut)
+            }
+            Op::Incise { point, normal } => {
+                let side = |c: [f64; 3]| (0..3).map(|k| (c[k] - point[k]) * normal[k]).sum::<f64>() > 0.0;
+                let cut: Vec<[u32; 2]> = self
+                    .glued
+                    .iter()
+                    .filter(|[a, b]| side(self.centroid(*a)) != side(self.centroid(*b)))
+                    .copied()
+                    .collect();
+                cut.iter().for_each(|p| {
+                    self.glued.remove(p);
+                });
+                (None, cut)
+            }
+            // A tear is replayed as the dissociations it lists (each must be glued).
+            Op::Tear { .. } => {
+                for p in &expect.dissociated {
+                    assert!(self.glued.remove(p), "tear lists {p:?}, which is not glued");
+                }
+                (None, expect.dissociated.clone())
+            }
+        }
+    }
+
+    /// Classes of `per` items of each live tet joined by `join` over glued faces.
+    fn classes(&self, per: usize, join: impl Fn(u32, u32, &[u32]) -> Vec<(usize, usize)>) -> (usize, Vec<usize>) {
+        let mut parent: Vec<usize> = (0..per * self.tets.len()).collect();
+        for &[a, b] in &self.glued {
+            let face: Vec<u32> =
+                self.tets[a as usize].iter().copied().filter(|p| self.tets[b as usize].contains(p)).collect();
+            for (x, y) in join(a, b, &face) {
+                let (x, y) = (find(&mut parent, x), find(&mut parent, y));
+                parent[x] = y;
+            }
+        }
+        let mut roots: Vec<usize> = (0..self.tets.len())
+            .filter(|&t| self.alive[t])
+            .flat_map(|t| (0..per).map(move |k| per * t + k))
+            .map(|x| find(&mut parent, x))
+            .collect();
+        let label = roots.clone();
+        roots.sort_unstable();
+        roots.dedup();
+        (roots.len(), label)
+    }
+
+    fn tet_share(&self, t: usize) -> (f64, f64) {
+        tet_share(&self.points, &self.tets[t], self.density, self.young)
+    }
+
+    fn check(&self, want: &Expect, got: (Option<Refusal>, Vec<[u32; 2]>), at: &str) {
+        let corner = |t: u32, p: u32| 4 * t as usize + self.tets[t as usize].iter().position(|&q| q == p).unwrap();
+        let (v, _) = self.classes(4, |a, b, face| face.iter().map(|&p| (corner(a, p), corner(b, p))).collect());
+        const EDGES: [(usize, usize); 6] = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
+        let edge = |t: u32, p: u32, q: u32| {
+            let tet = self.tets[t as usize];
+            6 * t as usize
+                + EDGES.iter().position(|&(i, j)| (tet[i], tet[j]) == (p, q) || (tet[i], tet[j]) == (q, p)).unwrap()
+        };
+        let (e, _) = self.classes(6, |a, b, f| {
+            [(f[0], f[1]), (f[0], f[2]), (f[1], f[2])].iter().map(|&(p, q)| (edge(a, p, q), edge(b, p, q))).collect()
+        });
+        let (components, labels) = self.classes(1, |a, b, _| vec![(a as usize, b as usize)]);
+        let live: Vec<usize> = (0..self.tets.len()).filter(|&t| self.alive[t]).collect();
+        let t = live.len();
+        let f = 4 * t - self.glued.len();
+        let mut per_root: std::collections::BTreeMap<usize, f64> = Default::default();
+        for (i, &tet) in live.iter().enumerate() {
+            *per_root.entry(labels[i]).or_default() += self.tet_share(tet).0;
+        }
+        let mut masses: Vec<f64> = per_root.into_values().collect();
+        masses.sort_by(f64::total_cmp);
+        let mass: f64 = live.iter().map(|&x| self.tet_share(x).0).sum();
+        let stiffness: f64 = live.iter().map(|&x| self.tet_share(x).1).sum();
+        assert_eq!((want.refused, &want.dissociated), (got.0, &got.1), "{at}");
+        assert_eq!(want.cells, [v, e, f, t], "{at}: cells");
+        assert_eq!(
+            (want.darts, want.boundary_faces, want.components),
+            (24 * t, 4 * t - 2 * self.glued.len(), components),
+            "{at}"
+        );
+        assert_eq!(want.euler, v as i64 - e as i64 + f as i64 - t as i64, "{at}");
+        let near = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs()).max(1e-300);
+        assert!(near(want.total_mass, mass) || (want.total_mass == 0.0 && mass == 0.0), "{at}: mass");
+        assert!(near(want.total_stiffness, stiffness) || (want.total_stiffness == 0.0 && stiffness == 0.0), "{at}: Σk");
+        assert!(want.component_masses.len() == masses.len(), "{at}: component masses");
+        assert!(want.component_masses.iter().zip(&masses).all(|(&a, &b)| near(a, b)), "{at}: component masses");
+    }
+}
+
+#[test]
+fn an_engine_without_gmaps_replays_every_vector() {
+    for (_, v) in committed() {
+        let mut engine = TetListEngine::new(&v);
+        engine.check(&v.initial, (None, vec![]), &format!("{} initial", v.name));
+        for (i, step) in v.steps.iter().enumerate() {
+            let got = engine.apply(&step.op, &step.expect);
+            engine.check(&step.expect, got, &format!("{} step {i}", v.name));
+        }
+    }
+}

@@ -438,6 +438,7 @@ impl TetListEngine {
                 });
                 (None, cut)
             }
+            Op::Tear { tet, .. } if !self.alive[*tet as usize] => (Some(Refusal::RemovedTet), vec![]),
             // A tear is replayed as the dissociations it lists (each must be glued).
             Op::Tear { .. } => {
                 for p in &expect.dissociated {

@@ -95,9 +95,10 @@ fn chain_remove_middle() -> Recipe {
         "Three tets in a chain (each shares a face with the next; the first and the last share only the \
          edge {2,3}). Step 0 removes the middle tet: two components remain that touch along that edge only, \
          so in the map points 2 and 3 and the edge {2,3} each become two cells (connectivity is through \
-         faces). Mass and Σ stiffness drop by exactly the removed tet's share.",
+         faces). Mass and Σ stiffness drop by exactly the removed tet's share. Step 1 dissociates the face \
+         tets 0 and 1 shared, which must be refused (removed_tet).",
         inline((points, vec![[0, 1, 2, 3], [1, 2, 3, 4], [2, 3, 4, 5]])),
-        Ops::Listed(vec![Op::Remove { tet: 1 }]),
+        Ops::Listed(vec![Op::Remove { tet: 1 }, Op::Dissociate { tets: [0, 1], face: [1, 2, 3] }]),
     )
 }
 
@@ -140,9 +141,13 @@ fn kuhn2_tear_center() -> Recipe {
          (1,1,1) along (0.2, 0.3, 1): the fan of faces around it that starts with the face whose normal is \
          closest to the direction is dissociated; the faces are listed in expect.dissociated, so another \
          engine can replay the tear as those dissociations (here they also cut a piece off: 2 components). \
-         Step 1 removes tet 0.",
+         Step 1 removes tet 0; step 2 tears point 13 as seen from tet 0, which must be refused (removed_tet).",
         MeshSpec::KuhnCube { k: 2 },
-        Ops::Listed(vec![Op::Tear { tet: t, vertex: 13, direction: [0.2, 0.3, 1.0] }, Op::Remove { tet: 0 }]),
+        Ops::Listed(vec![
+            Op::Tear { tet: t, vertex: 13, direction: [0.2, 0.3, 1.0] },
+            Op::Remove { tet: 0 },
+            Op::Tear { tet: 0, vertex: 13, direction: [0.2, 0.3, 1.0] },
+        ]),
     )
 }
 

@@ -30,6 +30,7 @@
 
 pub mod ambiguity;
 pub mod build;
+pub mod conformance;
 pub mod cut;
 pub mod embedding;
 pub mod generate;

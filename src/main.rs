@@ -7,6 +7,7 @@
 //! topomech simulate MESH …       mass/spring simulation (see --help)
 //! topomech bench step MESH       map-driven vs flat-array step time
 //! topomech refine MESH …         adaptive 1→8 refinement around a point (see --help)
+//! topomech conformance generate DIR | check FILE_OR_DIR   conformance vectors (docs/CONFORMANCE.md)
 //! ```
 //!
 //! Exit status 0 on success, 1 with one line `topomech: error: …` on stderr when the input is bad
@@ -54,6 +55,8 @@ enum Command {
     Refine(cli::refine::RefineArgs),
     /// Validate a `.tmap`/`.tmapb` map file and list each broken law (exit 0 valid, 1 broken, 2 unreadable).
     Check(cli::check::CheckArgs),
+    /// Conformance vectors: `generate DIR` writes the standard set, `check FILE_OR_DIR` replays (exit 1 mismatch, 2 unreadable).
+    Conformance(cli::conformance::ConformanceArgs),
 }
 
 impl Command {
@@ -69,6 +72,7 @@ impl Command {
             Command::Tear(args) => cli::cut::run_tear(args),
             Command::Check(args) => cli::check::run(args),
             Command::Refine(args) => cli::refine::run(args),
+            Command::Conformance(args) => cli::conformance::run(args),
         }
     }
 }

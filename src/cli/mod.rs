@@ -7,6 +7,7 @@
 pub mod ambiguity;
 pub mod bench_step;
 pub mod check;
+pub mod conformance;
 pub mod cut;
 pub mod demo;
 pub mod info;

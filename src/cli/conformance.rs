@@ -1,0 +1,111 @@
+//! `topomech conformance generate DIR` and `topomech conformance check FILE_OR_DIR`: write the
+//! standard conformance vectors, or replay vector files and report one line per vector
+//! (`docs/CONFORMANCE.md`).
+//!
+//! `check` exits with 0 when every vector replays, 1 when one mismatches (or breaks a law),
+//! 2 when a file cannot be read or parsed (wrong format or version) or the directory holds none.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use topomech::conformance::{self, standard, ConformanceError, Vector};
+
+use super::CliError;
+
+/// Arguments of `topomech conformance`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct ConformanceArgs {
+    /// What to do.
+    #[command(subcommand)]
+    pub action: Action,
+}
+
+/// `generate` or `check`.
+#[derive(Debug, Clone, clap::Subcommand)]
+pub enum Action {
+    /// Write the standard set as DIR/NAME.json (review the diff before committing).
+    Generate {
+        /// Output directory (created if missing).
+        dir: PathBuf,
+        /// Repository root that mesh paths of file vectors are relative to.
+        #[arg(long, default_value = ".")]
+        root: PathBuf,
+    },
+    /// Replay one vector file, or every `*.json` of a directory.
+    Check {
+        /// A vector file or a directory of them.
+        path: PathBuf,
+        /// Repository root that mesh paths of file vectors are relative to.
+        #[arg(long, default_value = ".")]
+        root: PathBuf,
+    },
+}
+
+/// Runs the action (see the module docs for exit statuses). Cost: that of generating or
+/// replaying every vector.
+///
+/// # Errors
+/// [`CliError::Output`] when stdout fails, [`CliError::Other`] when generation fails or a file
+/// cannot be written; `check` ends the process with status 1 or 2 on a failed or unreadable
+/// vector instead of returning.
+pub fn run(args: ConformanceArgs) -> Result<(), CliError> {
+    match args.action {
+        Action::Generate { dir, root } => generate(&dir, &root),
+        Action::Check { path, root } => check(&path, &root),
+    }
+}
+
+fn generate(dir: &Path, root: &Path) -> Result<(), CliError> {
+    let vectors = standard::generate_all(root).map_err(|e| CliError::Other(Box::new(e)))?;
+    std::fs::create_dir_all(dir)?;
+    let mut out = std::io::stdout().lock();
+    for v in &vectors {
+        let path = dir.join(format!("{}.json", v.name));
+        std::fs::write(&path, v.to_json())
+            .map_err(|source| CliError::Other(Box::new(ConformanceError::Io { path: path.clone(), source })))?;
+        writeln!(out, "wrote {} ({} steps)", path.display(), v.steps.len())?;
+    }
+    writeln!(out, "review the changes (git diff {}) before committing them", dir.display())?;
+    Ok(())
+}
+
+/// 0 ok, 1 mismatch, 2 unreadable.
+fn status(e: &ConformanceError) -> u8 {
+    match e {
+        ConformanceError::Io { .. }
+        | ConformanceError::Json { .. }
+        | ConformanceError::Format { .. }
+        | ConformanceError::Version { .. } => 2,
+        _ => 1,
+    }
+}
+
+fn check(path: &Path, root: &Path) -> Result<(), CliError> {
+    let files = if path.is_dir() {
+        conformance::vector_files(path).map_err(|e| CliError::Other(Box::new(e)))?
+    } else {
+        vec![path.to_path_buf()]
+    };
+    let mut out = std::io::stdout().lock();
+    if files.is_empty() {
+        let _ = writeln!(std::io::stderr(), "topomech: error: {}: no *.json vectors", path.display());
+        std::process::exit(2);
+    }
+    let (mut worst, mut failed) = (0, 0);
+    for file in &files {
+        match Vector::read(file).and_then(|v| conformance::replay_in(&v, root).map(|()| v)) {
+            Ok(v) => writeln!(out, "ok    {} ({} steps)", v.name, v.steps.len())?,
+            Err(e) => {
+                worst = worst.max(status(&e));
+                failed += 1;
+                writeln!(out, "FAIL  {}: {e}", file.display())?;
+            }
+        }
+    }
+    writeln!(out, "{} vector(s) checked, {failed} failed", files.len())?;
+    out.flush()?;
+    if worst > 0 {
+        std::process::exit(worst.into());
+    }
+    Ok(())
+}

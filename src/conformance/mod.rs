@@ -1,0 +1,303 @@
+//! Conformance vectors: an input mesh, a sequence of cutting operations and the expected state
+//! after each, as JSON that another engine can replay (`docs/CONFORMANCE.md`, `conformance/`).
+//!
+//! ```text
+//!   Recipe ──generate──▶ Vector { mesh, material, initial: Expect, steps: [Step { op, expect }] }
+//!   Vector ──replay────▶ Ok(()) | ConformanceError naming the vector, the step, the field,
+//!                        expected vs got
+//! ```
+//!
+//! Everything in a vector is named the way any engine can name it: points and tets by their
+//! 0-based index in the input mesh (these never change: the operations split vertices, edges and
+//! faces but never tets), an inner face by the two input tets that share it (and, as a
+//! cross-check, by its sorted triple of input point ids), a vertex to tear by an input tet and
+//! one of its input points. The expected state holds only quantities that do not depend on how an
+//! engine stores its mesh: cell counts, components, boundary faces, Euler characteristic, darts
+//! (24 per tet), total mass, Σ spring stiffness, the masses of the components, and the inner
+//! faces each step dissociated.
+//!
+//! Replaying a vector also checks, after every step, the map's laws (`validate()`), the
+//! conservation laws ([`check_conservation`](crate::mechanics::check_conservation)) and the cell
+//! counts of an independent union-find model of the cut tet list ([`Oracle`](crate::cut::ops::Oracle)).
+
+mod runner;
+mod schema;
+pub mod standard;
+
+pub use runner::{generate, generate_in, replay, replay_in, Ops, Recipe};
+pub use schema::{Expect, MaterialSpec, MeshSpec, Op, Refusal, Step, Vector};
+
+use std::path::{Path, PathBuf};
+
+/// The value of [`Vector::format`].
+pub const FORMAT: &str = "topomech-conformance";
+/// The schema version this code reads and writes.
+pub const VERSION: u32 = 1;
+/// Default relative tolerance of every floating-point comparison (stored in each vector).
+pub const TOLERANCE: f64 = 1e-9;
+
+/// Why a vector could not be read, generated or replayed. Every variant that concerns a vector
+/// names it; those that concern a step carry its index (`None` = the initial state).
+#[derive(Debug, thiserror::Error)]
+pub enum ConformanceError {
+    /// A file could not be read or written.
+    #[error("{}: {source}", .path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The text is not JSON, or not a vector of this schema.
+    #[error("{origin}: not a conformance vector: {message}")]
+    Json {
+        /// The file (or `<memory>`).
+        origin: String,
+        /// What serde_json reported (with line and column).
+        message: String,
+    },
+    /// `format` is not [`FORMAT`].
+    #[error("{origin}: format is {found:?}, expected {FORMAT:?}")]
+    Format {
+        /// The file (or `<memory>`).
+        origin: String,
+        /// The format found.
+        found: String,
+    },
+    /// `version` is not [`VERSION`].
+    #[error("{origin}: version {found} is not supported (this topomech reads version {VERSION})")]
+    Version {
+        /// The file (or `<memory>`).
+        origin: String,
+        /// The version found.
+        found: String,
+    },
+    /// The mesh could not be loaded or built, or does not have the declared size.
+    #[error("vector {vector}: mesh: {message}")]
+    Mesh {
+        /// The vector.
+        vector: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A field of the vector is invalid (a negative tolerance, a non-finite material constant).
+    #[error("vector {vector}: {message}")]
+    Invalid {
+        /// The vector.
+        vector: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// An operation names something the mesh does not have (tet id out of range, two tets that
+    /// share no face, a point that is not a corner of the tet, a non-finite plane).
+    #[error("vector {vector}, {}: bad operation: {message}", at(.step))]
+    BadOp {
+        /// The vector.
+        vector: String,
+        /// The step index.
+        step: Option<usize>,
+        /// What is wrong.
+        message: String,
+    },
+    /// An observed value differs from the expected one.
+    #[error("vector {vector}, {}: {field}: expected {expected}, got {got}", at(.step))]
+    Mismatch {
+        /// The vector.
+        vector: String,
+        /// The step index (`None` = initial state).
+        step: Option<usize>,
+        /// The field of [`Expect`] that differs.
+        field: &'static str,
+        /// The stored value.
+        expected: String,
+        /// The replayed value.
+        got: String,
+    },
+    /// A law broke after a step: `validate()`, conservation, or the union-find model.
+    #[error("vector {vector}, {}: law broken: {message}", at(.step))]
+    Law {
+        /// The vector.
+        vector: String,
+        /// The step index.
+        step: Option<usize>,
+        /// Which law and how.
+        message: String,
+    },
+    /// Generation only: a cutting plane passes within the safety margin of a tet centroid, so
+    /// engines with different rounding could classify it differently.
+    #[error("vector {vector}, {}: the plane passes {distance:e} from a tet centroid (margin {margin:e})", at(.step))]
+    AmbiguousPlane {
+        /// The vector.
+        vector: String,
+        /// The step index.
+        step: Option<usize>,
+        /// The smallest centroid distance.
+        distance: f64,
+        /// The required margin.
+        margin: f64,
+    },
+}
+
+/// "initial state" or "step k".
+fn at(step: &Option<usize>) -> String {
+    match step {
+        None => "initial state".to_string(),
+        Some(k) => format!("step {k}"),
+    }
+}
+
+impl ConformanceError {
+    /// The step the error concerns (`None`: the initial state or not step-specific). O(1).
+    pub fn step(&self) -> Option<usize> {
+        match self {
+            ConformanceError::BadOp { step, .. }
+            | ConformanceError::Mismatch { step, .. }
+            | ConformanceError::Law { step, .. }
+            | ConformanceError::AmbiguousPlane { step, .. } => *step,
+            _ => None,
+        }
+    }
+
+    /// The mismatching field, for a [`ConformanceError::Mismatch`]. O(1).
+    pub fn field(&self) -> Option<&'static str> {
+        match self {
+            ConformanceError::Mismatch { field, .. } => Some(field),
+            _ => None,
+        }
+    }
+}
+
+impl Vector {
+    /// Parses a vector; `origin` names the text in errors. The envelope (`format`, `version`) is
+    /// checked before the rest, so a file of another format or version says so. O(text).
+    ///
+    /// # Errors
+    /// [`ConformanceError::Json`], [`ConformanceError::Format`], [`ConformanceError::Version`].
+    ///
+    /// ```
+    /// use topomech::conformance::{ConformanceError, Vector};
+    /// let e = Vector::from_json(r#"{"format": "topomech-conformance", "version": 9}"#, "x.json").unwrap_err();
+    /// assert!(matches!(e, ConformanceError::Version { .. }));
+    /// ```
+    pub fn from_json(text: &str, origin: &str) -> Result<Vector, ConformanceError> {
+        let json = |e: serde_json::Error| ConformanceError::Json { origin: origin.to_string(), message: e.to_string() };
+        let value: serde_json::Value = serde_json::from_str(text).map_err(json)?;
+        let format = value.get("format").cloned().unwrap_or(serde_json::Value::Null);
+        if format.as_str() != Some(FORMAT) {
+            return Err(ConformanceError::Format { origin: origin.to_string(), found: format.to_string() });
+        }
+        let version = value.get("version").cloned().unwrap_or(serde_json::Value::Null);
+        if version.as_u64() != Some(u64::from(VERSION)) {
+            return Err(ConformanceError::Version { origin: origin.to_string(), found: version.to_string() });
+        }
+        serde_json::from_value(value).map_err(json)
+    }
+
+    /// Reads and parses the vector file at `path`. O(file).
+    ///
+    /// # Errors
+    /// [`ConformanceError::Io`], then as [`Vector::from_json`].
+    pub fn read(path: &Path) -> Result<Vector, ConformanceError> {
+        let text =
+            std::fs::read_to_string(path).map_err(|source| ConformanceError::Io { path: path.into(), source })?;
+        Vector::from_json(&text, &path.display().to_string())
+    }
+
+    /// The vector as pretty-printed JSON (two-space indent, arrays of numbers on one line) with a
+    /// final newline: the exact bytes of the committed files, so regeneration can be compared
+    /// byte for byte. O(size).
+    pub fn to_json(&self) -> String {
+        let pretty = serde_json::to_string_pretty(self).expect("a vector always serialises (plain data)");
+        let mut s = flatten_scalar_arrays(&pretty);
+        s.push('\n');
+        s
+    }
+}
+
+/// The `*.json` files of `dir`, sorted by name. O(entries log entries).
+///
+/// # Errors
+/// [`ConformanceError::Io`] when the directory cannot be listed.
+pub fn vector_files(dir: &Path) -> Result<Vec<PathBuf>, ConformanceError> {
+    let io = |source| ConformanceError::Io { path: dir.into(), source };
+    let mut files = Vec::new();
+    for entry in std::fs::read_dir(dir).map_err(io)? {
+        let path = entry.map_err(io)?.path();
+        if path.extension().is_some_and(|e| e == "json") {
+            files.push(path);
+        }
+    }
+    files.sort();
+    Ok(files)
+}
+
+/// Rewrites every array of `pretty` that holds no array or object onto one line (`[1, 2, 3]`);
+/// strings are copied untouched. O(len).
+fn flatten_scalar_arrays(pretty: &str) -> String {
+    let mut out = String::with_capacity(pretty.len());
+    // For each open array: where it starts in `out`, and whether it holds only scalars so far.
+    let mut open: Vec<(usize, bool)> = Vec::new();
+    let (mut in_string, mut escaped) = (false, false);
+    for c in pretty.chars() {
+        if in_string {
+            out.push(c);
+            (in_string, escaped) = match (escaped, c) {
+                (true, _) => (true, false),
+                (false, '\\') => (true, true),
+                (false, '"') => (false, false),
+                _ => (true, false),
+            };
+            continue;
+        }
+        match c {
+            '"' => in_string = true,
+            '[' | '{' => {
+                if let Some(top) = open.last_mut() {
+                    top.1 = false;
+                }
+            }
+            _ => {}
+        }
+        if c == '[' {
+            open.push((out.len(), true));
+        }
+        if c == ']' {
+            if let Some((start, true)) = open.pop() {
+                let body = squeeze(&out[start..]);
+                out.truncate(start);
+                out.push_str(&body);
+            }
+        }
+        out.push(c);
+    }
+    out
+}
+
+/// `[\n  1,\n  2\n` → `[1, 2` (whitespace outside strings dropped, `,` followed by one space).
+fn squeeze(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let (mut in_string, mut escaped) = (false, false);
+    for c in text.chars() {
+        if in_string {
+            out.push(c);
+            (in_string, escaped) = match (escaped, c) {
+                (true, _) => (true, false),
+                (false, '\\') => (true, true),
+                (false, '"') => (false, false),
+                _ => (true, false),
+            };
+            continue;
+        }
+        match c {
+            '"' => {
+                in_string = true;
+                out.push(c);
+            }
+            ',' => out.push_str(", "),
+            c if c.is_whitespace() => {}
+            c => out.push(c),
+        }
+    }
+    out
+}

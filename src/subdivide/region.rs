@@ -114,7 +114,9 @@ fn triangle_distance(p: [f64; 3], [a, b, c]: [[f64; 3]; 3]) -> f64 {
 pub fn tet_distance(p: [f64; 3], t: [[f64; 3]; 4]) -> f64 {
     let faces = [[t[1], t[2], t[3]], [t[0], t[3], t[2]], [t[0], t[1], t[3]], [t[0], t[2], t[1]]];
     let vol = crate::mesh::signed_volume(t[0], t[1], t[2], t[3]);
-    let same_side = |f: &[[f64; 3]; 3]| crate::mesh::signed_volume(f[0], f[1], f[2], p) * vol >= 0.0;
+    // Each face is listed so that the opposite corner gives the sign of −vol: p is inside when it
+    // is on that side (or on the plane) of all four faces.
+    let same_side = |f: &[[f64; 3]; 3]| crate::mesh::signed_volume(f[0], f[1], f[2], p) * vol <= 0.0;
     if vol != 0.0 && faces.iter().all(same_side) {
         return 0.0;
     }

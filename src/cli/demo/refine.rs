@@ -154,8 +154,10 @@ mod tests {
         let before = topomech::surface::boundary_surface(&body);
         let tets: Vec<CellId> = (0..12).map(CellId).collect();
         let mut run = StageRun::default();
-        let (lm, checks) = refine(&body, &tets, &mut run, &ProgressBar::hidden()).unwrap();
-        assert_eq!((run.operations, checks), (12, 2));
+        let mass = body.attrs().total_tet_mass(body.map());
+        let (lm, masses, checks) = refine(&body, &tets, &mut run, &ProgressBar::hidden()).unwrap();
+        assert_eq!((run.operations, checks), (12, 3));
+        assert!((masses.total(&lm) - mass).abs() < 1e-12 * mass, "the children share the parents' masses");
         assert_eq!(lm.map().count_cells().0[3], 48 + 7 * 12, "1→8 per refined tet");
         let (after, levels) = refined_surface(&lm);
         assert_eq!(levels.len(), after.triangles.len());
@@ -168,7 +170,7 @@ mod tests {
     #[test]
     fn an_unrefined_map_gives_back_the_body_surface() {
         let body = cube();
-        let (lm, _) = refine(&body, &[], &mut StageRun::default(), &ProgressBar::hidden()).unwrap();
+        let (lm, _, _) = refine(&body, &[], &mut StageRun::default(), &ProgressBar::hidden()).unwrap();
         let (s, levels) = refined_surface(&lm);
         assert_eq!(s.triangles.len(), 12 * 4, "12k² boundary faces for k = 2");
         assert!(levels.iter().all(|&l| l == 0));

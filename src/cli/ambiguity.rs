@@ -215,8 +215,11 @@ fn count(s: &KStats, symptom: &str) -> usize {
     s.symptoms.iter().filter(|(x, _)| symptom_name(*x) == symptom).map(|x| x.1).sum()
 }
 
-/// The mesh: the file given, `kuhn:K`, or the built-in liver, as (name, positions, tets).
-fn load_mesh(path: Option<&Path>) -> Result<(String, Vec<[f64; 3]>, Vec<[u32; 4]>), CliError> {
+/// A mesh for the campaigns: (name, point positions, tets).
+type NamedMesh = (String, Vec<[f64; 3]>, Vec<[u32; 4]>);
+
+/// The mesh: the file given, `kuhn:K`, or the built-in liver.
+fn load_mesh(path: Option<&Path>) -> Result<NamedMesh, CliError> {
     let kuhn = path.and_then(|p| p.to_str()).and_then(|s| s.strip_prefix("kuhn:")).map(str::parse::<usize>);
     match (path, kuhn) {
         (_, Some(Ok(k))) if (1..=16).contains(&k) => {
@@ -229,7 +232,7 @@ fn load_mesh(path: Option<&Path>) -> Result<(String, Vec<[f64; 3]>, Vec<[u32; 4]
     }
 }
 
-fn from_loaded(loaded: topomech::load::Loaded) -> Result<(String, Vec<[f64; 3]>, Vec<[u32; 4]>), CliError> {
+fn from_loaded(loaded: topomech::load::Loaded) -> Result<NamedMesh, CliError> {
     Ok((loaded.path.display().to_string(), loaded.mesh.points, loaded.mesh.tets))
 }
 

@@ -23,7 +23,8 @@
 //!    is the ambiguity this module studies, not a bug.
 //!
 //! In mixed mode: 1'. the leveled map passes `check_all` (finest map and every level valid,
-//! μt ≤ μf ≤ μa); 5. the level law of [`crate::ambiguity::mixed`] holds (G_i is the finest map as
+//! μt ≤ μf ≤ μa); 4'. invariant 4 for every cut that splits no vertex or edge (the maps before
+//! and after it); 5. the level law of [`crate::ambiguity::mixed`] holds (G_i is the finest map as
 //! it was when level i ended); 6. when the tet list shows none of the symptoms (no hanging edge,
 //! no inexpressible or lost cut, no pinched point or non-manifold edge, as many points as g-map
 //! vertices), the map it means is the g-map, through the tet ↔ volume pairing.
@@ -192,6 +193,9 @@ fn check_mixed(selector: u8, rest: &[u8]) -> Result<FuzzReport, FuzzFailure> {
     if !run.level_law {
         return Err(FuzzFailure::LevelLaw);
     }
+    if run.skeleton_violations > 0 {
+        return Err(FuzzFailure::Skeleton);
+    }
     let clean = |c: &crate::ambiguity::mixed::Compare| {
         c.hanging_edges + c.pinched_points + c.non_manifold_edges == 0 && c.gmap_vertices == c.indexed_vertices
     };
@@ -203,7 +207,7 @@ fn check_mixed(selector: u8, rest: &[u8]) -> Result<FuzzReport, FuzzFailure> {
         cuts: run.cuts,
         subdivisions: run.subdivisions,
         ambiguous: run.ambiguous(),
-        skeleton_unchanged: false,
+        skeleton_unchanged: run.skeleton_cuts > 0,
     })
 }
 

@@ -19,7 +19,9 @@
 //! it was when level i ended), the map the tet list means (`GMap::from_tets`) is compared with
 //! the g-map through that pairing (an isomorphism sending each tet to its volume). When they
 //! differ, their incidence graphs are compared too: isomorphic graphs of non-isomorphic maps are
-//! an ambiguous pair. The *level law* is checked as well: G_i is isomorphic (through the dart
+//! an ambiguous pair. A cut that splits no g-map vertex or edge gives a *skeleton pair*: the maps
+//! before and after it share their vertex–edge graph but are not isomorphic (verified by VF2 and
+//! map isomorphism on maps of at most [`SKELETON_CHECK_DARTS`] darts). The *level law* is checked as well: G_i is isomorphic (through the dart
 //! identity) to the finest map as it was when level i ended.
 
 use rustc_hash::{FxHashMap, FxHashSet};
@@ -34,6 +36,10 @@ use crate::BuildError;
 
 /// Graphs with more nodes than this are not compared by VF2 (the pair is then *undecided*).
 pub const VF2_NODE_CAP: usize = 4000;
+
+/// Skeleton pairs are verified by VF2 (and map isomorphism) only on maps with at most this many
+/// darts.
+pub const SKELETON_CHECK_DARTS: usize = 6000;
 
 /// One operation; the index is reduced modulo the number of candidates when applied.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -116,6 +122,12 @@ pub struct MixedRun {
     pub cuts_inexpressible: usize,
     /// Cuts after which the two tets still shared their triple (the cut re-glued).
     pub cuts_lost: usize,
+    /// Cuts that split no g-map vertex or edge: the maps before and after share their
+    /// vertex–edge graph (skeleton pairs).
+    pub skeleton_cuts: usize,
+    /// Skeleton pairs whose verification failed: different vertex–edge graphs or isomorphic
+    /// maps (expected 0; only maps of at most [`SKELETON_CHECK_DARTS`] darts are verified).
+    pub skeleton_violations: usize,
     /// The final comparison.
     pub finest: Compare,
     /// The comparison at every level below the finest.
@@ -170,6 +182,8 @@ pub fn run_ops(points: &[[f64; 3]], tets: &[[u32; 4]], ops: &[Op]) -> Result<Mix
         refused: 0,
         cuts_inexpressible: 0,
         cuts_lost: 0,
+        skeleton_cuts: 0,
+        skeleton_violations: 0,
         finest: Compare::default(),
         levels: Vec::new(),
         level_law: true,
@@ -222,8 +236,22 @@ fn cut(s: &mut Sides, i: u32, run: &mut MixedRun) -> Result<(), MixedError> {
     let tet_of: FxHashMap<u32, u32> =
         s.vol_dart.iter().enumerate().map(|(t, &x)| (map.cell_id(3, x).0, t as u32)).collect();
     let (t1, t2) = (tet_of[&map.cell_id(3, d).0], tet_of[&map.cell_id(3, map.alpha::<3>(d)).0]);
+    let before_counts = map.count_cells();
+    let before = (map.dart_count() <= SKELETON_CHECK_DARTS).then(|| map.clone());
     s.lm.unsew_face(d, s.lm.max_level())?;
     run.cuts += 1;
+    let after = s.lm.map();
+    if after.count_cells().0[..2] == before_counts.0[..2] {
+        run.skeleton_cuts += 1;
+        if let Some(before) = before {
+            let same = graphs_isomorphic(
+                &graph_of(&before, GraphKind::VertexEdge),
+                &graph_of(after, GraphKind::VertexEdge),
+                Multiplicity::Ignore,
+            );
+            run.skeleton_violations += usize::from(!same || before.is_isomorphic(after));
+        }
+    }
     match s.model.model.cut(t1, t2) {
         Ok(out) => run.cuts_lost += usize::from(out.face_still_shared),
         Err(IndexedError::NoSharedFace(..)) => run.cuts_inexpressible += 1,
@@ -365,6 +393,10 @@ pub struct MixedStats {
     pub vertices_differ: usize,
     /// Sequences where the maps differ but the incidence graphs are isomorphic (final or at a level).
     pub graph_pairs: usize,
+    /// Sequences with a skeleton pair (a cut splitting no g-map vertex or edge).
+    pub skeleton_pairs: usize,
+    /// Skeleton pairs whose verification failed, in total (expected 0).
+    pub skeleton_violations: usize,
     /// Sequences where such a pair could not be decided (graphs too large).
     pub graph_undecided: usize,
     /// Cuts, subdivisions and refused subdivisions, in total.
@@ -395,6 +427,8 @@ impl MixedStats {
         self.non_manifold += usize::from(r.finest.pinched_points + r.finest.non_manifold_edges > 0);
         self.vertices_differ += usize::from(r.finest.gmap_vertices != r.finest.indexed_vertices);
         self.graph_pairs += usize::from(all().any(|c| c.graph_pair == Some(true)));
+        self.skeleton_pairs += usize::from(r.skeleton_cuts > 0);
+        self.skeleton_violations += r.skeleton_violations;
         self.graph_undecided += usize::from(all().any(|c| c.map_differs && c.graph_pair.is_none()));
         self.cuts += r.cuts;
         self.subdivisions += r.subdivisions;
@@ -472,6 +506,8 @@ mod tests {
         assert_eq!(stats.subdivisions + stats.refused, 0);
         assert_eq!(stats.level_law_broken + stats.gmap_invalid, 0);
         assert_eq!(stats.cuts, 40);
+        assert_eq!(stats.skeleton_violations, 0);
+        assert!(stats.skeleton_pairs > 0, "a Kuhn cube has faces whose cut splits nothing: {stats:?}");
         assert!(stats.wrong >= stats.lost, "a lost cut is a different gluing: {stats:?}");
     }
 

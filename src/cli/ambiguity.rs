@@ -104,6 +104,9 @@ pub struct SubdivideJson {
     pub sequences_tried: usize,
     /// Sequences after which the indexed model cannot represent the g-map (summed over every k).
     pub indexed_ambiguous: usize,
+    /// Sequences with a skeleton pair: a cut splitting no g-map vertex or edge, so the maps before
+    /// and after it share their vertex–edge graph (summed over every k).
+    pub skeleton_pairs: usize,
     /// Statistics per number of ops.
     pub per_k: Vec<MixedStats>,
     /// The first ambiguous run and the first run with a graph pair (ops and comparisons).
@@ -202,6 +205,7 @@ fn mixed_campaign(
         graph_kind: "incidence",
         sequences_tried: per_k.iter().map(|s| s.sequences).sum(),
         indexed_ambiguous: per_k.iter().map(|s| s.ambiguous).sum(),
+        skeleton_pairs: per_k.iter().map(|s| s.skeleton_pairs).sum(),
         per_k,
         first_runs,
     })
@@ -330,7 +334,7 @@ fn write_mixed(out: &mut dyn Write, m: &SubdivideJson) -> std::io::Result<()> {
     writeln!(out, "cuts and subdivisions interleaved, P(subdivide) = {}", m.probability)?;
     writeln!(
         out,
-        "  {:>4} {:>6} {:>10} {:>7} {:>8} {:>8} {:>6} {:>8} {:>9} {:>6} {:>6} {:>7} {:>8} {:>9}",
+        "  {:>4} {:>6} {:>10} {:>7} {:>8} {:>8} {:>6} {:>8} {:>9} {:>6} {:>5} {:>6} {:>7} {:>8} {:>9}",
         "k",
         "seqs",
         "ambiguous",
@@ -341,6 +345,7 @@ fn write_mixed(out: &mut dyn Write, m: &SubdivideJson) -> std::io::Result<()> {
         "non_mfd",
         "vert_diff",
         "pairs",
+        "skel",
         "subdiv",
         "refused",
         "levels",
@@ -349,7 +354,7 @@ fn write_mixed(out: &mut dyn Write, m: &SubdivideJson) -> std::io::Result<()> {
     for s in &m.per_k {
         writeln!(
             out,
-            "  {:>4} {:>6} {:>10} {:>7} {:>8} {:>8} {:>6} {:>8} {:>9} {:>6} {:>6} {:>7} {:>8} {:>9}",
+            "  {:>4} {:>6} {:>10} {:>7} {:>8} {:>8} {:>6} {:>8} {:>9} {:>6} {:>5} {:>6} {:>7} {:>8} {:>9}",
             s.k,
             s.sequences,
             s.ambiguous,
@@ -360,23 +365,24 @@ fn write_mixed(out: &mut dyn Write, m: &SubdivideJson) -> std::io::Result<()> {
             s.non_manifold,
             s.vertices_differ,
             s.graph_pairs,
+            s.skeleton_pairs,
             s.subdivisions,
             s.refused,
             s.levels_compared,
             s.levels_ambiguous
         )?;
-        if s.level_law_broken + s.gmap_invalid + s.graph_undecided > 0 {
+        if s.level_law_broken + s.gmap_invalid + s.graph_undecided + s.skeleton_violations > 0 {
             writeln!(
                 out,
-                "       level law broken {}, g-map invalid {}, graph pairs undecided {}",
-                s.level_law_broken, s.gmap_invalid, s.graph_undecided
+                "       level law broken {}, g-map invalid {}, graph pairs undecided {}, skeleton violations {}",
+                s.level_law_broken, s.gmap_invalid, s.graph_undecided, s.skeleton_violations
             )?;
         }
     }
     writeln!(
         out,
-        "pairs_found {} (graph_kind {}), sequences_tried {}",
-        m.pairs_found, m.graph_kind, m.sequences_tried
+        "pairs_found {} (graph_kind {}), skeleton_pairs {} (graph_kind vertex_edge), sequences_tried {}",
+        m.pairs_found, m.graph_kind, m.skeleton_pairs, m.sequences_tried
     )?;
     for r in &m.first_runs {
         let shown: Vec<_> = r.ops.iter().take(6).collect();

@@ -59,3 +59,49 @@ impl LeveledMap<3> {
         Ok(side.len())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gmap::GMap;
+
+    fn two_tets() -> LeveledMap<3> {
+        let points = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 1.0]];
+        let (map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [1, 2, 3, 4]]).expect("builds");
+        LeveledMap::new(map, points)
+    }
+
+    fn glued(m: &LeveledMap<3>) -> DartId {
+        m.map().darts().find(|&d| !m.map().is_free(3, d)).expect("a glued face")
+    }
+
+    #[test]
+    fn a_cut_face_stays_glued_below_its_level_and_split_vertices_keep_their_positions() {
+        let mut m = two_tets();
+        m.subdivide_tet(DartId(0), 1).expect("subdivides");
+        let before = m.map().clone();
+        let positions: Vec<(DartId, [f64; 3])> = before.darts().map(|x| (x, m.position(x))).collect();
+        let d = glued(&m);
+        m.unsew_face(d, 2).expect("cuts");
+        m.check_all().expect("every level valid");
+        let g1 = m.level(1).expect("level 1").map;
+        assert!(g1.is_isomorphic(&before), "G_1 is the map before the cut");
+        assert!(!m.level(2).expect("level 2").map.is_isomorphic(&before));
+        assert!(m.map().count_cells().0[0] > before.count_cells().0[0], "the cut split vertices");
+        for (x, p) in positions {
+            assert_eq!(m.position(x), p, "the vertex of {x:?} kept its position");
+        }
+    }
+
+    #[test]
+    fn bad_cuts_are_errors_and_change_nothing() {
+        let mut m = two_tets();
+        let free = m.map().darts().find(|&d| m.map().is_free(3, d)).expect("a boundary face");
+        assert_eq!(m.unsew_face(free, 0), Err(SubdivideError::FaceNotSewn(free)));
+        m.subdivide_tet(DartId(0), 2).expect("subdivides");
+        let d = glued(&m);
+        assert_eq!(m.unsew_face(d, 1), Err(SubdivideError::LevelBelowMax { level: 1, max_level: 2 }));
+        assert_eq!(m.unsew_face(DartId(1_000_000), 2), Err(SubdivideError::NoSuchDart(DartId(1_000_000))));
+        assert!(!m.map().is_free(3, d));
+    }
+}

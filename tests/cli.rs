@@ -279,3 +279,22 @@ fn a_bad_command_line_is_a_usage_error_not_a_panic() {
     assert!(stderr(&out).contains("Usage"), "{}", stderr(&out));
     assert!(!stderr(&out).contains("panicked"));
 }
+
+#[test]
+fn ambiguity_subdivide_reports_the_mixed_campaign_and_rejects_a_bad_probability() {
+    let o = run(&["ambiguity", "kuhn:1", "--cuts", "2", "--sequences", "3", "--subdivide", "0.5", "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).expect("one JSON object");
+    let m = &v["subdivide"];
+    assert_eq!(m["probability"], 0.5);
+    assert_eq!(m["sequences_tried"], 3);
+    let k = &m["per_k"][0];
+    assert_eq!(k["k"], 2);
+    assert_eq!(k["level_law_broken"], 0);
+    assert_eq!(k["gmap_invalid"], 0);
+    let ops = k["cuts"].as_u64().unwrap() + k["subdivisions"].as_u64().unwrap() + k["refused"].as_u64().unwrap();
+    assert_eq!(ops, 6, "3 sequences of 2 ops on a cube with glued faces left");
+    let bad = run(&["ambiguity", "kuhn:1", "--subdivide", "1.5"]);
+    assert!(!bad.status.success());
+    assert!(stderr(&bad).contains("not a probability"), "{}", stderr(&bad));
+}

@@ -1,9 +1,15 @@
 //! The comparison driven by arbitrary bytes: the body of the cargo-fuzz target
 //! `fuzz/fuzz_targets/ambiguity.rs` and of the corpus replay test.
 //!
-//! Decoding: byte 0 picks the mesh (Kuhn cube k = 1 or 2, or the ring of three tets around an
-//! edge); every following byte picks one still-glued interior face (index modulo their number) and
-//! cuts it on both models. At most [`MAX_CUTS`] cuts; empty input does nothing.
+//! Decoding: byte 0 picks the mesh (`byte0 % 3`: Kuhn cube k = 1 or 2, or the ring of three tets
+//! around an edge) and the mode. Empty input does nothing.
+//! - *Cut mode* (byte 0 < [`MIXED`]; the corpus files of before the mixed mode all are): every
+//!   following byte picks one still-glued interior face (index modulo their number) and cuts it on
+//!   both models. At most [`MAX_CUTS`] cuts.
+//! - *Mixed mode* (byte 0 ≥ [`MIXED`]): every following byte is an [`Op`] ([`decode_ops`]):
+//!   b < 192 cuts glued face b, b ≥ 192 subdivides tet b − 192 (indices modulo the current
+//!   count), run by [`run_ops`] on the leveled g-map and the refined indexed model. At most
+//!   [`MAX_CUTS`] ops, of which at most [`MAX_SUBDIVISIONS`] subdivisions (later ones are dropped).
 //!
 //! Invariants checked (each failure is a bug in topomech, reported as a [`FuzzFailure`]):
 //! 1. the g-map passes `validate()` after every cut and its cell counts from ids equal those from
@@ -15,16 +21,57 @@
 //! 4. when no cut split a vertex or an edge, the cut and uncut g-maps have isomorphic vertex–edge
 //!    graphs, and (after at least one cut) are not isomorphic. The converse of 2 may fail: that
 //!    is the ambiguity this module studies, not a bug.
+//!
+//! In mixed mode: 1'. the leveled map passes `check_all` (finest map and every level valid,
+//! μt ≤ μf ≤ μa); 4'. invariant 4 for every cut that splits no vertex or edge (the maps before
+//! and after it); 5. the level law of [`crate::ambiguity::mixed`] holds (G_i is the finest map as
+//! it was when level i ended); 6. when the tet list shows none of the symptoms (no hanging edge,
+//! no inexpressible or lost cut, no pinched point or non-manifold edge, as many points as g-map
+//! vertices), the map it means is the g-map, through the tet ↔ volume pairing.
 
 use crate::ambiguity::campaign::run_cuts;
 use crate::ambiguity::construct::glued_faces;
 use crate::ambiguity::darts::DartsJson;
+use crate::ambiguity::mixed::{run_ops, Op};
 use crate::gmap::GMap;
 use crate::graph::{graph_of, graphs_isomorphic, GraphKind, Multiplicity};
 
-/// Most cuts decoded from one input.
+/// Most cuts (or ops, in mixed mode) decoded from one input.
 pub const MAX_CUTS: usize = 64;
 
+/// Byte 0 at or above this selects the mixed mode.
+pub const MIXED: u8 = 128;
+
+/// Most subdivisions decoded from one input in mixed mode.
+pub const MAX_SUBDIVISIONS: usize = 12;
+
+/// The ops of the mixed mode (bytes after byte 0): b < 192 is `Op::Cut(b)`, b ≥ 192 is
+/// `Op::Subdivide(b − 192)`. At most [`MAX_CUTS`] ops; subdivisions past [`MAX_SUBDIVISIONS`]
+/// are dropped. O(bytes).
+pub fn decode_ops(bytes: &[u8]) -> Vec<Op> {
+    let mut subdivisions = 0;
+    let mut ops = Vec::new();
+    for &b in bytes.iter().take(MAX_CUTS) {
+        if b < 192 {
+            ops.push(Op::Cut(u32::from(b)));
+        } else if subdivisions < MAX_SUBDIVISIONS {
+            subdivisions += 1;
+            ops.push(Op::Subdivide(u32::from(b - 192)));
+        }
+    }
+    ops
+}
+
+/// The byte encoding of `ops` for the mixed mode on mesh `mesh` (0, 1 or 2), inverse of
+/// [`decode_ops`] for ops with small indices (cut indices are reduced modulo 192, subdivision
+/// indices modulo 64). O(ops).
+pub fn encode_ops(mesh: u8, ops: &[Op]) -> Vec<u8> {
+    let body = ops.iter().map(|op| match *op {
+        Op::Cut(i) => (i % 192) as u8,
+        Op::Subdivide(i) => 192 + (i % 64) as u8,
+    });
+    std::iter::once(MIXED + mesh % 3).chain(body).collect()
+}
 /// An invariant of the [module docs](self) that failed.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum FuzzFailure {
@@ -50,6 +97,12 @@ pub enum FuzzFailure {
     /// Invariant 4.
     #[error("no vertex or edge split, yet the vertex-edge graphs differ or the maps are isomorphic")]
     Skeleton,
+    /// Invariant 5 (mixed mode).
+    #[error("a level of the leveled map is not the finest map as it was when that level ended")]
+    LevelLaw,
+    /// Invariant 6 (mixed mode).
+    #[error("the tet list shows no symptom yet means another map than the g-map")]
+    CleanButDifferent,
     /// A step that cannot fail on these meshes failed.
     #[error("unexpected error: {0}")]
     Unexpected(String),
@@ -60,31 +113,34 @@ pub enum FuzzFailure {
 pub struct FuzzReport {
     /// Cuts made.
     pub cuts: usize,
+    /// Subdivisions made (mixed mode).
+    pub subdivisions: usize,
     /// Whether the indexed model ended ambiguous.
     pub ambiguous: bool,
     /// Whether the cut and uncut maps share their vertex–edge graph.
     pub skeleton_unchanged: bool,
 }
 
-/// The mesh byte 0 selects: (points, tets).
-fn mesh(selector: u8) -> (usize, Vec<[u32; 4]>) {
+/// The mesh byte 0 selects: (point positions, tets).
+pub fn mesh(selector: u8) -> (Vec<[f64; 3]>, Vec<[u32; 4]>) {
     match selector % 3 {
-        0 => {
-            let (p, t) = crate::generate::kuhn_cube(1);
-            (p.len(), t)
+        0 => crate::generate::kuhn_cube(1),
+        1 => crate::generate::kuhn_cube(2),
+        _ => {
+            let ring = [[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.5], [-0.5, 0.87, 0.5], [-0.5, -0.87, 0.5]];
+            (ring.to_vec(), vec![[0, 1, 2, 3], [0, 1, 3, 4], [0, 1, 4, 2]])
         }
-        1 => {
-            let (p, t) = crate::generate::kuhn_cube(2);
-            (p.len(), t)
-        }
-        _ => (5, vec![[0, 1, 2, 3], [0, 1, 3, 4], [0, 1, 4, 2]]),
     }
 }
 
 /// Decodes `bytes` and checks the invariants. O(cuts · darts · n²) plus one VF2 per check.
 pub fn check_bytes(bytes: &[u8]) -> Result<FuzzReport, FuzzFailure> {
     let Some((&selector, rest)) = bytes.split_first() else { return Ok(FuzzReport::default()) };
-    let (points, tets) = mesh(selector);
+    if selector >= MIXED {
+        return check_mixed(selector, rest);
+    }
+    let (positions, tets) = mesh(selector);
+    let points = positions.len();
     let unexpected = |e: &dyn std::fmt::Display| FuzzFailure::Unexpected(e.to_string());
     let (fresh, _) = GMap::<3>::from_tets(points, &tets).map_err(|e| unexpected(&e))?;
     let mut gmap = fresh.clone();
@@ -118,7 +174,41 @@ pub fn check_bytes(bytes: &[u8]) -> Result<FuzzReport, FuzzFailure> {
             return Err(FuzzFailure::Skeleton);
         }
     }
-    Ok(FuzzReport { cuts: cuts.len(), ambiguous: run.audit.ambiguous(), skeleton_unchanged: run.skeleton_unchanged })
+    Ok(FuzzReport {
+        cuts: cuts.len(),
+        subdivisions: 0,
+        ambiguous: run.audit.ambiguous(),
+        skeleton_unchanged: run.skeleton_unchanged,
+    })
+}
+
+/// The mixed mode: invariants 1', 5 and 6 of the [module docs](self).
+fn check_mixed(selector: u8, rest: &[u8]) -> Result<FuzzReport, FuzzFailure> {
+    let (points, tets) = mesh(selector);
+    let ops = decode_ops(rest);
+    let run = run_ops(&points, &tets, &ops).map_err(|e| FuzzFailure::Unexpected(e.to_string()))?;
+    if !run.gmap_valid {
+        return Err(FuzzFailure::Invalid { cut: ops.len(), detail: "the leveled map fails check_all".into() });
+    }
+    if !run.level_law {
+        return Err(FuzzFailure::LevelLaw);
+    }
+    if run.skeleton_violations > 0 {
+        return Err(FuzzFailure::Skeleton);
+    }
+    let clean = |c: &crate::ambiguity::mixed::Compare| {
+        c.hanging_edges + c.pinched_points + c.non_manifold_edges == 0 && c.gmap_vertices == c.indexed_vertices
+    };
+    let cuts_fine = run.cuts_inexpressible + run.cuts_lost == 0;
+    if cuts_fine && clean(&run.finest) && run.finest.map_differs {
+        return Err(FuzzFailure::CleanButDifferent);
+    }
+    Ok(FuzzReport {
+        cuts: run.cuts,
+        subdivisions: run.subdivisions,
+        ambiguous: run.ambiguous(),
+        skeleton_unchanged: run.skeleton_cuts > 0,
+    })
 }
 
 /// The indexed model's points and tets after the cuts.
@@ -167,5 +257,17 @@ mod tests {
         assert_eq!(r.cuts, 1);
         let r = check_bytes(&[1, 5, 9, 200, 3]).expect("invariants hold");
         assert_eq!(r.cuts, 4);
+    }
+
+    #[test]
+    fn mixed_inputs_decode_to_ops_and_back() {
+        let ops = [Op::Cut(5), Op::Subdivide(3), Op::Cut(191), Op::Subdivide(63)];
+        let bytes = encode_ops(1, &ops);
+        assert_eq!(bytes[0], MIXED + 1);
+        assert_eq!(decode_ops(&bytes[1..]), ops);
+        let r = check_bytes(&bytes).expect("invariants hold");
+        assert_eq!(r.cuts + r.subdivisions, 4);
+        let many = decode_ops(&[255; 40]);
+        assert_eq!(many.len(), MAX_SUBDIVISIONS);
     }
 }

@@ -183,6 +183,41 @@ impl IndexedModel {
         copy
     }
 
+    /// Adds a point of its own (not a copy of another) and returns it. O(1).
+    pub fn add_point(&mut self) -> u32 {
+        let p = self.points as u32;
+        self.points += 1;
+        self.origin.push(p);
+        self.around.push(Vec::new());
+        p
+    }
+
+    /// Replaces tet t by `tet` (t must exist, the points of `tet` too). O(tets around its points).
+    pub fn set_tet(&mut self, t: u32, tet: [u32; 4]) {
+        for p in self.tets[t as usize] {
+            self.around[p as usize].retain(|&u| u != t);
+        }
+        for p in tet {
+            self.around[p as usize].push(t);
+        }
+        self.tets[t as usize] = tet;
+    }
+
+    /// Appends a tet over existing points and returns its index. O(1).
+    pub fn push_tet(&mut self, tet: [u32; 4]) -> u32 {
+        let t = self.tets.len() as u32;
+        self.tets.push(tet);
+        for p in tet {
+            self.around[p as usize].push(t);
+        }
+        t
+    }
+
+    /// Whether some tet uses point p. O(1).
+    pub fn is_used(&self, p: u32) -> bool {
+        self.around.get(p as usize).is_some_and(|a| !a.is_empty())
+    }
+
     /// The number of points some tet uses. O(points).
     pub fn used_points(&self) -> usize {
         self.around.iter().filter(|a| !a.is_empty()).count()

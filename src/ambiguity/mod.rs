@@ -11,6 +11,8 @@
 //!   against the g-map cut the same way;
 //! - [`campaign`]: random cut sequences on real meshes, statistics, and the delta-debugging
 //!   shrinker;
+//! - [`mixed`], [`refine`]: random interleavings of cuts and tetrahedron subdivisions, the
+//!   leveled g-map against the indexed model refined with an edge → midpoint hash;
 //! - [`vector`]: the JSON test vectors of the catalogue (`tests/vectors/ambiguity/`);
 //! - [`fuzz`]: the byte-driven comparison behind the cargo-fuzz target.
 //!
@@ -23,4 +25,6 @@ pub mod darts;
 pub mod finder;
 pub mod fuzz;
 pub mod indexed;
+pub mod mixed;
+pub mod refine;
 pub mod vector;

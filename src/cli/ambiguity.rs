@@ -1,5 +1,7 @@
-//! `topomech ambiguity [MESH] [--cuts K] [--seed S] [--json]`: the random cut campaign of
-//! `docs/ambiguity.md` — the g-map and the naive indexed model cut side by side — and, with
+//! `topomech ambiguity [MESH] [--cuts K] [--seed S] [--subdivide P] [--json]`: the random cut
+//! campaign of `docs/ambiguity.md` — the g-map and the naive indexed model cut side by side —,
+//! with `--subdivide P` the mixed campaign (cuts and tet subdivisions interleaved, each op a
+//! subdivision with probability P, on the leveled g-map and the refined indexed model) and, with
 //! `--catalogue`, the exhaustive search for maps sharing an adjacency graph.
 
 use std::io::Write;
@@ -7,6 +9,7 @@ use std::path::{Path, PathBuf};
 
 use topomech::ambiguity::campaign::{campaign_k, KStats, Run};
 use topomech::ambiguity::catalogue::{campaign_vectors, catalogue, symptom_name, Bounds, Catalogue};
+use topomech::ambiguity::mixed::{campaign_mixed, MixedRun, MixedStats};
 use topomech::ambiguity::vector::Vector;
 use topomech::generate::{kuhn_cube, SplitMix64};
 
@@ -27,8 +30,12 @@ pub struct AmbiguityArgs {
     /// Random sequences per number of cuts.
     #[arg(long, default_value_t = 100)]
     pub sequences: usize,
+    /// Also run the mixed campaign: sequences of K ops (K from --cuts), each a tet subdivision
+    /// with probability P (in 0..=1) and a cut otherwise.
+    #[arg(long, value_name = "P", value_parser = probability)]
+    pub subdivide: Option<f64>,
     /// Print one JSON object (keys pairs_found, graph_kind, sequences_tried, mesh, tets, per_k,
-    /// first_pairs, and catalogue with --catalogue).
+    /// first_pairs, subdivide with --subdivide, and catalogue with --catalogue).
     #[arg(long)]
     pub json: bool,
     /// Also run the exhaustive search over small 2D and 3D complexes.
@@ -75,11 +82,45 @@ pub struct AmbiguityJson {
     pub per_k: Vec<KStats>,
     /// The first sequence showing each symptom.
     pub first_pairs: Vec<Finding>,
+    /// The mixed campaign, with --subdivide.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub subdivide: Option<SubdivideJson>,
     /// The exhaustive search, with --catalogue.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub catalogue: Option<CatalogueJson>,
 }
 
+/// The mixed cut/subdivide campaign part of the JSON report.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct SubdivideJson {
+    /// Probability of a subdivision per op.
+    pub probability: f64,
+    /// Sequences where the tet list means another map whose incidence graph is isomorphic to
+    /// the g-map's (final state or some level), summed over every k.
+    pub pairs_found: usize,
+    /// The graph of those pairs.
+    pub graph_kind: &'static str,
+    /// Mixed sequences run.
+    pub sequences_tried: usize,
+    /// Sequences after which the indexed model cannot represent the g-map (summed over every k).
+    pub indexed_ambiguous: usize,
+    /// Sequences with a skeleton pair: a cut splitting no g-map vertex or edge, so the maps before
+    /// and after it share their vertex–edge graph (summed over every k).
+    pub skeleton_pairs: usize,
+    /// Statistics per number of ops.
+    pub per_k: Vec<MixedStats>,
+    /// The first ambiguous run and the first run with a graph pair (ops and comparisons).
+    pub first_runs: Vec<MixedRun>,
+}
+
+/// Parses a probability in 0..=1.
+fn probability(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(p) if (0.0..=1.0).contains(&p) => Ok(p),
+        Ok(p) => Err(format!("{p} is not a probability in 0..=1")),
+        Err(e) => Err(format!("{s:?} is not a number: {e}")),
+    }
+}
 /// The catalogue part of the JSON report (counts and names, not the darts).
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct CatalogueJson {
@@ -95,7 +136,8 @@ pub struct CatalogueJson {
 /// [`CliError::Load`] when the mesh cannot be read or built; [`CliError::Other`] when a cut fails
 /// (a bug) or the vectors cannot be written; [`CliError::Output`] / [`CliError::Json`] on output.
 pub fn run(args: AmbiguityArgs) -> Result<(), CliError> {
-    let (name, points, tets) = load_mesh(args.mesh.as_deref())?;
+    let (name, positions, tets) = load_mesh(args.mesh.as_deref())?;
+    let points = positions.len();
     let mut rng = SplitMix64(args.seed);
     let mut per_k = Vec::new();
     let mut firsts: Vec<(usize, Run)> = Vec::new();
@@ -104,6 +146,10 @@ pub fn run(args: AmbiguityArgs) -> Result<(), CliError> {
         per_k.push(stats);
         firsts.extend(runs.into_iter().map(|r| (k, r)));
     }
+    let subdivide = match args.subdivide {
+        Some(p) => Some(mixed_campaign(&positions, &tets, &args.cuts, p, args.sequences, args.seed)?),
+        None => None,
+    };
     let cat = args.catalogue.then(|| catalogue(Bounds::CATALOGUE));
     if let Some(dir) = &args.write_vectors {
         write_vectors(dir, points, &tets, &firsts, cat.as_ref(), args.shrink_budget)?;
@@ -118,6 +164,7 @@ pub fn run(args: AmbiguityArgs) -> Result<(), CliError> {
         seed: args.seed,
         per_k,
         first_pairs: firsts.iter().map(|(k, r)| finding(*k, r)).collect(),
+        subdivide,
         catalogue: cat.map(|c| CatalogueJson {
             counts: c.counts,
             pairs: c.pairs.into_iter().map(|p| (p.name, p.description)).collect(),
@@ -134,6 +181,36 @@ pub fn run(args: AmbiguityArgs) -> Result<(), CliError> {
     Ok(())
 }
 
+/// The mixed campaign for every k, with its own generator (seeded by `seed`), so adding
+/// `--subdivide` leaves the cut campaign's figures unchanged.
+fn mixed_campaign(
+    positions: &[[f64; 3]],
+    tets: &[[u32; 4]],
+    ks: &[usize],
+    p: f64,
+    sequences: usize,
+    seed: u64,
+) -> Result<SubdivideJson, CliError> {
+    let mut rng = SplitMix64(seed);
+    let mut per_k = Vec::new();
+    let mut first_runs = Vec::new();
+    for &k in ks {
+        let (stats, runs) = campaign_mixed(positions, tets, k, p, sequences, &mut rng).map_err(other)?;
+        per_k.push(stats);
+        first_runs.extend(runs);
+    }
+    Ok(SubdivideJson {
+        probability: p,
+        pairs_found: per_k.iter().map(|s| s.graph_pairs).sum(),
+        graph_kind: "incidence",
+        sequences_tried: per_k.iter().map(|s| s.sequences).sum(),
+        indexed_ambiguous: per_k.iter().map(|s| s.ambiguous).sum(),
+        skeleton_pairs: per_k.iter().map(|s| s.skeleton_pairs).sum(),
+        per_k,
+        first_runs,
+    })
+}
+
 fn other(e: impl std::error::Error + Send + Sync + 'static) -> CliError {
     CliError::Other(Box::new(e))
 }
@@ -142,13 +219,16 @@ fn count(s: &KStats, symptom: &str) -> usize {
     s.symptoms.iter().filter(|(x, _)| symptom_name(*x) == symptom).map(|x| x.1).sum()
 }
 
+/// A mesh for the campaigns: (name, point positions, tets).
+type NamedMesh = (String, Vec<[f64; 3]>, Vec<[u32; 4]>);
+
 /// The mesh: the file given, `kuhn:K`, or the built-in liver.
-fn load_mesh(path: Option<&Path>) -> Result<(String, usize, Vec<[u32; 4]>), CliError> {
+fn load_mesh(path: Option<&Path>) -> Result<NamedMesh, CliError> {
     let kuhn = path.and_then(|p| p.to_str()).and_then(|s| s.strip_prefix("kuhn:")).map(str::parse::<usize>);
     match (path, kuhn) {
         (_, Some(Ok(k))) if (1..=16).contains(&k) => {
             let (points, tets) = kuhn_cube(k);
-            Ok((format!("kuhn:{k}"), points.len(), tets))
+            Ok((format!("kuhn:{k}"), points, tets))
         }
         (_, Some(_)) => Err(CliError::Other("kuhn:K needs K in 1..=16".into())),
         (Some(p), None) => from_loaded(topomech::load::load_tet_map(p)?),
@@ -156,8 +236,8 @@ fn load_mesh(path: Option<&Path>) -> Result<(String, usize, Vec<[u32; 4]>), CliE
     }
 }
 
-fn from_loaded(loaded: topomech::load::Loaded) -> Result<(String, usize, Vec<[u32; 4]>), CliError> {
-    Ok((loaded.path.display().to_string(), loaded.mesh.points.len(), loaded.mesh.tets))
+fn from_loaded(loaded: topomech::load::Loaded) -> Result<NamedMesh, CliError> {
+    Ok((loaded.path.display().to_string(), loaded.mesh.points, loaded.mesh.tets))
 }
 
 /// A run as a finding (shrinking is `--write-vectors`'s job).
@@ -227,6 +307,9 @@ fn write_table(out: &mut dyn Write, r: &AmbiguityJson) -> std::io::Result<()> {
             if f.cuts.len() > 5 { " …" } else { "" }
         )?;
     }
+    if let Some(m) = &r.subdivide {
+        write_mixed(out, m)?;
+    }
     if let Some(c) = &r.catalogue {
         writeln!(out, "exhaustive search:")?;
         for g in &c.counts {
@@ -243,6 +326,73 @@ fn write_table(out: &mut dyn Write, r: &AmbiguityJson) -> std::io::Result<()> {
         for (name, text) in &c.pairs {
             writeln!(out, "  {name}: {text}")?;
         }
+    }
+    Ok(())
+}
+
+fn write_mixed(out: &mut dyn Write, m: &SubdivideJson) -> std::io::Result<()> {
+    writeln!(out, "cuts and subdivisions interleaved, P(subdivide) = {}", m.probability)?;
+    writeln!(
+        out,
+        "  {:>4} {:>6} {:>10} {:>7} {:>8} {:>8} {:>6} {:>8} {:>9} {:>6} {:>5} {:>6} {:>7} {:>8} {:>9}",
+        "k",
+        "seqs",
+        "ambiguous",
+        "wrong",
+        "hanging",
+        "inexpr",
+        "lost",
+        "non_mfd",
+        "vert_diff",
+        "pairs",
+        "skel",
+        "subdiv",
+        "refused",
+        "levels",
+        "lvl_ambig"
+    )?;
+    for s in &m.per_k {
+        writeln!(
+            out,
+            "  {:>4} {:>6} {:>10} {:>7} {:>8} {:>8} {:>6} {:>8} {:>9} {:>6} {:>5} {:>6} {:>7} {:>8} {:>9}",
+            s.k,
+            s.sequences,
+            s.ambiguous,
+            s.wrong,
+            s.hanging,
+            s.inexpressible,
+            s.lost,
+            s.non_manifold,
+            s.vertices_differ,
+            s.graph_pairs,
+            s.skeleton_pairs,
+            s.subdivisions,
+            s.refused,
+            s.levels_compared,
+            s.levels_ambiguous
+        )?;
+        if s.level_law_broken + s.gmap_invalid + s.graph_undecided + s.skeleton_violations > 0 {
+            writeln!(
+                out,
+                "       level law broken {}, g-map invalid {}, graph pairs undecided {}, skeleton violations {}",
+                s.level_law_broken, s.gmap_invalid, s.graph_undecided, s.skeleton_violations
+            )?;
+        }
+    }
+    writeln!(
+        out,
+        "pairs_found {} (graph_kind {}), skeleton_pairs {} (graph_kind vertex_edge), sequences_tried {}",
+        m.pairs_found, m.graph_kind, m.skeleton_pairs, m.sequences_tried
+    )?;
+    for r in &m.first_runs {
+        let shown: Vec<_> = r.ops.iter().take(6).collect();
+        writeln!(
+            out,
+            "  first {}: ops {:?}{}",
+            if r.ambiguous() { "ambiguous" } else { "graph pair" },
+            shown,
+            if r.ops.len() > 6 { " …" } else { "" }
+        )?;
     }
     Ok(())
 }

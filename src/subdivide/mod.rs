@@ -21,6 +21,7 @@
 //! μt ≤ μf ≤ μa for every dart (Theorem 1 and its corollary); μa constant on edges, μf on faces,
 //! μt on volumes of the finest level; dart levels ≤ max level.
 
+mod cut;
 pub mod fuzz;
 mod ops;
 mod region;
@@ -108,6 +109,9 @@ pub enum SubdivideError {
         /// A dart of the offending face (or of the volume when the face count is wrong).
         dart: DartId,
     },
+    /// The face to cut has an α3-free dart: it is not glued to another volume there.
+    #[error("the face of {0} is not sewn (α3-free)")]
+    FaceNotSewn(DartId),
     /// The edge has an α0-free dart: it has no second vertex to split between.
     #[error("the edge of {0} is open (α0-free)")]
     OpenEdge(DartId),

@@ -79,6 +79,17 @@ impl<const N: usize> LeveledMap<N> {
         self.map.link_raw(j, a, b);
     }
 
+    /// Makes `a` and its αj partner j-free, recording both changes.
+    pub(super) fn unlink(&mut self, j: usize, a: DartId) {
+        let pa = self.map.alpha_dyn(j, a);
+        if pa == a {
+            return;
+        }
+        self.touch(j, a);
+        self.touch(j, pa);
+        self.map.unlink_raw(j, a);
+    }
+
     /// Creates a free dart of the current level with levels `mu` and the given flat flag.
     pub(super) fn new_dart(&mut self, mu: Mu, flat: bool) -> DartId {
         let d = DartId(self.map.alloc_darts_raw(1));

@@ -22,10 +22,12 @@
 //! μt on volumes of the finest level; dart levels ≤ max level.
 
 mod ops;
+mod parts;
 mod region;
 mod tet;
 mod tri;
 
+pub use parts::{record_errors, DartLevels, HistoryEntry, LevelParts, LevelPartsError};
 pub use region::{tet_distance, Refinement, TetMasses};
 
 use crate::gmap::{AlphaMask, DartId, GMap, InvariantViolation};

@@ -411,3 +411,20 @@ fn the_documented_example_is_the_small_leveled_map() {
     let written = store::encode(&Document::from_leveled(&small()), Format::Text).unwrap();
     assert_eq!(String::from_utf8(written).unwrap(), example);
 }
+
+#[test]
+fn mechanics_and_levels_sections_coexist() {
+    use topomech::mechanics::{Body, Material};
+    let (points, tets) = kuhn_cube(1);
+    let body = Body::from_tets(&points, &tets, Material::default()).unwrap().0;
+    let mut m = LeveledMap::new(body.map().clone(), points);
+    apply(&mut m, &[(3, 0, true)]);
+    let mut doc = Document::from_body(&body);
+    doc.map = Document::from_leveled(&m).map;
+    doc.levels = Document::from_leveled(&m).levels;
+    // Structure only: the attributes are those of the unrefined body, so no law is checked here.
+    for format in FORMATS {
+        let back = store::decode(&store::encode(&doc, format).unwrap()).unwrap();
+        assert_eq!(back, doc, "{format:?}");
+    }
+}

@@ -9,6 +9,7 @@ use std::path::PathBuf;
 
 use topomech::gmap::InvariantViolation;
 use topomech::store::{self, CheckReport, Finding};
+use topomech::subdivide::{LevelError, LevelPartsError};
 
 use super::CliError;
 
@@ -17,8 +18,8 @@ use super::CliError;
 pub struct CheckArgs {
     /// A `.tmap` (text) or `.tmapb` (binary) map file; the form is told by its first bytes.
     pub file: PathBuf,
-    /// Print one JSON object: file, dimension, darts, valid, findings [{law, darts, message}],
-    /// truncated.
+    /// Print one JSON object: file, dimension, darts, max_level (null without levels), valid,
+    /// findings [{law, darts, message}], truncated.
     #[arg(long)]
     pub json: bool,
     /// List at most this many broken laws.
@@ -42,13 +43,14 @@ pub fn run(args: CheckArgs) -> Result<(), CliError> {
     };
     let report = store::check_all_laws(&doc, args.limit);
     let darts = doc.map.capacity as usize - doc.map.free_darts.len();
+    let levels = doc.levels.as_ref().map(|l| l.max_level);
     let mut out = std::io::stdout().lock();
     if args.json {
-        let value = json_report(&args, doc.map.dimension, darts, &report);
+        let value = json_report(&args, doc.map.dimension, darts, levels, &report);
         serde_json::to_writer(&mut out, &value)?;
         writeln!(out)?;
     } else {
-        write_table(&mut out, &args, doc.map.dimension, darts, &report)?;
+        write_table(&mut out, &args, (doc.map.dimension, darts, levels), &report)?;
     }
     out.flush()?;
     if !report.valid {
@@ -60,12 +62,12 @@ pub fn run(args: CheckArgs) -> Result<(), CliError> {
 fn write_table(
     out: &mut dyn Write,
     args: &CheckArgs,
-    dim: usize,
-    darts: usize,
+    (dim, darts, levels): (usize, usize, Option<u8>),
     report: &CheckReport,
 ) -> std::io::Result<()> {
     let verdict = if report.valid { "valid" } else { "INVALID" };
-    writeln!(out, "{}: {dim}-G-map, {darts} darts: {verdict}", args.file.display())?;
+    let levels = levels.map_or(String::new(), |k| format!(", levels 0..={k}"));
+    writeln!(out, "{}: {dim}-G-map, {darts} darts{levels}: {verdict}", args.file.display())?;
     for f in &report.findings {
         writeln!(out, "  [{}] {f}", law_name(f))?;
     }
@@ -75,7 +77,13 @@ fn write_table(
     Ok(())
 }
 
-fn json_report(args: &CheckArgs, dim: usize, darts: usize, report: &CheckReport) -> serde_json::Value {
+fn json_report(
+    args: &CheckArgs,
+    dim: usize,
+    darts: usize,
+    levels: Option<u8>,
+    report: &CheckReport,
+) -> serde_json::Value {
     let findings: Vec<serde_json::Value> = report
         .findings
         .iter()
@@ -85,35 +93,70 @@ fn json_report(args: &CheckArgs, dim: usize, darts: usize, report: &CheckReport)
         "file": args.file.display().to_string(),
         "dimension": dim,
         "darts": darts,
+        "max_level": levels,
         "valid": report.valid,
         "findings": findings,
         "truncated": report.truncated,
     })
 }
 
-/// Stable law names: involution, quasi_manifold, cell_id_constant, cell_id_unique, conservation.
+/// Stable law names: involution, quasi_manifold, cell_id_constant, cell_id_unique, conservation,
+/// and for levels: level_record, mu_order, mu_constant, level_closed, level_valid.
 fn law_name(f: &Finding) -> &'static str {
     match f {
-        Finding::Map(v) => match v.law() {
-            topomech::gmap::Law::Involution => "involution",
-            topomech::gmap::Law::QuasiManifold => "quasi_manifold",
-            topomech::gmap::Law::CellIdConstant => "cell_id_constant",
-            topomech::gmap::Law::CellIdUnique => "cell_id_unique",
-        },
+        Finding::Map(v) => map_law_name(v),
         Finding::Conservation(_) => "conservation",
+        Finding::Level(LevelPartsError::Law(e)) => match e {
+            LevelError::MuOrder { .. } => "mu_order",
+            LevelError::MuNotConstant { .. } => "mu_constant",
+            LevelError::NotClosed { .. } => "level_closed",
+            LevelError::InvalidLevel { .. } | LevelError::InvalidMap(_) => "level_valid",
+        },
+        Finding::Level(_) => "level_record",
+        Finding::LevelMap { .. } => "level_valid",
+    }
+}
+
+fn map_law_name(v: &InvariantViolation) -> &'static str {
+    match v.law() {
+        topomech::gmap::Law::Involution => "involution",
+        topomech::gmap::Law::QuasiManifold => "quasi_manifold",
+        topomech::gmap::Law::CellIdConstant => "cell_id_constant",
+        topomech::gmap::Law::CellIdUnique => "cell_id_unique",
     }
 }
 
 /// The darts a finding names (the first is the dart the law fails at).
 fn darts_of(f: &Finding) -> Vec<u32> {
-    use InvariantViolation::*;
     match f {
-        Finding::Map(DanglingLink { dart, .. }) => vec![dart.0],
-        Finding::Map(NotInvolution { dart, image, .. }) => vec![dart.0, image.0],
-        Finding::Map(QuasiManifold { dart, .. }) => vec![dart.0],
-        Finding::Map(CellIdDiffers { dart, other, .. }) => vec![dart.0, other.0],
-        Finding::Map(CellIdNotLive { dart, .. }) => vec![dart.0],
-        Finding::Map(CellIdShared { first, second, .. }) => vec![first.0, second.0],
-        Finding::Map(CellIdOrphan { .. }) | Finding::Conservation(_) => Vec::new(),
+        Finding::Map(v) | Finding::LevelMap { violation: v, .. } => violation_darts(v),
+        Finding::Conservation(_) => Vec::new(),
+        Finding::Level(e) => level_darts(e),
+    }
+}
+
+fn violation_darts(v: &InvariantViolation) -> Vec<u32> {
+    use InvariantViolation::*;
+    match v {
+        DanglingLink { dart, .. } => vec![dart.0],
+        NotInvolution { dart, image, .. } => vec![dart.0, image.0],
+        QuasiManifold { dart, .. } => vec![dart.0],
+        CellIdDiffers { dart, other, .. } => vec![dart.0, other.0],
+        CellIdNotLive { dart, .. } => vec![dart.0],
+        CellIdShared { first, second, .. } => vec![first.0, second.0],
+        CellIdOrphan { .. } => Vec::new(),
+    }
+}
+
+fn level_darts(e: &LevelPartsError) -> Vec<u32> {
+    match e {
+        LevelPartsError::DartLevelAboveMax { dart, .. } | LevelPartsError::BadHistory { dart, .. } => vec![dart.0],
+        LevelPartsError::Law(LevelError::MuOrder { dart, .. }) => vec![dart.0],
+        LevelPartsError::Law(LevelError::MuNotConstant { dart, other, .. }) => vec![dart.0, other.0],
+        LevelPartsError::Law(LevelError::NotClosed { dart, image, .. }) => vec![dart.0, image.0],
+        LevelPartsError::Law(LevelError::InvalidLevel { source: v, .. } | LevelError::InvalidMap(v)) => {
+            violation_darts(v)
+        }
+        LevelPartsError::WrongLength { .. } | LevelPartsError::MaxLevelTooHigh(_) => Vec::new(),
     }
 }

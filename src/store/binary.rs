@@ -1,12 +1,17 @@
 //! The binary form `.tmapb` (layout in `docs/FILE_FORMAT.md`): little-endian, FNV-1a 64 checksum.
 
 use super::raw::{IdAllocRecord, RawMap, RawMechanics, VertexRecord, UNSET};
-use super::{structure, Document, StoreError, Where, BINARY_MAGIC, MAX_DIMENSION, VERSION};
+use super::{
+    structure, Document, StoreError, Where, BINARY_MAGIC, LEVELS_VERSION, MAX_DIMENSION, MIN_VERSION, VERSION,
+};
+use crate::subdivide::{DartLevels, HistoryEntry, LevelParts, Mu};
 
 /// Bytes before the payload: magic, version, dimension, flags, payload length.
 const HEADER: usize = 8 + 4 + 4 + 4 + 8;
 /// Flag bit: a mechanics section follows the map.
 const FLAG_MECHANICS: u32 = 1;
+/// Flag bit: a levels section follows (version 2 and later).
+const FLAG_LEVELS: u32 = 2;
 
 /// FNV-1a, 64 bits, over `bytes`. O(len).
 pub(super) fn fnv1a64(bytes: &[u8]) -> u64 {
@@ -31,11 +36,15 @@ pub(super) fn encode(doc: &Document) -> Vec<u8> {
     if let Some(mech) = &doc.mechanics {
         encode_mechanics(&mut p, mech);
     }
+    if let Some(levels) = &doc.levels {
+        encode_levels(&mut p, levels, &m.live());
+    }
     let mut out = Vec::with_capacity(HEADER + p.len() + 8);
     out.extend_from_slice(&BINARY_MAGIC);
-    out.extend_from_slice(&VERSION.to_le_bytes());
+    out.extend_from_slice(&doc.version().to_le_bytes());
     out.extend_from_slice(&(m.dimension as u32).to_le_bytes());
-    let flags = if doc.mechanics.is_some() { FLAG_MECHANICS } else { 0 };
+    let flags =
+        if doc.mechanics.is_some() { FLAG_MECHANICS } else { 0 } | if doc.levels.is_some() { FLAG_LEVELS } else { 0 };
     out.extend_from_slice(&flags.to_le_bytes());
     out.extend_from_slice(&(p.len() as u64).to_le_bytes());
     out.extend_from_slice(&p);
@@ -66,6 +75,22 @@ fn encode_mechanics(p: &mut Vec<u8>, m: &RawMechanics) {
     m.volumes.iter().flatten().for_each(|&x| f(p, x));
 }
 
+/// u8 max level; per live dart (increasing id): u8 level, μa, μf, μt, flat, u32 h, h × (u8 level,
+/// u8 j, u32 old); u32 np, np × 3 f64.
+fn encode_levels(p: &mut Vec<u8>, l: &LevelParts, live: &[bool]) {
+    p.push(l.max_level);
+    for rec in l.darts.iter().enumerate().filter(|&(d, _)| live[d]).map(|(_, r)| r) {
+        p.extend_from_slice(&[rec.level, rec.mu.edge, rec.mu.face, rec.mu.tet, u8::from(rec.flat)]);
+        p.extend_from_slice(&(rec.history.len() as u32).to_le_bytes());
+        for h in &rec.history {
+            p.extend_from_slice(&[h.level, h.j]);
+            p.extend_from_slice(&h.old.to_le_bytes());
+        }
+    }
+    p.extend_from_slice(&(l.points.len() as u32).to_le_bytes());
+    l.points.iter().flatten().for_each(|x| p.extend_from_slice(&x.to_bits().to_le_bytes()));
+}
+
 /// A bounds-checked little-endian reader that knows its absolute offset.
 struct Reader<'a> {
     bytes: &'a [u8],
@@ -86,6 +111,10 @@ impl<'a> Reader<'a> {
     fn u32(&mut self, what: &str) -> Result<u32, StoreError> {
         let s = self.take(4, what)?;
         Ok(u32::from_le_bytes([s[0], s[1], s[2], s[3]]))
+    }
+
+    fn u8(&mut self, what: &str) -> Result<u8, StoreError> {
+        Ok(self.take(1, what)?[0])
     }
 
     fn u64(&mut self, what: &str) -> Result<u64, StoreError> {
@@ -137,7 +166,7 @@ pub(super) fn decode(bytes: &[u8]) -> Result<Document, StoreError> {
     let mut r = Reader { bytes, pos: BINARY_MAGIC.len() };
     let version_at = Where::Byte(r.pos);
     let version = r.u32("the format version")?;
-    if version != VERSION {
+    if !(MIN_VERSION..=VERSION).contains(&version) {
         return Err(StoreError::UnsupportedVersion { at: version_at, found: version.into() });
     }
     let dim_at = Where::Byte(r.pos);
@@ -147,8 +176,12 @@ pub(super) fn decode(bytes: &[u8]) -> Result<Document, StoreError> {
     }
     let flags_at = Where::Byte(r.pos);
     let flags = r.u32("the flags")?;
-    if flags & !FLAG_MECHANICS != 0 {
+    if flags & !(FLAG_MECHANICS | FLAG_LEVELS) != 0 {
         return Err(StoreError::Inconsistent { at: flags_at, message: format!("unknown flags {flags:#x}") });
+    }
+    if flags & FLAG_LEVELS != 0 && version < LEVELS_VERSION {
+        let message = format!("the levels flag needs format version {LEVELS_VERSION}, the header says {version}");
+        return Err(StoreError::Inconsistent { at: flags_at, message });
     }
     let len_at = r.pos;
     let len = r.u64("the payload length")?;
@@ -171,10 +204,11 @@ pub(super) fn decode(bytes: &[u8]) -> Result<Document, StoreError> {
     let mut r = Reader { bytes: &bytes[..end], pos: HEADER };
     let map = decode_map(&mut r, dim)?;
     let mechanics = if flags & FLAG_MECHANICS != 0 { Some(decode_mechanics(&mut r)?) } else { None };
+    let levels = if flags & FLAG_LEVELS != 0 { Some(decode_levels(&mut r, &map)?) } else { None };
     if r.pos != end {
         return Err(StoreError::TrailingData { at: Where::Byte(r.pos) });
     }
-    Ok(Document { map, mechanics })
+    Ok(Document { map, mechanics, levels })
 }
 
 fn decode_map(r: &mut Reader<'_>, dim: usize) -> Result<RawMap, StoreError> {
@@ -246,4 +280,38 @@ fn decode_mechanics(r: &mut Reader<'_>) -> Result<RawMechanics, StoreError> {
         m.volumes.push([r.f64("volume attribute", k)?, r.f64("volume attribute", k)?, r.f64("volume attribute", k)?]);
     }
     Ok(m)
+}
+
+/// The levels section (structure only: flags 0|1, j ≤ n, old < capacity, finite points).
+fn decode_levels(r: &mut Reader<'_>, map: &RawMap) -> Result<LevelParts, StoreError> {
+    let max_level = r.u8("the max level")?;
+    let alive = map.live();
+    let mut darts = vec![DartLevels::default(); map.capacity as usize];
+    for d in (0..map.capacity as usize).filter(|&d| alive[d]) {
+        let b = r.take(4, "a dart level record")?;
+        let (level, mu) = (b[0], Mu { edge: b[1], face: b[2], tet: b[3] });
+        let flat = r.flag("flat")?;
+        let h = r.count("history entries", 6)?;
+        let mut history = Vec::with_capacity(h);
+        for _ in 0..h {
+            let at = Where::Byte(r.pos);
+            let (hl, j) = (r.u8("a history level")?, r.u8("a history involution")?);
+            let old = r.u32("a history link")?;
+            if usize::from(j) > map.dimension {
+                let message = format!("history of dart {d}: α{j} is above the dimension {}", map.dimension);
+                return Err(StoreError::Inconsistent { at, message });
+            }
+            if old >= map.capacity {
+                return Err(StoreError::DartOutOfRange { at, dart: old.into(), capacity: map.capacity.into() });
+            }
+            history.push(HistoryEntry { level: hl, j, old });
+        }
+        darts[d] = DartLevels { level, mu, flat, history };
+    }
+    let np = r.count("points", 24)?;
+    let mut points = Vec::with_capacity(np);
+    for k in 0..np {
+        points.push([r.f64("point", k)?, r.f64("point", k)?, r.f64("point", k)?]);
+    }
+    Ok(LevelParts { max_level, darts, points })
 }

@@ -2,6 +2,7 @@
 
 use crate::gmap::InvariantViolation;
 use crate::mechanics::ConservationError;
+use crate::subdivide::LevelPartsError;
 use crate::{CellId, DartId, GMap};
 
 use super::raw::RawMap;
@@ -14,6 +15,16 @@ pub enum Finding {
     Map(InvariantViolation),
     /// A conservation law of the mechanical attributes (checked only when the map is valid).
     Conservation(ConservationError),
+    /// A malformed level record or a μ law (order, constancy) or an unclosed level, with darts.
+    Level(LevelPartsError),
+    /// A G-map law broken by the map extracted at `level`, with the leveled map's dart ids
+    /// (checked only when the finest map is valid and every level record well formed).
+    LevelMap {
+        /// The level i of G_i.
+        level: u8,
+        /// The law broken.
+        violation: InvariantViolation,
+    },
 }
 
 impl std::fmt::Display for Finding {
@@ -21,6 +32,8 @@ impl std::fmt::Display for Finding {
         match self {
             Finding::Map(v) => write!(f, "{v}"),
             Finding::Conservation(c) => write!(f, "conservation: {c}"),
+            Finding::Level(e) => write!(f, "levels: {e}"),
+            Finding::LevelMap { level, violation } => write!(f, "level {level}: {violation}"),
         }
     }
 }
@@ -39,10 +52,13 @@ pub struct CheckReport {
 
 /// Lists up to `limit` broken laws of `doc`: involution (dangling links, αi(αi(d)) ≠ d),
 /// quasi-manifold (αiαj ≠ αjαi for j ≥ i + 2), cell ids constant and live on each cell, cell ids
-/// unique (one id per orbit, no orphan live id), then conservation for a body whose map is valid.
+/// unique (one id per orbit, no orphan live id), then conservation for a body whose map is valid,
+/// then, for a document with levels: malformed records, μt ≤ μf ≤ μa and μ constant on cells at
+/// every dart, and (when the map is valid and the records well formed) every law of every
+/// extracted level G_0 … G_k, with the leveled map's dart ids.
 /// The verdict comes from the kernel's `validate()` when n ≤ 3; the listing is a separate pass
 /// on the raw arrays that never stops at the first violation.
-/// Cost O(capacity · n² + cell ids) time and memory.
+/// Cost O(capacity · n² + cell ids) time and memory, O(k · capacity · n²) with k levels.
 pub fn check_all_laws(doc: &Document, limit: usize) -> CheckReport {
     let mut out = Collector { findings: Vec::new(), limit, truncated: false };
     let raw = &doc.map;
@@ -69,17 +85,20 @@ pub fn check_all_laws(doc: &Document, limit: usize) -> CheckReport {
             }
         }
     }
+    if super::check_levels::check_levels(doc, map_valid, &mut out) {
+        valid = false;
+    }
     CheckReport { valid, findings: out.findings, truncated: out.truncated }
 }
 
-struct Collector {
+pub(super) struct Collector {
     findings: Vec<Finding>,
     limit: usize,
     truncated: bool,
 }
 
 impl Collector {
-    fn push(&mut self, f: Finding) {
+    pub(super) fn push(&mut self, f: Finding) {
         if self.findings.len() < self.limit {
             self.findings.push(f);
         } else {

@@ -27,12 +27,18 @@
 //! }
 //! ```
 //!
+//! A leveled map ([`crate::subdivide::LeveledMap`]) adds an optional *levels* part
+//! ([`LevelParts`]: max level, per-dart level, μ, flat flag and link history, vertex positions);
+//! a file holding it is version 2 ([`save_leveled`] / [`load_leveled`]). Files without it are
+//! still written and read as version 1, byte for byte as before.
+//!
 //! Writes are atomic: [`save_document`] writes a temporary file in the target's directory, flushes
 //! and fsyncs it, then renames it into place, so a crash or an error leaves either the old file or
 //! the new one, never half of one.
 
 mod binary;
 mod check;
+mod check_levels;
 mod raw;
 mod structure;
 mod text;
@@ -41,14 +47,21 @@ use std::fmt;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+pub use crate::subdivide::{DartLevels, HistoryEntry, LevelParts};
 pub use check::{check_all_laws, CheckReport, Finding};
 pub use raw::{IdAllocRecord, RawMap, RawMechanics, VertexRecord};
 
 use crate::mechanics::{Body, ConservationError};
+use crate::subdivide::{LevelPartsError, LeveledMap};
 use crate::{GMap, InvariantViolation};
 
-/// The version of both forms this library writes and the only one it reads.
-pub const VERSION: u32 = 1;
+/// The newest version of both forms: this library reads versions [`MIN_VERSION`]`..=VERSION`.
+/// It writes version 2 for a document with a levels part and version 1 otherwise.
+pub const VERSION: u32 = 2;
+/// The oldest version this library reads (and writes for documents without levels).
+pub const MIN_VERSION: u32 = 1;
+/// The first version that may hold a levels part.
+pub const LEVELS_VERSION: u32 = 2;
 /// First token of the text form.
 pub const TEXT_MAGIC: &str = "topomech-gmap";
 /// First 8 bytes of the binary form (the CR LF catches text-mode transfers).
@@ -111,7 +124,7 @@ pub enum StoreError {
         found: String,
     },
     /// The file was written by another version of the format.
-    #[error("{at}: format version {found} is not supported (this topomech reads version {VERSION})")]
+    #[error("{at}: format version {found} is not supported (this topomech reads versions {MIN_VERSION} to {VERSION})")]
     UnsupportedVersion {
         /// Where the version is.
         at: Where,
@@ -213,6 +226,12 @@ pub enum StoreError {
     /// A body was asked for but the file holds no mechanical attributes.
     #[error("the file holds a bare map, not a mechanical body")]
     NoMechanics,
+    /// A leveled map was asked for but the file holds no levels part.
+    #[error("the file holds no levels part (it was not saved from a leveled map)")]
+    NoLevels,
+    /// The levels part is malformed or breaks a level law.
+    #[error("the levels part is not acceptable: {0}")]
+    Levels(#[from] LevelPartsError),
     /// Saving: the body holds values the format cannot represent exactly (non-finite floats).
     #[error("cannot save: {what}")]
     Unrepresentable {
@@ -228,17 +247,43 @@ pub struct Document {
     pub map: RawMap,
     /// The mechanical attributes of a body (3-G-maps only).
     pub mechanics: Option<RawMechanics>,
+    /// The levels of a leveled map (version 2): one record per dart slot (dead slots are not
+    /// stored and come back as defaults), the max level and the vertex positions.
+    pub levels: Option<LevelParts>,
 }
 
 impl Document {
     /// The document of a bare map. O(capacity · n).
     pub fn from_map<const N: usize>(map: &GMap<N>) -> Self {
-        Document { map: RawMap::from_map(map), mechanics: None }
+        Document { map: RawMap::from_map(map), mechanics: None, levels: None }
+    }
+
+    /// The document of a leveled map: its finest map and its levels part. Dead dart slots get
+    /// default records (they are not stored). O(capacity · n + history entries + points).
+    pub fn from_leveled<const N: usize>(m: &LeveledMap<N>) -> Self {
+        let mut parts = m.to_parts();
+        for (k, rec) in parts.darts.iter_mut().enumerate() {
+            if !m.map().contains(crate::DartId(k as u32)) {
+                *rec = DartLevels::default();
+            }
+        }
+        Document { map: RawMap::from_map(m.map()), mechanics: None, levels: Some(parts) }
+    }
+
+    /// The version a document is written with: [`LEVELS_VERSION`] with a levels part,
+    /// [`MIN_VERSION`] without. O(1).
+    pub fn version(&self) -> u32 {
+        if self.levels.is_some() {
+            LEVELS_VERSION
+        } else {
+            MIN_VERSION
+        }
     }
 
     /// The document of a body (map + mechanics). O(capacity + cells).
     pub fn from_body(body: &Body) -> Self {
-        Document { map: RawMap::from_map(body.map()), mechanics: Some(RawMechanics::from_mechanics(body.attrs())) }
+        let mechanics = Some(RawMechanics::from_mechanics(body.attrs()));
+        Document { map: RawMap::from_map(body.map()), mechanics, levels: None }
     }
 
     /// The map, required to satisfy every law. O(darts · n²).
@@ -249,6 +294,19 @@ impl Document {
         let map = self.map.to_gmap_raw::<N>()?;
         map.validate()?;
         Ok(map)
+    }
+
+    /// The leveled map, required to satisfy every law of the map and of levels
+    /// ([`LeveledMap::from_parts`]). O(k · darts · n²).
+    ///
+    /// # Errors
+    /// [`StoreError::NoLevels`], [`StoreError::WrongDimension`], [`StoreError::BrokenLaw`],
+    /// [`StoreError::Levels`] (a malformed record or the first level law broken).
+    pub fn into_leveled<const N: usize>(self) -> Result<LeveledMap<N>, StoreError> {
+        let parts = self.levels.ok_or(StoreError::NoLevels)?;
+        let map = self.map.to_gmap_raw::<N>()?;
+        map.validate()?;
+        Ok(LeveledMap::from_parts(map, parts)?)
     }
 
     /// The body, required to satisfy every law of the map and of conservation. O(darts).
@@ -274,10 +332,25 @@ pub fn encode(doc: &Document, format: Format) -> Result<Vec<u8>, StoreError> {
     if let Some(m) = &doc.mechanics {
         m.check_finite().map_err(|what| StoreError::Unrepresentable { what })?;
     }
+    if let Some(l) = &doc.levels {
+        check_levels_representable(&doc.map, l).map_err(|what| StoreError::Unrepresentable { what })?;
+    }
     Ok(match format {
         Format::Text => text::encode(doc).into_bytes(),
         Format::Binary => binary::encode(doc),
     })
+}
+
+/// `Err(description)` when the levels part cannot be written: not one record per dart slot, or
+/// a non-finite point. O(capacity + points).
+fn check_levels_representable(map: &RawMap, l: &LevelParts) -> Result<(), String> {
+    if l.darts.len() != map.capacity as usize {
+        return Err(format!("{} dart level records for {} dart slots", l.darts.len(), map.capacity));
+    }
+    if let Some(k) = l.points.iter().position(|p| p.iter().any(|x| !x.is_finite())) {
+        return Err(format!("point {k} is not finite"));
+    }
+    Ok(())
 }
 
 /// Decodes either form (told apart by the magic) into a raw document, checking its structure but
@@ -320,6 +393,22 @@ pub fn load_map<const N: usize>(path: &Path) -> Result<GMap<N>, StoreError> {
 /// As [`read_document`] and [`Document::into_body`].
 pub fn load_body(path: &Path) -> Result<Body, StoreError> {
     read_document(path)?.into_body()
+}
+
+/// Loads a leveled map whose map and levels satisfy every law. O(size + k · darts · n²).
+///
+/// # Errors
+/// As [`read_document`] and [`Document::into_leveled`].
+pub fn load_leveled<const N: usize>(path: &Path) -> Result<LeveledMap<N>, StoreError> {
+    read_document(path)?.into_leveled()
+}
+
+/// Saves a leveled map (version 2) in `format`, atomically. O(capacity · n + entries).
+///
+/// # Errors
+/// As [`save_document`].
+pub fn save_leveled<const N: usize>(m: &LeveledMap<N>, path: &Path, format: Format) -> Result<(), StoreError> {
+    save_document(&Document::from_leveled(m), path, format)
 }
 
 /// Saves a map in `format`, atomically. O(capacity · n).

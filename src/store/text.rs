@@ -3,7 +3,8 @@
 use std::fmt::Write as _;
 
 use super::raw::{IdAllocRecord, RawMap, RawMechanics, VertexRecord, UNSET};
-use super::{structure, Document, StoreError, Where, MAX_DIMENSION, TEXT_MAGIC, VERSION};
+use super::{structure, Document, StoreError, Where, LEVELS_VERSION, MAX_DIMENSION, MIN_VERSION, TEXT_MAGIC, VERSION};
+use crate::subdivide::{DartLevels, HistoryEntry, LevelParts, Mu};
 
 /// Writes the document. Floats use Rust's shortest round-trip notation (`{:?}`). O(size).
 pub(super) fn encode(doc: &Document) -> String {
@@ -12,7 +13,7 @@ pub(super) fn encode(doc: &Document) -> String {
     let mut s = String::new();
     let live = m.live();
     // `write!` into a String cannot fail.
-    let _ = writeln!(s, "{TEXT_MAGIC} {VERSION} {}", m.dimension);
+    let _ = writeln!(s, "{TEXT_MAGIC} {} {}", doc.version(), m.dimension);
     let _ = writeln!(s, "darts {} {}", m.capacity, m.capacity as usize - m.free_darts.len());
     for d in (0..m.capacity).filter(|&d| live[d as usize]) {
         let row = d as usize * n1..(d as usize + 1) * n1;
@@ -32,6 +33,9 @@ pub(super) fn encode(doc: &Document) -> String {
     }
     if let Some(mech) = &doc.mechanics {
         encode_mechanics(&mut s, mech);
+    }
+    if let Some(levels) = &doc.levels {
+        encode_levels(&mut s, levels, &live);
     }
     s.push_str("end\n");
     s
@@ -77,6 +81,25 @@ fn encode_mechanics(s: &mut String, m: &RawMechanics) {
     for (k, t) in m.volumes.iter().enumerate() {
         let _ = write!(s, "t {k}");
         floats(s, t);
+        s.push('\n');
+    }
+}
+
+/// `levels K LIVE NP`, one `l` line per live dart (increasing id), one `p` line per point.
+fn encode_levels(s: &mut String, l: &LevelParts, live: &[bool]) {
+    let live_count = live.iter().filter(|&&x| x).count();
+    let _ = writeln!(s, "levels {} {live_count} {}", l.max_level, l.points.len());
+    for (d, rec) in l.darts.iter().enumerate().filter(|&(d, _)| live[d]) {
+        let Mu { edge, face, tet } = rec.mu;
+        let _ = write!(s, "l {d} {} {edge} {face} {tet} {} {}", rec.level, u8::from(rec.flat), rec.history.len());
+        for h in &rec.history {
+            let _ = write!(s, " {} {} {}", h.level, h.j, h.old);
+        }
+        s.push('\n');
+    }
+    for (k, p) in l.points.iter().enumerate() {
+        let _ = write!(s, "p {k}");
+        floats(s, p);
         s.push('\n');
     }
 }
@@ -162,8 +185,8 @@ pub(super) fn decode(bytes: &[u8]) -> Result<Document, StoreError> {
         syntax(line, "the text is not valid UTF-8".into())
     })?;
     let mut lines = Lines::new(text);
-    let map = decode_map(&mut lines)?;
-    let (no, head) = lines.next("", "\"mechanics\" or \"end\"")?;
+    let (version, map) = decode_map(&mut lines)?;
+    let (no, head) = lines.next("", "\"mechanics\", \"levels\" or \"end\"")?;
     let mechanics = match head.first() {
         Some(&"mechanics") => Some(decode_mechanics(&mut lines, no, &head)?),
         _ => {
@@ -171,7 +194,19 @@ pub(super) fn decode(bytes: &[u8]) -> Result<Document, StoreError> {
             None
         }
     };
-    let (no, end) = lines.next("end", "\"end\"")?;
+    let (no, head) = lines.next("", "\"levels\" or \"end\"")?;
+    let levels = match head.first() {
+        Some(&"levels") if version < LEVELS_VERSION => {
+            let message = format!("a levels section needs format version {LEVELS_VERSION}, the header says {version}");
+            return Err(StoreError::Inconsistent { at: Where::Line(no), message });
+        }
+        Some(&"levels") => Some(decode_levels(&mut lines, no, &head, &map)?),
+        _ => {
+            lines.pos -= 1;
+            None
+        }
+    };
+    let (no, end) = lines.next("end", "\"end\" (the sections are mechanics, then levels)")?;
     arity(&end, 1, no, "end")?;
     if let Some(&(extra, _)) = lines.lines.get(lines.pos) {
         return Err(StoreError::TrailingData { at: Where::Line(extra) });
@@ -179,16 +214,16 @@ pub(super) fn decode(bytes: &[u8]) -> Result<Document, StoreError> {
     if !text.ends_with('\n') {
         return Err(StoreError::Truncated { at: Where::Line(no), expected: "a newline after \"end\"".into() });
     }
-    Ok(Document { map, mechanics })
+    Ok(Document { map, mechanics, levels })
 }
 
-fn decode_header(lines: &mut Lines<'_>) -> Result<usize, StoreError> {
+fn decode_header(lines: &mut Lines<'_>) -> Result<(u32, usize), StoreError> {
     let (no, h) = lines.next(TEXT_MAGIC, "the header")?;
     if h.len() < 2 {
         return Err(StoreError::Truncated { at: Where::Line(no), expected: "the format version".into() });
     }
     let version = int(h[1], no, "version")?;
-    if version != u64::from(VERSION) {
+    if !(u64::from(MIN_VERSION)..=u64::from(VERSION)).contains(&version) {
         return Err(StoreError::UnsupportedVersion { at: Where::Line(no), found: version });
     }
     arity(&h, 3, no, "header")?;
@@ -196,11 +231,11 @@ fn decode_header(lines: &mut Lines<'_>) -> Result<usize, StoreError> {
     if dim == 0 || dim > MAX_DIMENSION as u64 {
         return Err(StoreError::BadDimension { at: Where::Line(no), found: dim });
     }
-    Ok(dim as usize)
+    Ok((version as u32, dim as usize))
 }
 
-fn decode_map(lines: &mut Lines<'_>) -> Result<RawMap, StoreError> {
-    let dim = decode_header(lines)?;
+fn decode_map(lines: &mut Lines<'_>) -> Result<(u32, RawMap), StoreError> {
+    let (version, dim) = decode_header(lines)?;
     let n1 = dim + 1;
     let (no, h) = lines.next("darts", "\"darts CAPACITY LIVE\"")?;
     arity(&h, 3, no, "darts")?;
@@ -265,7 +300,7 @@ fn decode_map(lines: &mut Lines<'_>) -> Result<RawMap, StoreError> {
     }
     let raw = RawMap { dimension: dim, capacity, alpha, cell, free_darts, ids };
     structure::check(&raw, Where::Line(no))?;
-    Ok(raw)
+    Ok((version, raw))
 }
 
 /// `COUNT IDS…` starting at token `start`.
@@ -352,4 +387,75 @@ fn flag(tok: &str, no: usize) -> Result<bool, StoreError> {
         "1" => Ok(true),
         _ => Err(syntax(no, format!("expected a flag 0 or 1, found {tok:?}"))),
     }
+}
+
+fn int8(tok: &str, line: usize, what: &str) -> Result<u8, StoreError> {
+    let v = int(tok, line, what)?;
+    u8::try_from(v).map_err(|_| syntax(line, format!("{what}: {v} does not fit in 8 bits")))
+}
+
+/// `levels K LIVE NP` (already read as `head`), then the `l` and `p` lines. Structure only:
+/// one `l` line per live dart in increasing id order, j ≤ n, old < capacity, finite points.
+fn decode_levels(lines: &mut Lines<'_>, no: usize, head: &[&str], map: &RawMap) -> Result<LevelParts, StoreError> {
+    arity(head, 4, no, "levels")?;
+    let max_level = int8(head[1], no, "max level")?;
+    let live: Vec<u32> = {
+        let alive = map.live();
+        (0..map.capacity).filter(|&d| alive[d as usize]).collect()
+    };
+    let live_count = int(head[2], no, "level records")?;
+    if live_count != live.len() as u64 {
+        let (what, limit) = ("level records (one per live dart)", live.len() as u64);
+        return Err(StoreError::BadCount { at: Where::Line(no), what, count: live_count, limit });
+    }
+    let np = int(head[3], no, "points")?;
+    if np > lines.remaining() as u64 {
+        let limit = lines.remaining() as u64;
+        return Err(StoreError::BadCount { at: Where::Line(no), what: "points", count: np, limit });
+    }
+    let mut darts = vec![DartLevels::default(); map.capacity as usize];
+    for &d in &live {
+        let (no, t) = lines.next("l", &format!("the level line \"l {d} …\""))?;
+        darts[d as usize] = level_line(&t, no, d, map)?;
+    }
+    let mut points = Vec::with_capacity(np as usize);
+    for k in 0..np as usize {
+        let (no, t) = record(lines, "p", k, 4)?;
+        let xs = floats_of(&t[2..], no, "point", k)?;
+        points.push([xs[0], xs[1], xs[2]]);
+    }
+    Ok(LevelParts { max_level, darts, points })
+}
+
+/// `l D LEVEL MUA MUF MUT FLAT H (LEVEL J OLD){H}` for live dart `d`.
+fn level_line(t: &[&str], no: usize, d: u32, map: &RawMap) -> Result<DartLevels, StoreError> {
+    if t.len() < 8 {
+        return Err(syntax(no, format!("level line: expected at least 8 fields, found {}", t.len())));
+    }
+    if int(t[1], no, "dart id")? != u64::from(d) {
+        let message = format!("expected the level line of dart {d} (one per live dart, ids increasing)");
+        return Err(StoreError::Inconsistent { at: Where::Line(no), message });
+    }
+    let h = int(t[7], no, "history length")?;
+    if h.checked_mul(3).and_then(|x| x.checked_add(8)) != Some(t.len() as u64) {
+        return Err(syntax(no, format!("level line: history length {h} but {} fields follow", t.len() - 8)));
+    }
+    let mu = Mu { edge: int8(t[3], no, "μa")?, face: int8(t[4], no, "μf")?, tet: int8(t[5], no, "μt")? };
+    let mut rec = DartLevels { level: int8(t[2], no, "dart level")?, mu, flat: flag(t[6], no)?, history: Vec::new() };
+    for e in t[8..].chunks_exact(3) {
+        let entry = HistoryEntry {
+            level: int8(e[0], no, "history level")?,
+            j: int8(e[1], no, "history j")?,
+            old: int32(e[2], no, "history old")?,
+        };
+        if usize::from(entry.j) > map.dimension {
+            return Err(syntax(no, format!("history: α{} is above the dimension {}", entry.j, map.dimension)));
+        }
+        if entry.old >= map.capacity {
+            let (dart, capacity) = (entry.old.into(), map.capacity.into());
+            return Err(StoreError::DartOutOfRange { at: Where::Line(no), dart, capacity });
+        }
+        rec.history.push(entry);
+    }
+    Ok(rec)
 }

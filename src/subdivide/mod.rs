@@ -20,14 +20,22 @@
 //! # Laws checked by [`LeveledMap::check_levels`]
 //! μt ≤ μf ≤ μa for every dart (Theorem 1 and its corollary); μa constant on edges, μf on faces,
 //! μt on volumes of the finest level; dart levels ≤ max level.
+//!
+//! # Saving
+//! [`LeveledMap::to_parts`] exports every record as plain data ([`LevelParts`]);
+//! [`LeveledMap::from_parts`] rebuilds a leveled map from its finest map and those records after
+//! checking them (lengths, level bounds, well-formed histories, every level's links closed and
+//! involutive, then [`LeveledMap::check_all`]). `store::save_leveled` / `load_leveled` use them.
 
 mod cut;
 pub mod fuzz;
 mod ops;
+mod parts;
 mod region;
 mod tet;
 mod tri;
 
+pub use parts::{record_errors, DartLevels, HistoryEntry, LevelParts, LevelPartsError};
 pub use region::{tet_distance, Refinement, TetMasses};
 
 use crate::gmap::{AlphaMask, DartId, GMap, InvariantViolation};

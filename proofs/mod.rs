@@ -9,6 +9,8 @@
 //!   some law is broken, and must name a law that is broken, with a true witness.
 //! * [`cut_dissociation`]: every order of dissociating every subset of inner faces (and removing
 //!   tets) on two tets, a closed fan of three and the Kuhn cube k = 1, every cut law checked.
+//! * [`subdivision`]: every sequence of a few edge splits, triangle 1→4 and tet 1→8 (one dart per
+//!   cell, levels ≤ 2) on one or two triangles and one or two tets, every level law checked.
 //! * [`harnesses`]: Kani proof harnesses that run here as seeded randomized tests through
 //!   [`kani_shim`], and unchanged under `cargo kani --tests`.
 //!
@@ -23,3 +25,4 @@ mod harnesses;
 mod invalid;
 mod kani_shim;
 mod laws;
+mod subdivision;

@@ -224,7 +224,13 @@ fn masses_total(m: &LeveledMap<3>) -> Result<f64, String> {
     Ok(masses.total(m))
 }
 
-fn check_accepted<const N: usize>(m: &LeveledMap<N>, chi: i64) -> Result<(), String> {
+/// The laws after an accepted operation: [`LeveledMap::check_all`], level k isomorphic to the
+/// finest map, the Euler characteristic of every level equal to `chi` (the input's). Shared by the
+/// fuzz decoder and the exhaustive checks of `proofs/`. O(k · capacity · n²).
+///
+/// # Errors
+/// The first law broken, as a message.
+pub fn check_accepted<const N: usize>(m: &LeveledMap<N>, chi: i64) -> Result<(), String> {
     m.check_all().map_err(|e| e.to_string())?;
     let top = m.level(m.max_level()).map_err(|e| e.to_string())?;
     if !top.map.is_isomorphic(m.map()) {
@@ -239,7 +245,13 @@ fn check_accepted<const N: usize>(m: &LeveledMap<N>, chi: i64) -> Result<(), Str
     Ok(())
 }
 
-fn check_refused<const N: usize>(
+/// The laws after a refused operation: `e` is a documented refusal for a live dart at a valid level
+/// and the map is unchanged (same darts, same maximum level, isomorphic) and still valid. Shared
+/// by the fuzz decoder and `proofs/`. O(k · capacity · n²).
+///
+/// # Errors
+/// The first law broken, as a message.
+pub fn check_refused<const N: usize>(
     before: &LeveledMap<N>,
     after: &LeveledMap<N>,
     e: &SubdivideError,

@@ -21,12 +21,16 @@
 //! μt ≤ μf ≤ μa for every dart (Theorem 1 and its corollary); μa constant on edges, μf on faces,
 //! μt on volumes of the finest level; dart levels ≤ max level.
 
+mod conform;
+mod cut_error;
 pub mod fuzz;
 mod ops;
 mod region;
 mod tet;
 mod tri;
 
+pub use conform::{triangulate_polygon, ConformingMesh};
+pub use cut_error::{cut_error, measure_cut, CutSurfaceError};
 pub use region::{tet_distance, Refinement, TetMasses};
 
 use crate::gmap::{AlphaMask, DartId, GMap, InvariantViolation};
@@ -111,6 +115,10 @@ pub enum SubdivideError {
     /// The edge has an α0-free dart: it has no second vertex to split between.
     #[error("the edge of {0} is open (α0-free)")]
     OpenEdge(DartId),
+    /// The conforming closure met a face polygon it cannot triangulate (zero area or a reflex
+    /// corner) or a cone tet of zero volume, at the face or volume of this dart.
+    #[error("the face or volume of {0} is degenerate: no conforming triangulation")]
+    DegenerateFace(DartId),
 }
 
 /// Violations of the level laws found by [`LeveledMap::check_levels`] and [`LeveledMap::check_all`].

@@ -19,9 +19,10 @@
 //!   and the centroid is strictly inside, so every cone tet has a positive volume, and the cones
 //!   tile the tet exactly.
 //! - A face polygon is shared by the two volumes on its sides (it is one face cell of the finest
-//!   map); it is triangulated **once** (cached by face id) and both sides use the same triangles,
-//!   so neighbouring tets meet along identical triangles: the mesh is conforming. A plain tet's
-//!   face is a triangle, triangulated as itself, so the plain tets match too.
+//!   map); it is triangulated **once** (cached by face id, from its vertex cycle in a canonical
+//!   order: smallest vertex id first, towards its smaller neighbour) and both sides use the same
+//!   triangles, so neighbouring tets meet along identical triangles: the mesh is conforming. A
+//!   plain tet's face is a triangle, triangulated as itself, so the plain tets match too.
 //!
 //! This is not the classical red-green closure (a table of green splits of a tet by the pattern of
 //! its split edges, without new vertices). It adds one vertex per closed tet, but it is valid for
@@ -32,6 +33,8 @@
 //! O(darts) to walk the volumes and faces, plus O(k³) per face polygon of k vertices for the ear
 //! clipping (k is 3 for a plain face and small otherwise). Output: Σ_{closed tets} Σ_faces (k − 2)
 //! cone tets, one Steiner point per closed tet.
+
+use std::collections::hash_map::Entry;
 
 use rustc_hash::{FxHashMap, FxHashSet};
 
@@ -152,6 +155,19 @@ pub fn triangulate_polygon(cycle: &[u32], points: &[[f64; 3]]) -> Option<Vec<[u3
     Some(out)
 }
 
+/// The cycle rotated to start at its smallest vertex id and turned towards the smaller of that
+/// vertex's two neighbours, so that a face gets the same triangulation whichever side and dart it
+/// is read from. O(k).
+fn canonical_cycle(mut cycle: Vec<u32>) -> Vec<u32> {
+    if let Some(i) = cycle.iter().enumerate().min_by_key(|&(_, &v)| v).map(|(i, _)| i) {
+        cycle.rotate_left(i);
+    }
+    if cycle.len() > 2 && cycle[cycle.len() - 1] < cycle[1] {
+        cycle[1..].reverse();
+    }
+    cycle
+}
+
 impl LeveledMap<3> {
     /// A conforming tetrahedral mesh of the finest level (module docs of `conform`): tets without
     /// inserted vertices as they are, every other volume coned from a Steiner point at its
@@ -197,12 +213,14 @@ impl LeveledMap<3> {
             out.points.push(centroid);
             for f in self.face_sides(d) {
                 let id = self.map.cell_id(2, f).0;
-                if !face_tris.contains_key(&id) {
-                    let cycle = self.face_cycle(f)?;
-                    let tris = triangulate_polygon(&cycle, &out.points).ok_or(SubdivideError::DegenerateFace(f))?;
-                    face_tris.insert(id, tris);
-                }
-                for &[a, b, c] in &face_tris[&id] {
+                let tris = match face_tris.entry(id) {
+                    Entry::Occupied(e) => e.into_mut(),
+                    Entry::Vacant(e) => {
+                        let cycle = canonical_cycle(self.face_cycle(f)?);
+                        e.insert(triangulate_polygon(&cycle, &out.points).ok_or(SubdivideError::DegenerateFace(f))?)
+                    }
+                };
+                for &[a, b, c] in tris.iter() {
                     out.tets.push(self.oriented([a, b, c, apex], &out.points, f)?);
                 }
             }

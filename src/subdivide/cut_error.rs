@@ -39,7 +39,8 @@ pub fn measure_cut(body: &Body, incision: &Incision, plane: &Plane, zone: Option
     let dist = |x: [f64; 3]| ((0..3).map(|k| (x[k] - plane.point[k]) * plane.normal[k]).sum::<f64>() / len).abs();
     let (mut measured, mut max, mut sum) = (0usize, 0.0f64, 0.0);
     for dis in &incision.dissociations {
-        let mut ids: Vec<_> = map.orbit(dis.dart, AlphaMask::of(&[0, 1])).into_iter().map(|x| map.vertex_id(x)).collect();
+        let mut ids: Vec<_> =
+            map.orbit(dis.dart, AlphaMask::of(&[0, 1])).into_iter().map(|x| map.vertex_id(x)).collect();
         ids.sort_unstable();
         ids.dedup();
         let pts: Vec<[f64; 3]> = ids.iter().map(|&v| mech.position[v]).collect();
@@ -80,4 +81,3 @@ pub fn cut_error(body: &mut Body, plane: &Plane, zone: Option<([f64; 3], f64)>) 
     let incision = incise_plane(body, plane)?;
     Ok(measure_cut(body, &incision, plane, zone))
 }
-

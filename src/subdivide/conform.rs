@@ -184,18 +184,19 @@ impl LeveledMap<3> {
     /// use topomech::generate::kuhn_cube;
     /// use topomech::subdivide::{LeveledMap, TetMasses};
     /// use topomech::GMap;
-    /// let (points, tets) = kuhn_cube(1);
+    /// // [0, 2]³ in 8 unit cells; the ball refines the 6 tets of the first cell only.
+    /// let (points, tets) = kuhn_cube(2);
     /// let (map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
     /// let mut m = LeveledMap::new(map, points);
     /// let mut masses = TetMasses::from_density(&m, 1.0).unwrap();
-    /// m.refine_around([0.0, 0.0, 0.0], 0.1, 1, &mut masses).unwrap();
+    /// m.refine_around([0.5, 0.5, 0.5], 0.1, 1, &mut masses).unwrap();
     /// let c = m.conforming_tets().unwrap();
     /// assert!(c.closed > 0);
     /// let v: f64 = c.tets.iter().map(|t| {
     ///     let p = t.map(|v| c.points[v as usize]);
     ///     topomech::mesh::signed_volume(p[0], p[1], p[2], p[3])
     /// }).sum();
-    /// assert!((v - 1.0).abs() < 1e-12);
+    /// assert!((v - 8.0).abs() < 1e-12);
     /// ```
     pub fn conforming_tets(&self) -> Result<ConformingMesh, SubdivideError> {
         let mut out = ConformingMesh { points: self.points.clone(), ..ConformingMesh::default() };

@@ -1,14 +1,19 @@
-//! `topomech refine MESH --around X,Y,Z --radius R --levels L [--density D] [--out DIR] [--json]`:
+//! `topomech refine MESH --around X,Y,Z --radius R --levels L [--conforming]
+//! [--cut PX,PY,PZ,NX,NY,NZ] [--density D] [--out DIR] [--json]`:
 //! adaptive 1→8 refinement of the tets meeting a ball, level by level (issue 5, seed 004), with
 //! tet masses shared among the children by rest volume; every law checked at the end.
+//! `--conforming` builds the conforming closure (a tet mesh without hanging vertices) and a
+//! mechanical body on it; `--cut` also incises the unrefined and the refined bodies along the
+//! plane and reports the distance of the cut faces to the plane inside the zone, before and after.
 
 use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 
+use topomech::cut::Plane;
 use topomech::load;
-use topomech::mechanics::{Material, Vec3};
-use topomech::subdivide::{LevelError, LeveledMap, TetMasses};
+use topomech::mechanics::{check_conservation, Body, Material, Vec3};
+use topomech::subdivide::{cut_error, ConformingMesh, CutSurfaceError, LevelError, LeveledMap, TetMasses};
 use topomech::vtk::Frame;
 
 use super::{print_warnings, CliError};
@@ -30,7 +35,16 @@ pub struct RefineArgs {
     /// Mass density ρ (tet mass = ρ · volume).
     #[arg(long, default_value_t = Material::default().density)]
     pub density: f64,
-    /// Write `refined.vtu` (the finest level) into this directory.
+    /// Build the conforming closure (tets only, no hanging vertex) and a body on it.
+    #[arg(long)]
+    pub conforming: bool,
+    /// Incise the unrefined and the (conforming) refined body along the plane `PX,PY,PZ,NX,NY,NZ`
+    /// and report the cut error against the plane inside the zone, before and after (implies
+    /// `--conforming`).
+    #[arg(long, value_parser = parse_plane, allow_hyphen_values = true)]
+    pub cut: Option<[f64; 6]>,
+    /// Write `refined.vtu` (the finest level; with `--conforming` also `conforming.vtu`) into this
+    /// directory.
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Print one JSON object (keys of [`RefineJson`]).
@@ -63,6 +77,33 @@ pub struct RefineJson {
     pub total_vertex_mass_after: f64,
     /// Wall time of the refinement in milliseconds.
     pub refine_ms: f64,
+    /// Tets of the conforming closure (`--conforming` or `--cut`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub conforming_tets: Option<usize>,
+    /// Faces the incision dissociated in the unrefined body (`--cut`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cut_faces_before: Option<usize>,
+    /// Faces the incision dissociated in the conforming refined body (`--cut`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cut_faces_after: Option<usize>,
+    /// Cut faces with their centroid in the zone, unrefined body (`--cut`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cut_zone_faces_before: Option<usize>,
+    /// Cut faces with their centroid in the zone, refined body (`--cut`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cut_zone_faces_after: Option<usize>,
+    /// Largest distance to the plane of a vertex of a cut face in the zone, unrefined (`--cut`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cut_error_max_before: Option<f64>,
+    /// The same on the refined body (`--cut`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cut_error_max_after: Option<f64>,
+    /// Mean over the cut faces in the zone of their mean vertex distance to the plane, unrefined.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cut_error_mean_before: Option<f64>,
+    /// The same on the refined body (`--cut`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cut_error_mean_after: Option<f64>,
 }
 
 fn parse_point(s: &str) -> Result<Vec3, String> {
@@ -74,6 +115,25 @@ fn parse_point(s: &str) -> Result<Vec3, String> {
         Err(e) => Err(format!("bad number {t:?}: {e}")),
     };
     Ok([p(x)?, p(y)?, p(z)?])
+}
+
+fn parse_plane(s: &str) -> Result<[f64; 6], String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    if parts.len() != 6 {
+        return Err(format!("expected PX,PY,PZ,NX,NY,NZ, got {s:?}"));
+    }
+    let mut out = [0.0; 6];
+    for (o, t) in out.iter_mut().zip(&parts) {
+        *o = match t.trim().parse::<f64>() {
+            Ok(v) if v.is_finite() => v,
+            Ok(v) => return Err(format!("coordinate {v} is not finite")),
+            Err(e) => return Err(format!("bad number {t:?}: {e}")),
+        };
+    }
+    if out[3..].iter().all(|&c| c == 0.0) {
+        return Err(format!("the normal of {s:?} is zero"));
+    }
+    Ok(out)
 }
 
 fn other(msg: String) -> CliError {
@@ -96,15 +156,34 @@ pub fn run(args: RefineArgs) -> Result<(), CliError> {
     }
     let loaded = load::load_tet_map(&args.mesh)?;
     print_warnings(&loaded);
+    let material = Material { density: args.density, ..Material::default() };
+    let before_cut = match args.cut {
+        Some(plane) => Some(cut_body(&loaded.mesh.points, &loaded.mesh.tets, material, plane, &args, "unrefined")?),
+        None => None,
+    };
     let mut m = LeveledMap::new(loaded.map, loaded.mesh.points);
     let mut masses = TetMasses::from_density(&m, args.density).map_err(|e| other(e.to_string()))?;
     let start = Instant::now();
     let refinement = m.refine_around(args.around, args.radius, args.levels, &mut masses);
     let refine_ms = start.elapsed().as_secs_f64() * 1e3;
     let refinement = refinement.map_err(|e| other(format!("{}: refinement refused: {e}", args.mesh.display())))?;
-    let report = report(&m, &masses, &refinement, refine_ms)?;
+    let mut report = report(&m, &masses, &refinement, refine_ms)?;
+    let closure = if args.conforming || args.cut.is_some() {
+        let c = m.conforming_tets().map_err(|e| other(format!("{}: conforming closure: {e}", args.mesh.display())))?;
+        report.conforming_tets = Some(c.tets.len());
+        Some(c)
+    } else {
+        None
+    };
+    if let (Some(plane), Some(c), Some(before)) = (args.cut, &closure, before_cut) {
+        let after = cut_body(&c.points, &c.tets, material, plane, &args, "refined")?;
+        fill_cut(&mut report, &before, &after);
+    }
     if let Some(dir) = &args.out {
         write_vtu(&m, dir)?;
+        if let Some(c) = &closure {
+            write_conforming(c, dir)?;
+        }
     }
     let mut out = std::io::stdout().lock();
     if args.json {
@@ -118,6 +197,39 @@ pub fn run(args: RefineArgs) -> Result<(), CliError> {
         Ok(()) => Ok(()),
         Err(e) => Err(other(format!("{}: the refined map breaks a law (a topomech bug): {e}", args.mesh.display()))),
     }
+}
+
+/// Builds a body on `tets`, incises it along `plane` and measures the cut in the zone of `args`;
+/// the body's map and conservation laws are checked after the cut.
+fn cut_body(
+    points: &[Vec3],
+    tets: &[[u32; 4]],
+    material: Material,
+    plane: [f64; 6],
+    args: &RefineArgs,
+    what: &str,
+) -> Result<CutSurfaceError, CliError> {
+    let name = args.mesh.display();
+    let (mut body, _) = Body::from_tets(points, tets, material)
+        .map_err(|e| other(format!("{name}: cannot build the {what} body: {e}")))?;
+    let plane = Plane { point: [plane[0], plane[1], plane[2]], normal: [plane[3], plane[4], plane[5]] };
+    let e = cut_error(&mut body, &plane, Some((args.around, args.radius)))
+        .map_err(|e| other(format!("{name}: cutting the {what} body: {e}")))?;
+    body.map().validate().map_err(|e| other(format!("{name}: the cut {what} map is invalid (a bug): {e}")))?;
+    check_conservation(body.map(), body.attrs())
+        .map_err(|e| other(format!("{name}: the cut {what} body breaks a conservation law (a bug): {e}")))?;
+    Ok(e)
+}
+
+fn fill_cut(r: &mut RefineJson, before: &CutSurfaceError, after: &CutSurfaceError) {
+    r.cut_faces_before = Some(before.faces);
+    r.cut_faces_after = Some(after.faces);
+    r.cut_zone_faces_before = Some(before.measured);
+    r.cut_zone_faces_after = Some(after.measured);
+    r.cut_error_max_before = Some(before.max);
+    r.cut_error_max_after = Some(after.max);
+    r.cut_error_mean_before = Some(before.mean);
+    r.cut_error_mean_after = Some(after.mean);
 }
 
 fn report(
@@ -150,6 +262,15 @@ fn report(
         total_mass_after: r.total_mass_after,
         total_vertex_mass_after: vertex.iter().sum(),
         refine_ms,
+        conforming_tets: None,
+        cut_faces_before: None,
+        cut_faces_after: None,
+        cut_zone_faces_before: None,
+        cut_zone_faces_after: None,
+        cut_error_max_before: None,
+        cut_error_max_after: None,
+        cut_error_mean_before: None,
+        cut_error_mean_after: None,
     })
 }
 
@@ -165,7 +286,30 @@ fn write_table(out: &mut dyn Write, r: &RefineJson) -> std::io::Result<()> {
         "  {:<26}{:.9} -> {:.9} (relative {residual:.1e})",
         "total mass", r.total_mass_before, r.total_mass_after
     )?;
-    writeln!(out, "  {:<26}{:.3} ms", "refine time", r.refine_ms)
+    writeln!(out, "  {:<26}{:.3} ms", "refine time", r.refine_ms)?;
+    if let Some(n) = r.conforming_tets {
+        writeln!(out, "  {:<26}{n}", "conforming tets")?;
+    }
+    if let (Some(fb), Some(fa)) = (r.cut_faces_before, r.cut_faces_after) {
+        let (zb, za) = (r.cut_zone_faces_before.unwrap_or(0), r.cut_zone_faces_after.unwrap_or(0));
+        writeln!(out, "  {:<26}{fb} -> {fa} (in the zone {zb} -> {za})", "cut faces")?;
+        let f = |x: Option<f64>| x.unwrap_or(f64::NAN);
+        writeln!(
+            out,
+            "  {:<26}max {:.6} -> {:.6}, mean {:.6} -> {:.6}",
+            "cut error in the zone",
+            f(r.cut_error_max_before),
+            f(r.cut_error_max_after),
+            f(r.cut_error_mean_before),
+            f(r.cut_error_mean_after)
+        )?;
+    }
+    Ok(())
+}
+
+fn write_conforming(c: &ConformingMesh, dir: &std::path::Path) -> Result<(), CliError> {
+    let frame = Frame { points: &c.points, tets: &c.tets, vectors: Vec::new() };
+    frame.write(&dir.join("conforming.vtu")).map_err(|e| other(e.to_string()))
 }
 
 fn write_vtu(m: &LeveledMap<3>, dir: &std::path::Path) -> Result<(), CliError> {

@@ -27,7 +27,9 @@
 //! checking them (lengths, level bounds, well-formed histories, every level's links closed and
 //! involutive, then [`LeveledMap::check_all`]). `store::save_leveled` / `load_leveled` use them.
 
+mod conform;
 mod cut;
+mod cut_error;
 pub mod fuzz;
 mod ops;
 mod parts;
@@ -35,6 +37,8 @@ mod region;
 mod tet;
 mod tri;
 
+pub use conform::{triangulate_polygon, ConformingMesh};
+pub use cut_error::{cut_error, measure_cut, CutSurfaceError};
 pub use parts::{record_errors, DartLevels, HistoryEntry, LevelParts, LevelPartsError};
 pub use region::{tet_distance, Refinement, TetMasses};
 
@@ -123,6 +127,10 @@ pub enum SubdivideError {
     /// The edge has an α0-free dart: it has no second vertex to split between.
     #[error("the edge of {0} is open (α0-free)")]
     OpenEdge(DartId),
+    /// The conforming closure met a face polygon it cannot triangulate (zero area or a reflex
+    /// corner) or a cone tet of zero volume, at the face or volume of this dart.
+    #[error("the face or volume of {0} is degenerate: no conforming triangulation")]
+    DegenerateFace(DartId),
 }
 
 /// Violations of the level laws found by [`LeveledMap::check_levels`] and [`LeveledMap::check_all`].

@@ -29,6 +29,18 @@ use std::fmt;
 pub const DEGENERACY_TOLERANCE: f64 = 1e-12;
 
 /// A tetrahedral volume mesh with 0-based indices into `points`.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mesh::TetMesh;
+///
+/// let unit = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+/// let mesh = TetMesh { points: unit, tets: vec![[0, 1, 2, 3]], ..Default::default() };
+/// assert!(mesh.check().unwrap().is_clean());
+/// assert!((mesh.total_volume() - 1.0 / 6.0).abs() < 1e-15);
+/// assert_eq!((mesh.edge_count(), mesh.boundary_face_count()), (6, 4));
+/// ```
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct TetMesh {
     /// Point coordinates.
@@ -44,6 +56,17 @@ pub struct TetMesh {
 }
 
 /// A triangle surface mesh with 0-based indices into `points`.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mesh::TriMesh;
+///
+/// let points = vec![[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0], [2.0, 2.0, 0.0]];
+/// let mesh = TriMesh { points, triangles: vec![[0, 1, 2], [1, 3, 2]] };
+/// assert!(mesh.check().unwrap().is_clean());
+/// assert!((mesh.total_area() - 4.0).abs() < 1e-12);
+/// ```
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct TriMesh {
     /// Point coordinates.
@@ -76,6 +99,17 @@ impl fmt::Display for CellKind {
 /// A defect that makes a mesh unusable (see the table in the [module docs](self)).
 ///
 /// Cell ids are 0-based positions in the cell list, point ids 0-based positions in `points`.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mesh::{MeshError, TetMesh};
+///
+/// let mesh = TetMesh { points: vec![[0.0; 3]; 4], tets: vec![[0, 1, 2, 2]], ..Default::default() };
+/// assert!(matches!(mesh.check(), Err(MeshError::RepeatedVertex { vertex: 2, .. })));
+/// let empty = TetMesh::default();
+/// assert!(matches!(empty.check(), Err(MeshError::Empty(_))));
+/// ```
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MeshError {
     /// The mesh has no cell of the kind that makes it (no tetrahedra / no triangles).
@@ -204,11 +238,31 @@ fn norm(a: [f64; 3]) -> f64 {
 ///
 /// Positive when `d` lies on the side of the plane `(a, b, c)` towards which
 /// `(b - a) x (c - a)` points. O(1).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mesh::signed_volume;
+///
+/// let (o, x, y, z) = ([0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]);
+/// assert!((signed_volume(o, x, y, z) - 1.0 / 6.0).abs() < 1e-15);
+/// assert!((signed_volume(o, y, x, z) + 1.0 / 6.0).abs() < 1e-15); // swapping two corners flips the sign
+/// assert_eq!(signed_volume(o, x, y, [1.0, 1.0, 0.0]), 0.0); // flat
+/// ```
 pub fn signed_volume(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> f64 {
     dot(cross(sub(b, a), sub(c, a)), sub(d, a)) / 6.0
 }
 
 /// Area of the triangle `(a, b, c)` (always `>= 0`). O(1).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mesh::triangle_area;
+///
+/// assert_eq!(triangle_area([0.0; 3], [3.0, 0.0, 0.0], [0.0, 4.0, 0.0]), 6.0);
+/// assert_eq!(triangle_area([0.0; 3], [1.0; 3], [2.0; 3]), 0.0); // collinear
+/// ```
 pub fn triangle_area(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
     0.5 * norm(cross(sub(b, a), sub(c, a)))
 }
@@ -301,6 +355,19 @@ impl TetMesh {
     /// [`MeshError::Empty`], [`MeshError::TooManyPoints`], [`MeshError::TagCountMismatch`],
     /// [`MeshError::NonFiniteCoordinate`], [`MeshError::IndexOutOfRange`],
     /// [`MeshError::RepeatedVertex`] (for tets and for `boundary_triangles`).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mesh::TetMesh;
+    ///
+    /// // The second tet lists its corners in the opposite orientation.
+    /// let unit = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0; 3]];
+    /// let mesh = TetMesh { points: unit, tets: vec![[0, 1, 2, 3], [2, 1, 3, 4]], ..Default::default() };
+    /// let report = mesh.check().unwrap();
+    /// assert_eq!(report.inverted_tets, vec![1]);
+    /// assert!(!report.is_clean());
+    /// ```
     pub fn check(&self) -> Result<MeshReport, MeshError> {
         if self.tets.is_empty() {
             return Err(MeshError::Empty(CellKind::Tet));
@@ -366,6 +433,17 @@ impl TetMesh {
     ///
     /// Computed from sorted 64-bit keys, independently of any map structure, so tests can use
     /// it as an oracle.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mesh::TetMesh;
+    ///
+    /// let mesh = TetMesh { points: vec![[0.0; 3]; 5], tets: vec![[0, 1, 2, 3], [4, 2, 1, 0]], ..Default::default() };
+    /// let edges = mesh.edges();
+    /// assert_eq!(edges.len(), 9); // 6 + 6 − 3 shared
+    /// assert!(edges.windows(2).all(|w| w[0] < w[1]) && edges.iter().all(|e| e[0] < e[1]));
+    /// ```
     pub fn edges(&self) -> Vec<[u32; 2]> {
         let mut keys: Vec<u64> = Vec::with_capacity(6 * self.tets.len());
         for &[a, b, c, d] in &self.tets {
@@ -394,6 +472,20 @@ impl TetMesh {
     ///
     /// Computed from sorted keys, independently of any map structure. A face shared by three
     /// or more tets (non-manifold) is not reported as boundary.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mesh::{signed_volume, TetMesh};
+    ///
+    /// let points = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mesh = TetMesh { points: points.clone(), tets: vec![[0, 1, 2, 3]], ..Default::default() };
+    /// let faces = mesh.boundary_triangles_of_tets();
+    /// assert_eq!(faces.len(), 4);
+    /// // Every face's normal points out: the centre lies behind each one.
+    /// let p = |i: u32| points[i as usize];
+    /// assert!(faces.iter().all(|f| signed_volume(p(f[0]), p(f[1]), p(f[2]), [0.25; 3]) < 0.0));
+    /// ```
     pub fn boundary_triangles_of_tets(&self) -> Vec<[u32; 3]> {
         let mut faces: Vec<([u32; 3], [u32; 3])> = Vec::with_capacity(4 * self.tets.len());
         for &t in &self.tets {
@@ -444,6 +536,19 @@ impl TetMesh {
     /// point). `node_tags` follow their points; a boundary triangle with a dropped corner is
     /// dropped. O(P + T + B). Panics if an index is out of range (call [`TetMesh::check`]
     /// first).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mesh::TetMesh;
+    ///
+    /// let points = vec![[9.0; 3], [0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mesh = TetMesh { points, tets: vec![[1, 2, 3, 4]], ..Default::default() };
+    /// let (small, old_to_new) = mesh.compact();
+    /// assert_eq!(small.tets, vec![[0, 1, 2, 3]]);
+    /// assert_eq!(old_to_new, vec![u32::MAX, 0, 1, 2, 3]);
+    /// assert_eq!(small.total_volume(), mesh.total_volume());
+    /// ```
     pub fn compact(&self) -> (TetMesh, Vec<u32>) {
         let mut used = vec![false; self.points.len()];
         for t in &self.tets {

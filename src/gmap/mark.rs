@@ -3,6 +3,22 @@
 use super::{DartId, GMap};
 
 /// A set of darts as a bit set with a count. Grows on demand. Insert, remove and test are O(1).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::gmap::DartSet;
+/// use topomech::DartId;
+///
+/// let mut set = DartSet::with_capacity(10);
+/// assert!(set.insert(DartId(3)));
+/// assert!(!set.insert(DartId(3))); // already there
+/// assert!(set.insert(DartId(500))); // grows on demand
+/// assert_eq!(set.len(), 2);
+/// assert!(set.remove(DartId(3)) && !set.contains(DartId(3)));
+/// set.clear();
+/// assert!(set.is_empty());
+/// ```
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct DartSet {
     bits: Vec<u64>,
@@ -70,6 +86,21 @@ impl DartSet {
 ///
 /// Give it back with [`GMap::free_mark`] once every dart is unmarked again; a mark released or
 /// dropped while darts are still marked is a bug in the caller's algorithm and asserts.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::{AlphaMask, GMap};
+///
+/// let (mut map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let d = map.darts().next().unwrap();
+/// let mut mark = map.reserve_mark();
+/// map.mark_orbit(&mut mark, d, AlphaMask::cell(3, 2));
+/// assert_eq!(mark.count(), 6); // the darts of d's face
+/// assert!(mark.is_marked(d) && !mark.is_marked(map.alpha::<2>(d)));
+/// map.unmark_orbit(&mut mark, d, AlphaMask::cell(3, 2));
+/// map.free_mark(mark); // every dart is unmarked again
+/// ```
 #[derive(Debug)]
 pub struct Mark {
     set: DartSet,
@@ -107,6 +138,20 @@ impl Drop for Mark {
 
 impl<const N: usize> GMap<N> {
     /// Reserves a mark with no dart marked, reusing a released one if any. O(1) amortized.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let (mut map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+    /// let mut mark = map.reserve_mark();
+    /// let d = map.darts().next().unwrap();
+    /// assert!(mark.mark(d));
+    /// assert_eq!(mark.count(), 1);
+    /// assert!(mark.unmark(d));
+    /// map.free_mark(mark);
+    /// ```
     pub fn reserve_mark(&mut self) -> Mark {
         let set = self.mark_pool.pop().unwrap_or_else(|| DartSet::with_capacity(self.capacity()));
         debug_assert!(set.is_empty());

@@ -35,6 +35,20 @@ pub enum VtkError {
 }
 
 /// One frame: points, tets and named per-point vectors.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::vtk::{Frame, VtkError};
+///
+/// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+/// let velocity = [[0.0, 0.0, -1.0]; 4];
+/// let frame = Frame { points: &points, tets: &[[0, 1, 2, 3]], vectors: vec![("velocity", &velocity[..])] };
+/// let xml = frame.to_vtu().unwrap();
+/// assert!(xml.contains("NumberOfPoints=\"4\" NumberOfCells=\"1\"") && xml.contains("Name=\"velocity\""));
+/// let bad = Frame { vectors: vec![("velocity", &velocity[..3])], ..frame };
+/// assert!(matches!(bad.to_vtu(), Err(VtkError::BadArray { got: 3, expected: 4, .. })));
+/// ```
 #[derive(Clone, Debug, Default)]
 pub struct Frame<'a> {
     /// Point coordinates.
@@ -106,6 +120,22 @@ fn write_file(path: &Path, text: &str) -> Result<(), VtkError> {
 }
 
 /// A `.pvd` collection being written: frames are recorded as they are saved.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::vtk::{Frame, Series};
+///
+/// let dir = std::env::temp_dir().join(format!("topomech-doc-vtk-{}", std::process::id()));
+/// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+/// let frame = Frame { points: &points, tets: &[[0, 1, 2, 3]], vectors: vec![] };
+/// let mut series = Series::new(&dir, "run").unwrap();
+/// assert!(series.push(0.0, &frame).unwrap().ends_with("run_000000.vtu"));
+/// series.push(0.1, &frame).unwrap();
+/// let pvd = std::fs::read_to_string(series.pvd_path()).unwrap();
+/// std::fs::remove_dir_all(&dir).unwrap();
+/// assert_eq!(pvd.matches("<DataSet").count(), 2);
+/// ```
 #[derive(Clone, Debug)]
 pub struct Series {
     dir: PathBuf,
@@ -155,6 +185,22 @@ impl Series {
 
 /// The tets of a body as four vertex ids each (one per volume orbit), ordered so that their rest
 /// signed volume is positive. O(darts).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Material};
+/// use topomech::mesh::signed_volume;
+/// use topomech::vtk::body_tets;
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let out = body_tets(&body);
+/// assert_eq!(out.len(), 6);
+/// let p = |v: u32| points[v as usize];
+/// assert!(out.iter().all(|t| signed_volume(p(t[0]), p(t[1]), p(t[2]), p(t[3])) > 0.0));
+/// ```
 pub fn body_tets(body: &Body) -> Vec<[u32; 4]> {
     let map = body.map();
     let rest = &body.attrs().rest_position;

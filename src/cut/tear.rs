@@ -163,6 +163,23 @@ fn face_normal(body: &Body, d: DartId) -> Vec3 {
 /// # Errors
 /// [`CutError::NoSuchVertex`] (no live dart carries `v`; body unchanged); [`CutError::Body`] is a
 /// bug. A vertex with no inner face is left as is (an empty fan).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::tear_vertex;
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{check_conservation, Body, Material};
+/// use topomech::CellId;
+///
+/// // Tear the centre vertex (1, 1, 1) of the 2×2×2 cube across the x axis.
+/// let (points, tets) = kuhn_cube(2);
+/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let tear = tear_vertex(&mut body, CellId(13), [1.0, 0.0, 0.0], None).unwrap();
+/// assert!(tear.split && !tear.fan.is_empty());
+/// assert!(body.map().count_cells().0[0] > 27);
+/// check_conservation(body.map(), body.attrs()).unwrap();
+/// ```
 pub fn tear_vertex(body: &mut Body, v: CellId, direction: Vec3, hint: Option<DartId>) -> Result<Tear, CutError> {
     let map = body.map();
     let on_v = |d: DartId| map.contains(d) && map.vertex_id(d) == v;

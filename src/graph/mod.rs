@@ -92,6 +92,19 @@ pub enum Multiplicity {
 /// The incidences between k-cells and (k+1)-cells of `map`: ((k-cell id, (k+1)-cell id) →
 /// multiplicity), i.e. the number of orbits ⟨αj : j ∉ {k, k+1}⟩ carrying both ids. O(darts · n).
 /// Panics if k ≥ n (there is no (k+1)-cell).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::graph::incidences;
+/// use topomech::GMap;
+///
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let vertex_edge = incidences(&map, 0);
+/// assert_eq!(vertex_edge.len(), 12); // 6 edges × 2 ends
+/// assert!(vertex_edge.values().all(|&m| m == 1));
+/// assert_eq!(incidences(&map, 2).len(), 4); // 4 faces on the one volume
+/// ```
 pub fn incidences<const N: usize>(map: &GMap<N>, k: usize) -> BTreeMap<(u32, u32), u32> {
     assert!(k < N, "incidences({k}) of a {N}-map: there are no {}-cells", k + 1);
     let mask = AlphaMask(AlphaMask::all(N).0 & !(1 << k) & !(1 << (k + 1)));
@@ -167,6 +180,17 @@ fn join_through(b: &mut Builder, inc: &BTreeMap<(u32, u32), u32>, end_dim: usize
 
 /// The 1-skeleton: vertices, and one unit of weight per edge joining its two endpoints.
 /// O(darts · n). Panics for N = 0 (not a valid map dimension anyway).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::graph::vertex_edge_graph;
+/// use topomech::GMap;
+///
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let g = vertex_edge_graph(&map);
+/// assert_eq!((g.node_count(), g.edge_count()), (4, 6)); // the complete graph K4
+/// ```
 pub fn vertex_edge_graph<const N: usize>(map: &GMap<N>) -> CellGraph {
     let mut b = Builder::new(map, &[0]);
     let inc = incidences(map, 0);
@@ -176,6 +200,19 @@ pub fn vertex_edge_graph<const N: usize>(map: &GMap<N>) -> CellGraph {
 
 /// The dual graph: n-cells, and one unit of weight per (n−1)-cell lying between two of them.
 /// O(darts · n).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::graph::dual_graph;
+/// use topomech::{generate, GMap};
+///
+/// let (points, tets) = generate::kuhn_cube(1);
+/// let (map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+/// let g = dual_graph(&map);
+/// assert_eq!(g.node_count(), 6); // the tets
+/// assert_eq!(g.edge_count(), 18 - 12); // one per inner face
+/// ```
 pub fn dual_graph<const N: usize>(map: &GMap<N>) -> CellGraph {
     let mut b = Builder::new(map, &[N]);
     let inc = incidences(map, N - 1);
@@ -184,6 +221,18 @@ pub fn dual_graph<const N: usize>(map: &GMap<N>) -> CellGraph {
 }
 
 /// The incidence graph (Hasse diagram with multiplicities) of all cells. O(darts · n²).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::graph::incidence_graph;
+/// use topomech::GMap;
+///
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let g = incidence_graph(&map);
+/// assert_eq!(g.node_count(), 4 + 6 + 4 + 1);
+/// assert_eq!(g.edge_count(), 12 + 12 + 4); // vertex–edge, edge–face, face–volume
+/// ```
 pub fn incidence_graph<const N: usize>(map: &GMap<N>) -> CellGraph {
     let dims: Vec<usize> = (0..=N).collect();
     let mut b = Builder::new(map, &dims);
@@ -208,6 +257,20 @@ pub fn graph_of<const N: usize>(map: &GMap<N>, kind: GraphKind) -> CellGraph {
 /// Whether there is a bijection of nodes preserving dimensions and edges (and, with
 /// [`Multiplicity::Match`], edge weights): `petgraph`'s VF2 with a cheap invariant check first.
 /// Exponential in the worst case; fast on the small and sparse graphs of this study.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::graph::{graph_of, graphs_isomorphic, GraphKind, Multiplicity};
+/// use topomech::GMap;
+///
+/// let (a, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+/// let (b, _) = GMap::<3>::from_tets(5, &[[4, 3, 2, 0], [4, 3, 2, 1]]).unwrap();
+/// let (c, _) = GMap::<3>::from_tets(6, &[[0, 1, 2, 3], [0, 1, 4, 5]]).unwrap();
+/// let g = |m: &GMap<3>| graph_of(m, GraphKind::Incidence);
+/// assert!(graphs_isomorphic(&g(&a), &g(&b), Multiplicity::Match));
+/// assert!(!graphs_isomorphic(&g(&a), &g(&c), Multiplicity::Ignore)); // glued along an edge only
+/// ```
 pub fn graphs_isomorphic(a: &CellGraph, b: &CellGraph, multiplicity: Multiplicity) -> bool {
     if GraphInvariant::of(a, multiplicity) != GraphInvariant::of(b, multiplicity) {
         return false;
@@ -253,6 +316,20 @@ impl GraphInvariant {
 
 /// A cell graph in a canonical-looking, id-free JSON form for snapshots and test vectors: nodes
 /// renumbered by (dimension, id), edges as `[a, b, weight]` with a ≤ b, sorted.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::graph::{graphs_isomorphic, incidence_graph, GraphJson, GraphKind, Multiplicity};
+/// use topomech::GMap;
+///
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let g = incidence_graph(&map);
+/// let json = GraphJson::of(&g, GraphKind::Incidence);
+/// assert_eq!(json.nodes.len(), 15);
+/// let back = json.to_graph().unwrap();
+/// assert!(graphs_isomorphic(&g, &back, Multiplicity::Match));
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct GraphJson {
     /// Which graph.

@@ -104,6 +104,18 @@ pub enum StepError {
 }
 
 /// Parameters of the stepping.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mechanics::{Integrator, StepConfig};
+///
+/// let config = StepConfig::new("rk4".parse::<Integrator>().unwrap(), 1e-3);
+/// assert_eq!(config.integrator, Integrator::Rk4);
+/// assert!(!config.parallel && config.dt == 1e-3);
+/// assert!("leapfrog".parse::<Integrator>().is_err());
+/// assert_eq!(Integrator::Symplectic.name(), "symplectic");
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StepConfig {
     /// The scheme.

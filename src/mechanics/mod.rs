@@ -48,6 +48,18 @@ pub enum SimError {
 }
 
 /// Which vertices to fix, by rest position or id.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mechanics::PinSpec;
+/// use topomech::CellId;
+///
+/// let pins = PinSpec { ids: vec![7], below: Some((2, 0.0)), ..Default::default() };
+/// assert!(pins.pins(CellId(3), [1.0, 1.0, 0.0])); // on the floor
+/// assert!(pins.pins(CellId(7), [1.0, 1.0, 5.0])); // named
+/// assert!(!pins.pins(CellId(3), [1.0, 1.0, 0.5]));
+/// ```
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PinSpec {
     /// Vertex ids (points of the input mesh for a fresh body).
@@ -69,6 +81,26 @@ impl PinSpec {
 
 /// A map-driven simulation: the projection of a body and a stepper that advances the body's own
 /// position and velocity embeddings.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Integrator, Material, Simulation, StepConfig};
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// body.attrs_mut().pin_where(|_, rest| rest[2] == 0.0); // hold the bottom face
+/// let config = StepConfig::new(Integrator::Symplectic, 1e-3);
+/// let mut sim = Simulation::new(&mut body, [0.0, 0.0, -9.81], config).unwrap();
+/// for _ in 0..50 {
+///     sim.step(&mut body).unwrap();
+/// }
+/// let m = body.attrs();
+/// let z = |v: usize| m.position.as_slice()[v][2];
+/// assert!(z(7) < 1.0 && z(0) == 0.0); // the top corner sags, the pinned one stays
+/// assert!(sim.kinetic_energy(&body) > 0.0 && sim.max_displacement(&body) > 0.0);
+/// ```
 #[derive(Clone, Debug)]
 pub struct Simulation {
     /// The indexed projection the step loop runs on.
@@ -124,6 +156,23 @@ impl Simulation {
     ///
     /// # Errors
     /// As [`Simulation::new`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::dissociate_face;
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Integrator, Material, SimError, Simulation, StepConfig};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let mut sim = Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Euler, 1e-3)).unwrap();
+    /// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+    /// dissociate_face(&mut body, d).unwrap();
+    /// assert!(matches!(sim.step(&mut body), Err(SimError::StaleProjection { .. })));
+    /// sim.rebuild(&mut body).unwrap();
+    /// sim.step(&mut body).unwrap();
+    /// ```
     pub fn rebuild(&mut self, body: &mut Body) -> Result<(), SimError> {
         let config = *self.stepper.config();
         *self = Simulation::new(body, self.projection.system.gravity, config)?;
@@ -138,6 +187,23 @@ impl Simulation {
     ///
     /// # Errors
     /// As [`Simulation::new`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::dissociate_face;
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Integrator, Material, Projection, Simulation, StepConfig};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let mut sim = Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Euler, 1e-3)).unwrap();
+    /// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+    /// let cut = dissociate_face(&mut body, d).unwrap();
+    /// sim.update(&mut body, &cut.touched).unwrap(); // incremental: only the touched cells
+    /// sim.projection.equivalent(&Projection::build(&body, [0.0; 3])).unwrap(); // = a fresh build
+    /// sim.step(&mut body).unwrap();
+    /// ```
     pub fn update(&mut self, body: &mut Body, touched: &TouchedCells) -> Result<(), SimError> {
         self.projection.update(body, touched);
         let config = *self.stepper.config();

@@ -45,6 +45,20 @@ use super::conservation::{check_conservation, ConservationError};
 use super::geom::{add, cross, dot, norm, scale, sub, tet_volume, Vec3};
 
 /// Material constants of a homogeneous body.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Material, ModelError};
+///
+/// let (points, tets) = kuhn_cube(1); // the unit cube
+/// let dense = Material { density: 2.5, ..Material::default() };
+/// let (body, _) = Body::from_tets(&points, &tets, dense).unwrap();
+/// assert!((body.attrs().total_tet_mass(body.map()) - 2.5).abs() < 1e-12); // ρ · volume
+/// let bad = Material { young: -1.0, ..Material::default() };
+/// assert!(matches!(Body::from_tets(&points, &tets, bad), Err(ModelError::BadMaterial { name: "young", .. })));
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Material {
     /// Mass density ρ (mass per unit volume); m_t = ρ·V_t.
@@ -230,11 +244,41 @@ impl Mechanics {
     }
 
     /// Total mass Σ_v m_v over the live vertices of `map`. O(darts).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(2);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let (map, m) = (body.map(), body.attrs());
+    /// // Law 1 summed over the body: each tet gives a quarter of its mass to each corner.
+    /// assert!((m.total_vertex_mass(map) - m.total_tet_mass(map)).abs() < 1e-12);
+    /// assert!((m.total_tet_mass(map) - 8.0).abs() < 1e-12); // density 1, volume 2³
+    /// ```
     pub fn total_vertex_mass(&self, map: &GMap<3>) -> f64 {
         map.one_dart_per_cell(0).into_iter().map(|d| self.vertex_mass[map.vertex_id(d)]).sum()
     }
 
     /// Total mass Σ_t m_t over the live volumes of `map`. O(darts).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::remove_volume;
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    /// use topomech::CellId;
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let gone = remove_volume(&mut body, CellId(2)).unwrap().removed_mass;
+    /// let m = body.attrs();
+    /// assert!((m.total_tet_mass(body.map()) - (1.0 - gone)).abs() < 1e-12);
+    /// assert!((m.total_vertex_mass(body.map()) - m.total_tet_mass(body.map())).abs() < 1e-12);
+    /// ```
     pub fn total_tet_mass(&self, map: &GMap<3>) -> f64 {
         map.one_dart_per_cell(3).into_iter().map(|d| self.tet_mass[map.cell_id(3, d)]).sum()
     }
@@ -268,6 +312,18 @@ impl Mechanics {
     }
 
     /// Re-applies the pin set from a predicate on rest positions: `pin(v, rest)`. O(vertex ids).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// body.attrs_mut().pin_where(|_, rest| rest[2] == 0.0); // the bottom face
+    /// assert_eq!(body.attrs().pinned.as_slice().iter().filter(|&&p| p).count(), 4);
+    /// ```
     pub fn pin_where(&mut self, mut pin: impl FnMut(CellId, Vec3) -> bool) {
         for (i, (p, r)) in self.pinned.as_mut_slice().iter_mut().zip(self.rest_position.as_slice()).enumerate() {
             *p = pin(CellId(i as u32), *r);
@@ -446,6 +502,22 @@ impl Embedded<3, Mechanics> {
     ///
     /// # Errors
     /// [`ModelError`]: bad material, non-finite point, zero-volume tet, or a build error.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{check_conservation, Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, report) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// assert_eq!(body.map().count_cells().0, vec![8, 19, 18, 6]);
+    /// assert!(report.pinched_vertices.is_empty());
+    /// let m = body.attrs();
+    /// assert_eq!(m.rest_position.as_slice(), &points[..]); // vertex id = point index
+    /// assert_eq!(m.position.as_slice(), m.rest_position.as_slice()); // at rest
+    /// check_conservation(body.map(), m).unwrap();
+    /// ```
     pub fn from_tets(
         points: &[Vec3],
         tets: &[[u32; 4]],
@@ -486,6 +558,22 @@ impl Embedded<3, Mechanics> {
     /// # Errors
     /// [`BodyError::Sew`] if `d` is 3-free or not a dart; [`BodyError::Check`] under
     /// `expensive-checks` if a conservation law broke (a bug).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{check_conservation, Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+    /// let mass = body.attrs().total_vertex_mass(body.map());
+    /// body.unsew3(d).unwrap();
+    /// assert!(body.map().is_free(3, d));
+    /// assert!((body.attrs().total_vertex_mass(body.map()) - mass).abs() < 1e-12); // m = m1 + m2
+    /// check_conservation(body.map(), body.attrs()).unwrap();
+    /// ```
     pub fn unsew3(&mut self, d: DartId) -> Result<CellChanges, BodyError> {
         self.unsew(3, d)
     }
@@ -495,11 +583,42 @@ impl Embedded<3, Mechanics> {
     ///
     /// # Errors
     /// As [`Body::unsew3`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{check_conservation, Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let cells = body.map().count_cells();
+    /// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+    /// let e = body.map().alpha::<3>(d);
+    /// body.unsew3(d).unwrap();
+    /// body.sew3(d, e).unwrap();
+    /// assert_eq!(body.map().count_cells(), cells);
+    /// check_conservation(body.map(), body.attrs()).unwrap();
+    /// ```
     pub fn sew3(&mut self, d1: DartId, d2: DartId) -> Result<CellChanges, BodyError> {
         self.sew(3, d1, d2)
     }
 
     /// Total kinetic energy ½ Σ m_v |v_v|² over live vertices. O(darts).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// assert_eq!(body.kinetic_energy(), 0.0); // at rest
+    /// body.attrs_mut().velocity.as_mut_slice().fill([2.0, 0.0, 0.0]);
+    /// let mass = body.attrs().total_vertex_mass(body.map());
+    /// assert!((body.kinetic_energy() - 0.5 * mass * 4.0).abs() < 1e-12); // ½ m v²
+    /// ```
     pub fn kinetic_energy(&self) -> f64 {
         let m = self.attrs();
         let live = self.map().one_dart_per_cell(0);

@@ -1,6 +1,6 @@
 //! Seeded and structured mesh factories shared by tests, benchmarks and the demo.
 
-/// The cube [0,k]³ cut into k³ unit cubes, each cut into 6 tetrahedra around its 000–111
+/// The cube \[0,k\]³ cut into k³ unit cubes, each cut into 6 tetrahedra around its 000–111
 /// diagonal (the Kuhn / Freudenthal split, conforming across cubes).
 ///
 /// Closed forms (used as test oracles): V = (k+1)³, T = 6k³,
@@ -48,7 +48,7 @@ pub fn kuhn_cube(k: usize) -> (Vec<[f64; 3]>, Vec<[u32; 4]>) {
     (points, tets)
 }
 
-/// The square [0,n]² cut into n² unit squares, each cut into two triangles along its diagonal.
+/// The square \[0,n\]² cut into n² unit squares, each cut into two triangles along its diagonal.
 /// V = (n+1)², T = 2n², E = 3n² + 2n, boundary edges = 4n.
 ///
 /// # Examples

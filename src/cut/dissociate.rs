@@ -107,6 +107,21 @@ pub fn dissociate_face_id(body: &mut Body, f: CellId) -> Result<Dissociation, Cu
 }
 
 /// A dart of face `f`, or `None` if no live dart carries that id. O(darts).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::face_dart;
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Material};
+/// use topomech::CellId;
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let d = face_dart(&body, CellId(5)).unwrap();
+/// assert_eq!(body.map().cell_id(2, d), CellId(5));
+/// assert_eq!(face_dart(&body, CellId(18)), None); // 18 faces: ids 0..18
+/// ```
 pub fn face_dart(body: &Body, f: CellId) -> Option<DartId> {
     let map = body.map();
     map.darts().find(|&d| map.cell_id(2, d) == f)

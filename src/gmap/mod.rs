@@ -11,7 +11,7 @@
 //! liveness. Freed dart slots are reused.
 //!
 //! # Layers of mutators
-//! 1. crate-private raw links ([`GMap::link_raw`]) that may break validity;
+//! 1. crate-private raw links (`GMap::link_raw`) that may break validity;
 //! 2. topological [`GMap::sew`] / [`GMap::unsew`] that sew whole orbits so the quasi-manifold law
 //!    holds and keep cell ids exact, returning the [`CellChanges`] they made;
 //! 3. (in `embedding`) the version that also splits and merges attributes.

@@ -264,7 +264,9 @@ impl<const N: usize> GMap<N> {
         self.sew_pairs(i, d1, d2).is_ok()
     }
 
-    /// I-sews d1 with d2 (see the [module docs](self)). Errors leave the map unchanged.
+    /// I-sews d1 with d2, and with them the whole orbits ⟨αj : |i − j| ≥ 2⟩ of both, dart by dart, so the
+    /// quasi-manifold law holds; cells that meet are merged and reported in the [`CellChanges`].
+    /// Errors ([`SewError`]) leave the map unchanged.
     ///
     /// # Examples
     ///

@@ -144,7 +144,8 @@ impl InvariantViolation {
 }
 
 impl<const N: usize> GMap<N> {
-    /// Checks every law of the table in the [module docs](self). O(darts · n²).
+    /// Checks every law of [`Law`]: involutions, quasi-manifold, constant and unique cell ids.
+    /// O(darts · n²).
     ///
     /// Errors: the first violation in the order of the table (involution and quasi-manifold laws
     /// of every dart first, then cell ids of every dart, then uniqueness per dimension).

@@ -48,6 +48,15 @@ pub struct CellNode {
 pub type CellGraph = Graph<CellNode, u32, Undirected>;
 
 /// Which adjacency graph to export (see the [module docs](self)).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::graph::GraphKind;
+///
+/// assert_eq!(GraphKind::ALL.map(|k| k.name()), ["vertex_edge", "dual", "incidence"]);
+/// assert_eq!(GraphKind::Dual.to_string(), "dual");
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum GraphKind {
@@ -285,6 +294,20 @@ pub fn graphs_isomorphic(a: &CellGraph, b: &CellGraph, multiplicity: Multiplicit
 /// A cheap isomorphism invariant of a cell graph: the sorted multiset of (dimension, loop weight,
 /// sorted neighbour (dimension, weight) list) over nodes. Equal for isomorphic graphs; used to
 /// bucket graphs before VF2. O(nodes + edges · log).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::graph::{vertex_edge_graph, GraphInvariant, Multiplicity};
+/// use topomech::GMap;
+///
+/// let (a, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+/// let (b, _) = GMap::<3>::from_tets(5, &[[4, 3, 2, 1], [4, 3, 2, 0]]).unwrap();
+/// let (c, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let inv = |m: &GMap<3>| GraphInvariant::of(&vertex_edge_graph(m), Multiplicity::Match);
+/// assert_eq!(inv(&a), inv(&b)); // isomorphic graphs share it
+/// assert_ne!(inv(&a), inv(&c));
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct GraphInvariant(Vec<InvariantRow>);
 

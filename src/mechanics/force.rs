@@ -41,6 +41,23 @@ pub const PARALLEL_CHUNK: usize = 4096;
 /// Vertices are *slots* `0..slots()`: positions and velocities are passed in as slices of that
 /// length. A slot with `inv_mass == 0` does not move (pinned, dead or massless). Equality compares
 /// the arrays and, per slot, the incident lists in order (not where they sit in memory).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mechanics::SpringSystem;
+///
+/// // One spring of rest length 1 and stiffness 10, stretched to length 2 along x.
+/// let mut sys = SpringSystem::default();
+/// let (a, b) = (sys.push_slot(1.0, false, 0.0), sys.push_slot(1.0, false, 0.0));
+/// sys.push_spring([a as u32, b as u32], 1.0, 10.0, 0.0);
+/// let (x, v) = ([[0.0; 3], [2.0, 0.0, 0.0]], [[0.0; 3]; 2]);
+/// let (mut sf, mut out) = (vec![[0.0; 3]; 1], vec![[0.0; 3]; 2]);
+/// sys.forces(&x, &v, &mut sf, &mut out, false);
+/// assert_eq!(out, vec![[10.0, 0.0, 0.0], [-10.0, 0.0, 0.0]]); // equal and opposite
+/// assert_eq!(sys.elastic_energy(&x), 5.0); // ½ k (l − L)²
+/// sys.check_incidence().unwrap();
+/// ```
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct SpringSystem {
     /// Spring end slots (a, b).
@@ -323,6 +340,18 @@ impl SpringSystem {
 
     /// A bound on the largest angular frequency, ω_max² ≤ max_v Σ_{s ∋ v} 2 k_s / m_v
     /// (Gershgorin on M⁻¹K), over free slots. Explicit schemes need dt ≲ 2/ω_max. O(springs).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// sys.push_slot(2.0, true, 0.0); // fixed: does not count
+    /// sys.push_slot(0.5, false, 0.0);
+    /// sys.push_spring([0, 1], 1.0, 4.0, 0.0);
+    /// assert_eq!(sys.omega_max(), 4.0); // √(2k / m)
+    /// ```
     pub fn omega_max(&self) -> f64 {
         let mut w2: f64 = 0.0;
         for i in 0..self.slots() {
@@ -339,6 +368,18 @@ impl SpringSystem {
 const BLOCK: usize = 64;
 
 /// F_s on end a of a spring (see the module docs). Zero for a zero-length spring. O(1).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mechanics::force::spring_force;
+///
+/// let (a, b, still) = ([0.0; 3], [3.0, 0.0, 0.0], [0.0; 3]);
+/// assert_eq!(spring_force(a, b, still, still, 1.0, 5.0, 0.0), [10.0, 0.0, 0.0]); // pulled towards b
+/// assert_eq!(spring_force(a, b, still, still, 3.0, 5.0, 0.0), [0.0; 3]); // at rest length
+/// let closing = [1.0, 0.0, 0.0]; // a moves towards b: damping resists
+/// assert_eq!(spring_force(a, b, closing, still, 3.0, 5.0, 0.5), [-0.5, 0.0, 0.0]);
+/// ```
 #[inline(always)]
 pub fn spring_force(xa: Vec3, xb: Vec3, va: Vec3, vb: Vec3, rest: f64, k: f64, c: f64) -> Vec3 {
     let d = [xb[0] - xa[0], xb[1] - xa[1], xb[2] - xa[2]];

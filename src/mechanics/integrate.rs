@@ -148,6 +148,24 @@ impl StepConfig {
 }
 
 /// The integrator's scratch buffers and step counter; reused every step (no allocation).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mechanics::{Integrator, SpringSystem, StepConfig, Stepper};
+///
+/// // A unit mass hanging from a fixed point on a spring, released at the spring's rest length.
+/// let mut sys = SpringSystem::default();
+/// sys.gravity = [0.0, 0.0, -10.0];
+/// sys.push_slot(1.0, true, 0.0);
+/// sys.push_slot(1.0, false, 0.0);
+/// sys.push_spring([0, 1], 1.0, 100.0, 0.0);
+/// let (mut x, mut v) = (vec![[0.0; 3], [0.0, 0.0, -1.0]], vec![[0.0; 3]; 2]);
+/// let mut stepper = Stepper::new(StepConfig::new(Integrator::Symplectic, 1e-3), &sys, &x, &v).unwrap();
+/// (0..100).for_each(|_| stepper.step(&sys, &mut x, &mut v).unwrap());
+/// assert_eq!(stepper.steps_done(), 100);
+/// assert!(x[0] == [0.0; 3] && x[1][2] < -1.0); // the anchor stays, the mass falls
+/// ```
 #[derive(Clone, Debug)]
 pub struct Stepper {
     config: StepConfig,

@@ -24,7 +24,7 @@
 //! 4. **Ambient viscosity** γ_v = ν · m_v (ν in 1/s).
 //! 5. **Mass conservation**: Σ_v m_v = Σ_t m_t, after any dissociation.
 //!
-//! [`check_conservation`](super::check_conservation) verifies all five from the map's orbits.
+//! [`check_conservation`] verifies all five from the map's orbits.
 //!
 //! # Split and merge rules ([`CellRules`] for [`Mechanics`])
 //! - vertex split: both sides copy rest position, position, velocity and the pinned flag; each
@@ -115,6 +115,23 @@ pub enum ModelError {
 /// State variables (positions, velocities, forces, pins) are public fields: the simulation writes
 /// them every step. Parameters bound by the laws (masses, stiffnesses) are private and change only
 /// through the split/merge rules, so the laws cannot be broken from outside.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mechanics::{Body, Material};
+/// use topomech::{CellId, DartId};
+///
+/// let unit = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+/// let (body, _) = Body::from_tets(&unit, &[[0, 1, 2, 3]], Material::default()).unwrap();
+/// let m = body.attrs();
+/// assert!((m.tet_mass(CellId(0)) - 1.0 / 6.0).abs() < 1e-15); // ρ · V
+/// assert!((0..4).all(|v| (m.vertex_mass(CellId(v)) - 1.0 / 24.0).abs() < 1e-15)); // m_t / 4
+/// let f = body.map().cell_id(2, DartId(0));
+/// assert!(m.face_is_boundary(f));
+/// let n = m.face_normal(f);
+/// assert!((n[0] * n[0] + n[1] * n[1] + n[2] * n[2] - 1.0).abs() < 1e-12);
+/// ```
 #[derive(Clone, Debug)]
 pub struct Mechanics {
     pub(crate) material: Material,
@@ -284,6 +301,20 @@ impl Mechanics {
     }
 
     /// Law 1 at the vertex of `d`: Σ m_t/4 over the distinct volumes of its orbit. O(vertex).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let (map, m) = (body.map(), body.attrs());
+    /// for d in map.darts() {
+    ///     assert!((m.vertex_mass_from_map(map, d) - m.vertex_mass(map.vertex_id(d))).abs() < 1e-15);
+    /// }
+    /// ```
     pub fn vertex_mass_from_map(&self, map: &GMap<3>, d: DartId) -> f64 {
         let tets = distinct(map.cell_darts(0, d).into_iter().map(|x| map.cell_id(3, x)));
         tets.iter().map(|&t| self.tet_mass[t] / 4.0).sum()
@@ -291,6 +322,21 @@ impl Mechanics {
 
     /// Law 2 at the edge of `d`: Σ E_t·V_t/L_e² over the distinct volumes of its orbit, with L_e
     /// the edge's stored rest length. O(edge).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let (map, m) = (body.map(), body.attrs());
+    /// for d in map.one_dart_per_cell(1) {
+    ///     let stored = m.edge_stiffness(map.cell_id(1, d));
+    ///     assert!(stored > 0.0 && (m.edge_stiffness_from_map(map, d) - stored).abs() <= 1e-12 * stored);
+    /// }
+    /// ```
     pub fn edge_stiffness_from_map(&self, map: &GMap<3>, d: DartId) -> f64 {
         let l = self.edge_rest_length[map.cell_id(1, d)];
         let tets = distinct(map.cell_darts(1, d).into_iter().map(|x| map.cell_id(3, x)));
@@ -352,6 +398,16 @@ impl Mechanics {
 }
 
 /// Law 2's per-tet term: k_{t,e} = E·|V|/L², zero for a zero-length edge. O(1).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mechanics::model::stiffness_contribution;
+///
+/// assert_eq!(stiffness_contribution(1000.0, 0.5, 2.0), 125.0); // E·V/L²
+/// assert_eq!(stiffness_contribution(1000.0, -0.5, 2.0), 125.0); // |V|
+/// assert_eq!(stiffness_contribution(1000.0, 0.5, 0.0), 0.0); // a zero-length edge carries nothing
+/// ```
 pub fn stiffness_contribution(young: f64, volume: f64, rest_length: f64) -> f64 {
     if rest_length > 0.0 {
         young * volume.abs() / (rest_length * rest_length)
@@ -668,6 +724,17 @@ impl Mechanics {
     }
 
     /// Marks the live vertex ids of `map`: `live[v]` is true iff vertex id v has darts. O(capacity).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::{Body, Material, Mechanics};
+    ///
+    /// // Point 4 is used by no tet: its vertex id is free.
+    /// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [7.0; 3]];
+    /// let (body, _) = Body::from_tets(&points, &[[0, 1, 2, 3]], Material::default()).unwrap();
+    /// assert_eq!(Mechanics::live_vertices(body.map()), vec![true, true, true, true, false]);
+    /// ```
     pub fn live_vertices(map: &GMap<3>) -> Vec<bool> {
         let mut live = vec![false; map.cell_id_bound(0)];
         for d in map.darts() {

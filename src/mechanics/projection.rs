@@ -56,6 +56,22 @@ pub struct Projection {
 
 impl Projection {
     /// Projects `body` with gravity `gravity`. O(darts + E log E).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, Projection};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let p = Projection::build(&body, [0.0, 0.0, -9.81]);
+    /// assert_eq!((p.system.slots(), p.system.springs()), (8, 19));
+    /// for s in 0..p.system.springs() {
+    ///     assert_eq!(p.spring_of_edge(p.edge_of_spring(s)), Some(s));
+    /// }
+    /// assert!(p.is_current(&body));
+    /// ```
     pub fn build(body: &Body, gravity: Vec3) -> Self {
         let map = body.map();
         let mech = body.attrs();
@@ -89,6 +105,23 @@ impl Projection {
     }
 
     /// Whether the body has not changed topologically since the projection was built. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::dissociate_face;
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, Projection};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let mut p = Projection::build(&body, [0.0; 3]);
+    /// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+    /// let cut = dissociate_face(&mut body, d).unwrap();
+    /// assert!(!p.is_current(&body) && !cut.touched.is_empty());
+    /// p.update(&body, &cut.touched);
+    /// assert!(p.is_current(&body));
+    /// ```
     pub fn is_current(&self, body: &Body) -> bool {
         self.version == body.version()
     }
@@ -350,6 +383,21 @@ fn system_of(
 /// each edge orbit is covered once with a dart set, its spring taken between the vertices of b
 /// and α0(b); then each vertex gets gravity and viscosity. Pinned vertices get their force too.
 /// Dead ids get zero. O(darts).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{forces_by_coverage, Body, Material};
+///
+/// // At rest the springs pull nothing: the forces add up to the weight.
+/// let (points, tets) = kuhn_cube(1);
+/// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let f = forces_by_coverage(&body, [0.0, 0.0, -9.81]);
+/// let total_z: f64 = f.iter().map(|f| f[2]).sum();
+/// assert!((total_z + 9.81 * body.attrs().total_vertex_mass(body.map())).abs() < 1e-12);
+/// assert!(f.iter().all(|f| f[0] == 0.0 && f[1] == 0.0));
+/// ```
 pub fn forces_by_coverage(body: &Body, gravity: Vec3) -> Vec<Vec3> {
     let map = body.map();
     let mech = body.attrs();

@@ -91,6 +91,17 @@ pub struct SplitMix64(pub u64);
 
 impl SplitMix64 {
     /// The next 64 random bits.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::SplitMix64;
+    ///
+    /// let mut rng = SplitMix64(1);
+    /// let first = rng.next_u64();
+    /// assert_eq!(SplitMix64(1).next_u64(), first); // deterministic
+    /// assert_ne!(rng.next_u64(), first);
+    /// ```
     pub fn next_u64(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;
@@ -100,6 +111,17 @@ impl SplitMix64 {
     }
 
     /// A number in 0..n (n > 0).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::SplitMix64;
+    ///
+    /// let mut rng = SplitMix64(7);
+    /// let rolls: Vec<usize> = (0..600).map(|_| rng.below(6)).collect();
+    /// assert!(rolls.iter().all(|&r| r < 6));
+    /// assert!((0..6).all(|face| rolls.contains(&face))); // every value turns up
+    /// ```
     pub fn below(&mut self, n: usize) -> usize {
         (self.next_u64() % n as u64) as usize
     }

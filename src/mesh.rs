@@ -29,18 +29,6 @@ use std::fmt;
 pub const DEGENERACY_TOLERANCE: f64 = 1e-12;
 
 /// A tetrahedral volume mesh with 0-based indices into `points`.
-///
-/// # Examples
-///
-/// ```
-/// use topomech::mesh::TetMesh;
-///
-/// let unit = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-/// let mesh = TetMesh { points: unit, tets: vec![[0, 1, 2, 3]], ..Default::default() };
-/// assert!(mesh.check().unwrap().is_clean());
-/// assert!((mesh.total_volume() - 1.0 / 6.0).abs() < 1e-15);
-/// assert_eq!((mesh.edge_count(), mesh.boundary_face_count()), (6, 4));
-/// ```
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct TetMesh {
     /// Point coordinates.
@@ -56,17 +44,6 @@ pub struct TetMesh {
 }
 
 /// A triangle surface mesh with 0-based indices into `points`.
-///
-/// # Examples
-///
-/// ```
-/// use topomech::mesh::TriMesh;
-///
-/// let points = vec![[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0], [2.0, 2.0, 0.0]];
-/// let mesh = TriMesh { points, triangles: vec![[0, 1, 2], [1, 3, 2]] };
-/// assert!(mesh.check().unwrap().is_clean());
-/// assert!((mesh.total_area() - 4.0).abs() < 1e-12);
-/// ```
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct TriMesh {
     /// Point coordinates.
@@ -193,6 +170,15 @@ pub struct MeshReport {
 
 impl MeshReport {
     /// True when there is no warning at all. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mesh::MeshReport;
+    ///
+    /// assert!(MeshReport::default().is_clean());
+    /// assert!(!MeshReport { unreferenced_points: vec![3], ..Default::default() }.is_clean());
+    /// ```
     pub fn is_clean(&self) -> bool {
         self.zero_volume_tets.is_empty()
             && self.inverted_tets.is_empty()
@@ -419,6 +405,18 @@ impl TetMesh {
     ///
     /// Equals the enclosed volume for a valid mesh; inverted tets count positively.
     /// Panics if an index is out of range (call [`TetMesh::check`] first).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mesh::TetMesh;
+    ///
+    /// let unit = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mesh = TetMesh { points: unit, tets: vec![[0, 1, 2, 3]], ..Default::default() };
+    /// assert!(mesh.check().unwrap().is_clean());
+    /// assert!((mesh.total_volume() - 1.0 / 6.0).abs() < 1e-15);
+    /// assert_eq!((mesh.edge_count(), mesh.boundary_face_count()), (6, 4));
+    /// ```
     pub fn total_volume(&self) -> f64 {
         self.tets
             .iter()
@@ -463,6 +461,18 @@ impl TetMesh {
 
     /// Number of distinct edges (= springs of a mass/spring model). O(T log T); see
     /// [`TetMesh::edges`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mesh::TetMesh;
+    ///
+    /// let (points, tets) = kuhn_cube(2);
+    /// let mesh = TetMesh { points, tets, ..Default::default() };
+    /// assert_eq!(mesh.edge_count(), 98); // 3k(k+1)² + 3k²(k+1) + k³
+    /// assert_eq!(mesh.edge_count(), mesh.edges().len());
+    /// ```
     pub fn edge_count(&self) -> usize {
         self.edges().len()
     }
@@ -511,6 +521,17 @@ impl TetMesh {
 
     /// Number of faces used by exactly one tet. O(T log T); see
     /// [`TetMesh::boundary_triangles_of_tets`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mesh::TetMesh;
+    ///
+    /// let (points, tets) = kuhn_cube(2);
+    /// let mesh = TetMesh { points, tets, ..Default::default() };
+    /// assert_eq!(mesh.boundary_face_count(), 48); // 12k²
+    /// ```
     pub fn boundary_face_count(&self) -> usize {
         let mut keys: Vec<[u32; 3]> = Vec::with_capacity(4 * self.tets.len());
         for &t in &self.tets {
@@ -588,6 +609,20 @@ impl TriMesh {
     /// # Errors
     /// [`MeshError::Empty`], [`MeshError::TooManyPoints`], [`MeshError::NonFiniteCoordinate`],
     /// [`MeshError::IndexOutOfRange`], [`MeshError::RepeatedVertex`] (a degenerate triangle).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mesh::{MeshError, TriMesh};
+    ///
+    /// let points = vec![[0.0; 3], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    /// let report = TriMesh { points: points.clone(), triangles: vec![[0, 1, 2]] }.check().unwrap();
+    /// assert_eq!(report.zero_area_triangles, vec![0]); // collinear corners
+    /// assert_eq!(report.unreferenced_points, vec![3]);
+    /// assert!(!report.is_clean());
+    /// let bad = TriMesh { points, triangles: vec![[0, 1, 4]] };
+    /// assert!(matches!(bad.check(), Err(MeshError::IndexOutOfRange { .. })));
+    /// ```
     pub fn check(&self) -> Result<TriMeshReport, MeshError> {
         if self.triangles.is_empty() {
             return Err(MeshError::Empty(CellKind::Triangle));
@@ -609,6 +644,17 @@ impl TriMesh {
 
     /// Sum of the triangle areas. O(T). Panics if an index is out of range (call
     /// [`TriMesh::check`] first).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mesh::TriMesh;
+    ///
+    /// let points = vec![[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0], [2.0, 2.0, 0.0]];
+    /// let mesh = TriMesh { points, triangles: vec![[0, 1, 2], [1, 3, 2]] };
+    /// assert!(mesh.check().unwrap().is_clean());
+    /// assert!((mesh.total_area() - 4.0).abs() < 1e-12);
+    /// ```
     pub fn total_area(&self) -> f64 {
         self.triangles
             .iter()

@@ -17,6 +17,17 @@ pub struct Plane {
 
 impl Plane {
     /// Whether `x` is strictly on the positive side. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::Plane;
+    ///
+    /// let plane = Plane { point: [0.0, 0.0, 1.0], normal: [0.0, 0.0, 2.0] };
+    /// assert!(plane.positive([5.0, 5.0, 1.5]));
+    /// assert!(!plane.positive([0.0, 0.0, 1.0])); // on the plane: not strictly positive
+    /// assert!(!plane.positive([0.0, 0.0, -3.0]));
+    /// ```
     pub fn positive(&self, x: Vec3) -> bool {
         (0..3).map(|k| (x[k] - self.point[k]) * self.normal[k]).sum::<f64>() > 0.0
     }

@@ -5,20 +5,20 @@ use super::orbit::{generators, union_smaller_root};
 use super::{AlphaMask, DartId, DartSet, GMap};
 
 /// Number of i-cells for each i in 0..=n.
-///
-/// # Examples
-///
-/// ```
-/// use topomech::gmap::CellCounts;
-///
-/// assert_eq!(CellCounts(vec![4, 6, 4, 1]).euler_characteristic(), 1); // a tetrahedron
-/// assert_eq!(CellCounts(vec![4, 6, 4]).euler_characteristic(), 2); // its surface
-/// ```
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
 pub struct CellCounts(pub Vec<usize>);
 
 impl CellCounts {
     /// Σ (−1)^i · #i-cells.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::gmap::CellCounts;
+    ///
+    /// assert_eq!(CellCounts(vec![4, 6, 4, 1]).euler_characteristic(), 1); // a tetrahedron
+    /// assert_eq!(CellCounts(vec![4, 6, 4]).euler_characteristic(), 2); // its surface
+    /// ```
     pub fn euler_characteristic(&self) -> i64 {
         self.0.iter().enumerate().map(|(i, &c)| if i % 2 == 0 { c as i64 } else { -(c as i64) }).sum()
     }

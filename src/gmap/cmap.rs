@@ -7,22 +7,6 @@
 use super::{DartId, GMap};
 
 /// An n-map: darts 0..len, β1 a permutation, βi for i ≥ 2 partial involutions.
-///
-/// # Examples
-///
-/// ```
-/// use topomech::GMap;
-///
-/// // The surface of a tetrahedron as a 2-map: 12 of the 24 darts, β1 turns around each triangle.
-/// let surface = [[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]];
-/// let (map, _) = GMap::<2>::from_triangles(4, &surface).unwrap();
-/// let cmap = map.to_combinatorial_map().unwrap();
-/// assert!(cmap.is_valid());
-/// assert_eq!(cmap.origin.len(), 12);
-/// let b1 = |d: u32| cmap.beta1[d as usize];
-/// assert!((0..12).all(|d| b1(b1(b1(d))) == d && b1(d) != d));
-/// assert!(cmap.beta[0].iter().all(|b| b.is_some())); // closed surface: β2 everywhere
-/// ```
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct CombinatorialMap {
     /// For each combinatorial dart, the G-map dart it came from.
@@ -36,6 +20,22 @@ pub struct CombinatorialMap {
 impl CombinatorialMap {
     /// Checks that β1 is a permutation and every βi (i ≥ 2) an involution without fixed points
     /// where defined. O(darts · n).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// // The surface of a tetrahedron as a 2-map: 12 of the 24 darts, β1 turns around each triangle.
+    /// let surface = [[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]];
+    /// let (map, _) = GMap::<2>::from_triangles(4, &surface).unwrap();
+    /// let cmap = map.to_combinatorial_map().unwrap();
+    /// assert!(cmap.is_valid());
+    /// assert_eq!(cmap.origin.len(), 12);
+    /// let b1 = |d: u32| cmap.beta1[d as usize];
+    /// assert!((0..12).all(|d| b1(b1(b1(d))) == d && b1(d) != d));
+    /// assert!(cmap.beta[0].iter().all(|b| b.is_some())); // closed surface: β2 everywhere
+    /// ```
     pub fn is_valid(&self) -> bool {
         let n = self.origin.len();
         let mut hit = vec![false; n];

@@ -3,22 +3,6 @@
 use super::{DartId, GMap};
 
 /// A set of darts as a bit set with a count. Grows on demand. Insert, remove and test are O(1).
-///
-/// # Examples
-///
-/// ```
-/// use topomech::gmap::DartSet;
-/// use topomech::DartId;
-///
-/// let mut set = DartSet::with_capacity(10);
-/// assert!(set.insert(DartId(3)));
-/// assert!(!set.insert(DartId(3))); // already there
-/// assert!(set.insert(DartId(500))); // grows on demand
-/// assert_eq!(set.len(), 2);
-/// assert!(set.remove(DartId(3)) && !set.contains(DartId(3)));
-/// set.clear();
-/// assert!(set.is_empty());
-/// ```
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct DartSet {
     bits: Vec<u64>,
@@ -39,6 +23,22 @@ impl DartSet {
     }
 
     /// Adds d; returns whether it was absent. O(1) amortized.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::gmap::DartSet;
+    /// use topomech::DartId;
+    ///
+    /// let mut set = DartSet::with_capacity(10);
+    /// assert!(set.insert(DartId(3)));
+    /// assert!(!set.insert(DartId(3))); // already there
+    /// assert!(set.insert(DartId(500))); // grows on demand
+    /// assert_eq!(set.len(), 2);
+    /// assert!(set.remove(DartId(3)) && !set.contains(DartId(3)));
+    /// set.clear();
+    /// assert!(set.is_empty());
+    /// ```
     #[inline(always)]
     pub fn insert(&mut self, d: DartId) -> bool {
         let i = d.index();
@@ -86,21 +86,6 @@ impl DartSet {
 ///
 /// Give it back with [`GMap::free_mark`] once every dart is unmarked again; a mark released or
 /// dropped while darts are still marked is a bug in the caller's algorithm and asserts.
-///
-/// # Examples
-///
-/// ```
-/// use topomech::{AlphaMask, GMap};
-///
-/// let (mut map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
-/// let d = map.darts().next().unwrap();
-/// let mut mark = map.reserve_mark();
-/// map.mark_orbit(&mut mark, d, AlphaMask::cell(3, 2));
-/// assert_eq!(mark.count(), 6); // the darts of d's face
-/// assert!(mark.is_marked(d) && !mark.is_marked(map.alpha::<2>(d)));
-/// map.unmark_orbit(&mut mark, d, AlphaMask::cell(3, 2));
-/// map.free_mark(mark); // every dart is unmarked again
-/// ```
 #[derive(Debug)]
 pub struct Mark {
     set: DartSet,
@@ -159,12 +144,43 @@ impl<const N: usize> GMap<N> {
     }
 
     /// Returns a mark to the pool. Panics if some dart is still marked (a bug in the caller).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let (mut map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+    /// let d = map.darts().next().unwrap();
+    /// let mut mark = map.reserve_mark();
+    /// mark.mark(d);
+    /// mark.unmark(d); // a mark goes back clean
+    /// map.free_mark(mark);
+    /// let again = map.reserve_mark(); // reused from the pool, still clean
+    /// assert_eq!(again.count(), 0);
+    /// map.free_mark(again);
+    /// ```
     pub fn free_mark(&mut self, mut mark: Mark) {
         assert!(mark.set.is_empty(), "free_mark: {} darts are still marked", mark.set.len());
         self.mark_pool.push(std::mem::take(&mut mark.set));
     }
 
     /// Marks every dart of the orbit ⟨mask⟩(d). O(orbit).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::{AlphaMask, GMap};
+    ///
+    /// let (mut map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let d = map.darts().next().unwrap();
+    /// let mut mark = map.reserve_mark();
+    /// map.mark_orbit(&mut mark, d, AlphaMask::cell(3, 2));
+    /// assert_eq!(mark.count(), 6); // the darts of d's face
+    /// assert!(mark.is_marked(d) && !mark.is_marked(map.alpha::<2>(d)));
+    /// map.unmark_orbit(&mut mark, d, AlphaMask::cell(3, 2));
+    /// map.free_mark(mark); // every dart is unmarked again
+    /// ```
     pub fn mark_orbit(&self, mark: &mut Mark, d: DartId, mask: super::AlphaMask) {
         for e in self.orbit(d, mask) {
             mark.mark(e);
@@ -172,6 +188,22 @@ impl<const N: usize> GMap<N> {
     }
 
     /// Unmarks every dart of the orbit ⟨mask⟩(d). O(orbit).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::{AlphaMask, GMap};
+    ///
+    /// let (mut map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+    /// let d = map.darts().next().unwrap();
+    /// let mut mark = map.reserve_mark();
+    /// map.mark_orbit(&mut mark, d, AlphaMask::all(2));
+    /// assert_eq!(mark.count(), 6);
+    /// map.unmark_orbit(&mut mark, d, AlphaMask::of(&[0]));
+    /// assert_eq!(mark.count(), 4); // d and α0(d) unmarked
+    /// map.unmark_orbit(&mut mark, d, AlphaMask::all(2));
+    /// map.free_mark(mark);
+    /// ```
     pub fn unmark_orbit(&self, mark: &mut Mark, d: DartId, mask: super::AlphaMask) {
         for e in self.orbit(d, mask) {
             mark.unmark(e);

@@ -25,11 +25,30 @@ impl AlphaMask {
     pub const EMPTY: AlphaMask = AlphaMask(0);
 
     /// All involutions α0..=αn of an n-map.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::AlphaMask;
+    ///
+    /// assert_eq!(AlphaMask::all(2), AlphaMask::of(&[0, 1, 2]));
+    /// assert_eq!(AlphaMask::all(3).0, 0b1111);
+    /// ```
     pub const fn all(n: usize) -> AlphaMask {
         AlphaMask(((1u16 << (n + 1)) - 1) as u8)
     }
 
     /// The set {αj : j in `indices`}.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::AlphaMask;
+    ///
+    /// let mask = AlphaMask::of(&[2, 0]);
+    /// assert!(mask.contains(0) && mask.contains(2) && !mask.contains(1));
+    /// assert_eq!(mask.indices().collect::<Vec<_>>(), vec![0, 2]);
+    /// ```
     pub const fn of(indices: &[usize]) -> AlphaMask {
         let mut bits = 0u8;
         let mut k = 0;

@@ -138,6 +138,15 @@ impl<const N: usize> GMap<N> {
     }
 
     /// The dimension n.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// assert_eq!(GMap::<3>::new().dimension(), 3);
+    /// assert_eq!(GMap::<2>::ALPHAS, 3); // α0, α1, α2
+    /// ```
     pub const fn dimension(&self) -> usize {
         N
     }

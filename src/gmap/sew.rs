@@ -116,6 +116,20 @@ pub struct CellChanges {
 
 impl CellChanges {
     /// The splits of `dim`-cells, as (kept, new, dart_kept, dart_new).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let (mut map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+    /// let d = map.darts().find(|&d| !map.is_free(3, d)).unwrap();
+    /// let changes = map.unsew::<3>(d).unwrap();
+    /// for (kept, new, dart_kept, dart_new) in changes.splits(0) {
+    ///     assert_eq!((map.vertex_id(dart_kept), map.vertex_id(dart_new)), (kept, new));
+    /// }
+    /// assert_eq!((changes.splits(0).count(), changes.splits(1).count()), (3, 3));
+    /// ```
     pub fn splits(&self, dim: usize) -> impl Iterator<Item = (CellId, CellId, DartId, DartId)> + '_ {
         self.changes.iter().filter_map(move |c| match *c {
             CellChange::Split { dim: k, kept, new, dart_kept, dart_new } if k == dim => {
@@ -126,6 +140,20 @@ impl CellChanges {
     }
 
     /// The merges of `dim`-cells, as (kept, absorbed).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let (mut map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+    /// let d = map.darts().find(|&d| !map.is_free(3, d)).unwrap();
+    /// let e = map.alpha::<3>(d);
+    /// map.unsew::<3>(d).unwrap();
+    /// let changes = map.sew::<3>(d, e).unwrap();
+    /// assert_eq!(changes.merges(0).count(), 3); // the three split vertices meet again
+    /// assert!(changes.merges(0).all(|(kept, gone)| map.is_live_cell(0, kept) && !map.is_live_cell(0, gone)));
+    /// ```
     pub fn merges(&self, dim: usize) -> impl Iterator<Item = (CellId, CellId)> + '_ {
         self.changes.iter().filter_map(move |c| match *c {
             CellChange::Merged { dim: k, kept, absorbed } if k == dim => Some((kept, absorbed)),
@@ -260,6 +288,18 @@ impl<const N: usize> GMap<N> {
     }
 
     /// Run-time-index version of [`GMap::is_sewable`]; false for i > n.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let (map, _) = GMap::<2>::from_triangles(6, &[[0, 1, 2], [3, 4, 5]]).unwrap();
+    /// let (a, b) = (map.darts().next().unwrap(), map.darts().nth(6).unwrap()); // one dart of each triangle
+    /// assert!(map.is_sewable_dyn(2, a, b));
+    /// assert!(!map.is_sewable_dyn(1, a, b)); // a is 1-sewn already
+    /// assert!(!map.is_sewable_dyn(5, a, b)); // no α5
+    /// ```
     pub fn is_sewable_dyn(&self, i: usize, d1: DartId, d2: DartId) -> bool {
         self.sew_pairs(i, d1, d2).is_ok()
     }

@@ -33,17 +33,6 @@ pub enum Law {
 }
 
 /// A broken law, naming the dart(s), the indices and the law.
-///
-/// # Examples
-///
-/// ```
-/// use topomech::gmap::Law;
-/// use topomech::{DartId, InvariantViolation};
-///
-/// let v = InvariantViolation::NotInvolution { dart: DartId(3), i: 1, image: DartId(4), back: DartId(5) };
-/// assert_eq!(v.law(), Law::Involution);
-/// assert!(v.to_string().contains("alpha1(dart 3)"));
-/// ```
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum InvariantViolation {
     /// αi(d) is not a live dart.
@@ -132,6 +121,17 @@ pub enum InvariantViolation {
 
 impl InvariantViolation {
     /// The law broken.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::gmap::Law;
+    /// use topomech::{DartId, InvariantViolation};
+    ///
+    /// let v = InvariantViolation::NotInvolution { dart: DartId(3), i: 1, image: DartId(4), back: DartId(5) };
+    /// assert_eq!(v.law(), Law::Involution);
+    /// assert!(v.to_string().contains("alpha1(dart 3)"));
+    /// ```
     pub fn law(&self) -> Law {
         use InvariantViolation::*;
         match self {

@@ -73,6 +73,15 @@ impl GraphKind {
     pub const ALL: [GraphKind; 3] = [GraphKind::VertexEdge, GraphKind::Dual, GraphKind::Incidence];
 
     /// The snake-case name used in JSON and on the command line.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::graph::GraphKind;
+    ///
+    /// assert_eq!(GraphKind::ALL.map(|k| k.name()), ["vertex_edge", "dual", "incidence"]);
+    /// assert_eq!(GraphKind::Dual.to_string(), GraphKind::Dual.name());
+    /// ```
     pub const fn name(self) -> &'static str {
         match self {
             GraphKind::VertexEdge => "vertex_edge",
@@ -255,6 +264,18 @@ pub fn incidence_graph<const N: usize>(map: &GMap<N>) -> CellGraph {
 }
 
 /// The graph of the given kind. O(darts · n²).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::graph::{graph_of, GraphKind};
+/// use topomech::{generate, GMap};
+///
+/// let (points, triangles) = generate::grid_triangles(2);
+/// let (map, _) = GMap::<2>::from_triangles(points.len(), &triangles).unwrap();
+/// let sizes: Vec<_> = GraphKind::ALL.iter().map(|&k| graph_of(&map, k).node_count()).collect();
+/// assert_eq!(sizes, vec![9, 8, 9 + 16 + 8]); // vertices, triangles, all cells
+/// ```
 pub fn graph_of<const N: usize>(map: &GMap<N>, kind: GraphKind) -> CellGraph {
     match kind {
         GraphKind::VertexEdge => vertex_edge_graph(map),
@@ -294,20 +315,6 @@ pub fn graphs_isomorphic(a: &CellGraph, b: &CellGraph, multiplicity: Multiplicit
 /// A cheap isomorphism invariant of a cell graph: the sorted multiset of (dimension, loop weight,
 /// sorted neighbour (dimension, weight) list) over nodes. Equal for isomorphic graphs; used to
 /// bucket graphs before VF2. O(nodes + edges · log).
-///
-/// # Examples
-///
-/// ```
-/// use topomech::graph::{vertex_edge_graph, GraphInvariant, Multiplicity};
-/// use topomech::GMap;
-///
-/// let (a, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
-/// let (b, _) = GMap::<3>::from_tets(5, &[[4, 3, 2, 1], [4, 3, 2, 0]]).unwrap();
-/// let (c, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
-/// let inv = |m: &GMap<3>| GraphInvariant::of(&vertex_edge_graph(m), Multiplicity::Match);
-/// assert_eq!(inv(&a), inv(&b)); // isomorphic graphs share it
-/// assert_ne!(inv(&a), inv(&c));
-/// ```
 #[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct GraphInvariant(Vec<InvariantRow>);
 
@@ -316,6 +323,20 @@ pub type InvariantRow = (u8, u32, Vec<(u8, u32)>);
 
 impl GraphInvariant {
     /// The invariant of `g`; weights are replaced by 1 under [`Multiplicity::Ignore`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::graph::{vertex_edge_graph, GraphInvariant, Multiplicity};
+    /// use topomech::GMap;
+    ///
+    /// let (a, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+    /// let (b, _) = GMap::<3>::from_tets(5, &[[4, 3, 2, 1], [4, 3, 2, 0]]).unwrap();
+    /// let (c, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let inv = |m: &GMap<3>| GraphInvariant::of(&vertex_edge_graph(m), Multiplicity::Match);
+    /// assert_eq!(inv(&a), inv(&b)); // isomorphic graphs share it
+    /// assert_ne!(inv(&a), inv(&c));
+    /// ```
     pub fn of(g: &CellGraph, multiplicity: Multiplicity) -> Self {
         let w = |x: u32| if multiplicity == Multiplicity::Match { x } else { 1 };
         let mut rows: Vec<InvariantRow> = g.node_indices().map(|n| (g[n].dim, 0, Vec::new())).collect();
@@ -339,20 +360,6 @@ impl GraphInvariant {
 
 /// A cell graph in a canonical-looking, id-free JSON form for snapshots and test vectors: nodes
 /// renumbered by (dimension, id), edges as `[a, b, weight]` with a ≤ b, sorted.
-///
-/// # Examples
-///
-/// ```
-/// use topomech::graph::{graphs_isomorphic, incidence_graph, GraphJson, GraphKind, Multiplicity};
-/// use topomech::GMap;
-///
-/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
-/// let g = incidence_graph(&map);
-/// let json = GraphJson::of(&g, GraphKind::Incidence);
-/// assert_eq!(json.nodes.len(), 15);
-/// let back = json.to_graph().unwrap();
-/// assert!(graphs_isomorphic(&g, &back, Multiplicity::Match));
-/// ```
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct GraphJson {
     /// Which graph.
@@ -365,6 +372,19 @@ pub struct GraphJson {
 
 impl GraphJson {
     /// The JSON form of `g`. O(nodes + edges · log).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::graph::{vertex_edge_graph, GraphJson, GraphKind};
+    /// use topomech::GMap;
+    ///
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let json = GraphJson::of(&vertex_edge_graph(&map), GraphKind::VertexEdge);
+    /// assert_eq!(json.nodes, vec![0, 0, 0, 0]); // four vertices (dimension 0)
+    /// assert_eq!(json.edges.len(), 6);
+    /// assert!(json.edges.windows(2).all(|w| w[0] < w[1]) && json.edges.iter().all(|e| e[0] <= e[1]));
+    /// ```
     pub fn of(g: &CellGraph, kind: GraphKind) -> Self {
         let mut order: Vec<NodeIndex> = g.node_indices().collect();
         order.sort_by_key(|&n| g[n]);
@@ -386,6 +406,20 @@ impl GraphJson {
 
     /// Rebuilds a graph (node ids = ranks). Errors name the first edge with an endpoint out of
     /// range. O(nodes + edges).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::graph::{graphs_isomorphic, incidence_graph, GraphJson, GraphKind, Multiplicity};
+    /// use topomech::GMap;
+    ///
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let g = incidence_graph(&map);
+    /// let json = GraphJson::of(&g, GraphKind::Incidence);
+    /// assert_eq!(json.nodes.len(), 15);
+    /// let back = json.to_graph().unwrap();
+    /// assert!(graphs_isomorphic(&g, &back, Multiplicity::Match));
+    /// ```
     pub fn to_graph(&self) -> Result<CellGraph, GraphJsonError> {
         let mut g = CellGraph::default();
         let nodes: Vec<NodeIndex> =

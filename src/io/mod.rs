@@ -325,6 +325,21 @@ pub fn read_mesh(path: &Path) -> Result<TetMesh, ReadError> {
 ///
 /// # Errors
 /// Any [`ReadError`], naming whichever of the two files is at fault.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::io::read_tetgen;
+///
+/// let stem = std::env::temp_dir().join(format!("topomech-doc-{}", std::process::id()));
+/// let (node, ele) = (stem.with_extension("node"), stem.with_extension("ele"));
+/// std::fs::write(&node, "4 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n").unwrap(); // 0-based numbers
+/// std::fs::write(&ele, "1 4 0\n0 0 1 2 3\n").unwrap();
+/// let mesh = read_tetgen(&node, &ele);
+/// std::fs::remove_file(&node).unwrap();
+/// std::fs::remove_file(&ele).unwrap();
+/// assert_eq!(mesh.unwrap().tets, vec![[0, 1, 2, 3]]);
+/// ```
 pub fn read_tetgen(node_path: &Path, ele_path: &Path) -> Result<TetMesh, ReadError> {
     let node = read_file(node_path)?;
     let ele = read_file(ele_path)?;

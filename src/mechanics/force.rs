@@ -41,23 +41,6 @@ pub const PARALLEL_CHUNK: usize = 4096;
 /// Vertices are *slots* `0..slots()`: positions and velocities are passed in as slices of that
 /// length. A slot with `inv_mass == 0` does not move (pinned, dead or massless). Equality compares
 /// the arrays and, per slot, the incident lists in order (not where they sit in memory).
-///
-/// # Examples
-///
-/// ```
-/// use topomech::mechanics::SpringSystem;
-///
-/// // One spring of rest length 1 and stiffness 10, stretched to length 2 along x.
-/// let mut sys = SpringSystem::default();
-/// let (a, b) = (sys.push_slot(1.0, false, 0.0), sys.push_slot(1.0, false, 0.0));
-/// sys.push_spring([a as u32, b as u32], 1.0, 10.0, 0.0);
-/// let (x, v) = ([[0.0; 3], [2.0, 0.0, 0.0]], [[0.0; 3]; 2]);
-/// let (mut sf, mut out) = (vec![[0.0; 3]; 1], vec![[0.0; 3]; 2]);
-/// sys.forces(&x, &v, &mut sf, &mut out, false);
-/// assert_eq!(out, vec![[10.0, 0.0, 0.0], [-10.0, 0.0, 0.0]]); // equal and opposite
-/// assert_eq!(sys.elastic_energy(&x), 5.0); // ½ k (l − L)²
-/// sys.check_incidence().unwrap();
-/// ```
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct SpringSystem {
     /// Spring end slots (a, b).
@@ -85,6 +68,21 @@ impl SpringSystem {
     /// A system from its arrays; builds the incidence lists packed (module docs). O(slots + springs).
     ///
     /// Panics if the arrays disagree in length or an end is out of range (a bug of the builder).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let sys = SpringSystem::new(
+    ///     vec![[0, 1]], vec![1.0], vec![10.0], vec![0.0], // ends, rest length, stiffness, damping
+    ///     vec![1.0, 2.0], &[false, true], vec![0.0; 2], [0.0; 3], // mass, fixed, viscosity, gravity
+    /// );
+    /// assert_eq!(sys.inv_mass, vec![1.0, 0.0]); // slot 1 is fixed
+    /// assert_eq!((sys.slots(), sys.springs()), (2, 1));
+    /// assert_eq!(sys.incident(1).collect::<Vec<_>>(), vec![(0, -1.0)]); // end b of spring 0
+    /// sys.check_incidence().unwrap();
+    /// ```
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         ends: Vec<[u32; 2]>,
@@ -141,6 +139,20 @@ impl SpringSystem {
     /// Rewrites spring s: its ends (moving it between incidence lists when they change), rest
     /// length, stiffness and damping. O(degree of the old and new ends) amortised. Panics if s is
     /// not a spring, an end is not a slot or a = b.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// (0..3).for_each(|_| drop(sys.push_slot(1.0, false, 0.0)));
+    /// sys.push_spring([0, 1], 1.0, 1.0, 0.0);
+    /// sys.set_spring(0, [0, 2], 2.0, 5.0, 0.1); // re-attach end b to slot 2
+    /// assert_eq!((sys.incident(1).count(), sys.incident(2).count()), (0, 1));
+    /// assert_eq!((sys.rest[0], sys.stiffness[0], sys.damping[0]), (2.0, 5.0, 0.1));
+    /// sys.check_incidence().unwrap();
+    /// ```
     pub fn set_spring(&mut self, s: usize, ends: [u32; 2], rest: f64, stiffness: f64, damping: f64) {
         assert!(ends[0] != ends[1] && (ends[0].max(ends[1]) as usize) < self.slots(), "bad spring ends {ends:?}");
         let old = self.ends[s];
@@ -159,6 +171,21 @@ impl SpringSystem {
     /// Removes spring s; the last spring takes its index (its incidence entries are renamed).
     /// Returns the former index of the moved spring, `None` if s was last. O(degree of the ends
     /// of both springs). Panics if s is not a spring.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// (0..3).for_each(|_| drop(sys.push_slot(1.0, false, 0.0)));
+    /// sys.push_spring([0, 1], 1.0, 1.0, 0.0);
+    /// sys.push_spring([1, 2], 1.0, 1.0, 0.0);
+    /// assert_eq!(sys.swap_remove_spring(0), Some(1)); // spring 1 moved into index 0
+    /// assert_eq!((sys.springs(), sys.ends[0]), (1, [1, 2]));
+    /// assert_eq!(sys.incident(0).count(), 0);
+    /// sys.check_incidence().unwrap();
+    /// ```
     pub fn swap_remove_spring(&mut self, s: usize) -> Option<usize> {
         let [a, b] = self.ends[s];
         self.inc.remove(a as usize, true, s as u32);
@@ -266,12 +293,44 @@ impl SpringSystem {
     }
 
     /// Forces on every slot (pinned ones included) into `out`. O(slots + springs).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// // One spring of rest length 1 and stiffness 10, stretched to length 2 along x.
+    /// let mut sys = SpringSystem::default();
+    /// let (a, b) = (sys.push_slot(1.0, false, 0.0), sys.push_slot(1.0, false, 0.0));
+    /// sys.push_spring([a as u32, b as u32], 1.0, 10.0, 0.0);
+    /// let (x, v) = ([[0.0; 3], [2.0, 0.0, 0.0]], [[0.0; 3]; 2]);
+    /// let (mut sf, mut out) = (vec![[0.0; 3]; 1], vec![[0.0; 3]; 2]);
+    /// sys.forces(&x, &v, &mut sf, &mut out, false);
+    /// assert_eq!(out, vec![[10.0, 0.0, 0.0], [-10.0, 0.0, 0.0]]); // equal and opposite
+    /// assert_eq!(sys.elastic_energy(&x), 5.0); // ½ k (l − L)²
+    /// sys.check_incidence().unwrap();
+    /// ```
     pub fn forces(&self, x: &[Vec3], v: &[Vec3], sf: &mut [Vec3], out: &mut [Vec3], parallel: bool) {
         self.spring_forces(x, v, sf, parallel);
         self.per_slot(out, parallel, |i| self.vertex_force(i, v, sf));
     }
 
     /// Accelerations f_i / m_i (zero on fixed slots) into `acc`. O(slots + springs).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// // No springs: a free slot falls with g, a fixed one does not move.
+    /// let mut sys = SpringSystem::default();
+    /// sys.gravity = [0.0, 0.0, -9.81];
+    /// sys.push_slot(2.0, false, 0.0);
+    /// sys.push_slot(2.0, true, 0.0);
+    /// let (x, v, mut acc) = ([[0.0; 3]; 2], [[0.0; 3]; 2], [[1.0; 3]; 2]);
+    /// sys.accelerations(&x, &v, &mut [], &mut acc, false);
+    /// assert_eq!(acc, [[0.0, 0.0, -9.81], [0.0; 3]]);
+    /// ```
     pub fn accelerations(&self, x: &[Vec3], v: &[Vec3], sf: &mut [Vec3], acc: &mut [Vec3], parallel: bool) {
         self.spring_forces(x, v, sf, parallel);
         let sf: &[Vec3] = sf;
@@ -327,6 +386,18 @@ impl SpringSystem {
     }
 
     /// Gravitational potential −Σ m g·x over free slots. O(slots).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// sys.gravity = [0.0, 0.0, -10.0];
+    /// sys.push_slot(2.0, false, 0.0);
+    /// assert_eq!(sys.gravity_energy(&[[0.0, 0.0, 3.0]]), 60.0); // m g h
+    /// assert_eq!(sys.kinetic_energy(&[[0.0, 4.0, 0.0]]), 16.0); // ½ m v²
+    /// ```
     pub fn gravity_energy(&self, x: &[Vec3]) -> f64 {
         let g = self.gravity;
         self.mass

@@ -115,23 +115,6 @@ pub enum ModelError {
 /// State variables (positions, velocities, forces, pins) are public fields: the simulation writes
 /// them every step. Parameters bound by the laws (masses, stiffnesses) are private and change only
 /// through the split/merge rules, so the laws cannot be broken from outside.
-///
-/// # Examples
-///
-/// ```
-/// use topomech::mechanics::{Body, Material};
-/// use topomech::{CellId, DartId};
-///
-/// let unit = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-/// let (body, _) = Body::from_tets(&unit, &[[0, 1, 2, 3]], Material::default()).unwrap();
-/// let m = body.attrs();
-/// assert!((m.tet_mass(CellId(0)) - 1.0 / 6.0).abs() < 1e-15); // ρ · V
-/// assert!((0..4).all(|v| (m.vertex_mass(CellId(v)) - 1.0 / 24.0).abs() < 1e-15)); // m_t / 4
-/// let f = body.map().cell_id(2, DartId(0));
-/// assert!(m.face_is_boundary(f));
-/// let n = m.face_normal(f);
-/// assert!((n[0] * n[0] + n[1] * n[1] + n[2] * n[2] - 1.0).abs() < 1e-12);
-/// ```
 #[derive(Clone, Debug)]
 pub struct Mechanics {
     pub(crate) material: Material,
@@ -169,6 +152,18 @@ pub type BodyError = crate::embedding::EmbedError<ConservationError>;
 
 impl Mechanics {
     /// The material constants. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let stiff = Material { young: 5e4, ..Material::default() };
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, stiff).unwrap();
+    /// assert_eq!(body.attrs().material(), &stiff);
+    /// ```
     pub fn material(&self) -> &Material {
         &self.material
     }
@@ -179,6 +174,23 @@ impl Mechanics {
     }
 
     /// Mass m_t = ρ·V_t of volume `t`. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::{Body, Material};
+    /// use topomech::{CellId, DartId};
+    ///
+    /// let unit = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let (body, _) = Body::from_tets(&unit, &[[0, 1, 2, 3]], Material::default()).unwrap();
+    /// let m = body.attrs();
+    /// assert!((m.tet_mass(CellId(0)) - 1.0 / 6.0).abs() < 1e-15); // ρ · V
+    /// assert!((0..4).all(|v| (m.vertex_mass(CellId(v)) - 1.0 / 24.0).abs() < 1e-15)); // m_t / 4
+    /// let f = body.map().cell_id(2, DartId(0));
+    /// assert!(m.face_is_boundary(f));
+    /// let n = m.face_normal(f);
+    /// assert!((n[0] * n[0] + n[1] * n[1] + n[2] * n[2] - 1.0).abs() < 1e-12);
+    /// ```
     pub fn tet_mass(&self, t: CellId) -> f64 {
         self.tet_mass[t]
     }
@@ -189,6 +201,22 @@ impl Mechanics {
     }
 
     /// Rest length L_e of edge `e`. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// // The Kuhn cube's edges: 12 sides, 6 face diagonals, 1 space diagonal.
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let (map, m) = (body.map(), body.attrs());
+    /// let edges = map.one_dart_per_cell(1);
+    /// let lengths: Vec<f64> = edges.iter().map(|&d| m.edge_rest_length(map.cell_id(1, d))).collect();
+    /// let count = |l: f64| lengths.iter().filter(|&&x| (x - l).abs() < 1e-12).count();
+    /// assert_eq!((count(1.0), count(2f64.sqrt()), count(3f64.sqrt())), (12, 6, 1));
+    /// ```
     pub fn edge_rest_length(&self, e: CellId) -> f64 {
         self.edge_rest_length[e]
     }
@@ -199,6 +227,21 @@ impl Mechanics {
     }
 
     /// Damping c_e of edge `e`. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let (map, m) = (body.map(), body.attrs());
+    /// for d in map.one_dart_per_cell(1) {
+    ///     let e = map.cell_id(1, d);
+    ///     assert_eq!(m.edge_damping(e), m.material().damping * m.edge_stiffness(e)); // c = β k
+    /// }
+    /// ```
     pub fn edge_damping(&self, e: CellId) -> f64 {
         self.edge_damping[e]
     }
@@ -209,6 +252,19 @@ impl Mechanics {
     }
 
     /// Ambient viscosity γ_v = ν·m_v of vertex `v`. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    /// use topomech::CellId;
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let m = body.attrs();
+    /// assert!((0..8).map(CellId).all(|v| m.vertex_viscosity(v) == m.material().viscosity * m.vertex_mass(v)));
+    /// ```
     pub fn vertex_viscosity(&self, v: CellId) -> f64 {
         self.vertex_viscosity[v]
     }
@@ -226,6 +282,20 @@ impl Mechanics {
 
     /// Number of attribute slots of `dim`-cells (≥ the map's `cell_id_bound(dim)` when in sync).
     /// O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::dissociate_face;
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+    /// dissociate_face(&mut body, d).unwrap(); // new vertex, edge and face ids appear
+    /// assert!((0..=3).all(|i| body.attrs().attribute_len(i) >= body.map().cell_id_bound(i)));
+    /// ```
     pub fn attribute_len(&self, dim: usize) -> usize {
         match dim {
             0 => self.vertex_mass.len().min(self.position.len()),
@@ -236,6 +306,22 @@ impl Mechanics {
     }
 
     /// Recomputes every boundary face normal from the current positions. O(darts).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let map = body.map().clone();
+    /// let faces: Vec<_> = map.one_dart_per_cell(2).into_iter().map(|d| map.cell_id(2, d)).collect();
+    /// let top = *faces.iter().find(|&&f| body.attrs().face_normal(f) == [0.0, 0.0, 1.0]).unwrap();
+    /// body.attrs_mut().position.as_mut_slice().iter_mut().for_each(|p| p[2] = -p[2]); // mirror in z
+    /// body.attrs_mut().update_normals(&map);
+    /// assert_eq!(body.attrs().face_normal(top), [0.0, 0.0, -1.0]); // the top face now faces down
+    /// ```
     pub fn update_normals(&mut self, map: &GMap<3>) {
         for d in map.one_dart_per_cell(2) {
             let f = map.cell_id(2, d);

@@ -100,6 +100,23 @@ impl Projection {
     }
 
     /// Rebuilds from scratch after topological changes (keeps the gravity). O(darts + E log E).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::remove_volume;
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, Projection};
+    /// use topomech::CellId;
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let mut p = Projection::build(&body, [0.0; 3]);
+    /// remove_volume(&mut body, CellId(0)).unwrap();
+    /// assert!(!p.is_current(&body));
+    /// p.rebuild(&body);
+    /// assert_eq!((p.version(), p.system.springs()), (body.version(), body.map().count_cells().0[1]));
+    /// ```
     pub fn rebuild(&mut self, body: &Body) {
         *self = Projection::build(body, self.system.gravity);
     }
@@ -202,6 +219,19 @@ impl Projection {
     ///
     /// # Errors
     /// The first [`ProjectionMismatch`] found.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, Projection};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let a = Projection::build(&body, [0.0; 3]);
+    /// assert!(a.equivalent(&Projection::build(&body, [0.0; 3])).is_ok());
+    /// assert!(a.equivalent(&Projection::build(&body, [0.0, 0.0, -1.0])).is_err()); // other gravity
+    /// ```
     pub fn equivalent(&self, other: &Projection) -> Result<(), ProjectionMismatch> {
         let (a, b) = (&self.system, &other.system);
         a.check_incidence().map_err(ProjectionMismatch::Incidence)?;
@@ -250,6 +280,21 @@ impl Projection {
     }
 
     /// A dart of the vertex in slot `slot` (= vertex id), `None` for a dead id. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, Projection};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let p = Projection::build(&body, [0.0; 3]);
+    /// for slot in 0..p.system.slots() {
+    ///     assert_eq!(body.map().vertex_id(p.dart_of_vertex(slot).unwrap()).index(), slot); // slot = vertex id
+    /// }
+    /// assert_eq!(p.dart_of_vertex(99), None);
+    /// ```
     pub fn dart_of_vertex(&self, slot: usize) -> Option<DartId> {
         self.vertex_dart.get(slot).copied().flatten()
     }
@@ -300,6 +345,22 @@ impl TouchedCells {
     /// every split, the survivor and the absorbed id of every merge, and every edge around a
     /// vertex that got a new id (its spring's ends changed). O(changes + stars of renamed
     /// vertices).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, TouchedCells};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+    /// let changes = body.unsew3(d).unwrap();
+    /// let mut touched = TouchedCells::default();
+    /// assert!(touched.is_empty());
+    /// touched.record(body.map(), &changes);
+    /// assert!(!touched.is_empty() && !touched.vertices.is_empty());
+    /// ```
     pub fn record(&mut self, map: &GMap<3>, changes: &CellChanges) {
         for (kept, new, dk, dn) in changes.splits(0) {
             self.vertices.push((kept, Some(dk)));

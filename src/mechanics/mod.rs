@@ -217,7 +217,8 @@ impl Simulation {
     /// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
     /// let cut = dissociate_face(&mut body, d).unwrap();
     /// sim.update(&mut body, &cut.touched).unwrap(); // incremental: only the touched cells
-    /// sim.projection.equivalent(&Projection::build(&body, [0.0; 3])).unwrap(); // = a fresh build
+    /// assert!(sim.projection.is_current(&body));
+    /// assert!(sim.projection.equivalent(&Projection::build(&body, [0.0; 3])).is_ok()); // = a fresh build
     /// sim.step(&mut body).unwrap();
     /// ```
     pub fn update(&mut self, body: &mut Body, touched: &TouchedCells) -> Result<(), SimError> {

@@ -52,6 +52,20 @@ pub struct Incision {
 
 impl Incision {
     /// Number of faces cut. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::{incise_plane, Plane};
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(2);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let cut = incise_plane(&mut body, &Plane { point: [0.0, 0.0, 1.0], normal: [0.0, 0.0, 1.0] }).unwrap();
+    /// assert_eq!(cut.cut_faces(), cut.dissociations.len());
+    /// assert_eq!(body.map().boundary_cell_count(), 48 + 2 * cut.cut_faces()); // both sides of each cut face
+    /// ```
     pub fn cut_faces(&self) -> usize {
         self.dissociations.len()
     }

@@ -16,6 +16,18 @@ impl DartSet {
     }
 
     /// Whether d is in the set. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::gmap::DartSet;
+    /// use topomech::DartId;
+    ///
+    /// let mut set = DartSet::default();
+    /// assert!(!set.contains(DartId(1_000_000))); // past the end: simply absent
+    /// set.insert(DartId(64));
+    /// assert!(set.contains(DartId(64)) && !set.contains(DartId(63)));
+    /// ```
     #[inline(always)]
     pub fn contains(&self, d: DartId) -> bool {
         let i = d.index();
@@ -103,6 +115,21 @@ impl Mark {
     }
 
     /// Whether d is marked. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::{AlphaMask, GMap};
+    ///
+    /// let (mut map, _) = GMap::<2>::from_triangles(4, &[[0, 1, 2], [0, 2, 3]]).unwrap();
+    /// let d = map.darts().next().unwrap();
+    /// let mut mark = map.reserve_mark();
+    /// map.mark_orbit(&mut mark, d, AlphaMask::cell(2, 2)); // d's triangle
+    /// assert_eq!(map.darts().filter(|&e| mark.is_marked(e)).count(), 6);
+    /// assert!(map.darts().all(|e| mark.is_marked(e) == (map.cell_id(2, e) == map.cell_id(2, d))));
+    /// map.unmark_orbit(&mut mark, d, AlphaMask::cell(2, 2));
+    /// map.free_mark(mark);
+    /// ```
     pub fn is_marked(&self, d: DartId) -> bool {
         self.set.contains(d)
     }

@@ -124,6 +124,20 @@ impl SpringSystem {
 
     /// Appends spring `ends` = (a, b) with rest length, stiffness and damping; returns its index.
     /// O(degree of a and b) amortised. Panics if an end is not a slot or a = b.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// let (a, b) = (sys.push_slot(1.0, false, 0.0), sys.push_slot(0.0, false, 0.0));
+    /// assert_eq!(sys.inv_mass, vec![1.0, 0.0]); // a massless slot does not move
+    /// let s = sys.push_spring([a as u32, b as u32], 1.0, 3.0, 0.0);
+    /// assert_eq!((s, sys.springs()), (0, 1));
+    /// assert_eq!(sys.incident(a).collect::<Vec<_>>(), vec![(s, 1.0)]);
+    /// sys.check_incidence().unwrap();
+    /// ```
     pub fn push_spring(&mut self, ends: [u32; 2], rest: f64, stiffness: f64, damping: f64) -> usize {
         assert!(ends[0] != ends[1] && (ends[0].max(ends[1]) as usize) < self.slots(), "bad spring ends {ends:?}");
         let s = self.ends.len();
@@ -225,6 +239,23 @@ impl SpringSystem {
     }
 
     /// Pass 1: F_s (force on end a) of every spring into `sf`. O(springs).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// // Three slots on a line, springs of rest length 1: the first compressed, the second stretched.
+    /// let mut sys = SpringSystem::default();
+    /// (0..3).for_each(|_| drop(sys.push_slot(1.0, false, 0.0)));
+    /// sys.push_spring([0, 1], 1.0, 2.0, 0.0);
+    /// sys.push_spring([1, 2], 1.0, 2.0, 0.0);
+    /// let (x, v) = ([[0.0; 3], [0.5, 0.0, 0.0], [2.5, 0.0, 0.0]], [[0.0; 3]; 3]);
+    /// let mut sf = vec![[0.0; 3]; 2];
+    /// sys.spring_forces(&x, &v, &mut sf, false);
+    /// assert_eq!(sf, vec![[-1.0, 0.0, 0.0], [2.0, 0.0, 0.0]]); // F on end a: pushed away, pulled along
+    /// assert_eq!(sys.vertex_force(1, &v, &sf), [1.0 + 2.0, 0.0, 0.0]); // −F₀ + F₁ on the middle slot
+    /// ```
     pub fn spring_forces(&self, x: &[Vec3], v: &[Vec3], sf: &mut [Vec3], parallel: bool) {
         if parallel && sf.len() > PARALLEL_CHUNK {
             sf.par_chunks_mut(PARALLEL_CHUNK).enumerate().for_each(|(c, chunk)| {
@@ -375,6 +406,18 @@ impl SpringSystem {
     }
 
     /// Elastic energy ½ Σ k (l − L)². O(springs).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// (0..2).for_each(|_| drop(sys.push_slot(1.0, false, 0.0)));
+    /// sys.push_spring([0, 1], 2.0, 8.0, 0.0);
+    /// assert_eq!(sys.elastic_energy(&[[0.0; 3], [0.0, 2.0, 0.0]]), 0.0); // at rest length
+    /// assert_eq!(sys.elastic_energy(&[[0.0; 3], [0.0, 1.5, 0.0]]), 1.0); // ½ · 8 · 0.5²
+    /// ```
     pub fn elastic_energy(&self, x: &[Vec3]) -> f64 {
         (0..self.springs())
             .map(|s| {

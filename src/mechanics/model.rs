@@ -169,6 +169,18 @@ impl Mechanics {
     }
 
     /// Rest volume V_t of volume `t`. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::{Body, Material};
+    /// use topomech::CellId;
+    ///
+    /// let points = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 3.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let (body, _) = Body::from_tets(&points, &[[0, 2, 1, 3]], Material::default()).unwrap(); // inverted order
+    /// assert!((body.attrs().tet_rest_volume(CellId(0)) - 1.0).abs() < 1e-15); // |det| / 6 = 6 / 6
+    /// assert_eq!(body.attrs().tet_young(CellId(0)), Material::default().young);
+    /// ```
     pub fn tet_rest_volume(&self, t: CellId) -> f64 {
         self.tet_rest_volume[t]
     }
@@ -222,6 +234,22 @@ impl Mechanics {
     }
 
     /// Stiffness k_e of edge `e`. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// // One tet: each edge gets k = E·V/L² from its only tet.
+    /// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let (body, _) = Body::from_tets(&points, &[[0, 1, 2, 3]], Material::default()).unwrap();
+    /// let (map, m) = (body.map(), body.attrs());
+    /// for d in map.one_dart_per_cell(1) {
+    ///     let (e, young) = (map.cell_id(1, d), m.material().young);
+    ///     let l = m.edge_rest_length(e);
+    ///     assert!((m.edge_stiffness(e) - young * (1.0 / 6.0) / (l * l)).abs() < 1e-9);
+    /// }
+    /// ```
     pub fn edge_stiffness(&self, e: CellId) -> f64 {
         self.edge_stiffness[e]
     }
@@ -270,6 +298,19 @@ impl Mechanics {
     }
 
     /// Whether face `f` is on the boundary (its darts are α3-free). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let (map, m) = (body.map(), body.attrs());
+    /// let boundary = map.one_dart_per_cell(2).into_iter().filter(|&d| m.face_is_boundary(map.cell_id(2, d))).count();
+    /// assert_eq!(boundary, 12);
+    /// ```
     pub fn face_is_boundary(&self, f: CellId) -> bool {
         self.face_boundary.get(f).copied().unwrap_or(false)
     }

@@ -153,6 +153,23 @@ impl Projection {
     /// [`Projection::build`] of `body` and [`Projection::is_current`] holds.
     /// Cost: O(touched cells · degree + new ids) amortised (see [`SpringSystem`]'s incidence
     /// lists); nothing proportional to the mesh.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::{incise_plane, Plane};
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, Projection};
+    ///
+    /// let (points, tets) = kuhn_cube(2);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let mut p = Projection::build(&body, [0.0, 0.0, -9.81]);
+    /// let cut = incise_plane(&mut body, &Plane { point: [1.0; 3], normal: [1.0, 0.0, 0.0] }).unwrap();
+    /// p.update(&body, &cut.touched);
+    /// assert!(p.is_current(&body));
+    /// assert!(p.equivalent(&Projection::build(&body, [0.0, 0.0, -9.81])).is_ok());
+    /// assert_eq!(p.system.slots(), body.map().cell_id_bound(0)); // new vertex ids got slots
+    /// ```
     pub fn update(&mut self, body: &Body, touched: &TouchedCells) {
         let map = body.map();
         let mech = body.attrs();
@@ -269,7 +286,27 @@ impl Projection {
         self.spring_edge[s]
     }
 
-    /// A dart of spring s's edge; its vertex is end a. O(1).
+    /// A dart of spring s's edge; its vertex is one of the spring's two ends (either one: ends are
+    /// stored as `[lo, hi]`). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, Projection};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let p = Projection::build(&body, [0.0; 3]);
+    /// let map = body.map();
+    /// for s in 0..p.system.springs() {
+    ///     let d = p.dart_of_spring(s);
+    ///     assert_eq!(map.cell_id(1, d), p.edge_of_spring(s));
+    ///     let [a, b] = p.system.ends[s];
+    ///     assert!(a < b && [a, b].contains(&map.vertex_id(d).0));
+    ///     assert_eq!(map.vertex_id(map.alpha::<0>(d)).0, a + b - map.vertex_id(d).0); // α0: the other end
+    /// }
+    /// ```
     pub fn dart_of_spring(&self, s: usize) -> DartId {
         self.spring_dart[s]
     }
@@ -395,6 +432,25 @@ impl TouchedCells {
     }
 
     /// Appends the records of `other` (a later operation of the same batch). O(|other|).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::dissociate_face;
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, TouchedCells};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let mut batch = TouchedCells::default();
+    /// for _ in 0..2 {
+    ///     let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+    ///     let cut = dissociate_face(&mut body, d).unwrap();
+    ///     let n = batch.vertices.len() + cut.touched.vertices.len();
+    ///     batch.extend(cut.touched);
+    ///     assert_eq!(batch.vertices.len(), n);
+    /// }
+    /// ```
     pub fn extend(&mut self, other: TouchedCells) {
         self.vertices.extend(other.vertices);
         self.edges.extend(other.edges);

@@ -199,6 +199,16 @@ pub struct TriMeshReport {
 
 impl TriMeshReport {
     /// True when there is no warning at all. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mesh::TriMesh;
+    ///
+    /// let square = vec![[0.0; 3], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
+    /// let mesh = TriMesh { points: square, triangles: vec![[0, 1, 2], [0, 2, 3]] };
+    /// assert!(mesh.check().unwrap().is_clean());
+    /// ```
     pub fn is_clean(&self) -> bool {
         self.zero_area_triangles.is_empty() && self.unreferenced_points.is_empty()
     }

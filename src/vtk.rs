@@ -196,6 +196,18 @@ impl Series {
     }
 
     /// The `.pvd` path. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use std::path::Path;
+    /// use topomech::vtk::Series;
+    ///
+    /// let dir = std::env::temp_dir();
+    /// let series = Series::new(&dir, "liver").unwrap(); // creates nothing but the directory
+    /// assert_eq!(series.pvd_path(), dir.join("liver.pvd"));
+    /// assert!(series.pvd_path().extension() == Some(Path::new("pvd").as_os_str()));
+    /// ```
     pub fn pvd_path(&self) -> PathBuf {
         self.dir.join(format!("{}.pvd", self.stem))
     }

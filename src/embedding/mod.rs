@@ -174,6 +174,20 @@ pub struct Embedded<const N: usize, E> {
 
 impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
     /// Wraps a map and attributes that already agree with it. O(1) (plus [`CellRules::grow_to`]).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let (map, mech) = body.into_parts();
+    /// let rebuilt = Body::new(map.clone(), mech);
+    /// assert_eq!(rebuilt.version(), 0);
+    /// assert!(rebuilt.map().is_isomorphic(&map));
+    /// ```
     pub fn new(map: GMap<N>, mut attrs: E) -> Self {
         attrs.grow_to(&map);
         Embedded { map, attrs, version: 0 }
@@ -287,6 +301,20 @@ impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
     ///
     /// # Errors
     /// The check's error.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(2);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// assert!(body.check().is_ok());
+    /// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+    /// body.unsew3(d).unwrap();
+    /// assert!(body.check().is_ok()); // the split rules kept the laws
+    /// ```
     pub fn check(&self) -> Result<(), E::Error> {
         self.attrs.check(&self.map)
     }

@@ -66,6 +66,20 @@ impl DartSet {
     }
 
     /// Removes d; returns whether it was present. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::gmap::DartSet;
+    /// use topomech::DartId;
+    ///
+    /// let mut set = DartSet::with_capacity(8);
+    /// set.insert(DartId(2));
+    /// assert!(set.remove(DartId(2)));
+    /// assert!(!set.remove(DartId(2))); // already gone
+    /// assert!(!set.remove(DartId(500))); // never there
+    /// assert!(set.is_empty());
+    /// ```
     #[inline(always)]
     pub fn remove(&mut self, d: DartId) -> bool {
         let i = d.index();
@@ -135,6 +149,21 @@ impl Mark {
     }
 
     /// Number of marked darts. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::{AlphaMask, GMap};
+    ///
+    /// let (mut map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let d = map.darts().next().unwrap();
+    /// let mut mark = map.reserve_mark();
+    /// map.mark_orbit(&mut mark, d, AlphaMask::cell(3, 0)); // d's vertex: 6 darts
+    /// map.mark_orbit(&mut mark, d, AlphaMask::cell(3, 1)); // d's edge: 4 darts, 2 of them marked already
+    /// assert_eq!(mark.count(), 8);
+    /// map.unmark_orbit(&mut mark, d, AlphaMask::all(3));
+    /// map.free_mark(mark);
+    /// ```
     pub fn count(&self) -> usize {
         self.set.len()
     }

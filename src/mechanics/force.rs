@@ -116,6 +116,19 @@ impl SpringSystem {
 
     /// Sets slot v's mass, fixedness and viscosity (`inv_mass` = 0 when fixed or `mass <= 0`,
     /// else 1/mass). O(1). Panics if v is not a slot.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// let v = sys.push_slot(1.0, false, 0.0);
+    /// sys.set_slot(v, 4.0, false, 0.5);
+    /// assert_eq!((sys.mass[v], sys.inv_mass[v], sys.viscosity[v]), (4.0, 0.25, 0.5));
+    /// sys.set_slot(v, 4.0, true, 0.5); // pin it
+    /// assert_eq!(sys.inv_mass[v], 0.0);
+    /// ```
     pub fn set_slot(&mut self, v: usize, mass: f64, fixed: bool, viscosity: f64) {
         self.mass[v] = mass;
         self.viscosity[v] = viscosity;
@@ -389,12 +402,37 @@ impl SpringSystem {
     }
 
     /// The springs incident to slot i as (spring, sign): +1 where i is end a. O(degree).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// (0..3).for_each(|_| drop(sys.push_slot(1.0, false, 0.0)));
+    /// sys.push_spring([0, 1], 1.0, 1.0, 0.0);
+    /// sys.push_spring([1, 2], 1.0, 1.0, 0.0);
+    /// let mut at_1: Vec<_> = sys.incident(1).collect();
+    /// at_1.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    /// assert_eq!(at_1, vec![(0, -1.0), (1, 1.0)]); // end b of spring 0, end a of spring 1
+    /// ```
     pub fn incident(&self, i: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
         let (heads, tails) = self.inc.lists(i);
         heads.iter().map(|&s| (s as usize, 1.0)).chain(tails.iter().map(|&s| (s as usize, -1.0)))
     }
 
     /// Kinetic energy ½ Σ m |v|² over free slots. O(slots).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// sys.push_slot(2.0, false, 0.0);
+    /// sys.push_slot(2.0, true, 0.0); // fixed slots do not count
+    /// assert_eq!(sys.kinetic_energy(&[[3.0, 0.0, 4.0], [9.0; 3]]), 25.0); // ½ · 2 · 5²
+    /// ```
     pub fn kinetic_energy(&self, v: &[Vec3]) -> f64 {
         self.mass
             .iter()

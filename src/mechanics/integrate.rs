@@ -233,6 +233,22 @@ impl Stepper {
     }
 
     /// Steps made so far. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::{Integrator, SpringSystem, StepConfig, Stepper};
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// sys.push_slot(1.0, false, 0.0);
+    /// let (mut x, mut v) = (vec![[0.0; 3]], vec![[1.0, 0.0, 0.0]]);
+    /// let mut stepper = Stepper::new(StepConfig::new(Integrator::Euler, 0.5), &sys, &x, &v).unwrap();
+    /// for _ in 0..4 {
+    ///     stepper.step(&sys, &mut x, &mut v).unwrap();
+    /// }
+    /// assert_eq!(stepper.steps_done(), 4);
+    /// assert_eq!(x[0], [2.0, 0.0, 0.0]); // free flight: 4 steps × 0.5 s × 1 m/s
+    /// ```
     pub fn steps_done(&self) -> u64 {
         self.step
     }

@@ -275,6 +275,21 @@ impl Mechanics {
     }
 
     /// Mass m_v of vertex `v`. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    /// use topomech::CellId;
+    ///
+    /// // Corner (0, 0, 0) of the Kuhn cube touches all 6 tets; corner (1, 0, 0) only 2.
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let m = body.attrs();
+    /// assert!((m.vertex_mass(CellId(0)) - 6.0 * (1.0 / 6.0) / 4.0).abs() < 1e-15);
+    /// assert!((m.vertex_mass(CellId(1)) - 2.0 * (1.0 / 6.0) / 4.0).abs() < 1e-15);
+    /// ```
     pub fn vertex_mass(&self, v: CellId) -> f64 {
         self.vertex_mass[v]
     }
@@ -317,6 +332,22 @@ impl Mechanics {
 
     /// Outward unit normal of boundary face `f` at the last [`Mechanics::update_normals`] (zero
     /// for inner faces). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let (map, m) = (body.map(), body.attrs());
+    /// for d in map.one_dart_per_cell(2) {
+    ///     let (f, n) = (map.cell_id(2, d), m.face_normal(map.cell_id(2, d)));
+    ///     let axis_aligned = n.iter().filter(|c| c.abs() == 1.0).count() == 1; // outward ±x, ±y or ±z
+    ///     assert_eq!(axis_aligned, m.face_is_boundary(f)); // inner faces: zero normal
+    /// }
+    /// ```
     pub fn face_normal(&self, f: CellId) -> Vec3 {
         self.face_normal[f]
     }

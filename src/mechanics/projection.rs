@@ -144,6 +144,20 @@ impl Projection {
     }
 
     /// The body version the projection was built from. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, Projection};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+    /// body.unsew3(d).unwrap();
+    /// let p = Projection::build(&body, [0.0; 3]);
+    /// assert_eq!((p.version(), body.version()), (1, 1));
+    /// ```
     pub fn version(&self) -> u64 {
         self.version
     }
@@ -312,6 +326,24 @@ impl Projection {
     }
 
     /// The spring of edge `e`, if `e` is live. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::remove_volume;
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, Projection};
+    /// use topomech::CellId;
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// remove_volume(&mut body, CellId(0)).unwrap(); // edge (1,0,0)–(1,1,0) was only in tet 0
+    /// let (p, map) = (Projection::build(&body, [0.0; 3]), body.map());
+    /// let live: Vec<CellId> = map.one_dart_per_cell(1).iter().map(|&d| map.cell_id(1, d)).collect();
+    /// assert!(live.iter().all(|&e| p.spring_of_edge(e).is_some()) && p.system.springs() == live.len());
+    /// let dead: Vec<CellId> = (0..map.cell_id_bound(1) as u32).map(CellId).filter(|e| !live.contains(e)).collect();
+    /// assert!(!dead.is_empty() && dead.iter().all(|&e| p.spring_of_edge(e).is_none()));
+    /// ```
     pub fn spring_of_edge(&self, e: CellId) -> Option<usize> {
         self.edge_spring.get(e.index()).filter(|&&s| s != u32::MAX).map(|&s| s as usize)
     }

@@ -21,6 +21,19 @@ use rustc_hash::FxHashMap;
 use crate::gmap::{AlphaMask, DartId, GMap};
 
 /// Why a mesh could not be turned into a map. Nothing is built when one is returned.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::{BuildError, GMap};
+///
+/// assert_eq!(GMap::<3>::from_tets(4, &[]).unwrap_err(), BuildError::Empty("tetrahedra"));
+/// let err = GMap::<3>::from_tets(4, &[[0, 1, 2, 7]]).unwrap_err();
+/// assert_eq!(err, BuildError::IndexOutOfRange { element: 0, corner: 3, index: 7, points: 4 });
+/// // three tets on one face: no quasi-manifold has that
+/// let fan = [[0, 1, 2, 3], [0, 1, 2, 4], [0, 1, 2, 5]];
+/// assert!(matches!(GMap::<3>::from_tets(6, &fan), Err(BuildError::NonManifold { what: "face", .. })));
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum BuildError {
     /// No element at all.
@@ -63,6 +76,18 @@ pub enum BuildError {
 }
 
 /// What the build found worth knowing about the input, besides the map.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::GMap;
+///
+/// // Two tets that touch only at point 0: the map gets two vertices there.
+/// let (map, report) = GMap::<3>::from_tets(7, &[[0, 1, 2, 3], [0, 4, 5, 6]]).unwrap();
+/// assert_eq!(report.pinched_vertices, vec![(0, 2)]);
+/// assert_eq!(map.count_cells().0[0], 8);
+/// assert!(report.split_edges.is_empty() && report.unreferenced_points.is_empty());
+/// ```
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct BuildReport {
     /// Points whose elements form several fans: (point, number of g-map vertices it became).
@@ -151,6 +176,18 @@ fn sorted<const K: usize>(mut key: [u32; K]) -> [u32; K] {
 
 impl GMap<3> {
     /// The 3-G-map of a tetrahedral mesh with `points` points (see the [module docs](self)).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let (map, report) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+    /// assert_eq!(map.dart_count(), 2 * 24);
+    /// assert_eq!(map.count_cells().0, vec![5, 9, 7, 2]);
+    /// assert_eq!(map.darts().filter(|&d| !map.is_free(3, d)).count(), 12); // the shared face
+    /// assert_eq!(report, Default::default()); // nothing unusual in the input
+    /// ```
     pub fn from_tets(points: usize, tets: &[[u32; 4]]) -> Result<(GMap<3>, BuildReport), BuildError> {
         if tets.is_empty() {
             return Err(BuildError::Empty("tetrahedra"));
@@ -464,6 +501,19 @@ fn vertex_report(orbits_of: &[usize]) -> BuildReport {
 
 impl GMap<2> {
     /// The 2-G-map of a triangle mesh with `points` points (see the [module docs](self)).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::{generate, GMap};
+    ///
+    /// let (points, triangles) = generate::grid_triangles(2);
+    /// let (map, _) = GMap::<2>::from_triangles(points.len(), &triangles).unwrap();
+    /// assert_eq!(map.dart_count(), 6 * triangles.len());
+    /// assert_eq!(map.count_cells().0, vec![9, 16, 8]);
+    /// assert_eq!(map.boundary_cell_count(), 8); // 4n boundary edges
+    /// assert!(GMap::<2>::from_triangles(3, &[[0, 1, 1]]).is_err()); // repeated point
+    /// ```
     pub fn from_triangles(points: usize, triangles: &[[u32; 3]]) -> Result<(GMap<2>, BuildReport), BuildError> {
         if triangles.is_empty() {
             return Err(BuildError::Empty("triangles"));

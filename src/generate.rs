@@ -1,10 +1,22 @@
 //! Seeded and structured mesh factories shared by tests, benchmarks and the demo.
 
-/// The cube [0,k]³ cut into k³ unit cubes, each cut into 6 tetrahedra around its 000–111
+/// The cube \[0,k\]³ cut into k³ unit cubes, each cut into 6 tetrahedra around its 000–111
 /// diagonal (the Kuhn / Freudenthal split, conforming across cubes).
 ///
 /// Closed forms (used as test oracles): V = (k+1)³, T = 6k³,
 /// E = 3k(k+1)² + 3k²(k+1) + k³, F = 12k³ + 6k², boundary faces = 12k², darts = 144k³.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::{generate, GMap};
+///
+/// let (points, tets) = generate::kuhn_cube(2);
+/// assert_eq!((points.len(), tets.len()), (27, 48)); // (k+1)³ and 6k³
+/// let (map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+/// assert_eq!(map.count_cells().0, vec![27, 98, 120, 48]);
+/// assert_eq!(map.boundary_cell_count(), 48); // 12k²
+/// ```
 pub fn kuhn_cube(k: usize) -> (Vec<[f64; 3]>, Vec<[u32; 4]>) {
     let side = k + 1;
     let id = |x: usize, y: usize, z: usize| (x + side * (y + side * z)) as u32;
@@ -36,8 +48,18 @@ pub fn kuhn_cube(k: usize) -> (Vec<[f64; 3]>, Vec<[u32; 4]>) {
     (points, tets)
 }
 
-/// The square [0,n]² cut into n² unit squares, each cut into two triangles along its diagonal.
+/// The square \[0,n\]² cut into n² unit squares, each cut into two triangles along its diagonal.
 /// V = (n+1)², T = 2n², E = 3n² + 2n, boundary edges = 4n.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate;
+///
+/// let (points, triangles) = generate::grid_triangles(3);
+/// assert_eq!((points.len(), triangles.len()), (16, 18)); // (n+1)² and 2n²
+/// assert!(points.iter().all(|p| p[2] == 0.0 && p[0] <= 3.0 && p[1] <= 3.0));
+/// ```
 pub fn grid_triangles(n: usize) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
     let side = n + 1;
     let id = |x: usize, y: usize| (x + side * y) as u32;
@@ -53,11 +75,33 @@ pub fn grid_triangles(n: usize) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
 }
 
 /// A small deterministic pseudo-random generator (SplitMix64), so factories need no dependency.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate::SplitMix64;
+///
+/// let (mut a, mut b) = (SplitMix64(42), SplitMix64(42));
+/// assert_eq!(a.next_u64(), b.next_u64()); // same seed, same sequence
+/// assert_ne!(a.next_u64(), a.next_u64());
+/// assert!((0..100).all(|_| a.below(7) < 7));
+/// ```
 #[derive(Clone, Debug)]
 pub struct SplitMix64(pub u64);
 
 impl SplitMix64 {
     /// The next 64 random bits.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::SplitMix64;
+    ///
+    /// let mut rng = SplitMix64(1);
+    /// let first = rng.next_u64();
+    /// assert_eq!(SplitMix64(1).next_u64(), first); // deterministic
+    /// assert_ne!(rng.next_u64(), first);
+    /// ```
     pub fn next_u64(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;
@@ -67,6 +111,17 @@ impl SplitMix64 {
     }
 
     /// A number in 0..n (n > 0).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::SplitMix64;
+    ///
+    /// let mut rng = SplitMix64(7);
+    /// let rolls: Vec<usize> = (0..600).map(|_| rng.below(6)).collect();
+    /// assert!(rolls.iter().all(|&r| r < 6));
+    /// assert!((0..6).all(|face| rolls.contains(&face))); // every value turns up
+    /// ```
     pub fn below(&mut self, n: usize) -> usize {
         (self.next_u64() % n as u64) as usize
     }

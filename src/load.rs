@@ -29,6 +29,16 @@ pub const BUILTIN_MESH: &[u8] = include_bytes!("../data/liver_547_v22.msh");
 pub const BUILTIN_NAME: &str = "<built-in>/liver_547_v22.msh";
 
 /// A mesh file turned into a 3-G-map, with everything learnt on the way.
+///
+/// # Examples
+///
+/// ```
+/// let loaded = topomech::load::load_builtin().unwrap();
+/// assert_eq!(loaded.mesh.points.len(), 547);
+/// assert_eq!(loaded.map.dart_count(), 24 * loaded.mesh.tets.len());
+/// assert_eq!(loaded.map.count_cells().0[0], 547); // vertex id = point index
+/// assert!(loaded.warnings.is_clean());
+/// ```
 #[derive(Debug, Clone)]
 pub struct Loaded {
     /// The file the mesh came from ([`BUILTIN_NAME`] for the built-in mesh).
@@ -49,6 +59,17 @@ pub struct Loaded {
 }
 
 /// Why a mesh file could not be loaded. Every variant names the file.
+///
+/// # Examples
+///
+/// ```
+/// use std::path::Path;
+/// use topomech::load::{load_tet_map, LoadError};
+///
+/// let err = load_tet_map(Path::new("/no/such/dir/liver.msh")).unwrap_err();
+/// assert!(matches!(err, LoadError::Read(_)));
+/// assert!(err.to_string().contains("/no/such/dir/liver.msh"));
+/// ```
 #[derive(Debug, thiserror::Error)]
 pub enum LoadError {
     /// The reader failed; its message already names the file and the line or byte.
@@ -85,6 +106,19 @@ pub enum LoadError {
 /// [`LoadError::Read`] when the file cannot be read or parsed, [`LoadError::Check`] when the mesh
 /// has a defect [`TetMesh::check`] rejects, [`LoadError::Build`] when a face is shared by more
 /// than two tets or the mesh exceeds 32-bit dart ids.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::load::{load_tet_map, BUILTIN_MESH};
+///
+/// let path = std::env::temp_dir().join(format!("topomech-doc-{}.msh", std::process::id()));
+/// std::fs::write(&path, BUILTIN_MESH).unwrap();
+/// let loaded = load_tet_map(&path).unwrap();
+/// std::fs::remove_file(&path).unwrap();
+/// assert_eq!(loaded.path, path);
+/// assert_eq!(loaded.mesh.tets.len(), 1852);
+/// ```
 pub fn load_tet_map(path: &Path) -> Result<Loaded, LoadError> {
     let mesh = io::read_mesh(path)?;
     build_loaded(mesh, path)
@@ -95,6 +129,20 @@ pub fn load_tet_map(path: &Path) -> Result<Loaded, LoadError> {
 ///
 /// # Errors
 /// As [`load_tet_map`], except that no I/O error can occur.
+///
+/// # Examples
+///
+/// ```
+/// use std::path::Path;
+/// use topomech::load::load_tet_map_from_msh_bytes;
+///
+/// let msh = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n\
+///            $EndNodes\n$Elements\n1\n1 4 2 0 1 1 2 3 4\n$EndElements\n";
+/// let loaded = load_tet_map_from_msh_bytes(msh.as_bytes(), Path::new("one.msh")).unwrap();
+/// assert_eq!(loaded.map.count_cells().0, vec![4, 6, 4, 1]);
+/// assert_eq!(loaded.mesh.node_tags, vec![1, 2, 3, 4]);
+/// assert!(loaded.warnings.is_clean());
+/// ```
 pub fn load_tet_map_from_msh_bytes(bytes: &[u8], name: &Path) -> Result<Loaded, LoadError> {
     let mesh = io::parse_msh(bytes, name)?;
     build_loaded(mesh, name)
@@ -105,6 +153,19 @@ pub fn load_tet_map_from_msh_bytes(bytes: &[u8], name: &Path) -> Result<Loaded, 
 /// # Errors
 /// None in practice (the tests load it); the `Result` is kept so a corrupted build of the crate
 /// reports instead of panicking.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::load::load_builtin;
+///
+/// let liver = load_builtin().unwrap();
+/// assert_eq!(liver.mesh.tets.len(), 1852);
+/// assert_eq!(liver.map.count_cells().0[1], 2833); // edges
+/// assert_eq!(liver.map.boundary_cell_count(), 870);
+/// assert_eq!(liver.map.euler_characteristic(), 1); // one solid ball
+/// assert!((liver.mesh.total_volume() - 38.17).abs() < 0.01);
+/// ```
 pub fn load_builtin() -> Result<Loaded, LoadError> {
     load_tet_map_from_msh_bytes(BUILTIN_MESH, Path::new(BUILTIN_NAME))
 }
@@ -113,6 +174,20 @@ pub fn load_builtin() -> Result<Loaded, LoadError> {
 ///
 /// # Errors
 /// [`LoadError::Check`], [`LoadError::Build`].
+///
+/// # Examples
+///
+/// ```
+/// use std::path::Path;
+/// use topomech::load::{build_loaded, LoadError};
+/// use topomech::mesh::TetMesh;
+///
+/// let unit = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+/// let mesh = TetMesh { points: unit.clone(), tets: vec![[0, 1, 2, 3]], ..Default::default() };
+/// assert_eq!(build_loaded(mesh, Path::new("mem")).unwrap().map.dart_count(), 24);
+/// let bad = TetMesh { points: unit, tets: vec![[0, 1, 2, 9]], ..Default::default() };
+/// assert!(matches!(build_loaded(bad, Path::new("mem")), Err(LoadError::Check { .. })));
+/// ```
 pub fn build_loaded(mesh: TetMesh, path: &Path) -> Result<Loaded, LoadError> {
     let warnings = mesh.check().map_err(|source| LoadError::Check { path: path.to_path_buf(), source })?;
     let start = Instant::now();
@@ -141,6 +216,21 @@ fn build_hint(err: &BuildError, mesh: &TetMesh) -> String {
 
 /// One line per kind of warning in `loaded` (mesh check and build report), each naming the file
 /// and at most the first five ids. Empty when the mesh is clean. O(warnings).
+///
+/// # Examples
+///
+/// ```
+/// use std::path::Path;
+/// use topomech::load::{build_loaded, warning_lines};
+/// use topomech::mesh::TetMesh;
+///
+/// // Point 4 is used by no tet.
+/// let points = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [5.0; 3]];
+/// let mesh = TetMesh { points, tets: vec![[0, 1, 2, 3]], ..Default::default() };
+/// let lines = warning_lines(&build_loaded(mesh, Path::new("m.msh")).unwrap());
+/// assert_eq!(lines.len(), 1);
+/// assert!(lines[0].starts_with("m.msh: warning: 1 unreferenced points"), "{}", lines[0]);
+/// ```
 pub fn warning_lines(loaded: &Loaded) -> Vec<String> {
     let w = &loaded.warnings;
     let b = &loaded.build;

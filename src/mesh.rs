@@ -76,6 +76,17 @@ impl fmt::Display for CellKind {
 /// A defect that makes a mesh unusable (see the table in the [module docs](self)).
 ///
 /// Cell ids are 0-based positions in the cell list, point ids 0-based positions in `points`.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mesh::{MeshError, TetMesh};
+///
+/// let mesh = TetMesh { points: vec![[0.0; 3]; 4], tets: vec![[0, 1, 2, 2]], ..Default::default() };
+/// assert!(matches!(mesh.check(), Err(MeshError::RepeatedVertex { vertex: 2, .. })));
+/// let empty = TetMesh::default();
+/// assert!(matches!(empty.check(), Err(MeshError::Empty(_))));
+/// ```
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MeshError {
     /// The mesh has no cell of the kind that makes it (no tetrahedra / no triangles).
@@ -159,6 +170,15 @@ pub struct MeshReport {
 
 impl MeshReport {
     /// True when there is no warning at all. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mesh::MeshReport;
+    ///
+    /// assert!(MeshReport::default().is_clean());
+    /// assert!(!MeshReport { unreferenced_points: vec![3], ..Default::default() }.is_clean());
+    /// ```
     pub fn is_clean(&self) -> bool {
         self.zero_volume_tets.is_empty()
             && self.inverted_tets.is_empty()
@@ -179,6 +199,16 @@ pub struct TriMeshReport {
 
 impl TriMeshReport {
     /// True when there is no warning at all. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mesh::TriMesh;
+    ///
+    /// let square = vec![[0.0; 3], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
+    /// let mesh = TriMesh { points: square, triangles: vec![[0, 1, 2], [0, 2, 3]] };
+    /// assert!(mesh.check().unwrap().is_clean());
+    /// ```
     pub fn is_clean(&self) -> bool {
         self.zero_area_triangles.is_empty() && self.unreferenced_points.is_empty()
     }
@@ -204,11 +234,31 @@ fn norm(a: [f64; 3]) -> f64 {
 ///
 /// Positive when `d` lies on the side of the plane `(a, b, c)` towards which
 /// `(b - a) x (c - a)` points. O(1).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mesh::signed_volume;
+///
+/// let (o, x, y, z) = ([0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]);
+/// assert!((signed_volume(o, x, y, z) - 1.0 / 6.0).abs() < 1e-15);
+/// assert!((signed_volume(o, y, x, z) + 1.0 / 6.0).abs() < 1e-15); // swapping two corners flips the sign
+/// assert_eq!(signed_volume(o, x, y, [1.0, 1.0, 0.0]), 0.0); // flat
+/// ```
 pub fn signed_volume(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> f64 {
     dot(cross(sub(b, a), sub(c, a)), sub(d, a)) / 6.0
 }
 
 /// Area of the triangle `(a, b, c)` (always `>= 0`). O(1).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mesh::triangle_area;
+///
+/// assert_eq!(triangle_area([0.0; 3], [3.0, 0.0, 0.0], [0.0, 4.0, 0.0]), 6.0);
+/// assert_eq!(triangle_area([0.0; 3], [1.0; 3], [2.0; 3]), 0.0); // collinear
+/// ```
 pub fn triangle_area(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
     0.5 * norm(cross(sub(b, a), sub(c, a)))
 }
@@ -301,6 +351,19 @@ impl TetMesh {
     /// [`MeshError::Empty`], [`MeshError::TooManyPoints`], [`MeshError::TagCountMismatch`],
     /// [`MeshError::NonFiniteCoordinate`], [`MeshError::IndexOutOfRange`],
     /// [`MeshError::RepeatedVertex`] (for tets and for `boundary_triangles`).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mesh::TetMesh;
+    ///
+    /// // The second tet lists its corners in the opposite orientation.
+    /// let unit = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0; 3]];
+    /// let mesh = TetMesh { points: unit, tets: vec![[0, 1, 2, 3], [2, 1, 3, 4]], ..Default::default() };
+    /// let report = mesh.check().unwrap();
+    /// assert_eq!(report.inverted_tets, vec![1]);
+    /// assert!(!report.is_clean());
+    /// ```
     pub fn check(&self) -> Result<MeshReport, MeshError> {
         if self.tets.is_empty() {
             return Err(MeshError::Empty(CellKind::Tet));
@@ -352,6 +415,18 @@ impl TetMesh {
     ///
     /// Equals the enclosed volume for a valid mesh; inverted tets count positively.
     /// Panics if an index is out of range (call [`TetMesh::check`] first).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mesh::TetMesh;
+    ///
+    /// let unit = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mesh = TetMesh { points: unit, tets: vec![[0, 1, 2, 3]], ..Default::default() };
+    /// assert!(mesh.check().unwrap().is_clean());
+    /// assert!((mesh.total_volume() - 1.0 / 6.0).abs() < 1e-15);
+    /// assert_eq!((mesh.edge_count(), mesh.boundary_face_count()), (6, 4));
+    /// ```
     pub fn total_volume(&self) -> f64 {
         self.tets
             .iter()
@@ -366,6 +441,17 @@ impl TetMesh {
     ///
     /// Computed from sorted 64-bit keys, independently of any map structure, so tests can use
     /// it as an oracle.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mesh::TetMesh;
+    ///
+    /// let mesh = TetMesh { points: vec![[0.0; 3]; 5], tets: vec![[0, 1, 2, 3], [4, 2, 1, 0]], ..Default::default() };
+    /// let edges = mesh.edges();
+    /// assert_eq!(edges.len(), 9); // 6 + 6 − 3 shared
+    /// assert!(edges.windows(2).all(|w| w[0] < w[1]) && edges.iter().all(|e| e[0] < e[1]));
+    /// ```
     pub fn edges(&self) -> Vec<[u32; 2]> {
         let mut keys: Vec<u64> = Vec::with_capacity(6 * self.tets.len());
         for &[a, b, c, d] in &self.tets {
@@ -385,6 +471,18 @@ impl TetMesh {
 
     /// Number of distinct edges (= springs of a mass/spring model). O(T log T); see
     /// [`TetMesh::edges`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mesh::TetMesh;
+    ///
+    /// let (points, tets) = kuhn_cube(2);
+    /// let mesh = TetMesh { points, tets, ..Default::default() };
+    /// assert_eq!(mesh.edge_count(), 98); // 3k(k+1)² + 3k²(k+1) + k³
+    /// assert_eq!(mesh.edge_count(), mesh.edges().len());
+    /// ```
     pub fn edge_count(&self) -> usize {
         self.edges().len()
     }
@@ -394,6 +492,20 @@ impl TetMesh {
     ///
     /// Computed from sorted keys, independently of any map structure. A face shared by three
     /// or more tets (non-manifold) is not reported as boundary.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mesh::{signed_volume, TetMesh};
+    ///
+    /// let points = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mesh = TetMesh { points: points.clone(), tets: vec![[0, 1, 2, 3]], ..Default::default() };
+    /// let faces = mesh.boundary_triangles_of_tets();
+    /// assert_eq!(faces.len(), 4);
+    /// // Every face's normal points out: the centre lies behind each one.
+    /// let p = |i: u32| points[i as usize];
+    /// assert!(faces.iter().all(|f| signed_volume(p(f[0]), p(f[1]), p(f[2]), [0.25; 3]) < 0.0));
+    /// ```
     pub fn boundary_triangles_of_tets(&self) -> Vec<[u32; 3]> {
         let mut faces: Vec<([u32; 3], [u32; 3])> = Vec::with_capacity(4 * self.tets.len());
         for &t in &self.tets {
@@ -419,6 +531,17 @@ impl TetMesh {
 
     /// Number of faces used by exactly one tet. O(T log T); see
     /// [`TetMesh::boundary_triangles_of_tets`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mesh::TetMesh;
+    ///
+    /// let (points, tets) = kuhn_cube(2);
+    /// let mesh = TetMesh { points, tets, ..Default::default() };
+    /// assert_eq!(mesh.boundary_face_count(), 48); // 12k²
+    /// ```
     pub fn boundary_face_count(&self) -> usize {
         let mut keys: Vec<[u32; 3]> = Vec::with_capacity(4 * self.tets.len());
         for &t in &self.tets {
@@ -444,6 +567,19 @@ impl TetMesh {
     /// point). `node_tags` follow their points; a boundary triangle with a dropped corner is
     /// dropped. O(P + T + B). Panics if an index is out of range (call [`TetMesh::check`]
     /// first).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mesh::TetMesh;
+    ///
+    /// let points = vec![[9.0; 3], [0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mesh = TetMesh { points, tets: vec![[1, 2, 3, 4]], ..Default::default() };
+    /// let (small, old_to_new) = mesh.compact();
+    /// assert_eq!(small.tets, vec![[0, 1, 2, 3]]);
+    /// assert_eq!(old_to_new, vec![u32::MAX, 0, 1, 2, 3]);
+    /// assert_eq!(small.total_volume(), mesh.total_volume());
+    /// ```
     pub fn compact(&self) -> (TetMesh, Vec<u32>) {
         let mut used = vec![false; self.points.len()];
         for t in &self.tets {
@@ -483,6 +619,20 @@ impl TriMesh {
     /// # Errors
     /// [`MeshError::Empty`], [`MeshError::TooManyPoints`], [`MeshError::NonFiniteCoordinate`],
     /// [`MeshError::IndexOutOfRange`], [`MeshError::RepeatedVertex`] (a degenerate triangle).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mesh::{MeshError, TriMesh};
+    ///
+    /// let points = vec![[0.0; 3], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    /// let report = TriMesh { points: points.clone(), triangles: vec![[0, 1, 2]] }.check().unwrap();
+    /// assert_eq!(report.zero_area_triangles, vec![0]); // collinear corners
+    /// assert_eq!(report.unreferenced_points, vec![3]);
+    /// assert!(!report.is_clean());
+    /// let bad = TriMesh { points, triangles: vec![[0, 1, 4]] };
+    /// assert!(matches!(bad.check(), Err(MeshError::IndexOutOfRange { .. })));
+    /// ```
     pub fn check(&self) -> Result<TriMeshReport, MeshError> {
         if self.triangles.is_empty() {
             return Err(MeshError::Empty(CellKind::Triangle));
@@ -504,6 +654,17 @@ impl TriMesh {
 
     /// Sum of the triangle areas. O(T). Panics if an index is out of range (call
     /// [`TriMesh::check`] first).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mesh::TriMesh;
+    ///
+    /// let points = vec![[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0], [2.0, 2.0, 0.0]];
+    /// let mesh = TriMesh { points, triangles: vec![[0, 1, 2], [1, 3, 2]] };
+    /// assert!(mesh.check().unwrap().is_clean());
+    /// assert!((mesh.total_area() - 4.0).abs() < 1e-12);
+    /// ```
     pub fn total_area(&self) -> f64 {
         self.triangles
             .iter()

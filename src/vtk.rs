@@ -50,6 +50,20 @@ impl Frame<'_> {
     ///
     /// # Errors
     /// [`VtkError::BadArray`] when a vector array has the wrong length.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::vtk::{Frame, VtkError};
+    ///
+    /// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let velocity = [[0.0, 0.0, -1.0]; 4];
+    /// let frame = Frame { points: &points, tets: &[[0, 1, 2, 3]], vectors: vec![("velocity", &velocity[..])] };
+    /// let xml = frame.to_vtu().unwrap();
+    /// assert!(xml.contains("NumberOfPoints=\"4\" NumberOfCells=\"1\"") && xml.contains("Name=\"velocity\""));
+    /// let bad = Frame { vectors: vec![("velocity", &velocity[..3])], ..frame };
+    /// assert!(matches!(bad.to_vtu(), Err(VtkError::BadArray { got: 3, expected: 4, .. })));
+    /// ```
     pub fn to_vtu(&self) -> Result<String, VtkError> {
         let n = self.points.len();
         for (name, values) in &self.vectors {
@@ -86,6 +100,20 @@ impl Frame<'_> {
     ///
     /// # Errors
     /// [`VtkError`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::vtk::Frame;
+    ///
+    /// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let frame = Frame { points: &points, tets: &[[0, 1, 2, 3]], vectors: vec![] };
+    /// let path = std::env::temp_dir().join(format!("topomech-doc-{}.vtu", std::process::id()));
+    /// frame.write(&path).unwrap();
+    /// let text = std::fs::read_to_string(&path).unwrap();
+    /// std::fs::remove_file(&path).unwrap();
+    /// assert_eq!(text, frame.to_vtu().unwrap());
+    /// ```
     pub fn write(&self, path: &Path) -> Result<(), VtkError> {
         write_file(path, &self.to_vtu()?)
     }
@@ -118,6 +146,20 @@ impl Series {
     ///
     /// # Errors
     /// [`VtkError::Io`] if DIR cannot be created.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::vtk::{Series, VtkError};
+    ///
+    /// let file = std::env::temp_dir().join(format!("topomech-doc-file-{}", std::process::id()));
+    /// std::fs::write(&file, "not a directory").unwrap();
+    /// let err = Series::new(&file.join("frames"), "run"); // a directory under a file: refused
+    /// std::fs::remove_file(&file).unwrap();
+    /// assert!(matches!(err, Err(VtkError::Io { .. })));
+    /// let series = Series::new(&std::env::temp_dir(), "run").unwrap();
+    /// assert!(series.pvd_path().ends_with("run.pvd"));
+    /// ```
     pub fn new(dir: &Path, stem: &str) -> Result<Self, VtkError> {
         std::fs::create_dir_all(dir).map_err(|source| VtkError::Io { path: dir.to_path_buf(), source })?;
         Ok(Series { dir: dir.to_path_buf(), stem: stem.to_string(), frames: Vec::new() })
@@ -128,6 +170,22 @@ impl Series {
     ///
     /// # Errors
     /// [`VtkError`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::vtk::{Frame, Series};
+    ///
+    /// let dir = std::env::temp_dir().join(format!("topomech-doc-vtk-{}", std::process::id()));
+    /// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let frame = Frame { points: &points, tets: &[[0, 1, 2, 3]], vectors: vec![] };
+    /// let mut series = Series::new(&dir, "run").unwrap();
+    /// assert!(series.push(0.0, &frame).unwrap().ends_with("run_000000.vtu"));
+    /// series.push(0.1, &frame).unwrap();
+    /// let pvd = std::fs::read_to_string(series.pvd_path()).unwrap();
+    /// std::fs::remove_dir_all(&dir).unwrap();
+    /// assert_eq!(pvd.matches("<DataSet").count(), 2);
+    /// ```
     pub fn push(&mut self, time: f64, frame: &Frame<'_>) -> Result<PathBuf, VtkError> {
         let name = format!("{}_{:06}.vtu", self.stem, self.frames.len());
         let path = self.dir.join(&name);
@@ -138,6 +196,18 @@ impl Series {
     }
 
     /// The `.pvd` path. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use std::path::Path;
+    /// use topomech::vtk::Series;
+    ///
+    /// let dir = std::env::temp_dir();
+    /// let series = Series::new(&dir, "liver").unwrap(); // creates nothing but the directory
+    /// assert_eq!(series.pvd_path(), dir.join("liver.pvd"));
+    /// assert!(series.pvd_path().extension() == Some(Path::new("pvd").as_os_str()));
+    /// ```
     pub fn pvd_path(&self) -> PathBuf {
         self.dir.join(format!("{}.pvd", self.stem))
     }
@@ -155,6 +225,22 @@ impl Series {
 
 /// The tets of a body as four vertex ids each (one per volume orbit), ordered so that their rest
 /// signed volume is positive. O(darts).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Material};
+/// use topomech::mesh::signed_volume;
+/// use topomech::vtk::body_tets;
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let out = body_tets(&body);
+/// assert_eq!(out.len(), 6);
+/// let p = |v: u32| points[v as usize];
+/// assert!(out.iter().all(|t| signed_volume(p(t[0]), p(t[1]), p(t[2]), p(t[3])) > 0.0));
+/// ```
 pub fn body_tets(body: &Body) -> Vec<[u32; 4]> {
     let map = body.map();
     let rest = &body.attrs().rest_position;

@@ -18,6 +18,22 @@ pub struct Component {
 }
 
 /// The components of `body`, ordered by smallest dart. O(darts).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::{components, remove_volume};
+/// use topomech::mechanics::{Body, Material};
+/// use topomech::CellId;
+///
+/// // Three tets in a row: removing the middle one leaves two parts.
+/// let p = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 1.0], [2.0, 2.0, 0.0]];
+/// let (mut body, _) = Body::from_tets(&p, &[[0, 1, 2, 3], [1, 2, 3, 4], [2, 3, 4, 5]], Material::default()).unwrap();
+/// assert_eq!(components(&body).len(), 1);
+/// remove_volume(&mut body, CellId(1)).unwrap();
+/// let parts = components(&body);
+/// assert_eq!(parts.iter().map(|c| c.volumes).collect::<Vec<_>>(), vec![1, 1]);
+/// ```
 pub fn components(body: &Body) -> Vec<Component> {
     let (map, mech) = (body.map(), body.attrs());
     let (label, count) = map.component_labels();

@@ -49,6 +49,23 @@ pub struct Dissociation {
 /// # Errors
 /// [`CutError::NoSuchDart`], [`CutError::BoundaryFace`] (body unchanged); [`CutError::Body`] if the
 /// embedding layer's check fails (a bug, `expensive-checks` only).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::{components, dissociate_face, CutError};
+/// use topomech::mechanics::{check_conservation, Body, Material};
+///
+/// // Two tets glued along the face {0, 1, 2}.
+/// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
+/// let (mut body, _) = Body::from_tets(&points, &[[0, 1, 2, 3], [0, 1, 2, 4]], Material::default()).unwrap();
+/// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+/// let cut = dissociate_face(&mut body, d).unwrap();
+/// assert_eq!((cut.vertices.len(), cut.edges.len()), (3, 3)); // nothing else holds the tets together
+/// assert_eq!(components(&body).len(), 2);
+/// check_conservation(body.map(), body.attrs()).unwrap();
+/// assert!(matches!(dissociate_face(&mut body, d), Err(CutError::BoundaryFace { .. })));
+/// ```
 pub fn dissociate_face(body: &mut Body, d: DartId) -> Result<Dissociation, CutError> {
     let map = body.map();
     if !map.contains(d) {
@@ -67,12 +84,44 @@ pub fn dissociate_face(body: &mut Body, d: DartId) -> Result<Dissociation, CutEr
 ///
 /// # Errors
 /// [`CutError::NoSuchFace`], then as [`dissociate_face`].
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::{dissociate_face_id, face_dart, CutError};
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Material};
+/// use topomech::CellId;
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let inner = (0..18).map(CellId).find(|&f| !body.map().is_free(3, face_dart(&body, f).unwrap())).unwrap();
+/// let cut = dissociate_face_id(&mut body, inner).unwrap();
+/// assert_eq!(body.map().boundary_cell_count(), 12 + 2); // both sides are boundary now
+/// assert_ne!(cut.faces.0, cut.faces.1);
+/// assert!(matches!(dissociate_face_id(&mut body, CellId(99)), Err(CutError::NoSuchFace(_))));
+/// ```
 pub fn dissociate_face_id(body: &mut Body, f: CellId) -> Result<Dissociation, CutError> {
     let d = face_dart(body, f).ok_or(CutError::NoSuchFace(f))?;
     dissociate_face(body, d)
 }
 
 /// A dart of face `f`, or `None` if no live dart carries that id. O(darts).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::face_dart;
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Material};
+/// use topomech::CellId;
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let d = face_dart(&body, CellId(5)).unwrap();
+/// assert_eq!(body.map().cell_id(2, d), CellId(5));
+/// assert_eq!(face_dart(&body, CellId(18)), None); // 18 faces: ids 0..18
+/// ```
 pub fn face_dart(body: &Body, f: CellId) -> Option<DartId> {
     let map = body.map();
     map.darts().find(|&d| map.cell_id(2, d) == f)

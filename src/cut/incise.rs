@@ -17,6 +17,17 @@ pub struct Plane {
 
 impl Plane {
     /// Whether `x` is strictly on the positive side. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::Plane;
+    ///
+    /// let plane = Plane { point: [0.0, 0.0, 1.0], normal: [0.0, 0.0, 2.0] };
+    /// assert!(plane.positive([5.0, 5.0, 1.5]));
+    /// assert!(!plane.positive([0.0, 0.0, 1.0])); // on the plane: not strictly positive
+    /// assert!(!plane.positive([0.0, 0.0, -3.0]));
+    /// ```
     pub fn positive(&self, x: Vec3) -> bool {
         (0..3).map(|k| (x[k] - self.point[k]) * self.normal[k]).sum::<f64>() > 0.0
     }
@@ -41,6 +52,20 @@ pub struct Incision {
 
 impl Incision {
     /// Number of faces cut. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::{incise_plane, Plane};
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(2);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let cut = incise_plane(&mut body, &Plane { point: [0.0, 0.0, 1.0], normal: [0.0, 0.0, 1.0] }).unwrap();
+    /// assert_eq!(cut.cut_faces(), cut.dissociations.len());
+    /// assert_eq!(body.map().boundary_cell_count(), 48 + 2 * cut.cut_faces()); // both sides of each cut face
+    /// ```
     pub fn cut_faces(&self) -> usize {
         self.dissociations.len()
     }
@@ -48,6 +73,20 @@ impl Incision {
 
 /// For every live volume id, whether its centroid (mean of its vertices' current positions) is on
 /// the positive side of `plane`; `None` for dead ids. O(darts).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::{tet_sides, Plane};
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Material};
+///
+/// let (points, tets) = kuhn_cube(2);
+/// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let sides = tet_sides(&body, &Plane { point: [0.0, 0.0, 1.0], normal: [0.0, 0.0, 1.0] });
+/// assert_eq!(sides.iter().filter(|s| **s == Some(true)).count(), 24); // the upper layer
+/// assert_eq!(sides.iter().filter(|s| **s == Some(false)).count(), 24);
+/// ```
 pub fn tet_sides(body: &Body, plane: &Plane) -> Vec<Option<bool>> {
     let (map, mech) = (body.map(), body.attrs());
     let mut side = vec![None; map.cell_id_bound(3)];
@@ -74,6 +113,23 @@ pub fn tet_sides(body: &Body, plane: &Plane) -> Vec<Option<bool>> {
 ///
 /// # Errors
 /// [`CutError::BadPlane`] (body unchanged); [`CutError::Body`] is a bug.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::{components, incise_plane, Plane};
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Material};
+///
+/// // Split the 2×2×2 cube along x = 1.
+/// let (points, tets) = kuhn_cube(2);
+/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let cut = incise_plane(&mut body, &Plane { point: [1.0, 0.0, 0.0], normal: [1.0, 0.0, 0.0] }).unwrap();
+/// assert_eq!(cut.cut_faces(), 8); // 4 unit squares, 2 triangles each
+/// let parts = components(&body);
+/// assert_eq!(parts.len(), 2);
+/// assert!(parts.iter().all(|p| p.volumes == 24 && (p.mass - 4.0).abs() < 1e-9));
+/// ```
 pub fn incise_plane(body: &mut Body, plane: &Plane) -> Result<Incision, CutError> {
     plane.check()?;
     let side = tet_sides(body, plane);

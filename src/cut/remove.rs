@@ -25,6 +25,21 @@ pub struct Removal {
 
 /// A dart of volume `t`, or `None` if no live dart carries that id. Tries dart 24·t first (the
 /// builder's numbering), then scans. O(1) when the numbering still holds, else O(darts).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::volume_dart;
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Material};
+/// use topomech::CellId;
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let d = volume_dart(&body, CellId(4)).unwrap();
+/// assert_eq!(body.map().cell_id(3, d), CellId(4));
+/// assert_eq!(volume_dart(&body, CellId(6)), None); // only 6 tets
+/// ```
 pub fn volume_dart(body: &Body, t: CellId) -> Option<DartId> {
     let map = body.map();
     let guess = DartId(t.0.wrapping_mul(24));
@@ -47,6 +62,23 @@ pub fn volume_dart(body: &Body, t: CellId) -> Option<DartId> {
 /// # Errors
 /// [`CutError::NoSuchVolume`] (never existed or already removed), [`CutError::NotATet`] — body
 /// unchanged; [`CutError::Body`], [`CutError::Kernel`], [`CutError::Dart`] are bugs.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::{remove_volume, CutError};
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{check_conservation, Body, Material};
+/// use topomech::CellId;
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let removal = remove_volume(&mut body, CellId(0)).unwrap();
+/// assert!((removal.removed_mass - 1.0 / 6.0).abs() < 1e-12); // one sixth of the unit cube
+/// assert_eq!(body.map().count_cells().0[3], 5);
+/// check_conservation(body.map(), body.attrs()).unwrap();
+/// assert!(matches!(remove_volume(&mut body, CellId(0)), Err(CutError::NoSuchVolume(_))));
+/// ```
 pub fn remove_volume(body: &mut Body, t: CellId) -> Result<Removal, CutError> {
     let d = volume_dart(body, t).ok_or(CutError::NoSuchVolume(t))?;
     let darts = body.map().cell_darts(3, d);

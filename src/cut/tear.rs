@@ -48,6 +48,22 @@ pub struct TearStep {
 
 /// σ_v's principal pair for every vertex slot of `sim`'s projection, from `body`'s current
 /// positions. O(springs + slots).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::principal_stress;
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Integrator, Material, Simulation, StepConfig};
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let sim = Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Euler, 1e-3)).unwrap();
+/// assert!(principal_stress(&body, &sim).iter().all(|s| s.magnitude == 0.0)); // at rest
+/// body.attrs_mut().position.as_mut_slice()[7][2] += 0.5; // pull the top corner up
+/// let stress = principal_stress(&body, &sim);
+/// assert!(stress[7].magnitude > 0.0 && stress[7].direction[2].abs() > 0.5);
+/// ```
 pub fn principal_stress(body: &Body, sim: &Simulation) -> Vec<Stress> {
     let sys = &sim.projection.system;
     let x = body.attrs().position.as_slice();
@@ -100,6 +116,21 @@ fn largest_eigenpair(m: &[[f64; 3]; 3]) -> Stress {
 /// One dart per face of the fan around the vertex of `d0`, starting with `d0`'s face, in walk
 /// order (module docs). Faces met twice are listed once. Every walk is bounded by the dart count.
 /// O(fan).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::fan_darts;
+/// use topomech::generate::kuhn_cube;
+/// use topomech::GMap;
+///
+/// let (points, tets) = kuhn_cube(2);
+/// let (map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+/// let d = map.darts().find(|&d| map.vertex_id(d).0 == 13).unwrap(); // the centre (1, 1, 1)
+/// let fan = fan_darts(&map, d);
+/// assert_eq!(fan[0], d);
+/// assert!(fan.len() > 2 && fan.iter().all(|&e| map.vertex_id(e).0 == 13));
+/// ```
 pub fn fan_darts(map: &GMap<3>, d0: DartId) -> Vec<DartId> {
     let mut faces: Vec<CellId> = Vec::new();
     let mut out = Vec::new();
@@ -163,6 +194,23 @@ fn face_normal(body: &Body, d: DartId) -> Vec3 {
 /// # Errors
 /// [`CutError::NoSuchVertex`] (no live dart carries `v`; body unchanged); [`CutError::Body`] is a
 /// bug. A vertex with no inner face is left as is (an empty fan).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::tear_vertex;
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{check_conservation, Body, Material};
+/// use topomech::CellId;
+///
+/// // Tear the centre vertex (1, 1, 1) of the 2×2×2 cube across the x axis.
+/// let (points, tets) = kuhn_cube(2);
+/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let tear = tear_vertex(&mut body, CellId(13), [1.0, 0.0, 0.0], None).unwrap();
+/// assert!(tear.split && !tear.fan.is_empty());
+/// assert!(body.map().count_cells().0[0] > 27);
+/// check_conservation(body.map(), body.attrs()).unwrap();
+/// ```
 pub fn tear_vertex(body: &mut Body, v: CellId, direction: Vec3, hint: Option<DartId>) -> Result<Tear, CutError> {
     let map = body.map();
     let on_v = |d: DartId| map.contains(d) && map.vertex_id(d) == v;
@@ -197,6 +245,23 @@ pub fn tear_vertex(body: &mut Body, v: CellId, direction: Vec3, hint: Option<Dar
 ///
 /// # Errors
 /// [`CutError::Body`] or [`CutError::Sim`] (bugs or a bad time step).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::tear_step;
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Integrator, Material, Simulation, StepConfig};
+///
+/// let (points, tets) = kuhn_cube(2);
+/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let mut sim = Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Euler, 1e-4)).unwrap();
+/// assert!(tear_step(&mut body, &mut sim, 1.0, 4).unwrap().tears.is_empty()); // no tension at rest
+/// body.attrs_mut().position.as_mut_slice()[13][0] += 0.5; // stretch the centre vertex
+/// let step = tear_step(&mut body, &mut sim, 1.0, 1).unwrap();
+/// assert_eq!(step.tears.len(), 1);
+/// sim.step(&mut body).unwrap(); // the simulation followed the change
+/// ```
 pub fn tear_step(
     body: &mut Body,
     sim: &mut Simulation,

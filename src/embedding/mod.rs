@@ -26,6 +26,20 @@ use crate::{CellId, DartId, GMap};
 ///
 /// Index `id.index()` holds the attribute of cell `id`; slots of dead ids hold stale values that
 /// nothing reads. [`CellArray::grow`] extends it when the kernel hands out larger ids.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::embedding::CellArray;
+/// use topomech::CellId;
+///
+/// let mut mass = CellArray::filled(2, 0.5);
+/// mass.grow(4, 0.0); // the kernel handed out ids 2 and 3
+/// assert_eq!(mass.as_slice(), &[0.5, 0.5, 0.0, 0.0]);
+/// assert_eq!((mass[CellId(1)], mass.get(CellId(9))), (0.5, None));
+/// mass.grow(1, 9.9); // never shrinks
+/// assert_eq!(mass.len(), 4);
+/// ```
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct CellArray<T> {
     values: Vec<T>,
@@ -160,6 +174,20 @@ pub struct Embedded<const N: usize, E> {
 
 impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
     /// Wraps a map and attributes that already agree with it. O(1) (plus [`CellRules::grow_to`]).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let (map, mech) = body.into_parts();
+    /// let rebuilt = Body::new(map.clone(), mech);
+    /// assert_eq!(rebuilt.version(), 0);
+    /// assert!(rebuilt.map().is_isomorphic(&map));
+    /// ```
     pub fn new(map: GMap<N>, mut attrs: E) -> Self {
         attrs.grow_to(&map);
         Embedded { map, attrs, version: 0 }
@@ -182,6 +210,22 @@ impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
     }
 
     /// Number of topological operations applied so far. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// assert_eq!(body.version(), 0);
+    /// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+    /// body.unsew3(d).unwrap();
+    /// assert_eq!(body.version(), 1);
+    /// assert!(body.unsew3(d).is_err()); // refused: nothing changed
+    /// assert_eq!(body.version(), 1);
+    /// ```
     pub fn version(&self) -> u64 {
         self.version
     }
@@ -204,6 +248,22 @@ impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
     ///
     /// # Errors
     /// As [`Embedded::sew`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+    /// let e = body.map().alpha::<3>(d);
+    /// let changes = body.unsew(3, d).unwrap();
+    /// assert_eq!(changes.pairs.len(), 6); // the six darts of a triangle, each with its partner
+    /// body.sew(3, d, e).unwrap();
+    /// assert!(body.check().is_ok());
+    /// ```
     pub fn unsew(&mut self, i: usize, d: DartId) -> Result<CellChanges, EmbedError<E::Error>> {
         let changes = self.map.unsew_dyn(i, d)?;
         self.apply(&changes);
@@ -241,6 +301,20 @@ impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
     ///
     /// # Errors
     /// The check's error.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(2);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// assert!(body.check().is_ok());
+    /// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+    /// body.unsew3(d).unwrap();
+    /// assert!(body.check().is_ok()); // the split rules kept the laws
+    /// ```
     pub fn check(&self) -> Result<(), E::Error> {
         self.attrs.check(&self.map)
     }
@@ -254,6 +328,20 @@ impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
     }
 
     /// Splits into map and attributes. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let (map, mech) = body.into_parts();
+    /// let again = Body::new(map, mech); // back together, attributes unchanged
+    /// assert!(again.check().is_ok());
+    /// assert_eq!(again.map().dart_count(), 144);
+    /// ```
     pub fn into_parts(self) -> (GMap<N>, E) {
         (self.map, self.attrs)
     }

@@ -10,12 +10,34 @@ pub struct CellCounts(pub Vec<usize>);
 
 impl CellCounts {
     /// Σ (−1)^i · #i-cells.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::gmap::CellCounts;
+    ///
+    /// assert_eq!(CellCounts(vec![4, 6, 4, 1]).euler_characteristic(), 1); // a tetrahedron
+    /// assert_eq!(CellCounts(vec![4, 6, 4]).euler_characteristic(), 2); // its surface
+    /// ```
     pub fn euler_characteristic(&self) -> i64 {
         self.0.iter().enumerate().map(|(i, &c)| if i % 2 == 0 { c as i64 } else { -(c as i64) }).sum()
     }
 }
 
 /// The characteristics printed by `topomech info`.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::GMap;
+///
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let s = map.summary();
+/// assert_eq!((s.darts, s.boundary_faces, s.components), (24, 4, 1));
+/// assert_eq!(s.cells.0, vec![4, 6, 4, 1]);
+/// assert_eq!(s.euler_characteristic, 1);
+/// assert!(s.orientable && s.valid);
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
 pub struct MapSummary {
     /// Live darts.
@@ -36,6 +58,16 @@ pub struct MapSummary {
 
 impl<const N: usize> GMap<N> {
     /// Number of i-cells for every i, read from the id allocators. O(n).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::{generate, GMap};
+    ///
+    /// let (points, tets) = generate::kuhn_cube(1);
+    /// let (map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+    /// assert_eq!(map.count_cells().0, vec![8, 19, 18, 6]);
+    /// ```
     pub fn count_cells(&self) -> CellCounts {
         CellCounts(self.ids.iter().map(|a| a.live()).collect())
     }
@@ -49,6 +81,18 @@ impl<const N: usize> GMap<N> {
     /// the map), each link is met once, from its larger end. Rows are read in memory order and
     /// the forests' roots (the smallest dart of each orbit) stay in cache, unlike the random row
     /// reads of a flood.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::{generate, GMap};
+    ///
+    /// let (points, tets) = generate::kuhn_cube(2);
+    /// let (mut map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+    /// let d = map.darts().find(|&d| !map.is_free(3, d)).unwrap();
+    /// map.unsew::<3>(d).unwrap();
+    /// assert_eq!(map.count_cells_by_traversal(), map.count_cells()); // ids and orbits agree
+    /// ```
     pub fn count_cells_by_traversal(&self) -> CellCounts {
         let gens: Vec<([usize; 8], usize)> = (0..=N).map(|i| generators(N, AlphaMask::cell(N, i))).collect();
         let mut forests: Vec<Vec<u32>> = (0..=N).map(|_| (0..self.capacity() as u32).collect()).collect();
@@ -69,11 +113,33 @@ impl<const N: usize> GMap<N> {
     }
 
     /// Number of distinct orbits ⟨mask⟩ over all live darts. O(darts · n).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::{generate, AlphaMask, GMap};
+    ///
+    /// let (points, tets) = generate::kuhn_cube(1);
+    /// let (map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+    /// assert_eq!(map.count_orbits(AlphaMask::of(&[0, 1])), 24); // 4 faces per tet, one side each
+    /// assert_eq!(map.count_orbits(AlphaMask::cell(3, 2)), 18); // the faces of the mesh
+    /// ```
     pub fn count_orbits(&self, mask: AlphaMask) -> usize {
         self.for_each_orbit(mask, |_| {})
     }
 
     /// One dart per connected component (orbit of all involutions), smallest first. O(darts · n).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let (map, _) = GMap::<3>::from_tets(8, &[[0, 1, 2, 3], [4, 5, 6, 7]]).unwrap();
+    /// let roots = map.components();
+    /// assert_eq!(roots.len(), 2);
+    /// assert_eq!(map.orbit(roots[1], topomech::AlphaMask::all(3)).len(), 24);
+    /// ```
     pub fn components(&self) -> Vec<DartId> {
         let mut roots = Vec::new();
         self.for_each_orbit(AlphaMask::all(N), |d| roots.push(d));
@@ -82,6 +148,19 @@ impl<const N: usize> GMap<N> {
 
     /// Component index of every dart slot (`u32::MAX` for dead slots), and the count.
     /// O(darts · n).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::{DartId, GMap};
+    ///
+    /// let (map, _) = GMap::<3>::from_tets(8, &[[0, 1, 2, 3], [4, 5, 6, 7]]).unwrap();
+    /// let (label, count) = map.component_labels();
+    /// assert_eq!(count, 2);
+    /// assert_eq!(label[0], label[23]);
+    /// assert_ne!(label[0], label[24]); // darts 24.. belong to the second tet
+    /// assert!(map.contains(DartId(24)));
+    /// ```
     pub fn component_labels(&self) -> (Vec<u32>, usize) {
         let mut label = vec![u32::MAX; self.capacity()];
         let mut stack = Vec::new();
@@ -106,24 +185,73 @@ impl<const N: usize> GMap<N> {
     }
 
     /// The αn-free darts: the boundary. O(capacity).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::{generate, GMap};
+    ///
+    /// let (points, tets) = generate::kuhn_cube(1);
+    /// let (map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+    /// assert_eq!(map.boundary_darts().count(), 12 * 6); // 12 boundary triangles, 6 darts each
+    /// ```
     pub fn boundary_darts(&self) -> impl Iterator<Item = DartId> + '_ {
         self.darts().filter(|&d| self.is_free(N, d))
     }
 
     /// Number of (n−1)-cells on the boundary (distinct (n−1)-cell ids among αn-free darts).
     /// O(capacity).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::{generate, GMap};
+    ///
+    /// let (points, tets) = generate::kuhn_cube(2);
+    /// let (map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+    /// assert_eq!(map.boundary_cell_count(), 12 * 2 * 2); // 12k² for the k-cube
+    /// ```
     pub fn boundary_cell_count(&self) -> usize {
         let mut seen = DartSet::with_capacity(self.cell_id_bound(N - 1));
         self.boundary_darts().filter(|&d| seen.insert(DartId(self.cell_id(N - 1, d).0))).count()
     }
 
     /// Σ (−1)^i · #i-cells. O(n).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    ///
+    /// use topomech::GMap;
+    ///
+    /// // The surface of a tetrahedron is a sphere (χ = 2); the solid is a ball (χ = 1).
+    /// let surface = [[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]];
+    /// let (sphere, _) = GMap::<2>::from_triangles(4, &surface).unwrap();
+    /// assert_eq!(sphere.euler_characteristic(), 2);
+    /// let (ball, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// assert_eq!(ball.euler_characteristic(), 1);
+    /// ```
     pub fn euler_characteristic(&self) -> i64 {
         self.count_cells().euler_characteristic()
     }
 
     /// A 2-colouring of the darts such that every non-free αi link joins two colours, if one
     /// exists (colour `u8::MAX` on dead slots). The map is orientable iff it exists. O(darts · n).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let colour = map.orientation().unwrap();
+    /// for d in map.darts() {
+    ///     for i in 0..=2 {
+    ///         assert_ne!(colour[d.index()], colour[map.alpha_dyn(i, d).index()]);
+    ///     }
+    /// }
+    /// assert_eq!(colour.iter().filter(|&&c| c == 0).count(), 12);
+    /// ```
     pub fn orientation(&self) -> Option<Vec<u8>> {
         let mut colour = vec![u8::MAX; self.capacity()];
         let mut stack = Vec::new();
@@ -155,12 +283,37 @@ impl<const N: usize> GMap<N> {
     }
 
     /// Whether every component is orientable. O(darts · n).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// // Five triangles {i, i+1, i+2} (mod 5) close up into a Möbius strip.
+    /// let strip: Vec<[u32; 3]> = (0..5).map(|i| [i, (i + 1) % 5, (i + 2) % 5]).collect();
+    /// let (mobius, _) = GMap::<2>::from_triangles(5, &strip).unwrap();
+    /// assert!(!mobius.is_orientable());
+    /// let (disc, _) = GMap::<2>::from_triangles(4, &[[0, 1, 2], [0, 2, 3]]).unwrap();
+    /// assert!(disc.is_orientable());
+    /// ```
     pub fn is_orientable(&self) -> bool {
         self.orientation().is_some()
     }
 
     /// Darts, cells, boundary, components, Euler characteristic, orientability and validity.
     /// O(darts · n²).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::{generate, GMap};
+    ///
+    /// let (points, tets) = generate::kuhn_cube(1);
+    /// let (map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+    /// let s = map.summary();
+    /// assert_eq!(s.cells, map.count_cells());
+    /// assert_eq!((s.boundary_faces, s.euler_characteristic, s.valid), (12, 1, true));
+    /// ```
     pub fn summary(&self) -> MapSummary {
         let cells = self.count_cells();
         MapSummary {

@@ -20,6 +20,22 @@ pub struct CombinatorialMap {
 impl CombinatorialMap {
     /// Checks that β1 is a permutation and every βi (i ≥ 2) an involution without fixed points
     /// where defined. O(darts · n).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// // The surface of a tetrahedron as a 2-map: 12 of the 24 darts, β1 turns around each triangle.
+    /// let surface = [[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]];
+    /// let (map, _) = GMap::<2>::from_triangles(4, &surface).unwrap();
+    /// let cmap = map.to_combinatorial_map().unwrap();
+    /// assert!(cmap.is_valid());
+    /// assert_eq!(cmap.origin.len(), 12);
+    /// let b1 = |d: u32| cmap.beta1[d as usize];
+    /// assert!((0..12).all(|d| b1(b1(b1(d))) == d && b1(d) != d));
+    /// assert!(cmap.beta[0].iter().all(|b| b.is_some())); // closed surface: β2 everywhere
+    /// ```
     pub fn is_valid(&self) -> bool {
         let n = self.origin.len();
         let mut hit = vec![false; n];
@@ -40,6 +56,20 @@ impl CombinatorialMap {
 impl<const N: usize> GMap<N> {
     /// The combinatorial map of an orientable G-map, or `None` if it is not orientable or some
     /// dart is 0-free or 1-free (β1 would not be a permutation). O(darts · n).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let strip: Vec<[u32; 3]> = (0..5).map(|i| [i, (i + 1) % 5, (i + 2) % 5]).collect();
+    /// let (mobius, _) = GMap::<2>::from_triangles(5, &strip).unwrap();
+    /// assert!(mobius.to_combinatorial_map().is_none()); // not orientable
+    /// let (tet, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let cmap = tet.to_combinatorial_map().unwrap();
+    /// assert_eq!(cmap.origin.len(), 12);
+    /// assert!(cmap.beta[1].iter().all(|b| b.is_none())); // a lone tet: β3 undefined
+    /// ```
     pub fn to_combinatorial_map(&self) -> Option<CombinatorialMap> {
         let colour = self.orientation()?;
         if self.darts().any(|d| self.is_free(0, d) || self.is_free(1, d)) {

@@ -7,6 +7,19 @@
 use std::fmt;
 
 /// Index of a dart in a [`GMap`](crate::gmap::GMap). Four bytes; `u32::MAX` is never a valid dart.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::{DartId, GMap};
+///
+/// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+/// let d = DartId(4);
+/// assert!(map.contains(d));
+/// assert_eq!(d.index(), 4);
+/// assert_eq!(d.to_string(), "dart 4");
+/// assert_eq!(format!("{d:?}"), "d4");
+/// ```
 #[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Default)]
 pub struct DartId(pub u32);
 
@@ -32,6 +45,21 @@ impl fmt::Display for DartId {
 
 /// Identifier of an i-cell (the dimension is carried separately). Ids of one dimension are dense
 /// in `0..capacity` and reused after a cell disappears; embeddings are stored in arrays keyed by it.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::{CellId, GMap};
+///
+/// // One f64 per vertex, indexed by vertex id.
+/// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+/// let mut degree = vec![0usize; map.cell_id_bound(0)];
+/// for d in map.darts() {
+///     degree[map.vertex_id(d).index()] += 1;
+/// }
+/// assert_eq!(degree, vec![2, 2, 2]); // two darts per corner of a triangle
+/// assert_eq!(CellId(7).to_string(), "cell 7");
+/// ```
 #[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Default)]
 pub struct CellId(pub u32);
 

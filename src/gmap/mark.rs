@@ -16,6 +16,18 @@ impl DartSet {
     }
 
     /// Whether d is in the set. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::gmap::DartSet;
+    /// use topomech::DartId;
+    ///
+    /// let mut set = DartSet::default();
+    /// assert!(!set.contains(DartId(1_000_000))); // past the end: simply absent
+    /// set.insert(DartId(64));
+    /// assert!(set.contains(DartId(64)) && !set.contains(DartId(63)));
+    /// ```
     #[inline(always)]
     pub fn contains(&self, d: DartId) -> bool {
         let i = d.index();
@@ -23,6 +35,22 @@ impl DartSet {
     }
 
     /// Adds d; returns whether it was absent. O(1) amortized.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::gmap::DartSet;
+    /// use topomech::DartId;
+    ///
+    /// let mut set = DartSet::with_capacity(10);
+    /// assert!(set.insert(DartId(3)));
+    /// assert!(!set.insert(DartId(3))); // already there
+    /// assert!(set.insert(DartId(500))); // grows on demand
+    /// assert_eq!(set.len(), 2);
+    /// assert!(set.remove(DartId(3)) && !set.contains(DartId(3)));
+    /// set.clear();
+    /// assert!(set.is_empty());
+    /// ```
     #[inline(always)]
     pub fn insert(&mut self, d: DartId) -> bool {
         let i = d.index();
@@ -38,6 +66,20 @@ impl DartSet {
     }
 
     /// Removes d; returns whether it was present. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::gmap::DartSet;
+    /// use topomech::DartId;
+    ///
+    /// let mut set = DartSet::with_capacity(8);
+    /// set.insert(DartId(2));
+    /// assert!(set.remove(DartId(2)));
+    /// assert!(!set.remove(DartId(2))); // already gone
+    /// assert!(!set.remove(DartId(500))); // never there
+    /// assert!(set.is_empty());
+    /// ```
     #[inline(always)]
     pub fn remove(&mut self, d: DartId) -> bool {
         let i = d.index();
@@ -87,11 +129,41 @@ impl Mark {
     }
 
     /// Whether d is marked. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::{AlphaMask, GMap};
+    ///
+    /// let (mut map, _) = GMap::<2>::from_triangles(4, &[[0, 1, 2], [0, 2, 3]]).unwrap();
+    /// let d = map.darts().next().unwrap();
+    /// let mut mark = map.reserve_mark();
+    /// map.mark_orbit(&mut mark, d, AlphaMask::cell(2, 2)); // d's triangle
+    /// assert_eq!(map.darts().filter(|&e| mark.is_marked(e)).count(), 6);
+    /// assert!(map.darts().all(|e| mark.is_marked(e) == (map.cell_id(2, e) == map.cell_id(2, d))));
+    /// map.unmark_orbit(&mut mark, d, AlphaMask::cell(2, 2));
+    /// map.free_mark(mark);
+    /// ```
     pub fn is_marked(&self, d: DartId) -> bool {
         self.set.contains(d)
     }
 
     /// Number of marked darts. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::{AlphaMask, GMap};
+    ///
+    /// let (mut map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let d = map.darts().next().unwrap();
+    /// let mut mark = map.reserve_mark();
+    /// map.mark_orbit(&mut mark, d, AlphaMask::cell(3, 0)); // d's vertex: 6 darts
+    /// map.mark_orbit(&mut mark, d, AlphaMask::cell(3, 1)); // d's edge: 4 darts, 2 of them marked already
+    /// assert_eq!(mark.count(), 8);
+    /// map.unmark_orbit(&mut mark, d, AlphaMask::all(3));
+    /// map.free_mark(mark);
+    /// ```
     pub fn count(&self) -> usize {
         self.set.len()
     }
@@ -107,6 +179,20 @@ impl Drop for Mark {
 
 impl<const N: usize> GMap<N> {
     /// Reserves a mark with no dart marked, reusing a released one if any. O(1) amortized.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let (mut map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+    /// let mut mark = map.reserve_mark();
+    /// let d = map.darts().next().unwrap();
+    /// assert!(mark.mark(d));
+    /// assert_eq!(mark.count(), 1);
+    /// assert!(mark.unmark(d));
+    /// map.free_mark(mark);
+    /// ```
     pub fn reserve_mark(&mut self) -> Mark {
         let set = self.mark_pool.pop().unwrap_or_else(|| DartSet::with_capacity(self.capacity()));
         debug_assert!(set.is_empty());
@@ -114,12 +200,43 @@ impl<const N: usize> GMap<N> {
     }
 
     /// Returns a mark to the pool. Panics if some dart is still marked (a bug in the caller).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let (mut map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+    /// let d = map.darts().next().unwrap();
+    /// let mut mark = map.reserve_mark();
+    /// mark.mark(d);
+    /// mark.unmark(d); // a mark goes back clean
+    /// map.free_mark(mark);
+    /// let again = map.reserve_mark(); // reused from the pool, still clean
+    /// assert_eq!(again.count(), 0);
+    /// map.free_mark(again);
+    /// ```
     pub fn free_mark(&mut self, mut mark: Mark) {
         assert!(mark.set.is_empty(), "free_mark: {} darts are still marked", mark.set.len());
         self.mark_pool.push(std::mem::take(&mut mark.set));
     }
 
     /// Marks every dart of the orbit ⟨mask⟩(d). O(orbit).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::{AlphaMask, GMap};
+    ///
+    /// let (mut map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let d = map.darts().next().unwrap();
+    /// let mut mark = map.reserve_mark();
+    /// map.mark_orbit(&mut mark, d, AlphaMask::cell(3, 2));
+    /// assert_eq!(mark.count(), 6); // the darts of d's face
+    /// assert!(mark.is_marked(d) && !mark.is_marked(map.alpha::<2>(d)));
+    /// map.unmark_orbit(&mut mark, d, AlphaMask::cell(3, 2));
+    /// map.free_mark(mark); // every dart is unmarked again
+    /// ```
     pub fn mark_orbit(&self, mark: &mut Mark, d: DartId, mask: super::AlphaMask) {
         for e in self.orbit(d, mask) {
             mark.mark(e);
@@ -127,6 +244,22 @@ impl<const N: usize> GMap<N> {
     }
 
     /// Unmarks every dart of the orbit ⟨mask⟩(d). O(orbit).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::{AlphaMask, GMap};
+    ///
+    /// let (mut map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+    /// let d = map.darts().next().unwrap();
+    /// let mut mark = map.reserve_mark();
+    /// map.mark_orbit(&mut mark, d, AlphaMask::all(2));
+    /// assert_eq!(mark.count(), 6);
+    /// map.unmark_orbit(&mut mark, d, AlphaMask::of(&[0]));
+    /// assert_eq!(mark.count(), 4); // d and α0(d) unmarked
+    /// map.unmark_orbit(&mut mark, d, AlphaMask::all(2));
+    /// map.free_mark(mark);
+    /// ```
     pub fn unmark_orbit(&self, mark: &mut Mark, d: DartId, mask: super::AlphaMask) {
         for e in self.orbit(d, mask) {
             mark.unmark(e);

@@ -5,6 +5,18 @@
 /// The i-cell orbit of an n-G-map is `⟨⟩N−{i}`: [`AlphaMask::cell`]. The involutions that commute
 /// with αi by the quasi-manifold law (|i − j| ≥ 2) form [`AlphaMask::commuting_with`]; an i-sew
 /// links exactly the darts of that orbit.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::AlphaMask;
+///
+/// assert_eq!(AlphaMask::all(3), AlphaMask::of(&[0, 1, 2, 3]));
+/// assert_eq!(AlphaMask::cell(3, 1), AlphaMask::of(&[0, 2, 3])); // edges of a 3-map
+/// assert_eq!(AlphaMask::commuting_with(3, 0), AlphaMask::of(&[2, 3]));
+/// assert!(AlphaMask::of(&[1, 3]).contains(3));
+/// assert_eq!(AlphaMask::of(&[3, 1]).indices().collect::<Vec<_>>(), vec![1, 3]);
+/// ```
 #[derive(Clone, Copy, PartialEq, Eq, Hash, Debug, Default)]
 pub struct AlphaMask(pub u8);
 
@@ -13,11 +25,30 @@ impl AlphaMask {
     pub const EMPTY: AlphaMask = AlphaMask(0);
 
     /// All involutions α0..=αn of an n-map.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::AlphaMask;
+    ///
+    /// assert_eq!(AlphaMask::all(2), AlphaMask::of(&[0, 1, 2]));
+    /// assert_eq!(AlphaMask::all(3).0, 0b1111);
+    /// ```
     pub const fn all(n: usize) -> AlphaMask {
         AlphaMask(((1u16 << (n + 1)) - 1) as u8)
     }
 
     /// The set {αj : j in `indices`}.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::AlphaMask;
+    ///
+    /// let mask = AlphaMask::of(&[2, 0]);
+    /// assert!(mask.contains(0) && mask.contains(2) && !mask.contains(1));
+    /// assert_eq!(mask.indices().collect::<Vec<_>>(), vec![0, 2]);
+    /// ```
     pub const fn of(indices: &[usize]) -> AlphaMask {
         let mut bits = 0u8;
         let mut k = 0;
@@ -29,11 +60,32 @@ impl AlphaMask {
     }
 
     /// The generators of the i-cell orbit of an n-map: every αj but αi.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::{AlphaMask, GMap};
+    ///
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let d = map.darts().next().unwrap();
+    /// assert_eq!(map.orbit(d, AlphaMask::cell(3, 0)).len(), 6); // a corner of a tet: 3 edges × 2 faces
+    /// assert_eq!(map.orbit(d, AlphaMask::cell(3, 1)).len(), 4); // an edge: 2 ends × 2 faces
+    /// ```
     pub const fn cell(n: usize, i: usize) -> AlphaMask {
         AlphaMask(Self::all(n).0 & !(1 << i))
     }
 
     /// The involutions that must commute with αi in an n-map: αj with |i − j| ≥ 2.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::AlphaMask;
+    ///
+    /// assert_eq!(AlphaMask::commuting_with(3, 3), AlphaMask::of(&[0, 1]));
+    /// assert_eq!(AlphaMask::commuting_with(3, 1), AlphaMask::of(&[3]));
+    /// assert_eq!(AlphaMask::commuting_with(2, 1), AlphaMask::EMPTY);
+    /// ```
     pub const fn commuting_with(n: usize, i: usize) -> AlphaMask {
         let mut bits = 0u8;
         let mut j = 0;

@@ -11,7 +11,7 @@
 //! liveness. Freed dart slots are reused.
 //!
 //! # Layers of mutators
-//! 1. crate-private raw links ([`GMap::link_raw`]) that may break validity;
+//! 1. crate-private raw links (`GMap::link_raw`) that may break validity;
 //! 2. topological [`GMap::sew`] / [`GMap::unsew`] that sew whole orbits so the quasi-manifold law
 //!    holds and keep cell ids exact, returning the [`CellChanges`] they made;
 //! 3. (in `embedding`) the version that also splits and merges attributes.
@@ -112,6 +112,18 @@ impl<const N: usize> GMap<N> {
     pub const ALPHAS: usize = N + 1;
 
     /// An empty map. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let map = GMap::<2>::new();
+    /// assert_eq!(map.dart_count(), 0);
+    /// assert_eq!(map.dimension(), 2);
+    /// assert_eq!(map.count_cells().0, vec![0, 0, 0]);
+    /// assert!(map.validate().is_ok());
+    /// ```
     pub fn new() -> Self {
         const { assert!(N >= 1 && N <= 7, "dimension must be in 1..=7") };
         GMap {
@@ -126,21 +138,63 @@ impl<const N: usize> GMap<N> {
     }
 
     /// The dimension n.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// assert_eq!(GMap::<3>::new().dimension(), 3);
+    /// assert_eq!(GMap::<2>::ALPHAS, 3); // α0, α1, α2
+    /// ```
     pub const fn dimension(&self) -> usize {
         N
     }
 
     /// Number of live darts. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// assert_eq!(map.dart_count(), 24); // one dart per (vertex, edge, face) flag of the tet
+    /// assert_eq!(map.darts().count(), map.dart_count());
+    /// ```
     pub fn dart_count(&self) -> usize {
         self.n_alive
     }
 
     /// One past the largest dart index ever used: the length flat per-dart arrays need. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let mut map = GMap::<1>::new();
+    /// let a = map.create_dart().unwrap();
+    /// let _b = map.create_dart().unwrap();
+    /// map.delete_dart(a).unwrap();
+    /// assert_eq!(map.dart_count(), 1);
+    /// assert_eq!(map.capacity(), 2); // the freed slot still counts until it is reused
+    /// ```
     pub fn capacity(&self) -> usize {
         self.alpha.len() / (N + 1)
     }
 
     /// Whether `d` names a live dart of this map. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::{DartId, GMap};
+    ///
+    /// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+    /// assert!(map.contains(DartId(5)));
+    /// assert!(!map.contains(DartId(6))); // a triangle has 6 darts
+    /// ```
     #[inline]
     pub fn contains(&self, d: DartId) -> bool {
         let i = d.index();
@@ -148,11 +202,36 @@ impl<const N: usize> GMap<N> {
     }
 
     /// The live darts in increasing order. O(capacity).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let mut map = GMap::<2>::new();
+    /// let ids: Vec<_> = (0..3).map(|_| map.create_dart().unwrap()).collect();
+    /// map.delete_dart(ids[1]).unwrap();
+    /// assert_eq!(map.darts().collect::<Vec<_>>(), vec![ids[0], ids[2]]);
+    /// ```
     pub fn darts(&self) -> impl Iterator<Item = DartId> + '_ {
         (0..self.capacity() as u32).map(DartId).filter(|&d| self.contains(d))
     }
 
     /// αi(d) with i checked at compile time. O(1). `d` must be live (debug-asserted).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let d = map.darts().next().unwrap();
+    /// let e = map.alpha::<0>(d);
+    /// assert_ne!(e, d);
+    /// assert_eq!(map.alpha::<0>(e), d); // α0 is an involution
+    /// assert_ne!(map.vertex_id(e), map.vertex_id(d)); // ... that moves to the other end of the edge
+    /// assert_eq!(map.alpha::<3>(d), d); // a lone tet: every dart is 3-free
+    /// ```
     #[inline(always)]
     pub fn alpha<const I: usize>(&self, d: DartId) -> DartId {
         const { assert!(I <= N, "alpha index out of range for this dimension") };
@@ -160,6 +239,22 @@ impl<const N: usize> GMap<N> {
     }
 
     /// αi(d) with i given at run time. O(1). Panics if i > n.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// for d in map.darts() {
+    ///     for i in 0..=3 {
+    ///         assert_eq!(map.alpha_dyn(i, map.alpha_dyn(i, d)), d);
+    ///     }
+    ///     // the quasi-manifold law: α0∘α2 is an involution
+    ///     let once = map.alpha_dyn(0, map.alpha_dyn(2, d));
+    ///     assert_eq!(map.alpha_dyn(0, map.alpha_dyn(2, once)), d);
+    /// }
+    /// ```
     #[inline(always)]
     pub fn alpha_dyn(&self, i: usize, d: DartId) -> DartId {
         assert!(i <= N, "alpha index {i} out of range for a {N}-map");
@@ -168,6 +263,18 @@ impl<const N: usize> GMap<N> {
     }
 
     /// αi(d), or an error if `d` is not a live dart or i > n. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::gmap::DartError;
+    /// use topomech::{DartId, GMap};
+    ///
+    /// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+    /// assert_eq!(map.try_alpha(2, DartId(0)), Ok(DartId(0))); // a lone triangle is 2-free
+    /// assert_eq!(map.try_alpha(3, DartId(0)), Err(DartError::NoSuchDart(DartId(0))));
+    /// assert_eq!(map.try_alpha(1, DartId(6)), Err(DartError::NoSuchDart(DartId(6))));
+    /// ```
     pub fn try_alpha(&self, i: usize, d: DartId) -> Result<DartId, DartError> {
         if i > N || !self.contains(d) {
             return Err(DartError::NoSuchDart(d));
@@ -176,17 +283,53 @@ impl<const N: usize> GMap<N> {
     }
 
     /// Whether d is i-free (αi(d) = d). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::{generate, GMap};
+    ///
+    /// // Two triangles sharing the diagonal of a unit square.
+    /// let (points, triangles) = generate::grid_triangles(1);
+    /// let (map, _) = GMap::<2>::from_triangles(points.len(), &triangles).unwrap();
+    /// assert_eq!(map.darts().filter(|&d| !map.is_free(2, d)).count(), 4);
+    /// assert!(map.darts().all(|d| !map.is_free(0, d) && !map.is_free(1, d)));
+    /// ```
     #[inline]
     pub fn is_free(&self, i: usize, d: DartId) -> bool {
         self.alpha_dyn(i, d) == d
     }
 
     /// Whether d is free for every αi. O(n).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let mut map = GMap::<2>::new();
+    /// let (a, b) = (map.create_dart().unwrap(), map.create_dart().unwrap());
+    /// assert!(map.is_isolated(a));
+    /// map.sew::<1>(a, b).unwrap();
+    /// assert!(!map.is_isolated(a) && !map.is_isolated(b));
+    /// ```
     pub fn is_isolated(&self, d: DartId) -> bool {
         (0..=N).all(|i| self.is_free(i, d))
     }
 
     /// The i-sewn pairs {d, αi(d)} with d < αi(d), each once. O(capacity).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::{generate, GMap};
+    ///
+    /// let (points, triangles) = generate::grid_triangles(1);
+    /// let (map, _) = GMap::<2>::from_triangles(points.len(), &triangles).unwrap();
+    /// let pairs: Vec<_> = map.sewn_pairs(2).collect();
+    /// assert_eq!(pairs.len(), 2); // the shared diagonal: two darts on each side
+    /// assert!(pairs.iter().all(|&(d, e)| d < e && map.alpha::<2>(d) == e));
+    /// ```
     pub fn sewn_pairs(&self, i: usize) -> impl Iterator<Item = (DartId, DartId)> + '_ {
         self.darts().filter_map(move |d| {
             let e = self.alpha_dyn(i, d);
@@ -195,6 +338,20 @@ impl<const N: usize> GMap<N> {
     }
 
     /// The id of the i-cell that contains d. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::{CellId, GMap};
+    ///
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// for d in map.darts() {
+    ///     // α1, α2, α3 stay in d's vertex and keep its id; α0 leaves it.
+    ///     assert_eq!(map.cell_id(0, map.alpha::<1>(d)), map.cell_id(0, d));
+    ///     assert_ne!(map.cell_id(0, map.alpha::<0>(d)), map.cell_id(0, d));
+    ///     assert_eq!(map.cell_id(3, d), CellId(0)); // the volume id is the tet index
+    /// }
+    /// ```
     #[inline(always)]
     pub fn cell_id(&self, i: usize, d: DartId) -> CellId {
         assert!(i <= N, "cell dimension {i} out of range for a {N}-map");
@@ -202,23 +359,71 @@ impl<const N: usize> GMap<N> {
     }
 
     /// The vertex (0-cell) id of d. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// // Vertex ids are the input point indices.
+    /// let (map, _) = GMap::<3>::from_tets(6, &[[5, 1, 2, 3]]).unwrap();
+    /// let mut ids: Vec<u32> = map.darts().map(|d| map.vertex_id(d).0).collect();
+    /// ids.sort_unstable();
+    /// ids.dedup();
+    /// assert_eq!(ids, vec![1, 2, 3, 5]);
+    /// ```
     #[inline(always)]
     pub fn vertex_id(&self, d: DartId) -> CellId {
         self.cell_id(0, d)
     }
 
     /// One past the largest live i-cell id: the length an array keyed by i-cell id needs. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// // Points 0 and 4 are unused: their vertex ids stay free, below the bound.
+    /// let (map, report) = GMap::<3>::from_tets(6, &[[5, 1, 2, 3]]).unwrap();
+    /// assert_eq!(report.unreferenced_points, vec![0, 4]);
+    /// assert_eq!(map.cell_id_bound(0), 6);
+    /// assert_eq!(map.count_cells().0[0], 4);
+    /// ```
     pub fn cell_id_bound(&self, i: usize) -> usize {
         self.ids[i].next as usize
     }
 
     /// Whether `id` is a live i-cell id. O(free ids of dimension i).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::{CellId, GMap};
+    ///
+    /// let (map, _) = GMap::<3>::from_tets(6, &[[5, 1, 2, 3]]).unwrap();
+    /// assert!(map.is_live_cell(0, CellId(5)));
+    /// assert!(!map.is_live_cell(0, CellId(4))); // point 4 is used by no tet
+    /// assert!(!map.is_live_cell(3, CellId(1))); // only one volume
+    /// ```
     pub fn is_live_cell(&self, i: usize, id: CellId) -> bool {
         id.0 < self.ids[i].next && !self.ids[i].free.contains(&id.0)
     }
 
     /// Creates an isolated dart (free for every αi), reusing a freed slot if any. It is its own
     /// i-cell for every i and gets a fresh id in each dimension. Amortized O(n).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let mut map = GMap::<2>::new();
+    /// let d = map.create_dart().unwrap();
+    /// assert!(map.is_isolated(d));
+    /// assert_eq!(map.count_cells().0, vec![1, 1, 1]); // its own vertex, edge and face
+    /// map.validate().unwrap();
+    /// ```
     pub fn create_dart(&mut self) -> Result<DartId, DartError> {
         let d = match self.free_darts.pop() {
             Some(d) => d,
@@ -249,6 +454,22 @@ impl<const N: usize> GMap<N> {
     /// Deletes an isolated dart and frees its slot and cell ids. O(n).
     ///
     /// Errors: [`DartError::NoSuchDart`], [`DartError::NotIsolated`]; the map is unchanged then.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::gmap::DartError;
+    /// use topomech::GMap;
+    ///
+    /// let mut map = GMap::<2>::new();
+    /// let (a, b) = (map.create_dart().unwrap(), map.create_dart().unwrap());
+    /// map.sew::<0>(a, b).unwrap();
+    /// assert_eq!(map.delete_dart(a), Err(DartError::NotIsolated { dart: a, i: 0, other: b }));
+    /// map.unsew::<0>(a).unwrap();
+    /// map.delete_dart(a).unwrap();
+    /// assert_eq!((map.dart_count(), map.contains(a)), (1, false));
+    /// assert_eq!(map.delete_dart(a), Err(DartError::NoSuchDart(a)));
+    /// ```
     pub fn delete_dart(&mut self, d: DartId) -> Result<(), DartError> {
         if !self.contains(d) {
             return Err(DartError::NoSuchDart(d));
@@ -368,6 +589,17 @@ impl<const N: usize> GMap<N> {
     }
 
     /// Bytes used per live dart by topology and cell ids (not counting the mark pool). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::{generate, GMap};
+    ///
+    /// let (points, tets) = generate::kuhn_cube(1);
+    /// let (map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+    /// let bytes = map.bytes_per_dart();
+    /// assert!(bytes >= 32.0 && bytes < 64.0, "{bytes}"); // 4 links + 4 cell ids of 4 bytes each
+    /// ```
     pub fn bytes_per_dart(&self) -> f64 {
         let bytes = (self.alpha.capacity() + self.cell.capacity()) * 4 + self.alive.capacity() * 8;
         bytes as f64 / self.n_alive.max(1) as f64

@@ -138,6 +138,20 @@ pub(crate) fn generators(n: usize, mask: AlphaMask) -> ([usize; 8], usize) {
 
 impl<const N: usize> GMap<N> {
     /// The darts of ⟨mask⟩(d) in breadth-first order, d first. O(orbit · n).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::{AlphaMask, GMap};
+    ///
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let d = map.darts().next().unwrap();
+    /// let face = map.orbit(d, AlphaMask::of(&[0, 1]));
+    /// assert_eq!(face.len(), 6); // a triangle: 3 corners × 2 edges
+    /// assert_eq!(face[0], d);
+    /// assert_eq!(map.orbit(d, AlphaMask::all(3)).len(), 24);
+    /// assert_eq!(map.orbit(d, AlphaMask::EMPTY), vec![d]);
+    /// ```
     pub fn orbit(&self, d: DartId, mask: AlphaMask) -> Vec<DartId> {
         let mut seen = SmallDartSet::new();
         let mut out = vec![d];
@@ -159,6 +173,18 @@ impl<const N: usize> GMap<N> {
     }
 
     /// The darts of the i-cell of d, ⟨⟩N−{i}(d). O(cell · n).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let d = map.darts().next().unwrap();
+    /// let sizes: Vec<usize> = (0..=3).map(|i| map.cell_darts(i, d).len()).collect();
+    /// assert_eq!(sizes, vec![6, 4, 6, 24]); // corner, edge, face, volume of one tet
+    /// assert!(map.cell_darts(0, d).iter().all(|&e| map.vertex_id(e) == map.vertex_id(d)));
+    /// ```
     pub fn cell_darts(&self, i: usize, d: DartId) -> Vec<DartId> {
         self.orbit(d, AlphaMask::cell(N, i))
     }
@@ -166,6 +192,18 @@ impl<const N: usize> GMap<N> {
     /// Whether b lies in ⟨mask⟩(a). Walks from a and b at once and stops as soon as the walks
     /// meet or one of them is exhausted, so the cost is O(min(|orbit(a)|, |orbit(b)|) · n) when
     /// the orbits differ.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::{AlphaMask, GMap};
+    ///
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let d = map.darts().next().unwrap();
+    /// let e = map.alpha::<0>(d);
+    /// assert!(map.same_orbit(d, e, AlphaMask::cell(3, 1))); // same edge
+    /// assert!(!map.same_orbit(d, e, AlphaMask::cell(3, 0))); // different vertices
+    /// ```
     pub fn same_orbit(&self, a: DartId, b: DartId, mask: AlphaMask) -> bool {
         self.split_side(a, b, mask).is_none()
     }
@@ -208,6 +246,20 @@ impl<const N: usize> GMap<N> {
     }
 
     /// One dart per i-cell: for each live i-cell id, the smallest dart carrying it. O(capacity).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::{generate, GMap};
+    ///
+    /// let (points, tets) = generate::kuhn_cube(1);
+    /// let (map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+    /// for i in 0..=3 {
+    ///     let darts = map.one_dart_per_cell(i);
+    ///     assert_eq!(darts.len(), map.count_cells().0[i]);
+    ///     assert_eq!(darts.len(), map.one_dart_per_cell_by_traversal(i).len());
+    /// }
+    /// ```
     pub fn one_dart_per_cell(&self, i: usize) -> Vec<DartId> {
         let mut first = vec![u32::MAX; self.cell_id_bound(i)];
         for d in self.darts() {
@@ -221,6 +273,19 @@ impl<const N: usize> GMap<N> {
 
     /// One dart per i-cell, found by walking orbits with a mark and ignoring cell ids: the
     /// independent oracle for [`GMap::one_dart_per_cell`]. O(darts · n).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::{generate, GMap};
+    ///
+    /// let (points, triangles) = generate::grid_triangles(2);
+    /// let (map, _) = GMap::<2>::from_triangles(points.len(), &triangles).unwrap();
+    /// let mut ids: Vec<_> = map.one_dart_per_cell_by_traversal(1).iter().map(|&d| map.cell_id(1, d)).collect();
+    /// ids.sort_unstable();
+    /// ids.dedup();
+    /// assert_eq!(ids.len(), 16); // E = 3n² + 2n distinct edge ids
+    /// ```
     pub fn one_dart_per_cell_by_traversal(&self, i: usize) -> Vec<DartId> {
         let mut out = Vec::new();
         self.for_each_orbit(AlphaMask::cell(N, i), |d| out.push(d));
@@ -330,6 +395,18 @@ impl<const N: usize> GMap<N> {
     }
 
     /// The ids of the i-cells incident to d's j-cell, each once. O(j-cell · n).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let (map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+    /// let d = map.darts().find(|&d| !map.is_free(3, d)).unwrap(); // on the shared face
+    /// assert_eq!(map.incident_cells(d, 2, 0).len(), 3); // its corners
+    /// assert_eq!(map.incident_cells(d, 2, 3).len(), 2); // the two tets around it
+    /// assert_eq!(map.incident_cells(d, 0, 3).len(), 2);
+    /// ```
     pub fn incident_cells(&self, d: DartId, j: usize, i: usize) -> Vec<CellId> {
         let mut ids: Vec<CellId> = self.cell_darts(j, d).into_iter().map(|e| self.cell_id(i, e)).collect();
         ids.sort_unstable();

@@ -116,6 +116,20 @@ pub struct CellChanges {
 
 impl CellChanges {
     /// The splits of `dim`-cells, as (kept, new, dart_kept, dart_new).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let (mut map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+    /// let d = map.darts().find(|&d| !map.is_free(3, d)).unwrap();
+    /// let changes = map.unsew::<3>(d).unwrap();
+    /// for (kept, new, dart_kept, dart_new) in changes.splits(0) {
+    ///     assert_eq!((map.vertex_id(dart_kept), map.vertex_id(dart_new)), (kept, new));
+    /// }
+    /// assert_eq!((changes.splits(0).count(), changes.splits(1).count()), (3, 3));
+    /// ```
     pub fn splits(&self, dim: usize) -> impl Iterator<Item = (CellId, CellId, DartId, DartId)> + '_ {
         self.changes.iter().filter_map(move |c| match *c {
             CellChange::Split { dim: k, kept, new, dart_kept, dart_new } if k == dim => {
@@ -126,6 +140,20 @@ impl CellChanges {
     }
 
     /// The merges of `dim`-cells, as (kept, absorbed).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let (mut map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+    /// let d = map.darts().find(|&d| !map.is_free(3, d)).unwrap();
+    /// let e = map.alpha::<3>(d);
+    /// map.unsew::<3>(d).unwrap();
+    /// let changes = map.sew::<3>(d, e).unwrap();
+    /// assert_eq!(changes.merges(0).count(), 3); // the three split vertices meet again
+    /// assert!(changes.merges(0).all(|(kept, gone)| map.is_live_cell(0, kept) && !map.is_live_cell(0, gone)));
+    /// ```
     pub fn merges(&self, dim: usize) -> impl Iterator<Item = (CellId, CellId)> + '_ {
         self.changes.iter().filter_map(move |c| match *c {
             CellChange::Merged { dim: k, kept, absorbed } if k == dim => Some((kept, absorbed)),
@@ -240,23 +268,80 @@ impl<const N: usize> GMap<N> {
     }
 
     /// Whether `sew::<I>(d1, d2)` would succeed. O(|O1| · n).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let mut map = GMap::<2>::new();
+    /// let (a, b) = (map.create_dart().unwrap(), map.create_dart().unwrap());
+    /// assert!(map.is_sewable::<2>(a, b));
+    /// assert!(!map.is_sewable::<2>(a, a)); // αi(a) = a would not be a link
+    /// map.sew::<2>(a, b).unwrap();
+    /// assert!(!map.is_sewable::<2>(a, b)); // both are 2-sewn now
+    /// assert!(!map.is_sewable_dyn(3, a, b)); // no α3 in a 2-map
+    /// ```
     pub fn is_sewable<const I: usize>(&self, d1: DartId, d2: DartId) -> bool {
         const { assert!(I <= N) };
         self.sew_pairs(I, d1, d2).is_ok()
     }
 
     /// Run-time-index version of [`GMap::is_sewable`]; false for i > n.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let (map, _) = GMap::<2>::from_triangles(6, &[[0, 1, 2], [3, 4, 5]]).unwrap();
+    /// let (a, b) = (map.darts().next().unwrap(), map.darts().nth(6).unwrap()); // one dart of each triangle
+    /// assert!(map.is_sewable_dyn(2, a, b));
+    /// assert!(!map.is_sewable_dyn(1, a, b)); // a is 1-sewn already
+    /// assert!(!map.is_sewable_dyn(5, a, b)); // no α5
+    /// ```
     pub fn is_sewable_dyn(&self, i: usize, d1: DartId, d2: DartId) -> bool {
         self.sew_pairs(i, d1, d2).is_ok()
     }
 
-    /// I-sews d1 with d2 (see the [module docs](self)). Errors leave the map unchanged.
+    /// I-sews d1 with d2, and with them the whole orbits ⟨αj : |i − j| ≥ 2⟩ of both, dart by dart, so the
+    /// quasi-manifold law holds; cells that meet are merged and reported in the [`CellChanges`].
+    /// Errors ([`SewError`]) leave the map unchanged.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// // Two separate triangles; glue edge {0, 1} of the first onto edge {3, 4} of the second.
+    /// let (mut map, _) = GMap::<2>::from_triangles(6, &[[0, 1, 2], [3, 4, 5]]).unwrap();
+    /// let on = |a, b| map.darts().find(|&d| map.vertex_id(d).0 == a && map.vertex_id(map.alpha::<0>(d)).0 == b);
+    /// let (x, y) = (on(0, 1).unwrap(), on(3, 4).unwrap());
+    /// let changes = map.sew::<2>(x, y).unwrap();
+    /// assert_eq!(changes.merges(0).count(), 2); // 0 meets 3, 1 meets 4
+    /// assert_eq!(changes.merges(1).count(), 1);
+    /// assert_eq!(map.count_cells().0, vec![4, 5, 2]);
+    /// assert_eq!(map.components().len(), 1);
+    /// ```
     pub fn sew<const I: usize>(&mut self, d1: DartId, d2: DartId) -> Result<CellChanges, SewError> {
         const { assert!(I <= N) };
         self.sew_dyn(I, d1, d2)
     }
 
     /// Run-time-index version of [`GMap::sew`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::gmap::SewError;
+    /// use topomech::GMap;
+    ///
+    /// let mut map = GMap::<1>::new();
+    /// let (a, b) = (map.create_dart().unwrap(), map.create_dart().unwrap());
+    /// assert_eq!(map.sew_dyn(2, a, b), Err(SewError::BadIndex { i: 2, n: 1 }));
+    /// map.sew_dyn(0, a, b).unwrap(); // a segment: two darts, two vertices, one edge
+    /// assert_eq!(map.count_cells().0, vec![2, 1]);
+    /// ```
     pub fn sew_dyn(&mut self, i: usize, d1: DartId, d2: DartId) -> Result<CellChanges, SewError> {
         let pairs = self.sew_pairs(i, d1, d2)?;
         for &(x, y) in &pairs {
@@ -289,12 +374,42 @@ impl<const N: usize> GMap<N> {
 
     /// I-unsews d from αi(d), with the whole orbit ⟨αj : |i − j| ≥ 2⟩(d). Errors leave the map
     /// unchanged: [`SewError::AlreadyFree`] if d is i-free.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::{generate, GMap};
+    ///
+    /// // Cut the unit square along its diagonal.
+    /// let (points, triangles) = generate::grid_triangles(1);
+    /// let (mut map, _) = GMap::<2>::from_triangles(points.len(), &triangles).unwrap();
+    /// let d = map.darts().find(|&d| !map.is_free(2, d)).unwrap();
+    /// let changes = map.unsew::<2>(d).unwrap();
+    /// assert_eq!(changes.splits(0).count(), 2); // both ends of the diagonal split
+    /// assert_eq!(changes.splits(1).count(), 1);
+    /// assert_eq!(map.count_cells().0, vec![6, 6, 2]);
+    /// assert!(map.unsew::<2>(d).is_err()); // already free
+    /// ```
     pub fn unsew<const I: usize>(&mut self, d: DartId) -> Result<CellChanges, SewError> {
         const { assert!(I <= N) };
         self.unsew_dyn(I, d)
     }
 
     /// Run-time-index version of [`GMap::unsew`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::gmap::SewError;
+    /// use topomech::GMap;
+    ///
+    /// let mut map = GMap::<1>::new();
+    /// let (a, b) = (map.create_dart().unwrap(), map.create_dart().unwrap());
+    /// map.sew_dyn(0, a, b).unwrap();
+    /// map.unsew_dyn(0, b).unwrap();
+    /// assert!(map.is_isolated(a) && map.is_isolated(b));
+    /// assert_eq!(map.unsew_dyn(0, a), Err(SewError::AlreadyFree { dart: a, i: 0 }));
+    /// ```
     pub fn unsew_dyn(&mut self, i: usize, d: DartId) -> Result<CellChanges, SewError> {
         Self::check_index(i)?;
         self.check_dart(d)?;

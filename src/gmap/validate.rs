@@ -121,6 +121,17 @@ pub enum InvariantViolation {
 
 impl InvariantViolation {
     /// The law broken.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::gmap::Law;
+    /// use topomech::{DartId, InvariantViolation};
+    ///
+    /// let v = InvariantViolation::NotInvolution { dart: DartId(3), i: 1, image: DartId(4), back: DartId(5) };
+    /// assert_eq!(v.law(), Law::Involution);
+    /// assert!(v.to_string().contains("alpha1(dart 3)"));
+    /// ```
     pub fn law(&self) -> Law {
         use InvariantViolation::*;
         match self {
@@ -133,10 +144,24 @@ impl InvariantViolation {
 }
 
 impl<const N: usize> GMap<N> {
-    /// Checks every law of the table in the [module docs](self). O(darts · n²).
+    /// Checks every law of [`Law`]: involutions, quasi-manifold, constant and unique cell ids.
+    /// O(darts · n²).
     ///
     /// Errors: the first violation in the order of the table (involution and quasi-manifold laws
     /// of every dart first, then cell ids of every dart, then uniqueness per dimension).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::{generate, GMap};
+    ///
+    /// let (points, tets) = generate::kuhn_cube(2);
+    /// let (mut map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+    /// assert_eq!(map.validate(), Ok(()));
+    /// let d = map.darts().find(|&d| !map.is_free(3, d)).unwrap();
+    /// map.unsew::<3>(d).unwrap();
+    /// assert_eq!(map.validate(), Ok(())); // public mutators keep every law
+    /// ```
     pub fn validate(&self) -> Result<(), InvariantViolation> {
         if self.all_laws_hold() {
             return Ok(());
@@ -234,6 +259,17 @@ impl<const N: usize> GMap<N> {
 
     /// Checks the local laws (involution, quasi-manifold, constant cell ids) at the given darts
     /// and their αi neighbours. O(touched · n³).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let (map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+    /// let touched: Vec<_> = map.darts().filter(|&d| !map.is_free(3, d)).collect();
+    /// assert_eq!(touched.len(), 12);
+    /// assert!(map.validate_local(&touched).is_ok());
+    /// ```
     pub fn validate_local(&self, touched: &[DartId]) -> Result<(), InvariantViolation> {
         for &d in touched {
             if !self.contains(d) {

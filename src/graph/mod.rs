@@ -48,6 +48,15 @@ pub struct CellNode {
 pub type CellGraph = Graph<CellNode, u32, Undirected>;
 
 /// Which adjacency graph to export (see the [module docs](self)).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::graph::GraphKind;
+///
+/// assert_eq!(GraphKind::ALL.map(|k| k.name()), ["vertex_edge", "dual", "incidence"]);
+/// assert_eq!(GraphKind::Dual.to_string(), "dual");
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum GraphKind {
@@ -64,6 +73,15 @@ impl GraphKind {
     pub const ALL: [GraphKind; 3] = [GraphKind::VertexEdge, GraphKind::Dual, GraphKind::Incidence];
 
     /// The snake-case name used in JSON and on the command line.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::graph::GraphKind;
+    ///
+    /// assert_eq!(GraphKind::ALL.map(|k| k.name()), ["vertex_edge", "dual", "incidence"]);
+    /// assert_eq!(GraphKind::Dual.to_string(), GraphKind::Dual.name());
+    /// ```
     pub const fn name(self) -> &'static str {
         match self {
             GraphKind::VertexEdge => "vertex_edge",
@@ -92,6 +110,19 @@ pub enum Multiplicity {
 /// The incidences between k-cells and (k+1)-cells of `map`: ((k-cell id, (k+1)-cell id) →
 /// multiplicity), i.e. the number of orbits ⟨αj : j ∉ {k, k+1}⟩ carrying both ids. O(darts · n).
 /// Panics if k ≥ n (there is no (k+1)-cell).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::graph::incidences;
+/// use topomech::GMap;
+///
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let vertex_edge = incidences(&map, 0);
+/// assert_eq!(vertex_edge.len(), 12); // 6 edges × 2 ends
+/// assert!(vertex_edge.values().all(|&m| m == 1));
+/// assert_eq!(incidences(&map, 2).len(), 4); // 4 faces on the one volume
+/// ```
 pub fn incidences<const N: usize>(map: &GMap<N>, k: usize) -> BTreeMap<(u32, u32), u32> {
     assert!(k < N, "incidences({k}) of a {N}-map: there are no {}-cells", k + 1);
     let mask = AlphaMask(AlphaMask::all(N).0 & !(1 << k) & !(1 << (k + 1)));
@@ -167,6 +198,17 @@ fn join_through(b: &mut Builder, inc: &BTreeMap<(u32, u32), u32>, end_dim: usize
 
 /// The 1-skeleton: vertices, and one unit of weight per edge joining its two endpoints.
 /// O(darts · n). Panics for N = 0 (not a valid map dimension anyway).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::graph::vertex_edge_graph;
+/// use topomech::GMap;
+///
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let g = vertex_edge_graph(&map);
+/// assert_eq!((g.node_count(), g.edge_count()), (4, 6)); // the complete graph K4
+/// ```
 pub fn vertex_edge_graph<const N: usize>(map: &GMap<N>) -> CellGraph {
     let mut b = Builder::new(map, &[0]);
     let inc = incidences(map, 0);
@@ -176,6 +218,19 @@ pub fn vertex_edge_graph<const N: usize>(map: &GMap<N>) -> CellGraph {
 
 /// The dual graph: n-cells, and one unit of weight per (n−1)-cell lying between two of them.
 /// O(darts · n).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::graph::dual_graph;
+/// use topomech::{generate, GMap};
+///
+/// let (points, tets) = generate::kuhn_cube(1);
+/// let (map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+/// let g = dual_graph(&map);
+/// assert_eq!(g.node_count(), 6); // the tets
+/// assert_eq!(g.edge_count(), 18 - 12); // one per inner face
+/// ```
 pub fn dual_graph<const N: usize>(map: &GMap<N>) -> CellGraph {
     let mut b = Builder::new(map, &[N]);
     let inc = incidences(map, N - 1);
@@ -184,6 +239,18 @@ pub fn dual_graph<const N: usize>(map: &GMap<N>) -> CellGraph {
 }
 
 /// The incidence graph (Hasse diagram with multiplicities) of all cells. O(darts · n²).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::graph::incidence_graph;
+/// use topomech::GMap;
+///
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let g = incidence_graph(&map);
+/// assert_eq!(g.node_count(), 4 + 6 + 4 + 1);
+/// assert_eq!(g.edge_count(), 12 + 12 + 4); // vertex–edge, edge–face, face–volume
+/// ```
 pub fn incidence_graph<const N: usize>(map: &GMap<N>) -> CellGraph {
     let dims: Vec<usize> = (0..=N).collect();
     let mut b = Builder::new(map, &dims);
@@ -197,6 +264,18 @@ pub fn incidence_graph<const N: usize>(map: &GMap<N>) -> CellGraph {
 }
 
 /// The graph of the given kind. O(darts · n²).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::graph::{graph_of, GraphKind};
+/// use topomech::{generate, GMap};
+///
+/// let (points, triangles) = generate::grid_triangles(2);
+/// let (map, _) = GMap::<2>::from_triangles(points.len(), &triangles).unwrap();
+/// let sizes: Vec<_> = GraphKind::ALL.iter().map(|&k| graph_of(&map, k).node_count()).collect();
+/// assert_eq!(sizes, vec![9, 8, 9 + 16 + 8]); // vertices, triangles, all cells
+/// ```
 pub fn graph_of<const N: usize>(map: &GMap<N>, kind: GraphKind) -> CellGraph {
     match kind {
         GraphKind::VertexEdge => vertex_edge_graph(map),
@@ -208,6 +287,20 @@ pub fn graph_of<const N: usize>(map: &GMap<N>, kind: GraphKind) -> CellGraph {
 /// Whether there is a bijection of nodes preserving dimensions and edges (and, with
 /// [`Multiplicity::Match`], edge weights): `petgraph`'s VF2 with a cheap invariant check first.
 /// Exponential in the worst case; fast on the small and sparse graphs of this study.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::graph::{graph_of, graphs_isomorphic, GraphKind, Multiplicity};
+/// use topomech::GMap;
+///
+/// let (a, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+/// let (b, _) = GMap::<3>::from_tets(5, &[[4, 3, 2, 0], [4, 3, 2, 1]]).unwrap();
+/// let (c, _) = GMap::<3>::from_tets(6, &[[0, 1, 2, 3], [0, 1, 4, 5]]).unwrap();
+/// let g = |m: &GMap<3>| graph_of(m, GraphKind::Incidence);
+/// assert!(graphs_isomorphic(&g(&a), &g(&b), Multiplicity::Match));
+/// assert!(!graphs_isomorphic(&g(&a), &g(&c), Multiplicity::Ignore)); // glued along an edge only
+/// ```
 pub fn graphs_isomorphic(a: &CellGraph, b: &CellGraph, multiplicity: Multiplicity) -> bool {
     if GraphInvariant::of(a, multiplicity) != GraphInvariant::of(b, multiplicity) {
         return false;
@@ -230,6 +323,20 @@ pub type InvariantRow = (u8, u32, Vec<(u8, u32)>);
 
 impl GraphInvariant {
     /// The invariant of `g`; weights are replaced by 1 under [`Multiplicity::Ignore`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::graph::{vertex_edge_graph, GraphInvariant, Multiplicity};
+    /// use topomech::GMap;
+    ///
+    /// let (a, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+    /// let (b, _) = GMap::<3>::from_tets(5, &[[4, 3, 2, 1], [4, 3, 2, 0]]).unwrap();
+    /// let (c, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let inv = |m: &GMap<3>| GraphInvariant::of(&vertex_edge_graph(m), Multiplicity::Match);
+    /// assert_eq!(inv(&a), inv(&b)); // isomorphic graphs share it
+    /// assert_ne!(inv(&a), inv(&c));
+    /// ```
     pub fn of(g: &CellGraph, multiplicity: Multiplicity) -> Self {
         let w = |x: u32| if multiplicity == Multiplicity::Match { x } else { 1 };
         let mut rows: Vec<InvariantRow> = g.node_indices().map(|n| (g[n].dim, 0, Vec::new())).collect();
@@ -265,6 +372,19 @@ pub struct GraphJson {
 
 impl GraphJson {
     /// The JSON form of `g`. O(nodes + edges · log).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::graph::{vertex_edge_graph, GraphJson, GraphKind};
+    /// use topomech::GMap;
+    ///
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let json = GraphJson::of(&vertex_edge_graph(&map), GraphKind::VertexEdge);
+    /// assert_eq!(json.nodes, vec![0, 0, 0, 0]); // four vertices (dimension 0)
+    /// assert_eq!(json.edges.len(), 6);
+    /// assert!(json.edges.windows(2).all(|w| w[0] < w[1]) && json.edges.iter().all(|e| e[0] <= e[1]));
+    /// ```
     pub fn of(g: &CellGraph, kind: GraphKind) -> Self {
         let mut order: Vec<NodeIndex> = g.node_indices().collect();
         order.sort_by_key(|&n| g[n]);
@@ -286,6 +406,20 @@ impl GraphJson {
 
     /// Rebuilds a graph (node ids = ranks). Errors name the first edge with an endpoint out of
     /// range. O(nodes + edges).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::graph::{graphs_isomorphic, incidence_graph, GraphJson, GraphKind, Multiplicity};
+    /// use topomech::GMap;
+    ///
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let g = incidence_graph(&map);
+    /// let json = GraphJson::of(&g, GraphKind::Incidence);
+    /// assert_eq!(json.nodes.len(), 15);
+    /// let back = json.to_graph().unwrap();
+    /// assert!(graphs_isomorphic(&g, &back, Multiplicity::Match));
+    /// ```
     pub fn to_graph(&self) -> Result<CellGraph, GraphJsonError> {
         let mut g = CellGraph::default();
         let nodes: Vec<NodeIndex> =

@@ -46,6 +46,19 @@ impl fmt::Display for Location {
 }
 
 /// Why a mesh file could not be read. Every variant names the file; most name a [`Location`].
+///
+/// # Examples
+///
+/// ```
+/// use std::path::Path;
+/// use topomech::io::{parse_msh, ReadError};
+///
+/// let msh = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 1 0 zz\n3 0 1 0\n4 0 0 1\n\
+///            $EndNodes\n$Elements\n1\n1 4 2 0 1 1 2 3 4\n$EndElements\n";
+/// let err = parse_msh(msh.as_bytes(), Path::new("bad.msh")).unwrap_err();
+/// assert!(matches!(err, ReadError::Garbage { .. }), "{err}");
+/// assert!(err.to_string().starts_with("bad.msh: line 7: garbage token `zz`"), "{err}");
+/// ```
 #[derive(Debug, thiserror::Error)]
 pub enum ReadError {
     /// The file could not be read from disk.
@@ -285,6 +298,18 @@ fn extension(path: &Path) -> String {
 ///
 /// # Errors
 /// Any [`ReadError`]; [`ReadError::UnknownFormat`] for an OBJ file or an unrecognised header.
+///
+/// # Examples
+///
+/// ```
+/// use std::path::Path;
+/// use topomech::io::{read_mesh, ReadError};
+///
+/// let err = read_mesh(Path::new("/no/such/mesh.msh")).unwrap_err();
+/// assert!(matches!(err, ReadError::Io { .. }));
+/// let err = read_mesh(Path::new("/no/such/surface.obj")).unwrap_err();
+/// assert!(matches!(err, ReadError::UnknownFormat { .. })); // a surface format, refused by name
+/// ```
 pub fn read_mesh(path: &Path) -> Result<TetMesh, ReadError> {
     match extension(path).as_str() {
         "node" | "ele" => read_tetgen(&path.with_extension("node"), &path.with_extension("ele")),
@@ -300,6 +325,21 @@ pub fn read_mesh(path: &Path) -> Result<TetMesh, ReadError> {
 ///
 /// # Errors
 /// Any [`ReadError`], naming whichever of the two files is at fault.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::io::read_tetgen;
+///
+/// let stem = std::env::temp_dir().join(format!("topomech-doc-{}", std::process::id()));
+/// let (node, ele) = (stem.with_extension("node"), stem.with_extension("ele"));
+/// std::fs::write(&node, "4 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n").unwrap(); // 0-based numbers
+/// std::fs::write(&ele, "1 4 0\n0 0 1 2 3\n").unwrap();
+/// let mesh = read_tetgen(&node, &ele);
+/// std::fs::remove_file(&node).unwrap();
+/// std::fs::remove_file(&ele).unwrap();
+/// assert_eq!(mesh.unwrap().tets, vec![[0, 1, 2, 3]]);
+/// ```
 pub fn read_tetgen(node_path: &Path, ele_path: &Path) -> Result<TetMesh, ReadError> {
     let node = read_file(node_path)?;
     let ele = read_file(ele_path)?;
@@ -312,6 +352,18 @@ pub fn read_tetgen(node_path: &Path, ele_path: &Path) -> Result<TetMesh, ReadErr
 ///
 /// # Errors
 /// Any [`ReadError`]; [`ReadError::InvalidMesh`] when there is no triangle.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::io::read_tri_mesh;
+///
+/// let path = std::env::temp_dir().join(format!("topomech-doc-{}.obj", std::process::id()));
+/// std::fs::write(&path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+/// let mesh = read_tri_mesh(&path).unwrap();
+/// std::fs::remove_file(&path).unwrap();
+/// assert_eq!(mesh.triangles, vec![[0, 1, 2]]);
+/// ```
 pub fn read_tri_mesh(path: &Path) -> Result<TriMesh, ReadError> {
     let bytes = read_file(path)?;
     match extension(path).as_str() {
@@ -365,6 +417,20 @@ fn parse_msh_records(bytes: &[u8], path: &Path) -> Result<MeshBuilder, ReadError
 ///
 /// # Errors
 /// Any [`ReadError`] except `Io`.
+///
+/// # Examples
+///
+/// ```
+/// use std::path::Path;
+/// use topomech::io::parse_msh;
+///
+/// let msh = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n\
+///            $EndNodes\n$Elements\n2\n1 4 2 0 1 1 2 3 4\n2 2 2 0 1 1 2 3\n$EndElements\n";
+/// let mesh = parse_msh(msh.as_bytes(), Path::new("one.msh")).unwrap();
+/// assert_eq!(mesh.tets, vec![[0, 1, 2, 3]]); // node tags 1..4 become indices 0..3
+/// assert_eq!(mesh.boundary_triangles, vec![[0, 1, 2]]);
+/// assert!((mesh.total_volume() - 1.0 / 6.0).abs() < 1e-15);
+/// ```
 pub fn parse_msh(bytes: &[u8], path: &Path) -> Result<TetMesh, ReadError> {
     parse_msh_records(bytes, path)?.into_tet_mesh(path)
 }
@@ -374,6 +440,19 @@ pub fn parse_msh(bytes: &[u8], path: &Path) -> Result<TetMesh, ReadError> {
 ///
 /// # Errors
 /// Any [`ReadError`] except `Io`; `InvalidMesh` when there is no triangle.
+///
+/// # Examples
+///
+/// ```
+/// use std::path::Path;
+/// use topomech::io::parse_msh_tri;
+///
+/// let msh = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n3\n1 0 0 0\n2 2 0 0\n3 0 2 0\n\
+///            $EndNodes\n$Elements\n1\n1 2 2 0 1 1 2 3\n$EndElements\n";
+/// let mesh = parse_msh_tri(msh.as_bytes(), Path::new("tri.msh")).unwrap();
+/// assert_eq!(mesh.triangles, vec![[0, 1, 2]]);
+/// assert_eq!(mesh.total_area(), 2.0);
+/// ```
 pub fn parse_msh_tri(bytes: &[u8], path: &Path) -> Result<TriMesh, ReadError> {
     parse_msh_records(bytes, path)?.into_tri_mesh(path)
 }
@@ -383,6 +462,19 @@ pub fn parse_msh_tri(bytes: &[u8], path: &Path) -> Result<TriMesh, ReadError> {
 ///
 /// # Errors
 /// Any [`ReadError`] except `Io`.
+///
+/// # Examples
+///
+/// ```
+/// use std::path::Path;
+/// use topomech::io::parse_tetgen;
+///
+/// let node = "# a unit tet\n4 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n";
+/// let ele = "1 4 0\n1 1 2 3 4\n";
+/// let mesh = parse_tetgen(node.as_bytes(), Path::new("t.node"), ele.as_bytes(), Path::new("t.ele")).unwrap();
+/// assert_eq!((mesh.points.len(), mesh.tets.len()), (4, 1));
+/// assert_eq!(mesh.points[3], [0.0, 0.0, 1.0]);
+/// ```
 pub fn parse_tetgen(node: &[u8], node_path: &Path, ele: &[u8], ele_path: &Path) -> Result<TetMesh, ReadError> {
     let mut b = MeshBuilder::new();
     tetgen::parse_node(node, node_path, &mut b)?;
@@ -395,6 +487,19 @@ pub fn parse_tetgen(node: &[u8], node_path: &Path, ele: &[u8], ele_path: &Path) 
 ///
 /// # Errors
 /// Any [`ReadError`] except `Io`.
+///
+/// # Examples
+///
+/// ```
+/// use std::path::Path;
+/// use topomech::io::parse_obj;
+///
+/// let obj = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1/1 3/3 -1\n"; // -1: the last vertex so far
+/// let mesh = parse_obj(obj.as_bytes(), Path::new("quad.obj")).unwrap();
+/// assert_eq!(mesh.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+/// assert_eq!(mesh.total_area(), 1.0);
+/// assert!(parse_obj(b"v 0 0 0\nf 1 2 3\n", Path::new("x.obj")).is_err()); // vertices 2, 3 missing
+/// ```
 pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<TriMesh, ReadError> {
     obj::parse(bytes, path)?.into_tri_mesh(path)
 }

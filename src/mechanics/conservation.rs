@@ -124,6 +124,22 @@ struct Expected {
 ///
 /// # Errors
 /// The first [`ConservationError`] found, vertices first, then edges, then the totals.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::{incise_plane, Plane};
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{check_conservation, Body, Material};
+///
+/// let (points, tets) = kuhn_cube(2);
+/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// assert_eq!(check_conservation(body.map(), body.attrs()), Ok(()));
+/// let plane = Plane { point: [1.0, 1.0, 1.0], normal: [0.0, 1.0, 0.0] };
+/// incise_plane(&mut body, &plane).unwrap();
+/// assert_eq!(body.map().components().len(), 2);
+/// assert_eq!(check_conservation(body.map(), body.attrs()), Ok(())); // the laws hold after the cut too
+/// ```
 pub fn check_conservation(map: &GMap<3>, mech: &Mechanics) -> Result<(), ConservationError> {
     for dim in 0..=3 {
         let (len, bound) = (mech.attribute_len(dim), map.cell_id_bound(dim));

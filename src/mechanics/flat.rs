@@ -32,6 +32,19 @@ impl FlatModel {
     /// # Errors
     /// [`ModelError::Build`] for a bad index or repeated point, [`ModelError::DegenerateTet`] for a
     /// zero-volume tet, [`ModelError::NonFinitePoint`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{FlatModel, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let flat = FlatModel::from_tets(&points, &tets, Material::default(), [0.0; 3], &[]).unwrap();
+    /// assert_eq!((flat.system.slots(), flat.system.springs()), (8, 19)); // one spring per edge
+    /// assert!((flat.system.mass.iter().sum::<f64>() - 1.0).abs() < 1e-12); // density 1, unit cube
+    /// assert_eq!(flat.position, points);
+    /// ```
     pub fn from_tets(
         points: &[Vec3],
         tets: &[[u32; 4]],

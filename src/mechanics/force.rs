@@ -68,6 +68,21 @@ impl SpringSystem {
     /// A system from its arrays; builds the incidence lists packed (module docs). O(slots + springs).
     ///
     /// Panics if the arrays disagree in length or an end is out of range (a bug of the builder).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let sys = SpringSystem::new(
+    ///     vec![[0, 1]], vec![1.0], vec![10.0], vec![0.0], // ends, rest length, stiffness, damping
+    ///     vec![1.0, 2.0], &[false, true], vec![0.0; 2], [0.0; 3], // mass, fixed, viscosity, gravity
+    /// );
+    /// assert_eq!(sys.inv_mass, vec![1.0, 0.0]); // slot 1 is fixed
+    /// assert_eq!((sys.slots(), sys.springs()), (2, 1));
+    /// assert_eq!(sys.incident(1).collect::<Vec<_>>(), vec![(0, -1.0)]); // end b of spring 0
+    /// sys.check_incidence().unwrap();
+    /// ```
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         ends: Vec<[u32; 2]>,
@@ -101,6 +116,19 @@ impl SpringSystem {
 
     /// Sets slot v's mass, fixedness and viscosity (`inv_mass` = 0 when fixed or `mass <= 0`,
     /// else 1/mass). O(1). Panics if v is not a slot.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// let v = sys.push_slot(1.0, false, 0.0);
+    /// sys.set_slot(v, 4.0, false, 0.5);
+    /// assert_eq!((sys.mass[v], sys.inv_mass[v], sys.viscosity[v]), (4.0, 0.25, 0.5));
+    /// sys.set_slot(v, 4.0, true, 0.5); // pin it
+    /// assert_eq!(sys.inv_mass[v], 0.0);
+    /// ```
     pub fn set_slot(&mut self, v: usize, mass: f64, fixed: bool, viscosity: f64) {
         self.mass[v] = mass;
         self.viscosity[v] = viscosity;
@@ -109,6 +137,20 @@ impl SpringSystem {
 
     /// Appends spring `ends` = (a, b) with rest length, stiffness and damping; returns its index.
     /// O(degree of a and b) amortised. Panics if an end is not a slot or a = b.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// let (a, b) = (sys.push_slot(1.0, false, 0.0), sys.push_slot(0.0, false, 0.0));
+    /// assert_eq!(sys.inv_mass, vec![1.0, 0.0]); // a massless slot does not move
+    /// let s = sys.push_spring([a as u32, b as u32], 1.0, 3.0, 0.0);
+    /// assert_eq!((s, sys.springs()), (0, 1));
+    /// assert_eq!(sys.incident(a).collect::<Vec<_>>(), vec![(s, 1.0)]);
+    /// sys.check_incidence().unwrap();
+    /// ```
     pub fn push_spring(&mut self, ends: [u32; 2], rest: f64, stiffness: f64, damping: f64) -> usize {
         assert!(ends[0] != ends[1] && (ends[0].max(ends[1]) as usize) < self.slots(), "bad spring ends {ends:?}");
         let s = self.ends.len();
@@ -124,6 +166,20 @@ impl SpringSystem {
     /// Rewrites spring s: its ends (moving it between incidence lists when they change), rest
     /// length, stiffness and damping. O(degree of the old and new ends) amortised. Panics if s is
     /// not a spring, an end is not a slot or a = b.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// (0..3).for_each(|_| drop(sys.push_slot(1.0, false, 0.0)));
+    /// sys.push_spring([0, 1], 1.0, 1.0, 0.0);
+    /// sys.set_spring(0, [0, 2], 2.0, 5.0, 0.1); // re-attach end b to slot 2
+    /// assert_eq!((sys.incident(1).count(), sys.incident(2).count()), (0, 1));
+    /// assert_eq!((sys.rest[0], sys.stiffness[0], sys.damping[0]), (2.0, 5.0, 0.1));
+    /// sys.check_incidence().unwrap();
+    /// ```
     pub fn set_spring(&mut self, s: usize, ends: [u32; 2], rest: f64, stiffness: f64, damping: f64) {
         assert!(ends[0] != ends[1] && (ends[0].max(ends[1]) as usize) < self.slots(), "bad spring ends {ends:?}");
         let old = self.ends[s];
@@ -142,6 +198,21 @@ impl SpringSystem {
     /// Removes spring s; the last spring takes its index (its incidence entries are renamed).
     /// Returns the former index of the moved spring, `None` if s was last. O(degree of the ends
     /// of both springs). Panics if s is not a spring.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// (0..3).for_each(|_| drop(sys.push_slot(1.0, false, 0.0)));
+    /// sys.push_spring([0, 1], 1.0, 1.0, 0.0);
+    /// sys.push_spring([1, 2], 1.0, 1.0, 0.0);
+    /// assert_eq!(sys.swap_remove_spring(0), Some(1)); // spring 1 moved into index 0
+    /// assert_eq!((sys.springs(), sys.ends[0]), (1, [1, 2]));
+    /// assert_eq!(sys.incident(0).count(), 0);
+    /// sys.check_incidence().unwrap();
+    /// ```
     pub fn swap_remove_spring(&mut self, s: usize) -> Option<usize> {
         let [a, b] = self.ends[s];
         self.inc.remove(a as usize, true, s as u32);
@@ -181,6 +252,23 @@ impl SpringSystem {
     }
 
     /// Pass 1: F_s (force on end a) of every spring into `sf`. O(springs).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// // Three slots on a line, springs of rest length 1: the first compressed, the second stretched.
+    /// let mut sys = SpringSystem::default();
+    /// (0..3).for_each(|_| drop(sys.push_slot(1.0, false, 0.0)));
+    /// sys.push_spring([0, 1], 1.0, 2.0, 0.0);
+    /// sys.push_spring([1, 2], 1.0, 2.0, 0.0);
+    /// let (x, v) = ([[0.0; 3], [0.5, 0.0, 0.0], [2.5, 0.0, 0.0]], [[0.0; 3]; 3]);
+    /// let mut sf = vec![[0.0; 3]; 2];
+    /// sys.spring_forces(&x, &v, &mut sf, false);
+    /// assert_eq!(sf, vec![[-1.0, 0.0, 0.0], [2.0, 0.0, 0.0]]); // F on end a: pushed away, pulled along
+    /// assert_eq!(sys.vertex_force(1, &v, &sf), [1.0 + 2.0, 0.0, 0.0]); // −F₀ + F₁ on the middle slot
+    /// ```
     pub fn spring_forces(&self, x: &[Vec3], v: &[Vec3], sf: &mut [Vec3], parallel: bool) {
         if parallel && sf.len() > PARALLEL_CHUNK {
             sf.par_chunks_mut(PARALLEL_CHUNK).enumerate().for_each(|(c, chunk)| {
@@ -249,12 +337,44 @@ impl SpringSystem {
     }
 
     /// Forces on every slot (pinned ones included) into `out`. O(slots + springs).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// // One spring of rest length 1 and stiffness 10, stretched to length 2 along x.
+    /// let mut sys = SpringSystem::default();
+    /// let (a, b) = (sys.push_slot(1.0, false, 0.0), sys.push_slot(1.0, false, 0.0));
+    /// sys.push_spring([a as u32, b as u32], 1.0, 10.0, 0.0);
+    /// let (x, v) = ([[0.0; 3], [2.0, 0.0, 0.0]], [[0.0; 3]; 2]);
+    /// let (mut sf, mut out) = (vec![[0.0; 3]; 1], vec![[0.0; 3]; 2]);
+    /// sys.forces(&x, &v, &mut sf, &mut out, false);
+    /// assert_eq!(out, vec![[10.0, 0.0, 0.0], [-10.0, 0.0, 0.0]]); // equal and opposite
+    /// assert_eq!(sys.elastic_energy(&x), 5.0); // ½ k (l − L)²
+    /// sys.check_incidence().unwrap();
+    /// ```
     pub fn forces(&self, x: &[Vec3], v: &[Vec3], sf: &mut [Vec3], out: &mut [Vec3], parallel: bool) {
         self.spring_forces(x, v, sf, parallel);
         self.per_slot(out, parallel, |i| self.vertex_force(i, v, sf));
     }
 
     /// Accelerations f_i / m_i (zero on fixed slots) into `acc`. O(slots + springs).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// // No springs: a free slot falls with g, a fixed one does not move.
+    /// let mut sys = SpringSystem::default();
+    /// sys.gravity = [0.0, 0.0, -9.81];
+    /// sys.push_slot(2.0, false, 0.0);
+    /// sys.push_slot(2.0, true, 0.0);
+    /// let (x, v, mut acc) = ([[0.0; 3]; 2], [[0.0; 3]; 2], [[1.0; 3]; 2]);
+    /// sys.accelerations(&x, &v, &mut [], &mut acc, false);
+    /// assert_eq!(acc, [[0.0, 0.0, -9.81], [0.0; 3]]);
+    /// ```
     pub fn accelerations(&self, x: &[Vec3], v: &[Vec3], sf: &mut [Vec3], acc: &mut [Vec3], parallel: bool) {
         self.spring_forces(x, v, sf, parallel);
         let sf: &[Vec3] = sf;
@@ -282,12 +402,37 @@ impl SpringSystem {
     }
 
     /// The springs incident to slot i as (spring, sign): +1 where i is end a. O(degree).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// (0..3).for_each(|_| drop(sys.push_slot(1.0, false, 0.0)));
+    /// sys.push_spring([0, 1], 1.0, 1.0, 0.0);
+    /// sys.push_spring([1, 2], 1.0, 1.0, 0.0);
+    /// let mut at_1: Vec<_> = sys.incident(1).collect();
+    /// at_1.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    /// assert_eq!(at_1, vec![(0, -1.0), (1, 1.0)]); // end b of spring 0, end a of spring 1
+    /// ```
     pub fn incident(&self, i: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
         let (heads, tails) = self.inc.lists(i);
         heads.iter().map(|&s| (s as usize, 1.0)).chain(tails.iter().map(|&s| (s as usize, -1.0)))
     }
 
     /// Kinetic energy ½ Σ m |v|² over free slots. O(slots).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// sys.push_slot(2.0, false, 0.0);
+    /// sys.push_slot(2.0, true, 0.0); // fixed slots do not count
+    /// assert_eq!(sys.kinetic_energy(&[[3.0, 0.0, 4.0], [9.0; 3]]), 25.0); // ½ · 2 · 5²
+    /// ```
     pub fn kinetic_energy(&self, v: &[Vec3]) -> f64 {
         self.mass
             .iter()
@@ -299,6 +444,18 @@ impl SpringSystem {
     }
 
     /// Elastic energy ½ Σ k (l − L)². O(springs).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// (0..2).for_each(|_| drop(sys.push_slot(1.0, false, 0.0)));
+    /// sys.push_spring([0, 1], 2.0, 8.0, 0.0);
+    /// assert_eq!(sys.elastic_energy(&[[0.0; 3], [0.0, 2.0, 0.0]]), 0.0); // at rest length
+    /// assert_eq!(sys.elastic_energy(&[[0.0; 3], [0.0, 1.5, 0.0]]), 1.0); // ½ · 8 · 0.5²
+    /// ```
     pub fn elastic_energy(&self, x: &[Vec3]) -> f64 {
         (0..self.springs())
             .map(|s| {
@@ -310,6 +467,18 @@ impl SpringSystem {
     }
 
     /// Gravitational potential −Σ m g·x over free slots. O(slots).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// sys.gravity = [0.0, 0.0, -10.0];
+    /// sys.push_slot(2.0, false, 0.0);
+    /// assert_eq!(sys.gravity_energy(&[[0.0, 0.0, 3.0]]), 60.0); // m g h
+    /// assert_eq!(sys.kinetic_energy(&[[0.0, 4.0, 0.0]]), 16.0); // ½ m v²
+    /// ```
     pub fn gravity_energy(&self, x: &[Vec3]) -> f64 {
         let g = self.gravity;
         self.mass
@@ -323,6 +492,18 @@ impl SpringSystem {
 
     /// A bound on the largest angular frequency, ω_max² ≤ max_v Σ_{s ∋ v} 2 k_s / m_v
     /// (Gershgorin on M⁻¹K), over free slots. Explicit schemes need dt ≲ 2/ω_max. O(springs).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// sys.push_slot(2.0, true, 0.0); // fixed: does not count
+    /// sys.push_slot(0.5, false, 0.0);
+    /// sys.push_spring([0, 1], 1.0, 4.0, 0.0);
+    /// assert_eq!(sys.omega_max(), 4.0); // √(2k / m)
+    /// ```
     pub fn omega_max(&self) -> f64 {
         let mut w2: f64 = 0.0;
         for i in 0..self.slots() {
@@ -339,6 +520,18 @@ impl SpringSystem {
 const BLOCK: usize = 64;
 
 /// F_s on end a of a spring (see the module docs). Zero for a zero-length spring. O(1).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mechanics::force::spring_force;
+///
+/// let (a, b, still) = ([0.0; 3], [3.0, 0.0, 0.0], [0.0; 3]);
+/// assert_eq!(spring_force(a, b, still, still, 1.0, 5.0, 0.0), [10.0, 0.0, 0.0]); // pulled towards b
+/// assert_eq!(spring_force(a, b, still, still, 3.0, 5.0, 0.0), [0.0; 3]); // at rest length
+/// let closing = [1.0, 0.0, 0.0]; // a moves towards b: damping resists
+/// assert_eq!(spring_force(a, b, closing, still, 3.0, 5.0, 0.5), [-0.5, 0.0, 0.0]);
+/// ```
 #[inline(always)]
 pub fn spring_force(xa: Vec3, xb: Vec3, va: Vec3, vb: Vec3, rest: f64, k: f64, c: f64) -> Vec3 {
     let d = [xb[0] - xa[0], xb[1] - xa[1], xb[2] - xa[2]];

@@ -39,6 +39,16 @@ pub enum Integrator {
 
 impl Integrator {
     /// The CLI name: `euler`, `symplectic`, `rk4`, `implicit`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::Integrator;
+    ///
+    /// for scheme in [Integrator::Euler, Integrator::Symplectic, Integrator::Rk4, Integrator::Implicit] {
+    ///     assert_eq!(scheme.name().parse::<Integrator>(), Ok(scheme));
+    /// }
+    /// ```
     pub fn name(self) -> &'static str {
         match self {
             Integrator::Euler => "euler",
@@ -123,6 +133,18 @@ pub struct StepConfig {
 impl StepConfig {
     /// Defaults for `integrator` at step `dt`: serial, runaway factor 1e3, CG to 1e-10 in ≤ 1000
     /// iterations.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::{Integrator, StepConfig};
+    ///
+    /// let config = StepConfig::new("rk4".parse::<Integrator>().unwrap(), 1e-3);
+    /// assert_eq!(config.integrator, Integrator::Rk4);
+    /// assert!(!config.parallel && config.dt == 1e-3);
+    /// assert!("leapfrog".parse::<Integrator>().is_err());
+    /// assert_eq!(Integrator::Symplectic.name(), "symplectic");
+    /// ```
     pub fn new(integrator: Integrator, dt: f64) -> Self {
         StepConfig {
             integrator,
@@ -168,6 +190,20 @@ impl Stepper {
     ///
     /// # Errors
     /// [`StepError::BadTimeStep`], [`StepError::SizeMismatch`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::{Integrator, SpringSystem, StepConfig, StepError, Stepper};
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// sys.push_slot(1.0, false, 0.0);
+    /// let (x, v) = (vec![[0.0; 3]], vec![[0.0; 3]]);
+    /// let stepper = Stepper::new(StepConfig::new(Integrator::Implicit, 0.01), &sys, &x, &v).unwrap();
+    /// assert_eq!((stepper.steps_done(), stepper.config().dt), (0, 0.01));
+    /// let bad = Stepper::new(StepConfig::new(Integrator::Implicit, 0.01), &sys, &[], &v);
+    /// assert!(matches!(bad, Err(StepError::SizeMismatch { .. })));
+    /// ```
     pub fn new(config: StepConfig, sys: &SpringSystem, x: &[Vec3], v: &[Vec3]) -> Result<Self, StepError> {
         if !(config.dt.is_finite() && config.dt > 0.0) {
             return Err(StepError::BadTimeStep(config.dt));
@@ -197,6 +233,22 @@ impl Stepper {
     }
 
     /// Steps made so far. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::{Integrator, SpringSystem, StepConfig, Stepper};
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// sys.push_slot(1.0, false, 0.0);
+    /// let (mut x, mut v) = (vec![[0.0; 3]], vec![[1.0, 0.0, 0.0]]);
+    /// let mut stepper = Stepper::new(StepConfig::new(Integrator::Euler, 0.5), &sys, &x, &v).unwrap();
+    /// for _ in 0..4 {
+    ///     stepper.step(&sys, &mut x, &mut v).unwrap();
+    /// }
+    /// assert_eq!(stepper.steps_done(), 4);
+    /// assert_eq!(x[0], [2.0, 0.0, 0.0]); // free flight: 4 steps × 0.5 s × 1 m/s
+    /// ```
     pub fn steps_done(&self) -> u64 {
         self.step
     }
@@ -207,6 +259,24 @@ impl Stepper {
     /// # Errors
     /// [`StepError::BlowUp`], [`StepError::SolverFailed`], [`StepError::SizeMismatch`]. After an
     /// error the state holds the bad values (for inspection); do not continue.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::{Integrator, SpringSystem, StepConfig, Stepper};
+    ///
+    /// // A unit mass hanging from a fixed point on a spring, released at the spring's rest length.
+    /// let mut sys = SpringSystem::default();
+    /// sys.gravity = [0.0, 0.0, -10.0];
+    /// sys.push_slot(1.0, true, 0.0);
+    /// sys.push_slot(1.0, false, 0.0);
+    /// sys.push_spring([0, 1], 1.0, 100.0, 0.0);
+    /// let (mut x, mut v) = (vec![[0.0; 3], [0.0, 0.0, -1.0]], vec![[0.0; 3]; 2]);
+    /// let mut stepper = Stepper::new(StepConfig::new(Integrator::Symplectic, 1e-3), &sys, &x, &v).unwrap();
+    /// (0..100).for_each(|_| stepper.step(&sys, &mut x, &mut v).unwrap());
+    /// assert_eq!(stepper.steps_done(), 100);
+    /// assert!(x[0] == [0.0; 3] && x[1][2] < -1.0); // the anchor stays, the mass falls
+    /// ```
     pub fn step(&mut self, sys: &SpringSystem, x: &mut [Vec3], v: &mut [Vec3]) -> Result<(), StepError> {
         check_len(sys, x)?;
         check_len(sys, v)?;

@@ -60,6 +60,18 @@ pub struct PinSpec {
 
 impl PinSpec {
     /// Whether vertex `id` at rest position `p` is fixed. O(ids).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::PinSpec;
+    /// use topomech::CellId;
+    ///
+    /// let pins = PinSpec { ids: vec![7], below: Some((2, 0.0)), ..Default::default() };
+    /// assert!(pins.pins(CellId(3), [1.0, 1.0, 0.0])); // on the floor
+    /// assert!(pins.pins(CellId(7), [1.0, 1.0, 5.0])); // named
+    /// assert!(!pins.pins(CellId(3), [1.0, 1.0, 0.5]));
+    /// ```
     pub fn pins(&self, id: CellId, p: Vec3) -> bool {
         let below = self.below.is_some_and(|(axis, value)| p[axis] <= value);
         let inside = self.inside.is_some_and(|(lo, hi)| (0..3).all(|k| lo[k] <= p[k] && p[k] <= hi[k]));
@@ -83,6 +95,22 @@ impl Simulation {
     ///
     /// # Errors
     /// [`StepError::BadTimeStep`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Integrator, Material, Simulation, StepConfig};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// body.attrs_mut().velocity.as_mut_slice()[0] = [1.0, 0.0, 0.0];
+    /// body.attrs_mut().pinned.as_mut_slice()[0] = true;
+    /// let sim = Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Rk4, 1e-3)).unwrap();
+    /// assert_eq!(body.attrs().velocity.as_slice()[0], [0.0; 3]); // a pinned vertex starts still
+    /// assert_eq!(sim.projection.system.springs(), 19); // one spring per edge
+    /// assert!(Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Rk4, -1.0)).is_err());
+    /// ```
     pub fn new(body: &mut Body, gravity: Vec3, config: StepConfig) -> Result<Self, SimError> {
         let mech = body.attrs_mut();
         for (v, &p) in mech.velocity.as_mut_slice().iter_mut().zip(mech.pinned.as_slice()) {
@@ -107,6 +135,26 @@ impl Simulation {
     /// # Errors
     /// [`SimError::StaleProjection`] if the body changed topologically (call
     /// [`Simulation::rebuild`]); [`SimError::Step`] on blow-up (the slot is the vertex id).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Integrator, Material, Simulation, StepConfig};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// body.attrs_mut().pin_where(|_, rest| rest[2] == 0.0); // hold the bottom face
+    /// let config = StepConfig::new(Integrator::Symplectic, 1e-3);
+    /// let mut sim = Simulation::new(&mut body, [0.0, 0.0, -9.81], config).unwrap();
+    /// for _ in 0..50 {
+    ///     sim.step(&mut body).unwrap();
+    /// }
+    /// let m = body.attrs();
+    /// let z = |v: usize| m.position.as_slice()[v][2];
+    /// assert!(z(7) < 1.0 && z(0) == 0.0); // the top corner sags, the pinned one stays
+    /// assert!(sim.kinetic_energy(&body) > 0.0 && sim.max_displacement(&body) > 0.0);
+    /// ```
     pub fn step(&mut self, body: &mut Body) -> Result<(), SimError> {
         if !self.projection.is_current(body) {
             return Err(SimError::StaleProjection { built: self.projection.version(), now: body.version() });
@@ -124,6 +172,23 @@ impl Simulation {
     ///
     /// # Errors
     /// As [`Simulation::new`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::dissociate_face;
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Integrator, Material, SimError, Simulation, StepConfig};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let mut sim = Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Euler, 1e-3)).unwrap();
+    /// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+    /// dissociate_face(&mut body, d).unwrap();
+    /// assert!(matches!(sim.step(&mut body), Err(SimError::StaleProjection { .. })));
+    /// sim.rebuild(&mut body).unwrap();
+    /// sim.step(&mut body).unwrap();
+    /// ```
     pub fn rebuild(&mut self, body: &mut Body) -> Result<(), SimError> {
         let config = *self.stepper.config();
         *self = Simulation::new(body, self.projection.system.gravity, config)?;
@@ -138,6 +203,24 @@ impl Simulation {
     ///
     /// # Errors
     /// As [`Simulation::new`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::dissociate_face;
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Integrator, Material, Projection, Simulation, StepConfig};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let mut sim = Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Euler, 1e-3)).unwrap();
+    /// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+    /// let cut = dissociate_face(&mut body, d).unwrap();
+    /// sim.update(&mut body, &cut.touched).unwrap(); // incremental: only the touched cells
+    /// assert!(sim.projection.is_current(&body));
+    /// assert!(sim.projection.equivalent(&Projection::build(&body, [0.0; 3])).is_ok()); // = a fresh build
+    /// sim.step(&mut body).unwrap();
+    /// ```
     pub fn update(&mut self, body: &mut Body, touched: &TouchedCells) -> Result<(), SimError> {
         self.projection.update(body, touched);
         let config = *self.stepper.config();
@@ -154,12 +237,40 @@ impl Simulation {
     }
 
     /// Kinetic energy of the body's free vertices. O(vertex ids).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Integrator, Material, Simulation, StepConfig};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// body.attrs_mut().velocity.as_mut_slice().fill([0.0, 3.0, 0.0]);
+    /// let sim = Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Euler, 1e-3)).unwrap();
+    /// assert!((sim.kinetic_energy(&body) - 0.5 * 1.0 * 9.0).abs() < 1e-12); // ½ M v², M = 1
+    /// assert!((sim.kinetic_energy(&body) - body.kinetic_energy()).abs() < 1e-12);
+    /// ```
     pub fn kinetic_energy(&self, body: &Body) -> f64 {
         let slots = self.projection.system.slots();
         self.projection.system.kinetic_energy(&body.attrs().velocity.as_slice()[..slots])
     }
 
     /// Largest distance of a live vertex from its rest position. O(vertex ids).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Integrator, Material, Simulation, StepConfig};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let sim = Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Euler, 1e-3)).unwrap();
+    /// assert_eq!(sim.max_displacement(&body), 0.0);
+    /// body.attrs_mut().position.as_mut_slice()[5] = [1.0, 0.0, 1.25]; // vertex 5 rests at (1, 0, 1)
+    /// assert_eq!(sim.max_displacement(&body), 0.25);
+    /// ```
     pub fn max_displacement(&self, body: &Body) -> f64 {
         let m = body.attrs();
         (0..self.projection.system.slots())

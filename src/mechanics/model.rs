@@ -24,7 +24,7 @@
 //! 4. **Ambient viscosity** γ_v = ν · m_v (ν in 1/s).
 //! 5. **Mass conservation**: Σ_v m_v = Σ_t m_t, after any dissociation.
 //!
-//! [`check_conservation`](super::check_conservation) verifies all five from the map's orbits.
+//! [`check_conservation`] verifies all five from the map's orbits.
 //!
 //! # Split and merge rules ([`CellRules`] for [`Mechanics`])
 //! - vertex split: both sides copy rest position, position, velocity and the pinned flag; each
@@ -45,6 +45,20 @@ use super::conservation::{check_conservation, ConservationError};
 use super::geom::{add, cross, dot, norm, scale, sub, tet_volume, Vec3};
 
 /// Material constants of a homogeneous body.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Material, ModelError};
+///
+/// let (points, tets) = kuhn_cube(1); // the unit cube
+/// let dense = Material { density: 2.5, ..Material::default() };
+/// let (body, _) = Body::from_tets(&points, &tets, dense).unwrap();
+/// assert!((body.attrs().total_tet_mass(body.map()) - 2.5).abs() < 1e-12); // ρ · volume
+/// let bad = Material { young: -1.0, ..Material::default() };
+/// assert!(matches!(Body::from_tets(&points, &tets, bad), Err(ModelError::BadMaterial { name: "young", .. })));
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Material {
     /// Mass density ρ (mass per unit volume); m_t = ρ·V_t.
@@ -138,16 +152,57 @@ pub type BodyError = crate::embedding::EmbedError<ConservationError>;
 
 impl Mechanics {
     /// The material constants. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let stiff = Material { young: 5e4, ..Material::default() };
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, stiff).unwrap();
+    /// assert_eq!(body.attrs().material(), &stiff);
+    /// ```
     pub fn material(&self) -> &Material {
         &self.material
     }
 
     /// Rest volume V_t of volume `t`. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::{Body, Material};
+    /// use topomech::CellId;
+    ///
+    /// let points = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 3.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let (body, _) = Body::from_tets(&points, &[[0, 2, 1, 3]], Material::default()).unwrap(); // inverted order
+    /// assert!((body.attrs().tet_rest_volume(CellId(0)) - 1.0).abs() < 1e-15); // |det| / 6 = 6 / 6
+    /// assert_eq!(body.attrs().tet_young(CellId(0)), Material::default().young);
+    /// ```
     pub fn tet_rest_volume(&self, t: CellId) -> f64 {
         self.tet_rest_volume[t]
     }
 
     /// Mass m_t = ρ·V_t of volume `t`. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::{Body, Material};
+    /// use topomech::{CellId, DartId};
+    ///
+    /// let unit = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let (body, _) = Body::from_tets(&unit, &[[0, 1, 2, 3]], Material::default()).unwrap();
+    /// let m = body.attrs();
+    /// assert!((m.tet_mass(CellId(0)) - 1.0 / 6.0).abs() < 1e-15); // ρ · V
+    /// assert!((0..4).all(|v| (m.vertex_mass(CellId(v)) - 1.0 / 24.0).abs() < 1e-15)); // m_t / 4
+    /// let f = body.map().cell_id(2, DartId(0));
+    /// assert!(m.face_is_boundary(f));
+    /// let n = m.face_normal(f);
+    /// assert!((n[0] * n[0] + n[1] * n[1] + n[2] * n[2] - 1.0).abs() < 1e-12);
+    /// ```
     pub fn tet_mass(&self, t: CellId) -> f64 {
         self.tet_mass[t]
     }
@@ -158,43 +213,161 @@ impl Mechanics {
     }
 
     /// Rest length L_e of edge `e`. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// // The Kuhn cube's edges: 12 sides, 6 face diagonals, 1 space diagonal.
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let (map, m) = (body.map(), body.attrs());
+    /// let edges = map.one_dart_per_cell(1);
+    /// let lengths: Vec<f64> = edges.iter().map(|&d| m.edge_rest_length(map.cell_id(1, d))).collect();
+    /// let count = |l: f64| lengths.iter().filter(|&&x| (x - l).abs() < 1e-12).count();
+    /// assert_eq!((count(1.0), count(2f64.sqrt()), count(3f64.sqrt())), (12, 6, 1));
+    /// ```
     pub fn edge_rest_length(&self, e: CellId) -> f64 {
         self.edge_rest_length[e]
     }
 
     /// Stiffness k_e of edge `e`. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// // One tet: each edge gets k = E·V/L² from its only tet.
+    /// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let (body, _) = Body::from_tets(&points, &[[0, 1, 2, 3]], Material::default()).unwrap();
+    /// let (map, m) = (body.map(), body.attrs());
+    /// for d in map.one_dart_per_cell(1) {
+    ///     let (e, young) = (map.cell_id(1, d), m.material().young);
+    ///     let l = m.edge_rest_length(e);
+    ///     assert!((m.edge_stiffness(e) - young * (1.0 / 6.0) / (l * l)).abs() < 1e-9);
+    /// }
+    /// ```
     pub fn edge_stiffness(&self, e: CellId) -> f64 {
         self.edge_stiffness[e]
     }
 
     /// Damping c_e of edge `e`. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let (map, m) = (body.map(), body.attrs());
+    /// for d in map.one_dart_per_cell(1) {
+    ///     let e = map.cell_id(1, d);
+    ///     assert_eq!(m.edge_damping(e), m.material().damping * m.edge_stiffness(e)); // c = β k
+    /// }
+    /// ```
     pub fn edge_damping(&self, e: CellId) -> f64 {
         self.edge_damping[e]
     }
 
     /// Mass m_v of vertex `v`. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    /// use topomech::CellId;
+    ///
+    /// // Corner (0, 0, 0) of the Kuhn cube touches all 6 tets; corner (1, 0, 0) only 2.
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let m = body.attrs();
+    /// assert!((m.vertex_mass(CellId(0)) - 6.0 * (1.0 / 6.0) / 4.0).abs() < 1e-15);
+    /// assert!((m.vertex_mass(CellId(1)) - 2.0 * (1.0 / 6.0) / 4.0).abs() < 1e-15);
+    /// ```
     pub fn vertex_mass(&self, v: CellId) -> f64 {
         self.vertex_mass[v]
     }
 
     /// Ambient viscosity γ_v = ν·m_v of vertex `v`. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    /// use topomech::CellId;
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let m = body.attrs();
+    /// assert!((0..8).map(CellId).all(|v| m.vertex_viscosity(v) == m.material().viscosity * m.vertex_mass(v)));
+    /// ```
     pub fn vertex_viscosity(&self, v: CellId) -> f64 {
         self.vertex_viscosity[v]
     }
 
     /// Whether face `f` is on the boundary (its darts are α3-free). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let (map, m) = (body.map(), body.attrs());
+    /// let boundary = map.one_dart_per_cell(2).into_iter().filter(|&d| m.face_is_boundary(map.cell_id(2, d))).count();
+    /// assert_eq!(boundary, 12);
+    /// ```
     pub fn face_is_boundary(&self, f: CellId) -> bool {
         self.face_boundary.get(f).copied().unwrap_or(false)
     }
 
     /// Outward unit normal of boundary face `f` at the last [`Mechanics::update_normals`] (zero
     /// for inner faces). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let (map, m) = (body.map(), body.attrs());
+    /// for d in map.one_dart_per_cell(2) {
+    ///     let (f, n) = (map.cell_id(2, d), m.face_normal(map.cell_id(2, d)));
+    ///     let axis_aligned = n.iter().filter(|c| c.abs() == 1.0).count() == 1; // outward ±x, ±y or ±z
+    ///     assert_eq!(axis_aligned, m.face_is_boundary(f)); // inner faces: zero normal
+    /// }
+    /// ```
     pub fn face_normal(&self, f: CellId) -> Vec3 {
         self.face_normal[f]
     }
 
     /// Number of attribute slots of `dim`-cells (≥ the map's `cell_id_bound(dim)` when in sync).
     /// O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::dissociate_face;
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+    /// dissociate_face(&mut body, d).unwrap(); // new vertex, edge and face ids appear
+    /// assert!((0..=3).all(|i| body.attrs().attribute_len(i) >= body.map().cell_id_bound(i)));
+    /// ```
     pub fn attribute_len(&self, dim: usize) -> usize {
         match dim {
             0 => self.vertex_mass.len().min(self.position.len()),
@@ -205,6 +378,22 @@ impl Mechanics {
     }
 
     /// Recomputes every boundary face normal from the current positions. O(darts).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let map = body.map().clone();
+    /// let faces: Vec<_> = map.one_dart_per_cell(2).into_iter().map(|d| map.cell_id(2, d)).collect();
+    /// let top = *faces.iter().find(|&&f| body.attrs().face_normal(f) == [0.0, 0.0, 1.0]).unwrap();
+    /// body.attrs_mut().position.as_mut_slice().iter_mut().for_each(|p| p[2] = -p[2]); // mirror in z
+    /// body.attrs_mut().update_normals(&map);
+    /// assert_eq!(body.attrs().face_normal(top), [0.0, 0.0, -1.0]); // the top face now faces down
+    /// ```
     pub fn update_normals(&mut self, map: &GMap<3>) {
         for d in map.one_dart_per_cell(2) {
             let f = map.cell_id(2, d);
@@ -230,16 +419,60 @@ impl Mechanics {
     }
 
     /// Total mass Σ_v m_v over the live vertices of `map`. O(darts).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(2);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let (map, m) = (body.map(), body.attrs());
+    /// // Law 1 summed over the body: each tet gives a quarter of its mass to each corner.
+    /// assert!((m.total_vertex_mass(map) - m.total_tet_mass(map)).abs() < 1e-12);
+    /// assert!((m.total_tet_mass(map) - 8.0).abs() < 1e-12); // density 1, volume 2³
+    /// ```
     pub fn total_vertex_mass(&self, map: &GMap<3>) -> f64 {
         map.one_dart_per_cell(0).into_iter().map(|d| self.vertex_mass[map.vertex_id(d)]).sum()
     }
 
     /// Total mass Σ_t m_t over the live volumes of `map`. O(darts).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::remove_volume;
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    /// use topomech::CellId;
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let gone = remove_volume(&mut body, CellId(2)).unwrap().removed_mass;
+    /// let m = body.attrs();
+    /// assert!((m.total_tet_mass(body.map()) - (1.0 - gone)).abs() < 1e-12);
+    /// assert!((m.total_vertex_mass(body.map()) - m.total_tet_mass(body.map())).abs() < 1e-12);
+    /// ```
     pub fn total_tet_mass(&self, map: &GMap<3>) -> f64 {
         map.one_dart_per_cell(3).into_iter().map(|d| self.tet_mass[map.cell_id(3, d)]).sum()
     }
 
     /// Law 1 at the vertex of `d`: Σ m_t/4 over the distinct volumes of its orbit. O(vertex).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let (map, m) = (body.map(), body.attrs());
+    /// for d in map.darts() {
+    ///     assert!((m.vertex_mass_from_map(map, d) - m.vertex_mass(map.vertex_id(d))).abs() < 1e-15);
+    /// }
+    /// ```
     pub fn vertex_mass_from_map(&self, map: &GMap<3>, d: DartId) -> f64 {
         let tets = distinct(map.cell_darts(0, d).into_iter().map(|x| map.cell_id(3, x)));
         tets.iter().map(|&t| self.tet_mass[t] / 4.0).sum()
@@ -247,6 +480,21 @@ impl Mechanics {
 
     /// Law 2 at the edge of `d`: Σ E_t·V_t/L_e² over the distinct volumes of its orbit, with L_e
     /// the edge's stored rest length. O(edge).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let (map, m) = (body.map(), body.attrs());
+    /// for d in map.one_dart_per_cell(1) {
+    ///     let stored = m.edge_stiffness(map.cell_id(1, d));
+    ///     assert!(stored > 0.0 && (m.edge_stiffness_from_map(map, d) - stored).abs() <= 1e-12 * stored);
+    /// }
+    /// ```
     pub fn edge_stiffness_from_map(&self, map: &GMap<3>, d: DartId) -> f64 {
         let l = self.edge_rest_length[map.cell_id(1, d)];
         let tets = distinct(map.cell_darts(1, d).into_iter().map(|x| map.cell_id(3, x)));
@@ -268,6 +516,18 @@ impl Mechanics {
     }
 
     /// Re-applies the pin set from a predicate on rest positions: `pin(v, rest)`. O(vertex ids).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// body.attrs_mut().pin_where(|_, rest| rest[2] == 0.0); // the bottom face
+    /// assert_eq!(body.attrs().pinned.as_slice().iter().filter(|&&p| p).count(), 4);
+    /// ```
     pub fn pin_where(&mut self, mut pin: impl FnMut(CellId, Vec3) -> bool) {
         for (i, (p, r)) in self.pinned.as_mut_slice().iter_mut().zip(self.rest_position.as_slice()).enumerate() {
             *p = pin(CellId(i as u32), *r);
@@ -296,6 +556,16 @@ impl Mechanics {
 }
 
 /// Law 2's per-tet term: k_{t,e} = E·|V|/L², zero for a zero-length edge. O(1).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mechanics::model::stiffness_contribution;
+///
+/// assert_eq!(stiffness_contribution(1000.0, 0.5, 2.0), 125.0); // E·V/L²
+/// assert_eq!(stiffness_contribution(1000.0, -0.5, 2.0), 125.0); // |V|
+/// assert_eq!(stiffness_contribution(1000.0, 0.5, 0.0), 0.0); // a zero-length edge carries nothing
+/// ```
 pub fn stiffness_contribution(young: f64, volume: f64, rest_length: f64) -> f64 {
     if rest_length > 0.0 {
         young * volume.abs() / (rest_length * rest_length)
@@ -446,6 +716,22 @@ impl Embedded<3, Mechanics> {
     ///
     /// # Errors
     /// [`ModelError`]: bad material, non-finite point, zero-volume tet, or a build error.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{check_conservation, Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, report) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// assert_eq!(body.map().count_cells().0, vec![8, 19, 18, 6]);
+    /// assert!(report.pinched_vertices.is_empty());
+    /// let m = body.attrs();
+    /// assert_eq!(m.rest_position.as_slice(), &points[..]); // vertex id = point index
+    /// assert_eq!(m.position.as_slice(), m.rest_position.as_slice()); // at rest
+    /// check_conservation(body.map(), m).unwrap();
+    /// ```
     pub fn from_tets(
         points: &[Vec3],
         tets: &[[u32; 4]],
@@ -486,6 +772,22 @@ impl Embedded<3, Mechanics> {
     /// # Errors
     /// [`BodyError::Sew`] if `d` is 3-free or not a dart; [`BodyError::Check`] under
     /// `expensive-checks` if a conservation law broke (a bug).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{check_conservation, Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+    /// let mass = body.attrs().total_vertex_mass(body.map());
+    /// body.unsew3(d).unwrap();
+    /// assert!(body.map().is_free(3, d));
+    /// assert!((body.attrs().total_vertex_mass(body.map()) - mass).abs() < 1e-12); // m = m1 + m2
+    /// check_conservation(body.map(), body.attrs()).unwrap();
+    /// ```
     pub fn unsew3(&mut self, d: DartId) -> Result<CellChanges, BodyError> {
         self.unsew(3, d)
     }
@@ -495,11 +797,42 @@ impl Embedded<3, Mechanics> {
     ///
     /// # Errors
     /// As [`Body::unsew3`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{check_conservation, Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let cells = body.map().count_cells();
+    /// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+    /// let e = body.map().alpha::<3>(d);
+    /// body.unsew3(d).unwrap();
+    /// body.sew3(d, e).unwrap();
+    /// assert_eq!(body.map().count_cells(), cells);
+    /// check_conservation(body.map(), body.attrs()).unwrap();
+    /// ```
     pub fn sew3(&mut self, d1: DartId, d2: DartId) -> Result<CellChanges, BodyError> {
         self.sew(3, d1, d2)
     }
 
     /// Total kinetic energy ½ Σ m_v |v_v|² over live vertices. O(darts).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// assert_eq!(body.kinetic_energy(), 0.0); // at rest
+    /// body.attrs_mut().velocity.as_mut_slice().fill([2.0, 0.0, 0.0]);
+    /// let mass = body.attrs().total_vertex_mass(body.map());
+    /// assert!((body.kinetic_energy() - 0.5 * mass * 4.0).abs() < 1e-12); // ½ m v²
+    /// ```
     pub fn kinetic_energy(&self) -> f64 {
         let m = self.attrs();
         let live = self.map().one_dart_per_cell(0);
@@ -549,6 +882,17 @@ impl Mechanics {
     }
 
     /// Marks the live vertex ids of `map`: `live[v]` is true iff vertex id v has darts. O(capacity).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::{Body, Material, Mechanics};
+    ///
+    /// // Point 4 is used by no tet: its vertex id is free.
+    /// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [7.0; 3]];
+    /// let (body, _) = Body::from_tets(&points, &[[0, 1, 2, 3]], Material::default()).unwrap();
+    /// assert_eq!(Mechanics::live_vertices(body.map()), vec![true, true, true, true, false]);
+    /// ```
     pub fn live_vertices(map: &GMap<3>) -> Vec<bool> {
         let mut live = vec![false; map.cell_id_bound(0)];
         for d in map.darts() {

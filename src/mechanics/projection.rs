@@ -56,6 +56,22 @@ pub struct Projection {
 
 impl Projection {
     /// Projects `body` with gravity `gravity`. O(darts + E log E).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, Projection};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let p = Projection::build(&body, [0.0, 0.0, -9.81]);
+    /// assert_eq!((p.system.slots(), p.system.springs()), (8, 19));
+    /// for s in 0..p.system.springs() {
+    ///     assert_eq!(p.spring_of_edge(p.edge_of_spring(s)), Some(s));
+    /// }
+    /// assert!(p.is_current(&body));
+    /// ```
     pub fn build(body: &Body, gravity: Vec3) -> Self {
         let map = body.map();
         let mech = body.attrs();
@@ -84,16 +100,64 @@ impl Projection {
     }
 
     /// Rebuilds from scratch after topological changes (keeps the gravity). O(darts + E log E).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::remove_volume;
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, Projection};
+    /// use topomech::CellId;
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let mut p = Projection::build(&body, [0.0; 3]);
+    /// remove_volume(&mut body, CellId(0)).unwrap();
+    /// assert!(!p.is_current(&body));
+    /// p.rebuild(&body);
+    /// assert_eq!((p.version(), p.system.springs()), (body.version(), body.map().count_cells().0[1]));
+    /// ```
     pub fn rebuild(&mut self, body: &Body) {
         *self = Projection::build(body, self.system.gravity);
     }
 
     /// Whether the body has not changed topologically since the projection was built. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::dissociate_face;
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, Projection};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let mut p = Projection::build(&body, [0.0; 3]);
+    /// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+    /// let cut = dissociate_face(&mut body, d).unwrap();
+    /// assert!(!p.is_current(&body) && !cut.touched.is_empty());
+    /// p.update(&body, &cut.touched);
+    /// assert!(p.is_current(&body));
+    /// ```
     pub fn is_current(&self, body: &Body) -> bool {
         self.version == body.version()
     }
 
     /// The body version the projection was built from. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, Projection};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+    /// body.unsew3(d).unwrap();
+    /// let p = Projection::build(&body, [0.0; 3]);
+    /// assert_eq!((p.version(), body.version()), (1, 1));
+    /// ```
     pub fn version(&self) -> u64 {
         self.version
     }
@@ -103,6 +167,23 @@ impl Projection {
     /// [`Projection::build`] of `body` and [`Projection::is_current`] holds.
     /// Cost: O(touched cells · degree + new ids) amortised (see [`SpringSystem`]'s incidence
     /// lists); nothing proportional to the mesh.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::{incise_plane, Plane};
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, Projection};
+    ///
+    /// let (points, tets) = kuhn_cube(2);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let mut p = Projection::build(&body, [0.0, 0.0, -9.81]);
+    /// let cut = incise_plane(&mut body, &Plane { point: [1.0; 3], normal: [1.0, 0.0, 0.0] }).unwrap();
+    /// p.update(&body, &cut.touched);
+    /// assert!(p.is_current(&body));
+    /// assert!(p.equivalent(&Projection::build(&body, [0.0, 0.0, -9.81])).is_ok());
+    /// assert_eq!(p.system.slots(), body.map().cell_id_bound(0)); // new vertex ids got slots
+    /// ```
     pub fn update(&mut self, body: &Body, touched: &TouchedCells) {
         let map = body.map();
         let mech = body.attrs();
@@ -169,6 +250,19 @@ impl Projection {
     ///
     /// # Errors
     /// The first [`ProjectionMismatch`] found.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, Projection};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let a = Projection::build(&body, [0.0; 3]);
+    /// assert!(a.equivalent(&Projection::build(&body, [0.0; 3])).is_ok());
+    /// assert!(a.equivalent(&Projection::build(&body, [0.0, 0.0, -1.0])).is_err()); // other gravity
+    /// ```
     pub fn equivalent(&self, other: &Projection) -> Result<(), ProjectionMismatch> {
         let (a, b) = (&self.system, &other.system);
         a.check_incidence().map_err(ProjectionMismatch::Incidence)?;
@@ -206,17 +300,70 @@ impl Projection {
         self.spring_edge[s]
     }
 
-    /// A dart of spring s's edge; its vertex is end a. O(1).
+    /// A dart of spring s's edge; its vertex is one of the spring's two ends (either one: ends are
+    /// stored as `[lo, hi]`). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, Projection};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let p = Projection::build(&body, [0.0; 3]);
+    /// let map = body.map();
+    /// for s in 0..p.system.springs() {
+    ///     let d = p.dart_of_spring(s);
+    ///     assert_eq!(map.cell_id(1, d), p.edge_of_spring(s));
+    ///     let [a, b] = p.system.ends[s];
+    ///     assert!(a < b && [a, b].contains(&map.vertex_id(d).0));
+    ///     assert_eq!(map.vertex_id(map.alpha::<0>(d)).0, a + b - map.vertex_id(d).0); // α0: the other end
+    /// }
+    /// ```
     pub fn dart_of_spring(&self, s: usize) -> DartId {
         self.spring_dart[s]
     }
 
     /// The spring of edge `e`, if `e` is live. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::remove_volume;
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, Projection};
+    /// use topomech::CellId;
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// remove_volume(&mut body, CellId(0)).unwrap(); // edge (1,0,0)–(1,1,0) was only in tet 0
+    /// let (p, map) = (Projection::build(&body, [0.0; 3]), body.map());
+    /// let live: Vec<CellId> = map.one_dart_per_cell(1).iter().map(|&d| map.cell_id(1, d)).collect();
+    /// assert!(live.iter().all(|&e| p.spring_of_edge(e).is_some()) && p.system.springs() == live.len());
+    /// let dead: Vec<CellId> = (0..map.cell_id_bound(1) as u32).map(CellId).filter(|e| !live.contains(e)).collect();
+    /// assert!(!dead.is_empty() && dead.iter().all(|&e| p.spring_of_edge(e).is_none()));
+    /// ```
     pub fn spring_of_edge(&self, e: CellId) -> Option<usize> {
         self.edge_spring.get(e.index()).filter(|&&s| s != u32::MAX).map(|&s| s as usize)
     }
 
     /// A dart of the vertex in slot `slot` (= vertex id), `None` for a dead id. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, Projection};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let p = Projection::build(&body, [0.0; 3]);
+    /// for slot in 0..p.system.slots() {
+    ///     assert_eq!(body.map().vertex_id(p.dart_of_vertex(slot).unwrap()).index(), slot); // slot = vertex id
+    /// }
+    /// assert_eq!(p.dart_of_vertex(99), None);
+    /// ```
     pub fn dart_of_vertex(&self, slot: usize) -> Option<DartId> {
         self.vertex_dart.get(slot).copied().flatten()
     }
@@ -267,6 +414,22 @@ impl TouchedCells {
     /// every split, the survivor and the absorbed id of every merge, and every edge around a
     /// vertex that got a new id (its spring's ends changed). O(changes + stars of renamed
     /// vertices).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, TouchedCells};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+    /// let changes = body.unsew3(d).unwrap();
+    /// let mut touched = TouchedCells::default();
+    /// assert!(touched.is_empty());
+    /// touched.record(body.map(), &changes);
+    /// assert!(!touched.is_empty() && !touched.vertices.is_empty());
+    /// ```
     pub fn record(&mut self, map: &GMap<3>, changes: &CellChanges) {
         for (kept, new, dk, dn) in changes.splits(0) {
             self.vertices.push((kept, Some(dk)));
@@ -301,6 +464,25 @@ impl TouchedCells {
     }
 
     /// Appends the records of `other` (a later operation of the same batch). O(|other|).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::dissociate_face;
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, TouchedCells};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let mut batch = TouchedCells::default();
+    /// for _ in 0..2 {
+    ///     let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+    ///     let cut = dissociate_face(&mut body, d).unwrap();
+    ///     let n = batch.vertices.len() + cut.touched.vertices.len();
+    ///     batch.extend(cut.touched);
+    ///     assert_eq!(batch.vertices.len(), n);
+    /// }
+    /// ```
     pub fn extend(&mut self, other: TouchedCells) {
         self.vertices.extend(other.vertices);
         self.edges.extend(other.edges);
@@ -350,6 +532,21 @@ fn system_of(
 /// each edge orbit is covered once with a dart set, its spring taken between the vertices of b
 /// and α0(b); then each vertex gets gravity and viscosity. Pinned vertices get their force too.
 /// Dead ids get zero. O(darts).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{forces_by_coverage, Body, Material};
+///
+/// // At rest the springs pull nothing: the forces add up to the weight.
+/// let (points, tets) = kuhn_cube(1);
+/// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let f = forces_by_coverage(&body, [0.0, 0.0, -9.81]);
+/// let total_z: f64 = f.iter().map(|f| f[2]).sum();
+/// assert!((total_z + 9.81 * body.attrs().total_vertex_mass(body.map())).abs() < 1e-12);
+/// assert!(f.iter().all(|f| f[0] == 0.0 && f[1] == 0.0));
+/// ```
 pub fn forces_by_coverage(body: &Body, gravity: Vec3) -> Vec<Vec3> {
     let map = body.map();
     let mech = body.attrs();

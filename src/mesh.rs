@@ -341,6 +341,55 @@ fn unreferenced<const N: usize>(point_count: usize, cells: &[[u32; N]]) -> Vec<u
 }
 
 impl TetMesh {
+    /// The same mesh renumbered along a Z-order (Morton) space-filling curve: points sorted by the
+    /// Morton code of their position (21 bits per axis over the bounding box, ties by old
+    /// index), tets relabelled and sorted by the code of their centroid, file triangles relabelled.
+    /// Neighbouring points and tets then get nearby numbers, so the maps, cell ids, springs and
+    /// state arrays built from it are walked with far fewer cache misses on large meshes.
+    /// Returns the new mesh and `new_of_old` (point i of `self` is point `new_of_old[i]`).
+    /// O(P log P + T log T). Non-finite coordinates sort last (`check` refuses them anyway).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mesh::TetMesh;
+    ///
+    /// let points = vec![[1.0, 1.0, 1.0], [0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    /// let mesh = TetMesh { points, tets: vec![[0, 1, 2, 3]], ..Default::default() };
+    /// let (ordered, new_of_old) = mesh.spatially_ordered();
+    /// assert_eq!(new_of_old, vec![3, 0, 1, 2]); // the origin first, (1, 1, 1) last
+    /// assert_eq!(ordered.points[0], [0.0, 0.0, 0.0]);
+    /// assert_eq!(ordered.tets, vec![[3, 0, 1, 2]]);
+    /// ```
+    pub fn spatially_ordered(&self) -> (TetMesh, Vec<u32>) {
+        let (lo, hi) = bounding_box(&self.points);
+        let code = |p: [f64; 3]| morton_code(p, lo, hi);
+        let mut order: Vec<u32> = (0..self.points.len() as u32).collect();
+        order.sort_by_key(|&i| (code(self.points[i as usize]), i));
+        let mut new_of_old = vec![0u32; self.points.len()];
+        for (new, &old) in order.iter().enumerate() {
+            new_of_old[old as usize] = new as u32;
+        }
+        let points: Vec<[f64; 3]> = order.iter().map(|&i| self.points[i as usize]).collect();
+        let relabel = |v: u32| new_of_old.get(v as usize).copied().unwrap_or(v);
+        let mut tets: Vec<[u32; 4]> = self.tets.iter().map(|t| t.map(relabel)).collect();
+        let centroid = |t: &[u32; 4]| {
+            let c = t
+                .iter()
+                .filter_map(|&v| points.get(v as usize))
+                .fold([0.0; 3], |a, p| [a[0] + p[0] / 4.0, a[1] + p[1] / 4.0, a[2] + p[2] / 4.0]);
+            code(c)
+        };
+        tets.sort_by_cached_key(|t| (centroid(t), *t));
+        let boundary_triangles = self.boundary_triangles.iter().map(|t| t.map(relabel)).collect();
+        let node_tags = if self.node_tags.len() == self.points.len() {
+            order.iter().map(|&i| self.node_tags[i as usize]).collect()
+        } else {
+            self.node_tags.clone()
+        };
+        (TetMesh { points, tets, boundary_triangles, node_tags }, new_of_old)
+    }
+
     /// Checks the mesh: `Err` for a defect that makes it unusable, otherwise the list of
     /// warnings. See the table in the [module docs](self) for what is which.
     ///
@@ -773,4 +822,37 @@ mod tests {
         m.triangles.push([0, 0, 3]);
         assert!(m.check().unwrap_err().to_string().contains("repeated vertex"));
     }
+}
+
+/// The axis-aligned bounding box of the finite points ((0,0,0), (0,0,0) when there is none). O(P).
+fn bounding_box(points: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
+    let finite = points.iter().filter(|p| p.iter().all(|c| c.is_finite()));
+    let (lo, hi) = finite.fold(([f64::MAX; 3], [f64::MIN; 3]), |(lo, hi), p| {
+        ([lo[0].min(p[0]), lo[1].min(p[1]), lo[2].min(p[2])], [hi[0].max(p[0]), hi[1].max(p[1]), hi[2].max(p[2])])
+    });
+    if lo[0] > hi[0] {
+        ([0.0; 3], [0.0; 3])
+    } else {
+        (lo, hi)
+    }
+}
+
+/// The 63-bit Morton code of `p` in the box [lo, hi]: 21 bits per axis, interleaved x, y, z from
+/// the most significant bit. Non-finite points get `u64::MAX`. O(1).
+fn morton_code(p: [f64; 3], lo: [f64; 3], hi: [f64; 3]) -> u64 {
+    if p.iter().any(|c| !c.is_finite()) {
+        return u64::MAX;
+    }
+    const CELLS: f64 = ((1u32 << 21) - 1) as f64;
+    let q = |k: usize| {
+        let extent = hi[k] - lo[k];
+        let t = if extent > 0.0 { ((p[k] - lo[k]) / extent).clamp(0.0, 1.0) } else { 0.0 };
+        (t * CELLS) as u64
+    };
+    let (x, y, z) = (q(0), q(1), q(2));
+    let mut code = 0u64;
+    for bit in (0..21).rev() {
+        code = (code << 3) | (((x >> bit) & 1) << 2) | (((y >> bit) & 1) << 1) | ((z >> bit) & 1);
+    }
+    code
 }

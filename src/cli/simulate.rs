@@ -47,6 +47,10 @@ pub struct SimulateArgs {
     /// Ambient viscosity per unit mass ν in 1/s (γ = ν·m).
     #[arg(long, default_value_t = Material::default().viscosity)]
     pub viscosity: f64,
+    /// Renumber points and tets along a Z-order curve before building (faster on large meshes:
+    /// fewer cache misses). `--pin` ids still name the points of the file; frames use the new order.
+    #[arg(long)]
+    pub spatial_order: bool,
     /// Worker threads (1 = serial; more splits the force passes, same results bit for bit).
     #[arg(long, default_value_t = 1)]
     pub threads: usize,
@@ -121,8 +125,15 @@ fn simulate(args: &SimulateArgs, parallel: bool) -> Result<(), CliError> {
     print_warnings(&loaded);
     let material =
         Material { density: args.density, young: args.young, damping: args.damping, viscosity: args.viscosity };
-    let (mut body, _) = Body::from_tets(&loaded.mesh.points, &loaded.mesh.tets, material).map_err(other)?;
-    let pins = PinSpec { ids: args.pin.clone(), below: args.pin_below, inside: None };
+    let (mesh, pin_ids) = if args.spatial_order {
+        let (mesh, new_of_old) = loaded.mesh.spatially_ordered();
+        let ids = args.pin.iter().map(|&v| new_of_old.get(v as usize).copied().unwrap_or(v)).collect();
+        (mesh, ids)
+    } else {
+        (loaded.mesh, args.pin.clone())
+    };
+    let (mut body, _) = Body::from_tets(&mesh.points, &mesh.tets, material).map_err(other)?;
+    let pins = PinSpec { ids: pin_ids, below: args.pin_below, inside: None };
     body.attrs_mut().pin_where(|id, p| pins.pins(id, p));
     let mut config = StepConfig::new(args.integrator, args.dt);
     config.parallel = parallel;

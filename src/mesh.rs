@@ -725,6 +725,39 @@ impl TriMesh {
     }
 }
 
+/// The axis-aligned bounding box of the finite points ((0,0,0), (0,0,0) when there is none). O(P).
+fn bounding_box(points: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
+    let finite = points.iter().filter(|p| p.iter().all(|c| c.is_finite()));
+    let (lo, hi) = finite.fold(([f64::MAX; 3], [f64::MIN; 3]), |(lo, hi), p| {
+        ([lo[0].min(p[0]), lo[1].min(p[1]), lo[2].min(p[2])], [hi[0].max(p[0]), hi[1].max(p[1]), hi[2].max(p[2])])
+    });
+    if lo[0] > hi[0] {
+        ([0.0; 3], [0.0; 3])
+    } else {
+        (lo, hi)
+    }
+}
+
+/// The 63-bit Morton code of `p` in the box [lo, hi]: 21 bits per axis, interleaved x, y, z from
+/// the most significant bit. Non-finite points get `u64::MAX`. O(1).
+fn morton_code(p: [f64; 3], lo: [f64; 3], hi: [f64; 3]) -> u64 {
+    if p.iter().any(|c| !c.is_finite()) {
+        return u64::MAX;
+    }
+    const CELLS: f64 = ((1u32 << 21) - 1) as f64;
+    let q = |k: usize| {
+        let extent = hi[k] - lo[k];
+        let t = if extent > 0.0 { ((p[k] - lo[k]) / extent).clamp(0.0, 1.0) } else { 0.0 };
+        (t * CELLS) as u64
+    };
+    let (x, y, z) = (q(0), q(1), q(2));
+    let mut code = 0u64;
+    for bit in (0..21).rev() {
+        code = (code << 3) | (((x >> bit) & 1) << 2) | (((y >> bit) & 1) << 1) | ((z >> bit) & 1);
+    }
+    code
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -822,37 +855,4 @@ mod tests {
         m.triangles.push([0, 0, 3]);
         assert!(m.check().unwrap_err().to_string().contains("repeated vertex"));
     }
-}
-
-/// The axis-aligned bounding box of the finite points ((0,0,0), (0,0,0) when there is none). O(P).
-fn bounding_box(points: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
-    let finite = points.iter().filter(|p| p.iter().all(|c| c.is_finite()));
-    let (lo, hi) = finite.fold(([f64::MAX; 3], [f64::MIN; 3]), |(lo, hi), p| {
-        ([lo[0].min(p[0]), lo[1].min(p[1]), lo[2].min(p[2])], [hi[0].max(p[0]), hi[1].max(p[1]), hi[2].max(p[2])])
-    });
-    if lo[0] > hi[0] {
-        ([0.0; 3], [0.0; 3])
-    } else {
-        (lo, hi)
-    }
-}
-
-/// The 63-bit Morton code of `p` in the box [lo, hi]: 21 bits per axis, interleaved x, y, z from
-/// the most significant bit. Non-finite points get `u64::MAX`. O(1).
-fn morton_code(p: [f64; 3], lo: [f64; 3], hi: [f64; 3]) -> u64 {
-    if p.iter().any(|c| !c.is_finite()) {
-        return u64::MAX;
-    }
-    const CELLS: f64 = ((1u32 << 21) - 1) as f64;
-    let q = |k: usize| {
-        let extent = hi[k] - lo[k];
-        let t = if extent > 0.0 { ((p[k] - lo[k]) / extent).clamp(0.0, 1.0) } else { 0.0 };
-        (t * CELLS) as u64
-    };
-    let (x, y, z) = (q(0), q(1), q(2));
-    let mut code = 0u64;
-    for bit in (0..21).rev() {
-        code = (code << 3) | (((x >> bit) & 1) << 2) | (((y >> bit) & 1) << 1) | ((z >> bit) & 1);
-    }
-    code
 }

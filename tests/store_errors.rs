@@ -267,3 +267,27 @@ fn set_mode(p: &std::path::Path, mode: u32) {
 
 #[cfg(not(unix))]
 fn set_mode(_: &std::path::Path, _: u32) {}
+
+/// `check` lists every broken conservation law of a body, not only the first, each naming its
+/// cell: two tampered edge stiffnesses give four findings (stiffness and damping of each), and
+/// the listing stops at the limit with `truncated` set.
+#[test]
+fn every_broken_conservation_law_is_listed() {
+    let body = small_body();
+    let clean = store::check_all_laws(&Document::from_body(&body), 100);
+    assert!(clean.valid && clean.findings.is_empty(), "{:?}", clean.findings);
+    let mut doc = Document::from_body(&body);
+    let edges = &mut doc.mechanics.as_mut().expect("a body").edges;
+    edges[0][1] *= 2.0; // [rest length, stiffness, damping]
+    edges[3][1] *= 3.0;
+    let report = store::check_all_laws(&doc, 100);
+    assert!(!report.valid);
+    let edges: Vec<String> = report.findings.iter().map(|f| f.to_string()).collect();
+    assert_eq!(edges.len(), 4, "{edges:?}");
+    assert!(edges.iter().all(|f| f.starts_with("conservation: edge ")), "{edges:?}");
+    assert_eq!(edges.iter().filter(|f| f.contains("stiffness")).count(), 2, "{edges:?}");
+    assert!(edges[0].contains("edge cell 0 (e.g. dart 0)") && edges[2].contains("edge cell 3"), "{edges:?}");
+    let short = store::check_all_laws(&doc, 2);
+    assert_eq!(short.findings.len(), 2);
+    assert!(short.truncated && !short.valid);
+}

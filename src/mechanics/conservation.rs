@@ -141,15 +141,45 @@ struct Expected {
 /// assert_eq!(check_conservation(body.map(), body.attrs()), Ok(())); // the laws hold after the cut too
 /// ```
 pub fn check_conservation(map: &GMap<3>, mech: &Mechanics) -> Result<(), ConservationError> {
+    match conservation_violations(map, mech, 1).into_iter().next() {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}
+
+/// Every violation [`check_conservation`] would find, in the same order (tets while covering the
+/// volumes, then vertices, then edges, then the totals), at most `limit` of them: what
+/// `topomech check` lists. Its first element is exactly the error of [`check_conservation`].
+/// O(darts · log) time, O(cell ids) memory.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{conservation_violations, Body, Material};
+/// use topomech::CellId;
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// assert!(conservation_violations(body.map(), body.attrs(), usize::MAX).is_empty());
+/// // Moving a rest position breaks the rest length (and the stiffness) of every edge at vertex 0.
+/// body.attrs_mut().rest_position[CellId(0)][0] += 0.1;
+/// let all = conservation_violations(body.map(), body.attrs(), usize::MAX);
+/// assert!(all.len() > 3, "{all:?}");
+/// assert_eq!(conservation_violations(body.map(), body.attrs(), 3), all[..3].to_vec());
+/// ```
+pub fn conservation_violations(map: &GMap<3>, mech: &Mechanics, limit: usize) -> Vec<ConservationError> {
+    let mut sink = Sink { out: Vec::new(), limit };
     for dim in 0..=3 {
         let (len, bound) = (mech.attribute_len(dim), map.cell_id_bound(dim));
         if len < bound {
-            return Err(ConservationError::MissingAttributes { dim, len, bound });
+            sink.push(ConservationError::MissingAttributes { dim, len, bound });
+            return sink.out;
         }
     }
-    let exp = scatter_from_volumes(map, mech)?;
-    check_vertices(mech, &exp)?;
-    check_edges(mech, &exp)?;
+    let exp = scatter_from_volumes(map, mech, &mut sink);
+    check_vertices(mech, &exp, &mut sink);
+    check_edges(mech, &exp, &mut sink);
     let vertices: f64 = exp
         .vertex_dart
         .iter()
@@ -158,12 +188,30 @@ pub fn check_conservation(map: &GMap<3>, mech: &Mechanics) -> Result<(), Conserv
         .map(|(v, _)| mech.vertex_mass(CellId(v as u32)))
         .sum();
     if !close(vertices, exp.tet_mass_total, TOLERANCE) {
-        return Err(ConservationError::TotalMass { vertices, tets: exp.tet_mass_total });
+        sink.push(ConservationError::TotalMass { vertices, tets: exp.tet_mass_total });
     }
-    Ok(())
+    sink.out
 }
 
-fn scatter_from_volumes(map: &GMap<3>, mech: &Mechanics) -> Result<Expected, ConservationError> {
+/// The violations found so far, up to a limit.
+struct Sink {
+    out: Vec<ConservationError>,
+    limit: usize,
+}
+
+impl Sink {
+    fn push(&mut self, e: ConservationError) {
+        if self.out.len() < self.limit {
+            self.out.push(e);
+        }
+    }
+
+    fn full(&self) -> bool {
+        self.out.len() >= self.limit
+    }
+}
+
+fn scatter_from_volumes(map: &GMap<3>, mech: &Mechanics, sink: &mut Sink) -> Expected {
     let mut exp = Expected {
         vertex_mass: vec![0.0; map.cell_id_bound(0)],
         vertex_dart: vec![None; map.cell_id_bound(0)],
@@ -181,18 +229,18 @@ fn scatter_from_volumes(map: &GMap<3>, mech: &Mechanics) -> Result<Expected, Con
         for &x in &volume {
             seen.insert(x);
         }
-        scatter_one(map, mech, &volume, &mut exp)?;
+        scatter_one(map, mech, &volume, &mut exp, sink);
     }
-    Ok(exp)
+    exp
 }
 
 /// Adds the contributions of the tet made of `darts` (one volume orbit).
-fn scatter_one(map: &GMap<3>, mech: &Mechanics, darts: &[DartId], exp: &mut Expected) -> Result<(), ConservationError> {
+fn scatter_one(map: &GMap<3>, mech: &Mechanics, darts: &[DartId], exp: &mut Expected, sink: &mut Sink) {
     let t = map.cell_id(3, darts[0]);
     let (mass, volume, young) = (mech.tet_mass(t), mech.tet_rest_volume(t), mech.tet_young(t));
     let expected = mech.material().density * volume;
     if !close(mass, expected, TOLERANCE) {
-        return Err(ConservationError::TetMass { tet: t, stored: mass, expected });
+        sink.push(ConservationError::TetMass { tet: t, stored: mass, expected });
     }
     exp.tet_mass_total += mass;
     for v in distinct(darts.iter().map(|&x| map.vertex_id(x))) {
@@ -208,43 +256,46 @@ fn scatter_one(map: &GMap<3>, mech: &Mechanics, darts: &[DartId], exp: &mut Expe
         exp.edge_dart[e.index()] = Some(x);
         exp.edge_length[e.index()] = length;
     }
-    Ok(())
 }
 
-fn check_vertices(mech: &Mechanics, exp: &Expected) -> Result<(), ConservationError> {
+fn check_vertices(mech: &Mechanics, exp: &Expected, sink: &mut Sink) {
     let nu = mech.material().viscosity;
     for (v, dart) in exp.vertex_dart.iter().enumerate() {
         let Some(dart) = *dart else { continue };
+        if sink.full() {
+            return;
+        }
         let vertex = CellId(v as u32);
         let (stored, expected) = (mech.vertex_mass(vertex), exp.vertex_mass[v]);
         if !close(stored, expected, TOLERANCE) {
-            return Err(ConservationError::VertexMass { vertex, dart, stored, expected });
+            sink.push(ConservationError::VertexMass { vertex, dart, stored, expected });
         }
         let (stored, expected) = (mech.vertex_viscosity(vertex), nu * mech.vertex_mass(vertex));
         if !close(stored, expected, TOLERANCE) {
-            return Err(ConservationError::VertexViscosity { vertex, stored, expected });
+            sink.push(ConservationError::VertexViscosity { vertex, stored, expected });
         }
     }
-    Ok(())
 }
 
-fn check_edges(mech: &Mechanics, exp: &Expected) -> Result<(), ConservationError> {
+fn check_edges(mech: &Mechanics, exp: &Expected, sink: &mut Sink) {
     let beta = mech.material().damping;
     for (e, dart) in exp.edge_dart.iter().enumerate() {
         let Some(dart) = *dart else { continue };
+        if sink.full() {
+            return;
+        }
         let edge = CellId(e as u32);
         let (stored, expected) = (mech.edge_rest_length(edge), exp.edge_length[e]);
         if !close(stored, expected, TOLERANCE) {
-            return Err(ConservationError::RestLength { edge, dart, stored, expected });
+            sink.push(ConservationError::RestLength { edge, dart, stored, expected });
         }
         let (stored, expected) = (mech.edge_stiffness(edge), exp.edge_stiffness[e]);
         if !close(stored, expected, TOLERANCE) {
-            return Err(ConservationError::EdgeStiffness { edge, dart, stored, expected });
+            sink.push(ConservationError::EdgeStiffness { edge, dart, stored, expected });
         }
         let (stored, expected) = (mech.edge_damping(edge), beta * mech.edge_stiffness(edge));
         if !close(stored, expected, TOLERANCE) {
-            return Err(ConservationError::EdgeDamping { edge, stored, expected });
+            sink.push(ConservationError::EdgeDamping { edge, stored, expected });
         }
     }
-    Ok(())
 }

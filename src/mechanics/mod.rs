@@ -21,7 +21,7 @@ pub mod integrate;
 pub mod model;
 pub mod projection;
 
-pub use conservation::{check_conservation, ConservationError};
+pub use conservation::{check_conservation, conservation_violations, ConservationError};
 pub use flat::FlatModel;
 pub use force::{IncidenceError, SpringSystem};
 pub use geom::Vec3;

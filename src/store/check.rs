@@ -78,7 +78,10 @@ pub fn check_all_laws(doc: &Document, limit: usize) -> CheckReport {
     if map_valid {
         if let (Some(mech), 3) = (&doc.mechanics, raw.dimension) {
             if let Ok(map) = raw.to_gmap_raw::<3>() {
-                if let Err(e) = crate::mechanics::check_conservation(&map, &mech.to_mechanics()) {
+                // Every conservation violation, not only the first (one more than the room left, so
+                // the collector sees the listing is truncated).
+                let room = limit.saturating_sub(out.findings.len()).saturating_add(1);
+                for e in crate::mechanics::conservation_violations(&map, &mech.to_mechanics(), room) {
                     valid = false;
                     out.push(Finding::Conservation(e));
                 }

@@ -63,10 +63,9 @@ pub struct CheckReport {
 /// # Examples
 ///
 /// ```
-/// # use topomech::store::{self, Document, Format};
+/// # use topomech::store::{check_all_laws, Document};
 /// # use topomech::GMap;
 /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
-/// # use topomech::store::check_all_laws;
 /// let mut doc = Document::from_map(&map);
 /// assert!(check_all_laws(&doc, 10).valid);
 /// doc.map.alpha[0] = doc.map.alpha[1]; // α0(0) := α1(0): α0 is no longer an involution

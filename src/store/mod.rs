@@ -268,7 +268,7 @@ impl Document {
     /// # Examples
     ///
     /// ```
-    /// # use topomech::store::{self, Document, Format};
+    /// # use topomech::store::Document;
     /// # use topomech::GMap;
     /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
     /// let doc = Document::from_map(&map);
@@ -285,7 +285,7 @@ impl Document {
     /// # Examples
     ///
     /// ```
-    /// # use topomech::store::{self, Document, Format};
+    /// # use topomech::store::Document;
     /// # use topomech::{subdivide::LeveledMap, GMap};
     /// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
     /// let mut m = LeveledMap::new(map, vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
@@ -312,7 +312,7 @@ impl Document {
     /// # Examples
     ///
     /// ```
-    /// # use topomech::store::{self, Document, Format};
+    /// # use topomech::store::{self, Document};
     /// # use topomech::{subdivide::LeveledMap, GMap};
     /// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
     /// let mut m = LeveledMap::new(map, vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
@@ -334,7 +334,7 @@ impl Document {
     /// # Examples
     ///
     /// ```
-    /// # use topomech::store::{self, Document, Format};
+    /// # use topomech::store::Document;
     /// # use topomech::mechanics::{Body, Material};
     /// let (points, tets) = topomech::generate::kuhn_cube(1);
     /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
@@ -356,7 +356,7 @@ impl Document {
     /// # Examples
     ///
     /// ```
-    /// # use topomech::store::{self, Document, Format};
+    /// # use topomech::store::{self, Document};
     /// # use topomech::GMap;
     /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
     /// let back: GMap<3> = Document::from_map(&map).into_map().unwrap();
@@ -380,7 +380,7 @@ impl Document {
     /// # Examples
     ///
     /// ```
-    /// # use topomech::store::{self, Document, Format};
+    /// # use topomech::store::{self, Document};
     /// # use topomech::{subdivide::LeveledMap, GMap};
     /// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
     /// let mut m = LeveledMap::new(map, vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
@@ -407,7 +407,7 @@ impl Document {
     /// # Examples
     ///
     /// ```
-    /// # use topomech::store::{self, Document, Format};
+    /// # use topomech::store::{self, Document};
     /// # use topomech::mechanics::{Body, Material};
     /// let (points, tets) = topomech::generate::kuhn_cube(1);
     /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
@@ -532,7 +532,7 @@ pub fn read_document(path: &Path) -> Result<Document, StoreError> {
 /// # Examples
 ///
 /// ```
-/// # use topomech::store::{self, Document, Format};
+/// # use topomech::store::{self, Format};
 /// # use topomech::GMap;
 /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
 /// let path = std::env::temp_dir().join(format!("topomech-doc-{}-load.tmapb", std::process::id()));
@@ -576,7 +576,7 @@ pub fn load_body(path: &Path) -> Result<Body, StoreError> {
 /// # Examples
 ///
 /// ```
-/// # use topomech::store::{self, Document, Format};
+/// # use topomech::store::{self, Format};
 /// # use topomech::{subdivide::LeveledMap, GMap};
 /// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
 /// let mut m = LeveledMap::new(map, vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
@@ -600,7 +600,7 @@ pub fn load_leveled<const N: usize>(path: &Path) -> Result<LeveledMap<N>, StoreE
 /// # Examples
 ///
 /// ```
-/// # use topomech::store::{self, Document, Format};
+/// # use topomech::store::{self, Format};
 /// # use topomech::{subdivide::LeveledMap, GMap};
 /// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
 /// let mut m = LeveledMap::new(map, vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
@@ -625,7 +625,7 @@ pub fn save_leveled<const N: usize>(m: &LeveledMap<N>, path: &Path, format: Form
 /// # Examples
 ///
 /// ```
-/// # use topomech::store::{self, Document, Format};
+/// # use topomech::store::{self, Format};
 /// # use topomech::GMap;
 /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
 /// let path = std::env::temp_dir().join(format!("topomech-doc-{}-save.tmap", std::process::id()));

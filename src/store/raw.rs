@@ -45,10 +45,9 @@ impl RawMap {
     /// # Examples
     ///
     /// ```
-    /// # use topomech::store::{self, Document, Format};
     /// # use topomech::GMap;
-    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
     /// # use topomech::store::RawMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
     /// let raw = RawMap::from_map(&map);
     /// assert_eq!((raw.dimension, raw.capacity, raw.alpha.len()), (3, 24, 24 * 4));
     /// assert!(raw.free_darts.is_empty());
@@ -79,10 +78,9 @@ impl RawMap {
     /// # Examples
     ///
     /// ```
-    /// # use topomech::store::{self, Document, Format};
     /// # use topomech::GMap;
-    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
     /// # use topomech::store::RawMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
     /// assert_eq!(RawMap::from_map(&map).alphas(), 4);
     /// ```
     pub fn alphas(&self) -> usize {
@@ -94,10 +92,9 @@ impl RawMap {
     /// # Examples
     ///
     /// ```
-    /// # use topomech::store::{self, Document, Format};
     /// # use topomech::GMap;
-    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
     /// # use topomech::store::RawMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
     /// let live = RawMap::from_map(&map).live();
     /// assert_eq!(live.len(), 24);
     /// assert!(live.iter().all(|&l| l));
@@ -115,10 +112,9 @@ impl RawMap {
     /// # Examples
     ///
     /// ```
-    /// # use topomech::store::{self, Document, Format};
     /// # use topomech::GMap;
-    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
     /// # use topomech::{store::RawMap, DartId};
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
     /// let raw = RawMap::from_map(&map);
     /// for d in 0..24 {
     ///     assert_eq!(raw.alpha(2, d), map.alpha_dyn(2, DartId(d)).0);
@@ -133,10 +129,9 @@ impl RawMap {
     /// # Examples
     ///
     /// ```
-    /// # use topomech::store::{self, Document, Format};
     /// # use topomech::GMap;
-    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
     /// # use topomech::{store::RawMap, DartId};
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
     /// let raw = RawMap::from_map(&map);
     /// for d in 0..24 {
     ///     assert_eq!(raw.cell(0, d) as usize, map.vertex_id(DartId(d)).index());
@@ -154,10 +149,9 @@ impl RawMap {
     /// # Examples
     ///
     /// ```
-    /// # use topomech::store::{self, Document, Format};
     /// # use topomech::GMap;
-    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
     /// # use topomech::store::RawMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
     /// let raw = RawMap::from_map(&map);
     /// assert!(topomech::ops::same_raw(&raw.to_gmap_raw::<3>().unwrap(), &map));
     /// assert!(raw.to_gmap_raw::<2>().is_err());
@@ -232,11 +226,10 @@ impl RawMechanics {
     /// # Examples
     ///
     /// ```
-    /// # use topomech::store::{self, Document, Format};
     /// # use topomech::mechanics::{Body, Material};
+    /// # use topomech::store::RawMechanics;
     /// let (points, tets) = topomech::generate::kuhn_cube(1);
     /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
-    /// # use topomech::store::RawMechanics;
     /// let raw = RawMechanics::from_mechanics(body.attrs());
     /// let vertex_mass: f64 = raw.vertices.iter().map(|v| v.mass).sum();
     /// let tet_mass: f64 = raw.volumes.iter().map(|t| t[1]).sum();
@@ -283,11 +276,10 @@ impl RawMechanics {
     /// # Examples
     ///
     /// ```
-    /// # use topomech::store::{self, Document, Format};
     /// # use topomech::mechanics::{Body, Material};
+    /// # use topomech::store::RawMechanics;
     /// let (points, tets) = topomech::generate::kuhn_cube(1);
     /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
-    /// # use topomech::store::RawMechanics;
     /// let raw = RawMechanics::from_mechanics(body.attrs());
     /// assert_eq!(RawMechanics::from_mechanics(&raw.to_mechanics()), raw);
     /// ```
@@ -323,11 +315,10 @@ impl RawMechanics {
     /// # Examples
     ///
     /// ```
-    /// # use topomech::store::{self, Document, Format};
     /// # use topomech::mechanics::{Body, Material};
+    /// # use topomech::store::RawMechanics;
     /// let (points, tets) = topomech::generate::kuhn_cube(1);
     /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
-    /// # use topomech::store::RawMechanics;
     /// let mut raw = RawMechanics::from_mechanics(body.attrs());
     /// assert!(raw.check_finite().is_ok());
     /// raw.vertices[2].mass = f64::INFINITY;

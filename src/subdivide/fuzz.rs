@@ -256,11 +256,11 @@ fn masses_total(m: &LeveledMap<3>) -> Result<f64, String> {
 /// ```
 /// # use topomech::subdivide::LeveledMap;
 /// # use topomech::GMap;
+/// # use topomech::subdivide::fuzz::check_accepted;
 /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
 /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 /// let mut m = LeveledMap::new(map, pts);
 /// let d = m.map().darts().next().unwrap();
-/// # use topomech::subdivide::fuzz::check_accepted;
 /// m.subdivide_tet(d, 1).unwrap();
 /// assert!(check_accepted(&m, 1).is_ok()); // χ of a tetrahedron: 4 − 6 + 4 − 1
 /// assert!(check_accepted(&m, 2).is_err());
@@ -292,11 +292,11 @@ pub fn check_accepted<const N: usize>(m: &LeveledMap<N>, chi: i64) -> Result<(),
 /// ```
 /// # use topomech::subdivide::LeveledMap;
 /// # use topomech::GMap;
+/// # use topomech::subdivide::fuzz::check_refused;
 /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
 /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 /// let mut m = LeveledMap::new(map, pts);
 /// let d = m.map().darts().next().unwrap();
-/// # use topomech::subdivide::fuzz::check_refused;
 /// let before = m.clone();
 /// let e = m.subdivide_tet(d, 0).unwrap_err(); // μt is already 0
 /// assert!(check_refused(&before, &m, &e).is_ok());

@@ -219,7 +219,7 @@ impl<const N: usize> LeveledMap<N> {
     /// # use topomech::GMap;
     /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
     /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-    /// let mut m = LeveledMap::new(map, pts);
+    /// let m = LeveledMap::new(map, pts);
     /// let d = m.map().darts().next().unwrap();
     /// assert_eq!((m.max_level(), m.darts_at_level(0)), (0, 24));
     /// assert_eq!(m.mu(d), topomech::subdivide::Mu::default());

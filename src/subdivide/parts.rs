@@ -96,10 +96,10 @@ pub enum LevelPartsError {
 /// ```
 /// # use topomech::subdivide::LeveledMap;
 /// # use topomech::GMap;
+/// # use topomech::subdivide::record_errors;
 /// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
 /// let mut m = LeveledMap::new(map, vec![[0.0; 3], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]]);
 /// let d = m.map().darts().next().unwrap();
-/// # use topomech::subdivide::record_errors;
 /// m.subdivide_triangle(d, 1).unwrap();
 /// let mut parts = m.to_parts();
 /// assert!(record_errors(m.map(), &parts, 10).is_empty());
@@ -195,10 +195,10 @@ impl<const N: usize> LeveledMap<N> {
     /// ```
     /// # use topomech::subdivide::LeveledMap;
     /// # use topomech::GMap;
+    /// # use topomech::subdivide::LevelPartsError;
     /// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
     /// let mut m = LeveledMap::new(map, vec![[0.0; 3], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]]);
     /// let d = m.map().darts().next().unwrap();
-    /// # use topomech::subdivide::LevelPartsError;
     /// m.split_edge(d, 1).unwrap();
     /// let back = LeveledMap::from_parts(m.map().clone(), m.to_parts()).unwrap();
     /// assert_eq!(back.alpha_at(0, 0, d), m.alpha_at(0, 0, d));

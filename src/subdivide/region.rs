@@ -49,11 +49,10 @@ impl TetMasses {
     /// ```
     /// # use topomech::subdivide::LeveledMap;
     /// # use topomech::GMap;
+    /// # use topomech::subdivide::TetMasses;
     /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
     /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-    /// let mut m = LeveledMap::new(map, pts);
-    /// let d = m.map().darts().next().unwrap();
-    /// # use topomech::subdivide::TetMasses;
+    /// let m = LeveledMap::new(map, pts);
     /// let masses = TetMasses::from_density(&m, 6.0).unwrap(); // the volume is 1/6
     /// assert!((masses.total(&m) - 1.0).abs() < 1e-12);
     /// ```
@@ -73,11 +72,11 @@ impl TetMasses {
     /// ```
     /// # use topomech::subdivide::LeveledMap;
     /// # use topomech::GMap;
+    /// # use topomech::subdivide::TetMasses;
     /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
     /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
     /// let mut m = LeveledMap::new(map, pts);
     /// let d = m.map().darts().next().unwrap();
-    /// # use topomech::subdivide::TetMasses;
     /// let mut masses = TetMasses::from_density(&m, 12.0).unwrap();
     /// m.subdivide_tet_with_mass(d, 1, &mut masses).unwrap();
     /// assert!((masses.total(&m) - 2.0).abs() < 1e-12);
@@ -94,11 +93,10 @@ impl TetMasses {
     /// ```
     /// # use topomech::subdivide::LeveledMap;
     /// # use topomech::GMap;
+    /// # use topomech::subdivide::TetMasses;
     /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
     /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-    /// let mut m = LeveledMap::new(map, pts);
-    /// let d = m.map().darts().next().unwrap();
-    /// # use topomech::subdivide::TetMasses;
+    /// let m = LeveledMap::new(map, pts);
     /// let masses = TetMasses::from_density(&m, 6.0).unwrap();
     /// let v = masses.vertex_masses(&m).unwrap();
     /// assert!(v.iter().all(|&x| (x - 0.25).abs() < 1e-12));
@@ -238,7 +236,7 @@ impl LeveledMap<3> {
     /// # use topomech::GMap;
     /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
     /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-    /// let mut m = LeveledMap::new(map, pts);
+    /// let m = LeveledMap::new(map, pts);
     /// let d = m.map().darts().next().unwrap();
     /// assert!(m.tet_in_ball(d, [2.0, 0.0, 0.0], 1.5).unwrap());
     /// assert!(!m.tet_in_ball(d, [2.0, 0.0, 0.0], 0.5).unwrap());
@@ -258,11 +256,11 @@ impl LeveledMap<3> {
     /// ```
     /// # use topomech::subdivide::LeveledMap;
     /// # use topomech::GMap;
+    /// # use topomech::subdivide::TetMasses;
     /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
     /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
     /// let mut m = LeveledMap::new(map, pts);
     /// let d = m.map().darts().next().unwrap();
-    /// # use topomech::subdivide::TetMasses;
     /// let mut masses = TetMasses::from_density(&m, 6.0).unwrap();
     /// let children = m.subdivide_tet_with_mass(d, 1, &mut masses).unwrap();
     /// let cell = |c| m.map().cell_id(3, c).index();

@@ -59,6 +59,19 @@ pub struct CheckReport {
 /// The verdict comes from the kernel's `validate()` when n ≤ 3; the listing is a separate pass
 /// on the raw arrays that never stops at the first violation.
 /// Cost O(capacity · n² + cell ids) time and memory, O(k · capacity · n²) with k levels.
+///
+/// # Examples
+///
+/// ```
+/// # use topomech::store::{check_all_laws, Document};
+/// # use topomech::GMap;
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let mut doc = Document::from_map(&map);
+/// assert!(check_all_laws(&doc, 10).valid);
+/// doc.map.alpha[0] = doc.map.alpha[1]; // α0(0) := α1(0): α0 is no longer an involution
+/// let report = check_all_laws(&doc, 10);
+/// assert!(!report.valid && !report.findings.is_empty());
+/// ```
 pub fn check_all_laws(doc: &Document, limit: usize) -> CheckReport {
     let mut out = Collector { findings: Vec::new(), limit, truncated: false };
     let raw = &doc.map;

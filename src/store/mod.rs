@@ -80,6 +80,16 @@ pub enum Format {
 
 impl Format {
     /// `Binary` for a path ending in `.tmapb`, `Text` otherwise. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use std::path::Path;
+    /// use topomech::store::Format;
+    /// assert_eq!(Format::from_path(Path::new("out/liver.tmapb")), Format::Binary);
+    /// assert_eq!(Format::from_path(Path::new("liver.tmap")), Format::Text);
+    /// assert_eq!(Format::from_path(Path::new("liver")), Format::Text);
+    /// ```
     pub fn from_path(path: &Path) -> Format {
         match path.extension().and_then(|e| e.to_str()) {
             Some("tmapb") => Format::Binary,
@@ -254,12 +264,38 @@ pub struct Document {
 
 impl Document {
     /// The document of a bare map. O(capacity · n).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::store::Document;
+    /// # use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let doc = Document::from_map(&map);
+    /// assert_eq!((doc.map.dimension, doc.map.capacity, doc.version()), (3, 24, 1));
+    /// assert!(doc.mechanics.is_none() && doc.levels.is_none());
+    /// ```
     pub fn from_map<const N: usize>(map: &GMap<N>) -> Self {
         Document { map: RawMap::from_map(map), mechanics: None, levels: None }
     }
 
     /// The document of a leveled map: its finest map and its levels part. Dead dart slots get
     /// default records (they are not stored). O(capacity · n + history entries + points).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::store::Document;
+    /// # use topomech::{subdivide::LeveledMap, GMap};
+    /// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+    /// let mut m = LeveledMap::new(map, vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+    /// let d = m.map().darts().next().unwrap();
+    /// m.subdivide_triangle(d, 1).unwrap();
+    /// let doc = Document::from_leveled(&m);
+    /// assert_eq!(doc.levels.as_ref().unwrap().max_level, 1);
+    /// let back = doc.into_leveled::<2>().unwrap();
+    /// assert_eq!((back.darts_at_level(0), back.darts_at_level(1)), (6, 24));
+    /// ```
     pub fn from_leveled<const N: usize>(m: &LeveledMap<N>) -> Self {
         let mut parts = m.to_parts();
         for (k, rec) in parts.darts.iter_mut().enumerate() {
@@ -272,6 +308,19 @@ impl Document {
 
     /// The version a document is written with: [`LEVELS_VERSION`] with a levels part,
     /// [`MIN_VERSION`] without. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::store::{self, Document};
+    /// # use topomech::{subdivide::LeveledMap, GMap};
+    /// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+    /// let mut m = LeveledMap::new(map, vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+    /// let d = m.map().darts().next().unwrap();
+    /// m.subdivide_triangle(d, 1).unwrap();
+    /// assert_eq!(Document::from_map(m.map()).version(), store::MIN_VERSION);
+    /// assert_eq!(Document::from_leveled(&m).version(), store::LEVELS_VERSION);
+    /// ```
     pub fn version(&self) -> u32 {
         if self.levels.is_some() {
             LEVELS_VERSION
@@ -281,6 +330,19 @@ impl Document {
     }
 
     /// The document of a body (map + mechanics). O(capacity + cells).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::store::Document;
+    /// # use topomech::mechanics::{Body, Material};
+    /// let (points, tets) = topomech::generate::kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let doc = Document::from_body(&body);
+    /// assert!(doc.mechanics.is_some());
+    /// let back = doc.clone().into_body().unwrap();
+    /// assert_eq!(Document::from_body(&back), doc);
+    /// ```
     pub fn from_body(body: &Body) -> Self {
         let mechanics = Some(RawMechanics::from_mechanics(body.attrs()));
         Document { map: RawMap::from_map(body.map()), mechanics, levels: None }
@@ -290,6 +352,18 @@ impl Document {
     ///
     /// # Errors
     /// [`StoreError::WrongDimension`], [`StoreError::BrokenLaw`] (the first law broken).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::store::{self, Document};
+    /// # use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let back: GMap<3> = Document::from_map(&map).into_map().unwrap();
+    /// assert!(topomech::ops::same_raw(&back, &map));
+    /// let e = Document::from_map(&map).into_map::<2>().unwrap_err();
+    /// assert!(matches!(e, store::StoreError::WrongDimension { found: 3, expected: 2 }));
+    /// ```
     pub fn into_map<const N: usize>(self) -> Result<GMap<N>, StoreError> {
         let map = self.map.to_gmap_raw::<N>()?;
         map.validate()?;
@@ -302,6 +376,21 @@ impl Document {
     /// # Errors
     /// [`StoreError::NoLevels`], [`StoreError::WrongDimension`], [`StoreError::BrokenLaw`],
     /// [`StoreError::Levels`] (a malformed record or the first level law broken).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::store::{self, Document};
+    /// # use topomech::{subdivide::LeveledMap, GMap};
+    /// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+    /// let mut m = LeveledMap::new(map, vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+    /// let d = m.map().darts().next().unwrap();
+    /// m.subdivide_triangle(d, 1).unwrap();
+    /// let back = Document::from_leveled(&m).into_leveled::<2>().unwrap();
+    /// assert_eq!(back.to_parts(), m.to_parts());
+    /// let e = Document::from_map(m.map()).into_leveled::<2>().unwrap_err();
+    /// assert!(matches!(e, store::StoreError::NoLevels));
+    /// ```
     pub fn into_leveled<const N: usize>(self) -> Result<LeveledMap<N>, StoreError> {
         let parts = self.levels.ok_or(StoreError::NoLevels)?;
         let map = self.map.to_gmap_raw::<N>()?;
@@ -314,6 +403,19 @@ impl Document {
     /// # Errors
     /// [`StoreError::NoMechanics`], [`StoreError::WrongDimension`], [`StoreError::BrokenLaw`],
     /// [`StoreError::Conservation`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::store::{self, Document};
+    /// # use topomech::mechanics::{Body, Material};
+    /// let (points, tets) = topomech::generate::kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let back = Document::from_body(&body).into_body().unwrap();
+    /// assert!(back.map().is_isomorphic(body.map()));
+    /// let e = Document::from_map(body.map()).into_body().unwrap_err();
+    /// assert!(matches!(e, store::StoreError::NoMechanics));
+    /// ```
     pub fn into_body(self) -> Result<Body, StoreError> {
         let raw_mech = self.mechanics.ok_or(StoreError::NoMechanics)?;
         let map = self.map.to_gmap_raw::<3>()?;
@@ -328,6 +430,20 @@ impl Document {
 ///
 /// # Errors
 /// [`StoreError::Unrepresentable`] when an attribute is NaN or infinite (it could not be read back).
+///
+/// # Examples
+///
+/// ```
+/// # use topomech::store::{self, Document, Format};
+/// # use topomech::GMap;
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let doc = Document::from_map(&map);
+/// let text = store::encode(&doc, Format::Text).unwrap();
+/// assert!(text.starts_with(store::TEXT_MAGIC.as_bytes()));
+/// let bin = store::encode(&doc, Format::Binary).unwrap();
+/// assert!(bin.starts_with(&store::BINARY_MAGIC));
+/// assert_eq!(store::decode(&bin).unwrap(), store::decode(&text).unwrap());
+/// ```
 pub fn encode(doc: &Document, format: Format) -> Result<Vec<u8>, StoreError> {
     if let Some(m) = &doc.mechanics {
         m.check_finite().map_err(|what| StoreError::Unrepresentable { what })?;
@@ -359,6 +475,21 @@ fn check_levels_representable(map: &RawMap, l: &LevelParts) -> Result<(), String
 /// # Errors
 /// Every structural [`StoreError`] variant, with the line or byte offset; never panics and never
 /// allocates more than the data present justifies.
+///
+/// # Examples
+///
+/// ```
+/// # use topomech::store::{self, Document, Format};
+/// # use topomech::GMap;
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let doc = Document::from_map(&map);
+/// let mut bytes = store::encode(&doc, Format::Binary).unwrap();
+/// assert_eq!(store::decode(&bytes).unwrap(), doc);
+/// let last = bytes.len() - 1;
+/// bytes[last] ^= 1; // one flipped bit: the checksum no longer matches
+/// assert!(store::decode(&bytes).is_err());
+/// assert!(matches!(store::decode(b"hello"), Err(store::StoreError::BadMagic { .. })));
+/// ```
 pub fn decode(bytes: &[u8]) -> Result<Document, StoreError> {
     if bytes.starts_with(&BINARY_MAGIC) {
         binary::decode(bytes)
@@ -374,6 +505,20 @@ pub fn decode(bytes: &[u8]) -> Result<Document, StoreError> {
 ///
 /// # Errors
 /// [`StoreError::Io`] and the errors of [`decode`].
+///
+/// # Examples
+///
+/// ```
+/// # use topomech::store::{self, Document, Format};
+/// # use topomech::GMap;
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let path = std::env::temp_dir().join(format!("topomech-doc-{}-read.tmap", std::process::id()));
+/// let doc = Document::from_map(&map);
+/// store::save_document(&doc, &path, Format::Text).unwrap();
+/// assert_eq!(store::read_document(&path).unwrap(), doc);
+/// std::fs::remove_file(&path).unwrap();
+/// assert!(matches!(store::read_document(&path), Err(store::StoreError::Io { .. })));
+/// ```
 pub fn read_document(path: &Path) -> Result<Document, StoreError> {
     let bytes = std::fs::read(path).map_err(|source| StoreError::Io { path: path.to_path_buf(), source })?;
     decode(&bytes)
@@ -383,6 +528,20 @@ pub fn read_document(path: &Path) -> Result<Document, StoreError> {
 ///
 /// # Errors
 /// As [`read_document`] and [`Document::into_map`].
+///
+/// # Examples
+///
+/// ```
+/// # use topomech::store::{self, Format};
+/// # use topomech::GMap;
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let path = std::env::temp_dir().join(format!("topomech-doc-{}-load.tmapb", std::process::id()));
+/// store::save_map(&map, &path, Format::Binary).unwrap();
+/// let back: GMap<3> = store::load_map(&path).unwrap();
+/// assert!(topomech::ops::same_raw(&back, &map));
+/// assert!(store::load_map::<2>(&path).is_err()); // a 3-G-map is stored
+/// # std::fs::remove_file(&path).unwrap();
+/// ```
 pub fn load_map<const N: usize>(path: &Path) -> Result<GMap<N>, StoreError> {
     read_document(path)?.into_map()
 }
@@ -391,6 +550,20 @@ pub fn load_map<const N: usize>(path: &Path) -> Result<GMap<N>, StoreError> {
 ///
 /// # Errors
 /// As [`read_document`] and [`Document::into_body`].
+///
+/// # Examples
+///
+/// ```
+/// # use topomech::store::{self, Document, Format};
+/// # use topomech::mechanics::{Body, Material};
+/// let (points, tets) = topomech::generate::kuhn_cube(1);
+/// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let path = std::env::temp_dir().join(format!("topomech-doc-{}-load-body.tmapb", std::process::id()));
+/// store::save_body(&body, &path, Format::Binary).unwrap();
+/// let back = store::load_body(&path).unwrap();
+/// assert_eq!(Document::from_body(&back), Document::from_body(&body));
+/// # std::fs::remove_file(&path).unwrap();
+/// ```
 pub fn load_body(path: &Path) -> Result<Body, StoreError> {
     read_document(path)?.into_body()
 }
@@ -399,6 +572,22 @@ pub fn load_body(path: &Path) -> Result<Body, StoreError> {
 ///
 /// # Errors
 /// As [`read_document`] and [`Document::into_leveled`].
+///
+/// # Examples
+///
+/// ```
+/// # use topomech::store::{self, Format};
+/// # use topomech::{subdivide::LeveledMap, GMap};
+/// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+/// let mut m = LeveledMap::new(map, vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+/// let d = m.map().darts().next().unwrap();
+/// m.subdivide_triangle(d, 1).unwrap();
+/// let path = std::env::temp_dir().join(format!("topomech-doc-{}-load-lev.tmap", std::process::id()));
+/// store::save_leveled(&m, &path, Format::Text).unwrap();
+/// let back = store::load_leveled::<2>(&path).unwrap();
+/// assert_eq!(back.to_parts(), m.to_parts());
+/// # std::fs::remove_file(&path).unwrap();
+/// ```
 pub fn load_leveled<const N: usize>(path: &Path) -> Result<LeveledMap<N>, StoreError> {
     read_document(path)?.into_leveled()
 }
@@ -407,6 +596,23 @@ pub fn load_leveled<const N: usize>(path: &Path) -> Result<LeveledMap<N>, StoreE
 ///
 /// # Errors
 /// As [`save_document`].
+///
+/// # Examples
+///
+/// ```
+/// # use topomech::store::{self, Format};
+/// # use topomech::{subdivide::LeveledMap, GMap};
+/// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+/// let mut m = LeveledMap::new(map, vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+/// let d = m.map().darts().next().unwrap();
+/// m.subdivide_triangle(d, 1).unwrap();
+/// let path = std::env::temp_dir().join(format!("topomech-doc-{}-save-lev.tmapb", std::process::id()));
+/// store::save_leveled(&m, &path, Format::Binary).unwrap();
+/// let doc = store::read_document(&path).unwrap();
+/// assert_eq!(doc.version(), 2);
+/// assert_eq!(doc.levels.unwrap().max_level, m.max_level());
+/// # std::fs::remove_file(&path).unwrap();
+/// ```
 pub fn save_leveled<const N: usize>(m: &LeveledMap<N>, path: &Path, format: Format) -> Result<(), StoreError> {
     save_document(&Document::from_leveled(m), path, format)
 }
@@ -415,6 +621,20 @@ pub fn save_leveled<const N: usize>(m: &LeveledMap<N>, path: &Path, format: Form
 ///
 /// # Errors
 /// As [`save_document`].
+///
+/// # Examples
+///
+/// ```
+/// # use topomech::store::{self, Format};
+/// # use topomech::GMap;
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let path = std::env::temp_dir().join(format!("topomech-doc-{}-save.tmap", std::process::id()));
+/// store::save_map(&map, &path, Format::Text).unwrap();
+/// let text = std::fs::read_to_string(&path).unwrap();
+/// assert!(text.starts_with(store::TEXT_MAGIC));
+/// assert!(store::load_map::<3>(&path).unwrap().is_isomorphic(&map));
+/// # std::fs::remove_file(&path).unwrap();
+/// ```
 pub fn save_map<const N: usize>(map: &GMap<N>, path: &Path, format: Format) -> Result<(), StoreError> {
     save_document(&Document::from_map(map), path, format)
 }
@@ -423,6 +643,20 @@ pub fn save_map<const N: usize>(map: &GMap<N>, path: &Path, format: Format) -> R
 ///
 /// # Errors
 /// As [`save_document`].
+///
+/// # Examples
+///
+/// ```
+/// # use topomech::store::{self, Document, Format};
+/// # use topomech::mechanics::{Body, Material};
+/// let (points, tets) = topomech::generate::kuhn_cube(1);
+/// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let path = std::env::temp_dir().join(format!("topomech-doc-{}-save-body.tmap", std::process::id()));
+/// store::save_body(&body, &path, Format::Text).unwrap();
+/// let doc = store::read_document(&path).unwrap();
+/// assert_eq!(doc, Document::from_body(&body));
+/// # std::fs::remove_file(&path).unwrap();
+/// ```
 pub fn save_body(body: &Body, path: &Path, format: Format) -> Result<(), StoreError> {
     save_document(&Document::from_body(body), path, format)
 }
@@ -434,6 +668,23 @@ pub fn save_body(body: &Body, path: &Path, format: Format) -> Result<(), StoreEr
 /// # Errors
 /// [`StoreError::Unrepresentable`] (see [`encode`]); [`StoreError::Io`] naming the file the
 /// system refused.
+///
+/// # Examples
+///
+/// ```
+/// # use topomech::store::{self, Document, Format};
+/// # use topomech::mechanics::{Body, Material};
+/// let (points, tets) = topomech::generate::kuhn_cube(1);
+/// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let path = std::env::temp_dir().join(format!("topomech-doc-{}-save-doc.tmapb", std::process::id()));
+/// let mut doc = Document::from_body(&body);
+/// assert!(store::save_document(&doc, &path, Format::Binary).is_ok());
+/// doc.mechanics.as_mut().unwrap().material[0] = f64::NAN;
+/// let e = store::save_document(&doc, &path, Format::Binary).unwrap_err();
+/// assert!(matches!(e, store::StoreError::Unrepresentable { .. }));
+/// assert!(store::read_document(&path).is_ok()); // the first file is untouched
+/// # std::fs::remove_file(&path).unwrap();
+/// ```
 pub fn save_document(doc: &Document, path: &Path, format: Format) -> Result<(), StoreError> {
     let bytes = encode(doc, format)?;
     write_atomically(path, &bytes)
@@ -443,6 +694,17 @@ pub fn save_document(doc: &Document, path: &Path, format: Format) -> Result<(), 
 ///
 /// # Errors
 /// [`StoreError::Io`].
+///
+/// # Examples
+///
+/// ```
+/// let path = std::env::temp_dir().join(format!("topomech-doc-{}-atomic.bin", std::process::id()));
+/// topomech::store::write_atomically(&path, b"first").unwrap();
+/// topomech::store::write_atomically(&path, b"second").unwrap();
+/// assert_eq!(std::fs::read(&path).unwrap(), b"second");
+/// assert!(topomech::store::write_atomically(&path.join("no/such/dir"), b"x").is_err());
+/// # std::fs::remove_file(&path).unwrap();
+/// ```
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), StoreError> {
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),

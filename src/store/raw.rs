@@ -41,6 +41,17 @@ pub(crate) const UNSET: u32 = u32::MAX;
 
 impl RawMap {
     /// Copies every slot of `map`. O(capacity · n).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::GMap;
+    /// # use topomech::store::RawMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let raw = RawMap::from_map(&map);
+    /// assert_eq!((raw.dimension, raw.capacity, raw.alpha.len()), (3, 24, 24 * 4));
+    /// assert!(raw.free_darts.is_empty());
+    /// ```
     pub fn from_map<const N: usize>(map: &GMap<N>) -> Self {
         let cap = map.capacity();
         let mut alpha = Vec::with_capacity(cap * (N + 1));
@@ -63,11 +74,31 @@ impl RawMap {
     }
 
     /// Number of involutions, n + 1.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::GMap;
+    /// # use topomech::store::RawMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// assert_eq!(RawMap::from_map(&map).alphas(), 4);
+    /// ```
     pub fn alphas(&self) -> usize {
         self.dimension + 1
     }
 
     /// Liveness of every slot (false for the slots of `free_darts`). O(capacity).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::GMap;
+    /// # use topomech::store::RawMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let live = RawMap::from_map(&map).live();
+    /// assert_eq!(live.len(), 24);
+    /// assert!(live.iter().all(|&l| l));
+    /// ```
     pub fn live(&self) -> Vec<bool> {
         let mut live = vec![true; self.capacity as usize];
         for &d in &self.free_darts {
@@ -77,11 +108,35 @@ impl RawMap {
     }
 
     /// αi of slot d. O(1). Panics if d or i is out of range (the decoder guarantees neither is).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::GMap;
+    /// # use topomech::{store::RawMap, DartId};
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let raw = RawMap::from_map(&map);
+    /// for d in 0..24 {
+    ///     assert_eq!(raw.alpha(2, d), map.alpha_dyn(2, DartId(d)).0);
+    /// }
+    /// ```
     pub fn alpha(&self, i: usize, d: u32) -> u32 {
         self.alpha[d as usize * self.alphas() + i]
     }
 
     /// The i-cell id of slot d. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::GMap;
+    /// # use topomech::{store::RawMap, DartId};
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let raw = RawMap::from_map(&map);
+    /// for d in 0..24 {
+    ///     assert_eq!(raw.cell(0, d) as usize, map.vertex_id(DartId(d)).index());
+    /// }
+    /// ```
     pub fn cell(&self, i: usize, d: u32) -> u32 {
         self.cell[d as usize * self.alphas() + i]
     }
@@ -90,6 +145,17 @@ impl RawMap {
     ///
     /// # Errors
     /// [`StoreError::WrongDimension`] when the file's dimension is not `N`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::GMap;
+    /// # use topomech::store::RawMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let raw = RawMap::from_map(&map);
+    /// assert!(topomech::ops::same_raw(&raw.to_gmap_raw::<3>().unwrap(), &map));
+    /// assert!(raw.to_gmap_raw::<2>().is_err());
+    /// ```
     pub fn to_gmap_raw<const N: usize>(&self) -> Result<GMap<N>, StoreError> {
         if self.dimension != N {
             return Err(StoreError::WrongDimension { found: self.dimension, expected: N });
@@ -156,6 +222,19 @@ fn column<T: Copy + Default>(a: &CellArray<T>, len: usize) -> impl Iterator<Item
 
 impl RawMechanics {
     /// Copies every attribute. O(cells).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::mechanics::{Body, Material};
+    /// # use topomech::store::RawMechanics;
+    /// let (points, tets) = topomech::generate::kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let raw = RawMechanics::from_mechanics(body.attrs());
+    /// let vertex_mass: f64 = raw.vertices.iter().map(|v| v.mass).sum();
+    /// let tet_mass: f64 = raw.volumes.iter().map(|t| t[1]).sum();
+    /// assert!(tet_mass > 0.0 && (vertex_mass - tet_mass).abs() < 1e-12 * tet_mass);
+    /// ```
     pub fn from_mechanics(m: &Mechanics) -> Self {
         let Material { density, young, damping, viscosity } = m.material;
         let nv = m.vertex_mass.len().max(m.position.len());
@@ -193,6 +272,17 @@ impl RawMechanics {
     }
 
     /// Rebuilds the attributes exactly (no law checked). O(cells).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::mechanics::{Body, Material};
+    /// # use topomech::store::RawMechanics;
+    /// let (points, tets) = topomech::generate::kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let raw = RawMechanics::from_mechanics(body.attrs());
+    /// assert_eq!(RawMechanics::from_mechanics(&raw.to_mechanics()), raw);
+    /// ```
     pub fn to_mechanics(&self) -> Mechanics {
         let [density, young, damping, viscosity] = self.material;
         let vs = &self.vertices;
@@ -221,6 +311,19 @@ impl RawMechanics {
     }
 
     /// `Err(description)` naming the first NaN or infinite value. O(cells).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::mechanics::{Body, Material};
+    /// # use topomech::store::RawMechanics;
+    /// let (points, tets) = topomech::generate::kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let mut raw = RawMechanics::from_mechanics(body.attrs());
+    /// assert!(raw.check_finite().is_ok());
+    /// raw.vertices[2].mass = f64::INFINITY;
+    /// assert!(raw.check_finite().unwrap_err().contains("record 2"));
+    /// ```
     pub fn check_finite(&self) -> Result<(), String> {
         let bad = |what: &str, k: usize| Err(format!("{what} of record {k} is not finite"));
         if self.material.iter().any(|x| !x.is_finite()) {

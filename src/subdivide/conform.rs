@@ -234,6 +234,21 @@ impl LeveledMap<3> {
     /// vertices in order around the face). O(darts).
     ///
     /// Errors: [`SubdivideError::OpenEdge`] if a face is not closed.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::subdivide::LeveledMap;
+    /// # use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mut m = LeveledMap::new(map, pts);
+    /// let d = m.map().darts().next().unwrap();
+    /// assert_eq!(m.boundary_polygons().unwrap().len(), 4);
+    /// m.split_edge(d, 1).unwrap(); // the two faces of the edge get a 4th vertex
+    /// let sizes: usize = m.boundary_polygons().unwrap().iter().map(Vec::len).sum();
+    /// assert_eq!(sizes, 3 + 3 + 4 + 4);
+    /// ```
     pub fn boundary_polygons(&self) -> Result<Vec<Vec<u32>>, SubdivideError> {
         let mut out = Vec::new();
         for f in self.map.one_dart_per_cell(2) {

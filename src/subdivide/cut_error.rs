@@ -33,6 +33,22 @@ pub struct CutSurfaceError {
 /// Measures the faces of `incision` (already applied to `body`) against `plane`, restricted to the
 /// faces whose centroid lies in the ball `zone = (centre, radius)` when given (module docs).
 /// O(cut faces).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::{incise_plane, Plane};
+/// use topomech::mechanics::{Body, Material};
+/// use topomech::subdivide::measure_cut;
+/// let (points, tets) = topomech::generate::kuhn_cube(2);
+/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let plane = Plane { point: [1.0, 0.0, 0.0], normal: [1.0, 0.0, 0.0] };
+/// let inc = incise_plane(&mut body, &plane).unwrap();
+/// let all = measure_cut(&body, &inc, &plane, None);
+/// assert!(all.measured == all.faces && all.faces > 0 && all.max < 1e-12);
+/// let none = measure_cut(&body, &inc, &plane, Some(([9.0; 3], 0.1)));
+/// assert!(none.measured == 0 && none.max.is_nan());
+/// ```
 pub fn measure_cut(body: &Body, incision: &Incision, plane: &Plane, zone: Option<([f64; 3], f64)>) -> CutSurfaceError {
     let (map, mech) = (body.map(), body.attrs());
     let len = plane.normal.iter().map(|c| c * c).sum::<f64>().sqrt();

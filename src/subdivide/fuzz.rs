@@ -86,6 +86,16 @@ pub struct Report {
 }
 
 /// Decodes bytes into a mesh and operations (see the [module docs](self)). Never fails.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::subdivide::fuzz::{decode, Mesh, Op};
+/// let (mesh, ops) = decode(&[1, 0x80, 0, 5, 7]); // the trailing byte is ignored
+/// assert_eq!(mesh, Mesh::Cube);
+/// assert_eq!(ops, vec![Op::SplitEdge { pick: 5, up: true }]);
+/// assert_eq!(decode(&[]), (Mesh::Grid, vec![]));
+/// ```
 pub fn decode(bytes: &[u8]) -> (Mesh, Vec<Op>) {
     let mesh = match bytes.first().map_or(0, |b| b % 3) {
         0 => Mesh::Grid,
@@ -110,6 +120,16 @@ fn decode_op(a: u8, b: u8, c: u8) -> Op {
 ///
 /// # Errors
 /// A message naming the op index and the law that broke (a bug in topomech).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::subdivide::fuzz::run_bytes;
+/// // One tetrahedron, then a 1→8 subdivision one level up.
+/// let r = run_bytes(&[2, 0x82, 0, 0]).unwrap();
+/// assert_eq!((r.applied, r.refused, r.max_level), (1, 0, 1));
+/// assert_eq!(r.darts, 8 * 24);
+/// ```
 pub fn run_bytes(bytes: &[u8]) -> Result<Report, String> {
     let (mesh, ops) = decode(bytes);
     match mesh {
@@ -230,6 +250,21 @@ fn masses_total(m: &LeveledMap<3>) -> Result<f64, String> {
 ///
 /// # Errors
 /// The first law broken, as a message.
+///
+/// # Examples
+///
+/// ```
+/// # use topomech::subdivide::LeveledMap;
+/// # use topomech::GMap;
+/// # use topomech::subdivide::fuzz::check_accepted;
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+/// let mut m = LeveledMap::new(map, pts);
+/// let d = m.map().darts().next().unwrap();
+/// m.subdivide_tet(d, 1).unwrap();
+/// assert!(check_accepted(&m, 1).is_ok()); // χ of a tetrahedron: 4 − 6 + 4 − 1
+/// assert!(check_accepted(&m, 2).is_err());
+/// ```
 pub fn check_accepted<const N: usize>(m: &LeveledMap<N>, chi: i64) -> Result<(), String> {
     m.check_all().map_err(|e| e.to_string())?;
     let top = m.level(m.max_level()).map_err(|e| e.to_string())?;
@@ -251,6 +286,23 @@ pub fn check_accepted<const N: usize>(m: &LeveledMap<N>, chi: i64) -> Result<(),
 ///
 /// # Errors
 /// The first law broken, as a message.
+///
+/// # Examples
+///
+/// ```
+/// # use topomech::subdivide::LeveledMap;
+/// # use topomech::GMap;
+/// # use topomech::subdivide::fuzz::check_refused;
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+/// let mut m = LeveledMap::new(map, pts);
+/// let d = m.map().darts().next().unwrap();
+/// let before = m.clone();
+/// let e = m.subdivide_tet(d, 0).unwrap_err(); // μt is already 0
+/// assert!(check_refused(&before, &m, &e).is_ok());
+/// m.subdivide_tet(d, 1).unwrap();
+/// assert!(check_refused(&before, &m, &e).is_err()); // the map changed
+/// ```
 pub fn check_refused<const N: usize>(
     before: &LeveledMap<N>,
     after: &LeveledMap<N>,

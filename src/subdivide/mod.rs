@@ -211,6 +211,19 @@ impl<const N: usize> LeveledMap<N> {
     /// Wraps a G-map as level 0: every dart gets level 0 and μ = 0. `points[v]` is the position of
     /// the vertex with id v (may be empty when geometry is not needed; new vertices then get the
     /// origin). O(capacity).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::subdivide::LeveledMap;
+    /// # use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let m = LeveledMap::new(map, pts);
+    /// let d = m.map().darts().next().unwrap();
+    /// assert_eq!((m.max_level(), m.darts_at_level(0)), (0, 24));
+    /// assert_eq!(m.mu(d), topomech::subdivide::Mu::default());
+    /// ```
     pub fn new(map: GMap<N>, points: Vec<[f64; 3]>) -> Self {
         let cap = map.capacity();
         LeveledMap {
@@ -226,41 +239,146 @@ impl<const N: usize> LeveledMap<N> {
     }
 
     /// The finest level G_k. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::subdivide::LeveledMap;
+    /// # use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mut m = LeveledMap::new(map, pts);
+    /// let d = m.map().darts().next().unwrap();
+    /// m.split_edge(d, 1).unwrap();
+    /// assert_eq!(m.map().dart_count(), 28); // the 4 darts of the edge got a partner
+    /// assert_eq!(m.map().count_cells().0[0], 5);
+    /// ```
     pub fn map(&self) -> &GMap<N> {
         &self.map
     }
 
     /// The largest level any operation has used (k). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::subdivide::LeveledMap;
+    /// # use topomech::GMap;
+    /// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+    /// let mut m = LeveledMap::new(map, vec![[0.0; 3], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]]);
+    /// let d = m.map().darts().next().unwrap();
+    /// assert_eq!(m.max_level(), 0);
+    /// m.subdivide_triangle(d, 2).unwrap();
+    /// assert_eq!(m.max_level(), 2);
+    /// ```
     pub fn max_level(&self) -> u8 {
         self.max_level
     }
 
     /// The level at which dart `d` was created. O(1). Panics if `d` was never allocated.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::subdivide::LeveledMap;
+    /// # use topomech::GMap;
+    /// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+    /// let mut m = LeveledMap::new(map, vec![[0.0; 3], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]]);
+    /// let d = m.map().darts().next().unwrap();
+    /// let mid = m.split_edge(d, 1).unwrap();
+    /// assert_eq!((m.dart_level(d), m.dart_level(mid)), (0, 1));
+    /// ```
     pub fn dart_level(&self, d: DartId) -> u8 {
         self.dart_level[d.index()]
     }
 
     /// μa, μf, μt of dart `d`. O(1). Panics if `d` was never allocated.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::subdivide::LeveledMap;
+    /// # use topomech::GMap;
+    /// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+    /// let mut m = LeveledMap::new(map, vec![[0.0; 3], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]]);
+    /// let d = m.map().darts().next().unwrap();
+    /// m.subdivide_triangle(d, 1).unwrap();
+    /// let mu = m.mu(d);
+    /// assert_eq!((mu.edge, mu.face, mu.tet), (1, 1, 0));
+    /// ```
     pub fn mu(&self, d: DartId) -> Mu {
         self.mu[d.index()]
     }
 
     /// Vertex positions keyed by vertex id (new vertices are edge midpoints). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::subdivide::LeveledMap;
+    /// # use topomech::GMap;
+    /// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+    /// let mut m = LeveledMap::new(map, vec![[0.0; 3], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]]);
+    /// let d = m.map().darts().next().unwrap();
+    /// let mid = m.split_edge(d, 1).unwrap();
+    /// assert_eq!(m.points().len(), 4);
+    /// assert_eq!(m.points()[3], m.position(mid));
+    /// ```
     pub fn points(&self) -> &[[f64; 3]] {
         &self.points
     }
 
     /// Position of the vertex of dart `d` (the origin if no geometry was given). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::subdivide::LeveledMap;
+    /// # use topomech::GMap;
+    /// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+    /// let mut m = LeveledMap::new(map, vec![[0.0; 3], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]]);
+    /// let d = m.map().darts().next().unwrap();
+    /// let (a, b) = (m.position(d), m.position(m.map().alpha_dyn(0, d)));
+    /// let mid = m.split_edge(d, 1).unwrap();
+    /// assert_eq!(m.position(mid), [0, 1, 2].map(|k| (a[k] + b[k]) / 2.0));
+    /// ```
     pub fn position(&self, d: DartId) -> [f64; 3] {
         self.points.get(self.map.vertex_id(d).index()).copied().unwrap_or([0.0; 3])
     }
 
     /// Number of darts of B_i (created at a level ≤ i). O(capacity).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::subdivide::LeveledMap;
+    /// # use topomech::GMap;
+    /// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+    /// let mut m = LeveledMap::new(map, vec![[0.0; 3], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]]);
+    /// let d = m.map().darts().next().unwrap();
+    /// m.subdivide_triangle(d, 1).unwrap();
+    /// assert_eq!(m.darts_at_level(0), 6);
+    /// assert_eq!(m.darts_at_level(1), 24);
+    /// ```
     pub fn darts_at_level(&self, i: u8) -> usize {
         self.map.darts().filter(|d| self.dart_level[d.index()] <= i).count()
     }
 
     /// αj^i(d): the image of d by αj at level i (the paper's α0^i for j = 0). O(changes of d).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::subdivide::LeveledMap;
+    /// # use topomech::GMap;
+    /// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+    /// let mut m = LeveledMap::new(map, vec![[0.0; 3], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]]);
+    /// let d = m.map().darts().next().unwrap();
+    /// let old = m.map().alpha_dyn(0, d);
+    /// let mid = m.split_edge(d, 1).unwrap();
+    /// assert_eq!(m.alpha_at(0, 0, d), old); // before the split
+    /// assert_eq!(m.alpha_at(1, 0, d), mid);
+    /// ```
     pub fn alpha_at(&self, i: u8, j: usize, d: DartId) -> DartId {
         // The history of d is in non-decreasing level order; the first change made after level i
         // holds the value the link had at level i.
@@ -274,6 +392,20 @@ impl<const N: usize> LeveledMap<N> {
     /// cell ids. O(capacity + |B_i| · n).
     ///
     /// Errors: [`LevelError::NotClosed`] if some αj^i leaves B_i (a bug of this module).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::subdivide::LeveledMap;
+    /// # use topomech::GMap;
+    /// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+    /// let mut m = LeveledMap::new(map, vec![[0.0; 3], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]]);
+    /// let d = m.map().darts().next().unwrap();
+    /// m.subdivide_triangle(d, 1).unwrap();
+    /// let g0 = m.level(0).unwrap();
+    /// assert_eq!((g0.map.dart_count(), g0.map.count_cells().0[2]), (6, 1));
+    /// assert!(m.level(1).unwrap().map.is_isomorphic(m.map()));
+    /// ```
     pub fn level(&self, i: u8) -> Result<LevelView<N>, LevelError> {
         let darts: Vec<DartId> = self.map.darts().filter(|d| self.dart_level[d.index()] <= i).collect();
         let mut index = vec![u32::MAX; self.map.capacity()];
@@ -308,6 +440,19 @@ impl<const N: usize> LeveledMap<N> {
     /// edges, μf on faces, μt on volumes, dart levels ≤ max level. O(darts · n).
     ///
     /// Errors: the first [`LevelError::MuOrder`] or [`LevelError::MuNotConstant`] found.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::subdivide::LeveledMap;
+    /// # use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mut m = LeveledMap::new(map, pts);
+    /// let d = m.map().darts().next().unwrap();
+    /// m.subdivide_tet(d, 1).unwrap();
+    /// assert!(m.check_levels().is_ok());
+    /// ```
     pub fn check_levels(&self) -> Result<(), LevelError> {
         for d in self.map.darts() {
             let mu = self.mu[d.index()];
@@ -332,6 +477,20 @@ impl<const N: usize> LeveledMap<N> {
     /// Every law: the finest map valid, [`Self::check_levels`], and every level 0..=k extracted
     /// and valid (B_{i−1} ⊂ B_i holds by construction of B_i from dart levels).
     /// O(k · capacity · n²).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::subdivide::LeveledMap;
+    /// # use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mut m = LeveledMap::new(map, pts);
+    /// let d = m.map().darts().next().unwrap();
+    /// m.subdivide_tet(d, 1).unwrap();
+    /// m.subdivide_triangle(d, 2).unwrap();
+    /// assert!(m.check_all().is_ok());
+    /// ```
     pub fn check_all(&self) -> Result<(), LevelError> {
         self.map.validate().map_err(LevelError::InvalidMap)?;
         self.check_levels()?;

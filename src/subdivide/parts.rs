@@ -90,6 +90,22 @@ pub enum LevelPartsError {
 
 /// Every malformed record of `parts` for `map` (empty when all are well formed), at most `limit`.
 /// Laws are not checked here. O(capacity + history entries).
+///
+/// # Examples
+///
+/// ```
+/// # use topomech::subdivide::LeveledMap;
+/// # use topomech::GMap;
+/// # use topomech::subdivide::record_errors;
+/// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+/// let mut m = LeveledMap::new(map, vec![[0.0; 3], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]]);
+/// let d = m.map().darts().next().unwrap();
+/// m.subdivide_triangle(d, 1).unwrap();
+/// let mut parts = m.to_parts();
+/// assert!(record_errors(m.map(), &parts, 10).is_empty());
+/// parts.max_level = 0; // every new dart now has a level above the max
+/// assert_eq!(record_errors(m.map(), &parts, 3).len(), 3);
+/// ```
 pub fn record_errors<const N: usize>(map: &GMap<N>, parts: &LevelParts, limit: usize) -> Vec<LevelPartsError> {
     let cap = map.capacity();
     let mut out = Vec::new();
@@ -173,6 +189,24 @@ impl<const N: usize> LeveledMap<N> {
     /// broken: a level not closed or not an involution at some dart, then (from
     /// [`Self::check_all`]) the finest map invalid, μ order or constancy, a level not a valid
     /// G-map.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::subdivide::LeveledMap;
+    /// # use topomech::GMap;
+    /// # use topomech::subdivide::LevelPartsError;
+    /// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+    /// let mut m = LeveledMap::new(map, vec![[0.0; 3], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]]);
+    /// let d = m.map().darts().next().unwrap();
+    /// m.split_edge(d, 1).unwrap();
+    /// let back = LeveledMap::from_parts(m.map().clone(), m.to_parts()).unwrap();
+    /// assert_eq!(back.alpha_at(0, 0, d), m.alpha_at(0, 0, d));
+    /// let mut parts = m.to_parts();
+    /// parts.darts.pop();
+    /// let e = LeveledMap::from_parts(m.map().clone(), parts).unwrap_err();
+    /// assert!(matches!(e, LevelPartsError::WrongLength { .. }));
+    /// ```
     pub fn from_parts(map: GMap<N>, parts: LevelParts) -> Result<Self, LevelPartsError> {
         if let Some(e) = record_errors(&map, &parts, 1).into_iter().next() {
             return Err(e);

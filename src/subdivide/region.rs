@@ -43,6 +43,19 @@ impl TetMasses {
     /// Masses ρ · |V_t| from the positions of the map's vertices. O(darts).
     ///
     /// Errors: [`SubdivideError::NotATetrahedron`] if a volume does not have 4 vertices.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::subdivide::LeveledMap;
+    /// # use topomech::GMap;
+    /// # use topomech::subdivide::TetMasses;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let m = LeveledMap::new(map, pts);
+    /// let masses = TetMasses::from_density(&m, 6.0).unwrap(); // the volume is 1/6
+    /// assert!((masses.total(&m) - 1.0).abs() < 1e-12);
+    /// ```
     pub fn from_density(m: &LeveledMap<3>, density: f64) -> Result<Self, SubdivideError> {
         let map = m.map();
         let mut mass = vec![0.0; map.cell_id_bound(3)];
@@ -53,12 +66,41 @@ impl TetMasses {
     }
 
     /// Σ of the tet masses of the live volumes. O(darts).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::subdivide::LeveledMap;
+    /// # use topomech::GMap;
+    /// # use topomech::subdivide::TetMasses;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mut m = LeveledMap::new(map, pts);
+    /// let d = m.map().darts().next().unwrap();
+    /// let mut masses = TetMasses::from_density(&m, 12.0).unwrap();
+    /// m.subdivide_tet_with_mass(d, 1, &mut masses).unwrap();
+    /// assert!((masses.total(&m) - 2.0).abs() < 1e-12);
+    /// ```
     pub fn total(&self, m: &LeveledMap<3>) -> f64 {
         let map = m.map();
         map.one_dart_per_cell(3).into_iter().map(|d| self.mass[map.cell_id(3, d).index()]).sum()
     }
 
     /// Vertex masses m_v = Σ_{t ∋ v} m_t / 4, indexed by vertex id. O(darts).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::subdivide::LeveledMap;
+    /// # use topomech::GMap;
+    /// # use topomech::subdivide::TetMasses;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let m = LeveledMap::new(map, pts);
+    /// let masses = TetMasses::from_density(&m, 6.0).unwrap();
+    /// let v = masses.vertex_masses(&m).unwrap();
+    /// assert!(v.iter().all(|&x| (x - 0.25).abs() < 1e-12));
+    /// ```
     pub fn vertex_masses(&self, m: &LeveledMap<3>) -> Result<Vec<f64>, SubdivideError> {
         let map = m.map();
         let mut out = vec![0.0; map.cell_id_bound(0)];
@@ -111,6 +153,15 @@ fn triangle_distance(p: [f64; 3], [a, b, c]: [[f64; 3]; 3]) -> f64 {
 
 /// Distance from `p` to the closed tetrahedron with corners `t`: 0 inside, else the distance to
 /// the nearest face. O(1).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::subdivide::tet_distance;
+/// let t = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+/// assert_eq!(tet_distance([0.1, 0.1, 0.1], t), 0.0);
+/// assert!((tet_distance([0.0, 0.0, -3.0], t) - 3.0).abs() < 1e-12);
+/// ```
 pub fn tet_distance(p: [f64; 3], t: [[f64; 3]; 4]) -> f64 {
     let faces = [[t[1], t[2], t[3]], [t[0], t[3], t[2]], [t[0], t[1], t[3]], [t[0], t[2], t[1]]];
     let vol = crate::mesh::signed_volume(t[0], t[1], t[2], t[3]);
@@ -130,6 +181,20 @@ impl LeveledMap<3> {
     ///
     /// Errors: [`SubdivideError::NotATetrahedron`] when the volume at its level is not a tet,
     /// [`SubdivideError::OpenEdge`] when it is not closed.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::subdivide::LeveledMap;
+    /// # use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mut m = LeveledMap::new(map, pts);
+    /// let d = m.map().darts().next().unwrap();
+    /// assert_eq!(m.tet_vertices(d).unwrap(), [0, 1, 2, 3]);
+    /// let children = m.subdivide_tet(d, 1).unwrap();
+    /// assert!(children.iter().all(|&c| m.tet_vertices(c).unwrap().iter().all(|&v| v < 10)));
+    /// ```
     pub fn tet_vertices(&self, d: DartId) -> Result<[u32; 4], SubdivideError> {
         let mut corners = self.tet_corners(d, self.mu[d.index()].tet)?;
         corners.sort_unstable();
@@ -138,6 +203,21 @@ impl LeveledMap<3> {
 
     /// Signed volume of the tet of `d` from the stored positions (vertex ids in increasing
     /// order). O(volume).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::subdivide::LeveledMap;
+    /// # use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mut m = LeveledMap::new(map, pts);
+    /// let d = m.map().darts().next().unwrap();
+    /// assert!((m.tet_volume(d).unwrap().abs() - 1.0 / 6.0).abs() < 1e-15);
+    /// let children = m.subdivide_tet(d, 1).unwrap();
+    /// let sum: f64 = children.iter().map(|&c| m.tet_volume(c).unwrap().abs()).sum();
+    /// assert!((sum - 1.0 / 6.0).abs() < 1e-14);
+    /// ```
     pub fn tet_volume(&self, d: DartId) -> Result<f64, SubdivideError> {
         let p = self.tet_vertices(d)?.map(|v| self.vertex_position(v));
         Ok(crate::mesh::signed_volume(p[0], p[1], p[2], p[3]))
@@ -148,6 +228,19 @@ impl LeveledMap<3> {
     }
 
     /// Whether the tet of `d` meets the closed ball B(center, radius). O(volume).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::subdivide::LeveledMap;
+    /// # use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let m = LeveledMap::new(map, pts);
+    /// let d = m.map().darts().next().unwrap();
+    /// assert!(m.tet_in_ball(d, [2.0, 0.0, 0.0], 1.5).unwrap());
+    /// assert!(!m.tet_in_ball(d, [2.0, 0.0, 0.0], 0.5).unwrap());
+    /// ```
     pub fn tet_in_ball(&self, d: DartId, center: [f64; 3], radius: f64) -> Result<bool, SubdivideError> {
         let p = self.tet_vertices(d)?.map(|v| self.vertex_position(v));
         Ok(tet_distance(center, p) <= radius)
@@ -157,6 +250,23 @@ impl LeveledMap<3> {
     /// among the children in proportion to their rest volumes (module docs). O(volume + touched).
     ///
     /// Errors: those of [`Self::subdivide_tet`]; the map and the masses are unchanged on error.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::subdivide::LeveledMap;
+    /// # use topomech::GMap;
+    /// # use topomech::subdivide::TetMasses;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mut m = LeveledMap::new(map, pts);
+    /// let d = m.map().darts().next().unwrap();
+    /// let mut masses = TetMasses::from_density(&m, 6.0).unwrap();
+    /// let children = m.subdivide_tet_with_mass(d, 1, &mut masses).unwrap();
+    /// let cell = |c| m.map().cell_id(3, c).index();
+    /// let shared: f64 = children.iter().map(|&c| masses.mass[cell(c)]).sum();
+    /// assert!((shared - 1.0).abs() < 1e-12);
+    /// ```
     pub fn subdivide_tet_with_mass(
         &mut self,
         d: DartId,
@@ -240,6 +350,21 @@ impl LeveledMap<3> {
 
     /// The tets of the finest map as vertex quadruples (positive orientation) with their μt, for
     /// output. O(darts).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::subdivide::LeveledMap;
+    /// # use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mut m = LeveledMap::new(map, pts);
+    /// let d = m.map().darts().next().unwrap();
+    /// m.subdivide_tet(d, 1).unwrap();
+    /// let tets = m.finest_tets().unwrap();
+    /// assert_eq!(tets.len(), 8);
+    /// assert!(tets.iter().all(|&(_, level, _)| level == 1));
+    /// ```
     pub fn finest_tets(&self) -> Result<Vec<([u32; 4], u8, CellId)>, SubdivideError> {
         let mut out = Vec::new();
         for d in self.map.one_dart_per_cell(3) {

@@ -83,6 +83,21 @@ impl LeveledMap<3> {
     /// its own level μt is not a tetrahedron), [`SubdivideError::FaceRefinedTooFar`] (a face of the
     /// volume was refined beyond one 1→4 step or an inner edge of a split face carries a vertex;
     /// not supported yet). The map is unchanged on error.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::subdivide::LeveledMap;
+    /// # use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mut m = LeveledMap::new(map, pts);
+    /// let d = m.map().darts().next().unwrap();
+    /// let children = m.subdivide_tet(d, 1).unwrap();
+    /// assert_eq!(m.map().count_cells().0[3], 8);
+    /// assert!(children.iter().all(|&c| m.mu(c).tet == 1));
+    /// assert!(m.subdivide_tet(children[0], 1).is_err()); // already at level 1
+    /// ```
     pub fn subdivide_tet(&mut self, d: DartId, level: u8) -> Result<[DartId; 8], SubdivideError> {
         self.check_op_level(level)?;
         if !self.map.contains(d) {

@@ -33,6 +33,22 @@ impl<const N: usize> LeveledMap<N> {
     ///
     /// Errors: [`SubdivideError::NoSuchDart`], [`SubdivideError::OpenEdge`],
     /// [`SubdivideError::AlreadyAtLevel`] (μa(d) ≥ level), the level-order errors.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::subdivide::LeveledMap;
+    /// # use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mut m = LeveledMap::new(map, pts);
+    /// let d = m.map().darts().next().unwrap();
+    /// let old = m.map().alpha_dyn(0, d);
+    /// let mid = m.split_edge(d, 1).unwrap();
+    /// assert_eq!(m.map().alpha_dyn(0, d), mid);
+    /// assert!(m.split_edge(d, 1).is_err()); // that half already has μa = 1
+    /// assert_eq!(m.alpha_at(0, 0, d), old);
+    /// ```
     pub fn split_edge(&mut self, d: DartId, level: u8) -> Result<DartId, SubdivideError> {
         self.check_op_level(level)?;
         self.check_edge(d, level)?;
@@ -100,6 +116,20 @@ impl<const N: usize> LeveledMap<N> {
     /// Errors: [`SubdivideError::WrongDimension`] (n ∉ {2, 3}), [`SubdivideError::NoSuchDart`],
     /// [`SubdivideError::AlreadyAtLevel`] (μf(d) ≥ level), [`SubdivideError::NotATriangle`],
     /// [`SubdivideError::OpenEdge`], the level-order errors. The map is unchanged on error.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::subdivide::LeveledMap;
+    /// # use topomech::GMap;
+    /// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+    /// let mut m = LeveledMap::new(map, vec![[0.0; 3], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]]);
+    /// let d = m.map().darts().next().unwrap();
+    /// let children = m.subdivide_triangle(d, 1).unwrap();
+    /// assert_eq!(children.len(), 4);
+    /// assert_eq!(m.map().count_cells().0, vec![6, 9, 4]);
+    /// assert!(m.check_all().is_ok());
+    /// ```
     pub fn subdivide_triangle(&mut self, d: DartId, level: u8) -> Result<[DartId; 4], SubdivideError> {
         if !(2..=3).contains(&N) {
             return Err(SubdivideError::WrongDimension(N));

@@ -277,7 +277,8 @@ impl Image {
     ///
     /// let png = Image::new(5, 3, [0, 128, 255]).encode_png().unwrap();
     /// assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
-    /// assert_eq!((&png[12..16], &png[16..20], &png[20..24]), (&b"IHDR"[..], &5u32.to_be_bytes()[..], &3u32.to_be_bytes()[..]));
+    /// assert_eq!(&png[12..16], b"IHDR");
+    /// assert_eq!((&png[16..20], &png[20..24]), (&5u32.to_be_bytes()[..], &3u32.to_be_bytes()[..])); // width, height
     /// assert!(Image::new(0, 3, [0; 3]).encode_png().is_err());
     /// let broken = Image { width: 2, height: 2, rgb: vec![0; 5] };
     /// assert!(broken.encode_png().is_err());

@@ -132,6 +132,17 @@ impl Reader<'_> {
 /// Format: one tag byte per operation, `tag % 8` picks it — 0, 1: create; 2: delete (u16 dart);
 /// 3: sew (u8 i, u16 a, u16 b); 4: sew-free (same fields); 5, 6: unsew (u8 i, u16 a);
 /// 7: grow (u8 kind, u16 seed). Integers are little-endian; missing bytes read as 0.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ops::{decode, KernelOp};
+///
+/// // tag 0: create; tag 2: delete, dart 5 as a little-endian u16.
+/// assert_eq!(decode(&[0, 2, 5, 0]), vec![KernelOp::CreateDart, KernelOp::DeleteDart(5)]);
+/// assert!(decode(&[]).is_empty());
+/// assert_eq!(decode(&[3]), vec![KernelOp::Sew { i: 0, a: 0, b: 0 }]); // missing bytes read as 0
+/// ```
 pub fn decode(bytes: &[u8]) -> Vec<KernelOp> {
     let mut r = Reader { bytes, pos: 0 };
     let mut ops = Vec::new();
@@ -151,6 +162,16 @@ pub fn decode(bytes: &[u8]) -> Vec<KernelOp> {
 
 /// The bytes that [`decode`] turns back into `ops` (dart numbers are kept modulo 2^16, which is
 /// all decode can produce). O(len).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ops::{decode, encode, KernelOp};
+///
+/// let ops = vec![KernelOp::CreateDart, KernelOp::Sew { i: 2, a: 1, b: 300 }, KernelOp::Unsew { i: 0, a: 7 }];
+/// assert_eq!(decode(&encode(&ops)), ops);
+/// assert_eq!(encode(&[KernelOp::DeleteDart(5)]), vec![2, 5, 0]);
+/// ```
 pub fn encode(ops: &[KernelOp]) -> Vec<u8> {
     let mut out = Vec::new();
     let u16 = |out: &mut Vec<u8>, x: u32| out.extend_from_slice(&(x as u16).to_le_bytes());
@@ -218,6 +239,19 @@ pub enum Resolved {
 
 /// Resolves dart numbers modulo the capacity and indices modulo n + 2. O(capacity) for a
 /// sew-free (it ranks the free darts), O(1) otherwise.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ops::{resolve, KernelOp, Resolved};
+/// use topomech::{DartId, GMap};
+///
+/// let mut map = GMap::<2>::new();
+/// map.create_dart().unwrap();
+/// map.create_dart().unwrap();
+/// assert_eq!(resolve(&map, &KernelOp::DeleteDart(5)), Resolved::Delete(DartId(1))); // 5 mod 2
+/// assert_eq!(resolve(&GMap::<2>::new(), &KernelOp::DeleteDart(5)), Resolved::Nothing);
+/// ```
 pub fn resolve<const N: usize>(map: &GMap<N>, op: &KernelOp) -> Resolved {
     let cap = map.capacity() as u32;
     let dart = |x: u32| DartId(x % cap.max(1));
@@ -315,6 +349,20 @@ pub enum OpError {
 /// Runs one operation. Errors are refusals by the kernel or the builder (the map is then
 /// unchanged), except [`OpError::Rebuild`]. Cost: that of the kernel operation, plus O(capacity)
 /// for a sew-free and the size of the new map for a grow.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ops::{apply, Applied, KernelOp};
+/// use topomech::GMap;
+///
+/// let mut map = GMap::<2>::new();
+/// let Ok(Applied::Created(a)) = apply(&mut map, &KernelOp::CreateDart) else { panic!() };
+/// let Ok(Applied::Created(b)) = apply(&mut map, &KernelOp::CreateDart) else { panic!() };
+/// assert!(matches!(apply(&mut map, &KernelOp::Sew { i: 2, a: 0, b: 1 }), Ok(Applied::Sewn { .. })));
+/// assert_eq!(map.alpha_dyn(2, a), b);
+/// assert!(apply(&mut map, &KernelOp::DeleteDart(0)).is_err()); // a is sewn, so not isolated
+/// ```
 pub fn apply<const N: usize>(map: &mut GMap<N>, op: &KernelOp) -> Result<Applied, OpError> {
     match resolve(map, op) {
         Resolved::Nothing => Ok(Applied::Nothing),
@@ -346,6 +394,19 @@ pub fn apply<const N: usize>(map: &mut GMap<N>, op: &KernelOp) -> Result<Applied
 pub type AlphaTable = Vec<Vec<u32>>;
 
 /// The alpha table of a map, darts ranked in increasing id order. O(darts · n).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ops::{alpha_table, check_alpha_table};
+/// use topomech::GMap;
+///
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let table = alpha_table(&map);
+/// assert_eq!(table.len(), 24);
+/// assert!(table.iter().all(|row| row.len() == 4));
+/// assert!(check_alpha_table::<3>(&table).is_ok());
+/// ```
 pub fn alpha_table<const N: usize>(map: &GMap<N>) -> AlphaTable {
     let mut rank = vec![u32::MAX; map.capacity()];
     for (r, d) in map.darts().enumerate() {
@@ -356,6 +417,18 @@ pub fn alpha_table<const N: usize>(map: &GMap<N>) -> AlphaTable {
 
 /// Checks that a table has n + 1 entries per row, in range, forming involutions that satisfy
 /// the quasi-manifold law. O(rows · n²).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ops::check_alpha_table;
+///
+/// // One edge: α0 swaps the two darts, α1 fixes both.
+/// assert!(check_alpha_table::<1>(&vec![vec![1, 0], vec![0, 1]]).is_ok());
+/// assert!(check_alpha_table::<1>(&vec![vec![1, 0], vec![1, 1]]).is_err()); // α0 not an involution
+/// assert!(check_alpha_table::<1>(&vec![vec![2, 0], vec![0, 1]]).is_err()); // image out of range
+/// assert!(check_alpha_table::<2>(&vec![vec![1, 0], vec![0, 1]]).is_err()); // rows too short
+/// ```
 pub fn check_alpha_table<const N: usize>(table: &AlphaTable) -> Result<(), OpError> {
     let k = table.len();
     for (row, r) in table.iter().enumerate() {
@@ -388,6 +461,19 @@ pub fn check_alpha_table<const N: usize>(table: &AlphaTable) -> Result<(), OpErr
 /// Why increasing i always works on a valid table: when αi is sewn, α0..α(i−1) are complete and
 /// α(i+1).. are empty, so the orbit the kernel sews is ⟨α0..α(i−2)⟩(x), which the table's αi maps
 /// isomorphically onto that of αi(x) by the quasi-manifold law.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ops::{alpha_table, append_alpha_table};
+/// use topomech::GMap;
+///
+/// let (mut map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let table = alpha_table(&map);
+/// let new = append_alpha_table(&mut map, &table).unwrap();
+/// assert_eq!((new.len(), map.dart_count()), (24, 48));
+/// assert_eq!(map.components().len(), 2);
+/// ```
 pub fn append_alpha_table<const N: usize>(map: &mut GMap<N>, table: &AlphaTable) -> Result<Vec<DartId>, OpError> {
     check_alpha_table::<N>(table)?;
     let darts = (0..table.len()).map(|_| map.create_dart()).collect::<Result<Vec<_>, _>>()?;
@@ -404,6 +490,18 @@ pub fn append_alpha_table<const N: usize>(map: &mut GMap<N>, table: &AlphaTable)
 }
 
 /// A new map holding a valid alpha table, built through the public API only. O(rows · n) sews.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ops::{alpha_table, from_alpha_table};
+/// use topomech::GMap;
+///
+/// let (map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+/// let copy: GMap<3> = from_alpha_table(&alpha_table(&map)).unwrap();
+/// assert!(copy.is_isomorphic(&map));
+/// assert!(from_alpha_table::<1>(&vec![vec![1, 0], vec![1, 1]]).is_err());
+/// ```
 pub fn from_alpha_table<const N: usize>(table: &AlphaTable) -> Result<GMap<N>, OpError> {
     let mut map = GMap::new();
     append_alpha_table(&mut map, table)?;
@@ -413,6 +511,18 @@ pub fn from_alpha_table<const N: usize>(table: &AlphaTable) -> Result<GMap<N>, O
 /// A copy of a valid map whose dart of rank r becomes dart `perm[r]` (`perm` a permutation of
 /// 0..darts), built with `create_dart` + `sew` only. The copy is isomorphic to `map`. Errors if
 /// `perm` is not a permutation of the right length, or on a kernel bug. O(darts · n) sews.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ops::{permuted_copy, random_permutation};
+/// use topomech::GMap;
+///
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let copy = permuted_copy(&map, &random_permutation(24, 7)).unwrap();
+/// assert!(copy.is_isomorphic(&map));
+/// assert!(permuted_copy(&map, &[0, 1, 2]).is_err()); // wrong length
+/// ```
 pub fn permuted_copy<const N: usize>(map: &GMap<N>, perm: &[u32]) -> Result<GMap<N>, OpError> {
     let table = alpha_table(map);
     let k = table.len();
@@ -433,6 +543,18 @@ pub fn permuted_copy<const N: usize>(map: &GMap<N>, perm: &[u32]) -> Result<GMap
 }
 
 /// A random permutation of 0..k (Fisher–Yates with SplitMix64). O(k).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ops::random_permutation;
+///
+/// let p = random_permutation(10, 42);
+/// assert_eq!(p, random_permutation(10, 42)); // deterministic
+/// let mut sorted = p.clone();
+/// sorted.sort_unstable();
+/// assert_eq!(sorted, (0..10).collect::<Vec<u32>>());
+/// ```
 pub fn random_permutation(k: usize, seed: u64) -> Vec<u32> {
     let mut rng = SplitMix64(seed);
     let mut p: Vec<u32> = (0..k as u32).collect();
@@ -444,6 +566,17 @@ pub fn random_permutation(k: usize, seed: u64) -> Vec<u32> {
 
 /// The alpha table of a seeded map of the given family for dimension N (see [`Seed`]).
 /// Dimensions other than 1, 2, 3 get a closed polygon's table lifted to n (higher αi free).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ops::{check_alpha_table, seeded_table, Seed};
+///
+/// let cube = seeded_table::<3>(Seed::Structured, 0).unwrap(); // Kuhn cube k = 1: 6 tets
+/// assert_eq!(cube.len(), 6 * 24);
+/// assert!(check_alpha_table::<3>(&cube).is_ok());
+/// assert_eq!(seeded_table::<2>(Seed::Wild, 0).unwrap().len(), 4 * 6); // tetrahedron boundary
+/// ```
 pub fn seeded_table<const N: usize>(kind: Seed, seed: u32) -> Result<AlphaTable, OpError> {
     let mut rng = SplitMix64(u64::from(seed) ^ 0x5EED_0000);
     match N {
@@ -533,6 +666,19 @@ fn distinct<const K: usize>(rng: &mut SplitMix64, points: usize) -> [u32; K] {
 /// Whether two maps are equal slot for slot: same live darts, links, cell ids and id bounds.
 /// Stronger than isomorphism; what "a refused operation leaves the map unchanged" means.
 /// O(capacity · n).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ops::same_raw;
+/// use topomech::GMap;
+///
+/// let (mut map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let before = map.clone();
+/// assert!(same_raw(&before, &map));
+/// map.create_dart().unwrap();
+/// assert!(!same_raw(&before, &map));
+/// ```
 pub fn same_raw<const N: usize>(a: &GMap<N>, b: &GMap<N>) -> bool {
     a.capacity() == b.capacity()
         && a.dart_count() == b.dart_count()
@@ -552,6 +698,20 @@ pub fn same_raw<const N: usize>(a: &GMap<N>, b: &GMap<N>) -> bool {
 /// dart is refused; a sew is undone by an unsew of the same dart (and conversely) up to
 /// isomorphism; cell counts move by the merges/splits reported; cell ids match a from-scratch
 /// labelling by orbits and the reported changes. Cost: O(darts · n²) plus one clone.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ops::{apply, check_after_op, KernelOp};
+/// use topomech::GMap;
+///
+/// let (mut map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// for op in [KernelOp::Unsew { i: 2, a: 5 }, KernelOp::DeleteDart(3), KernelOp::CreateDart] {
+///     let before = map.clone();
+///     let result = apply(&mut map, &op);
+///     assert_eq!(check_after_op(&before, &map, &op, &result), Ok(()));
+/// }
+/// ```
 pub fn check_after_op<const N: usize>(
     before: &GMap<N>,
     after: &GMap<N>,
@@ -569,6 +729,17 @@ pub fn check_after_op<const N: usize>(
 }
 
 /// The laws every valid map satisfies, whatever happened before. O(darts · n²).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ops::check_map_laws;
+/// use topomech::GMap;
+///
+/// let (map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+/// assert_eq!(check_map_laws(&map), Ok(()));
+/// assert_eq!(check_map_laws(&GMap::<2>::new()), Ok(()));
+/// ```
 pub fn check_map_laws<const N: usize>(map: &GMap<N>) -> Result<(), String> {
     map.validate().map_err(|e| format!("validate(): {e}"))?;
     let (counts, walked) = (map.count_cells(), map.count_cells_by_traversal());
@@ -595,6 +766,19 @@ pub fn check_map_laws<const N: usize>(map: &GMap<N>) -> Result<(), String> {
 /// Cell ids equal a from-scratch labelling by orbits: for every dimension, two darts share an id
 /// iff they lie in the same orbit ⟨⟩N−{i} (computed here by an independent flood over αj), every
 /// id is live, and the live ids are exactly the cells. O(darts · n²).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ops::check_cell_ids_exact;
+/// use topomech::GMap;
+///
+/// let (mut map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+/// assert_eq!(check_cell_ids_exact(&map), Ok(()));
+/// let d = map.darts().find(|&d| !map.is_free(3, d)).unwrap();
+/// map.unsew::<3>(d).unwrap(); // splits vertices, edges and the face: ids must follow
+/// assert_eq!(check_cell_ids_exact(&map), Ok(()));
+/// ```
 pub fn check_cell_ids_exact<const N: usize>(map: &GMap<N>) -> Result<(), String> {
     for dim in 0..=N {
         let label = orbit_labels(map, dim);
@@ -756,6 +940,20 @@ fn check_unsewn<const N: usize>(
 /// cell counts move by the number of merges/splits. (That d1 keeps its ids is checked by the
 /// caller, which knows d1.)
 /// O(darts · n).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ops::check_cell_changes;
+/// use topomech::GMap;
+///
+/// let (mut map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+/// let before = map.clone();
+/// let d = map.darts().find(|&d| !map.is_free(3, d)).unwrap();
+/// let changes = map.unsew::<3>(d).unwrap();
+/// assert_eq!(check_cell_changes(&before, &map, 3, &changes, false), Ok(()));
+/// assert!(check_cell_changes(&before, &map, 3, &changes, true).is_err()); // not a sew
+/// ```
 pub fn check_cell_changes<const N: usize>(
     before: &GMap<N>,
     after: &GMap<N>,
@@ -841,6 +1039,18 @@ fn reaches(edges: &[(CellId, CellId)], from: CellId, to: CellId, must_end: bool)
 
 /// Applies `ops` in order, checking [`check_after_op`] after each; returns the index and message
 /// of the first broken law. Cost: Σ over steps of O(darts · n²).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ops::{run_ops, KernelOp};
+/// use topomech::GMap;
+///
+/// let ops = [KernelOp::CreateDart, KernelOp::CreateDart, KernelOp::Sew { i: 2, a: 0, b: 1 }];
+/// let mut map = GMap::<2>::new();
+/// assert_eq!(run_ops(&mut map, &ops), Ok(()));
+/// assert_eq!((map.dart_count(), map.is_free(2, topomech::DartId(0))), (2, false));
+/// ```
 pub fn run_ops<const N: usize>(map: &mut GMap<N>, ops: &[KernelOp]) -> Result<(), String> {
     for (k, op) in ops.iter().enumerate() {
         let before = map.clone();
@@ -852,6 +1062,16 @@ pub fn run_ops<const N: usize>(map: &mut GMap<N>, ops: &[KernelOp]) -> Result<()
 
 /// Runs a whole fuzz input: byte 0 picks n = 1 + byte % 3, the rest is [`decode`]d and run from
 /// an empty map with [`run_ops`]. Returns the first broken law.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ops::run_bytes;
+///
+/// assert_eq!(run_bytes(&[]), Ok(()));
+/// // n = 3; grow a Kuhn cube, then unsew dart 10 along α3 and create a dart.
+/// assert_eq!(run_bytes(&[2, 7, 0, 1, 0, 5, 3, 10, 0, 0]), Ok(()));
+/// ```
 pub fn run_bytes(bytes: &[u8]) -> Result<(), String> {
     let Some((&first, rest)) = bytes.split_first() else { return Ok(()) };
     let ops = decode(rest);

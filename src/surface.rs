@@ -223,6 +223,16 @@ impl Builder {
 impl Surface {
     /// The axis-aligned bounding box `(min, max)` of the vertices, or `None` for an empty
     /// surface. Non-finite coordinates are skipped. O(vertices).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::surface::boundary_surface_of_tets;
+    ///
+    /// let points = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 3.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let s = boundary_surface_of_tets(&points, &[[0, 1, 2, 3]]).unwrap();
+    /// assert_eq!(s.bounds(), Some(([0.0; 3], [2.0, 3.0, 1.0])));
+    /// ```
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
         let mut it = self.positions.iter().filter(|p| p.iter().all(|c| c.is_finite()));
         let first = *it.next()?;
@@ -234,12 +244,35 @@ impl Surface {
     /// The signed volume enclosed by the triangles, Σ a·(b × c) / 6 (divergence theorem). For a
     /// closed, outward-oriented surface it is the volume of the solid; it is independent of the
     /// origin only when the surface is closed. O(triangles).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::surface::boundary_surface_of_tets;
+    ///
+    /// let (points, tets) = kuhn_cube(2); // side 2
+    /// let s = boundary_surface_of_tets(&points, &tets).unwrap();
+    /// assert!((s.enclosed_volume() - 8.0).abs() < 1e-12);
+    /// ```
     pub fn enclosed_volume(&self) -> f64 {
         let p = |i: u32| self.positions[i as usize];
         self.triangles.iter().map(|&[a, b, c]| dot(p(a), cross(p(b), p(c)))).sum::<f64>() / 6.0
     }
 
     /// Total area of the triangles. O(triangles).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::surface::boundary_surface_of_tets;
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let s = boundary_surface_of_tets(&points, &tets).unwrap();
+    /// assert_eq!(s.triangles.len(), 12);
+    /// assert!((s.area() - 6.0).abs() < 1e-12);
+    /// ```
     pub fn area(&self) -> f64 {
         let p = |i: u32| self.positions[i as usize];
         self.triangles.iter().map(|&[a, b, c]| norm(cross(sub(p(b), p(a)), sub(p(c), p(a)))) / 2.0).sum()
@@ -279,6 +312,20 @@ impl Surface {
     ///
     /// # Errors
     /// [`SurfaceError::Write`] naming `path`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::surface::boundary_surface_of_tets;
+    ///
+    /// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let s = boundary_surface_of_tets(&points, &[[0, 1, 2, 3]]).unwrap();
+    /// let path = std::env::temp_dir().join(format!("topomech_doc_{}.obj", std::process::id()));
+    /// s.write_obj(&path).unwrap();
+    /// assert_eq!(std::fs::read_to_string(&path).unwrap(), s.to_obj());
+    /// std::fs::remove_file(&path).unwrap();
+    /// assert!(s.write_obj(std::path::Path::new("/nonexistent-dir/x.obj")).is_err());
+    /// ```
     pub fn write_obj(&self, path: &Path) -> Result<(), SurfaceError> {
         crate::store::write_atomically(path, self.to_obj().as_bytes())
             .map_err(|source| SurfaceError::Write { path: path.to_path_buf(), source })

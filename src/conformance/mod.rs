@@ -149,6 +149,25 @@ fn at(step: &Option<usize>) -> String {
 
 impl ConformanceError {
     /// The step the error concerns (`None`: the initial state or not step-specific). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::conformance::{generate, replay};
+    /// # use topomech::conformance::{MeshSpec, Op, Ops, Recipe};
+    /// # let recipe = Recipe {
+    /// #     name: "one".into(),
+    /// #     description: "remove a tet".into(),
+    /// #     mesh: MeshSpec::KuhnCube { k: 1 },
+    /// #     material: topomech::mechanics::Material::default().into(),
+    /// #     ops: Ops::Listed(vec![Op::Remove { tet: 0 }]),
+    /// # };
+    /// let mut v = generate(&recipe).unwrap();
+    /// v.steps[0].expect.cells[3] = 4; // a wrong expectation after step 0
+    /// assert_eq!(replay(&v).unwrap_err().step(), Some(0));
+    /// v.initial.darts += 1; // now the initial state is already wrong
+    /// assert_eq!(replay(&v).unwrap_err().step(), None);
+    /// ```
     pub fn step(&self) -> Option<usize> {
         match self {
             ConformanceError::BadOp { step, .. }
@@ -160,6 +179,23 @@ impl ConformanceError {
     }
 
     /// The mismatching field, for a [`ConformanceError::Mismatch`]. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::conformance::{generate, replay};
+    /// # use topomech::conformance::{MeshSpec, Op, Ops, Recipe};
+    /// # let recipe = Recipe {
+    /// #     name: "one".into(),
+    /// #     description: "remove a tet".into(),
+    /// #     mesh: MeshSpec::KuhnCube { k: 1 },
+    /// #     material: topomech::mechanics::Material::default().into(),
+    /// #     ops: Ops::Listed(vec![Op::Remove { tet: 0 }]),
+    /// # };
+    /// let mut v = generate(&recipe).unwrap();
+    /// v.steps[0].expect.total_mass *= 2.0;
+    /// assert_eq!(replay(&v).unwrap_err().field(), Some("total_mass"));
+    /// ```
     pub fn field(&self) -> Option<&'static str> {
         match self {
             ConformanceError::Mismatch { field, .. } => Some(field),
@@ -198,6 +234,26 @@ impl Vector {
     ///
     /// # Errors
     /// [`ConformanceError::Io`], then as [`Vector::from_json`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::conformance::{generate, Vector};
+    /// # use topomech::conformance::{MeshSpec, Op, Ops, Recipe};
+    /// # let recipe = Recipe {
+    /// #     name: "one".into(),
+    /// #     description: "remove a tet".into(),
+    /// #     mesh: MeshSpec::KuhnCube { k: 1 },
+    /// #     material: topomech::mechanics::Material::default().into(),
+    /// #     ops: Ops::Listed(vec![Op::Remove { tet: 0 }]),
+    /// # };
+    /// let v = generate(&recipe).unwrap();
+    /// let path = std::env::temp_dir().join(format!("topomech_doc_read_{}.json", std::process::id()));
+    /// std::fs::write(&path, v.to_json()).unwrap();
+    /// assert_eq!(Vector::read(&path).unwrap(), v);
+    /// std::fs::remove_file(&path).unwrap();
+    /// assert!(Vector::read(&path).is_err()); // gone: an I/O error naming the path
+    /// ```
     pub fn read(path: &Path) -> Result<Vector, ConformanceError> {
         let text =
             std::fs::read_to_string(path).map_err(|source| ConformanceError::Io { path: path.into(), source })?;
@@ -207,6 +263,24 @@ impl Vector {
     /// The vector as pretty-printed JSON (two-space indent, arrays of numbers on one line) with a
     /// final newline: the exact bytes of the committed files, so regeneration can be compared
     /// byte for byte. O(size).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::conformance::{generate, Vector};
+    /// # use topomech::conformance::{MeshSpec, Op, Ops, Recipe};
+    /// # let recipe = Recipe {
+    /// #     name: "one".into(),
+    /// #     description: "remove a tet".into(),
+    /// #     mesh: MeshSpec::KuhnCube { k: 1 },
+    /// #     material: topomech::mechanics::Material::default().into(),
+    /// #     ops: Ops::Listed(vec![Op::Remove { tet: 0 }]),
+    /// # };
+    /// let v = generate(&recipe).unwrap();
+    /// let text = v.to_json();
+    /// assert!(text.ends_with("}\n"));
+    /// assert_eq!(Vector::from_json(&text, "mem").unwrap(), v);
+    /// ```
     pub fn to_json(&self) -> String {
         let pretty = serde_json::to_string_pretty(self).expect("a vector always serialises (plain data)");
         let mut s = flatten_scalar_arrays(&pretty);
@@ -219,6 +293,21 @@ impl Vector {
 ///
 /// # Errors
 /// [`ConformanceError::Io`] when the directory cannot be listed.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::conformance::vector_files;
+///
+/// let dir = std::env::temp_dir().join(format!("topomech_doc_vectors_{}", std::process::id()));
+/// std::fs::create_dir_all(&dir).unwrap();
+/// for name in ["b.json", "notes.txt", "a.json"] {
+///     std::fs::write(dir.join(name), "{}").unwrap();
+/// }
+/// assert_eq!(vector_files(&dir).unwrap(), vec![dir.join("a.json"), dir.join("b.json")]);
+/// std::fs::remove_dir_all(&dir).unwrap();
+/// assert!(vector_files(&dir).is_err());
+/// ```
 pub fn vector_files(dir: &Path) -> Result<Vec<PathBuf>, ConformanceError> {
     let io = |source| ConformanceError::Io { path: dir.into(), source };
     let mut files = Vec::new();

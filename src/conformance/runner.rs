@@ -68,6 +68,24 @@ struct Runner {
 ///
 /// # Errors
 /// As [`generate_in`].
+///
+/// # Examples
+///
+/// ```
+/// use topomech::conformance::generate;
+/// # use topomech::conformance::{MeshSpec, Op, Ops, Recipe};
+/// # let recipe = Recipe {
+/// #     name: "one".into(),
+/// #     description: "remove a tet".into(),
+/// #     mesh: MeshSpec::KuhnCube { k: 1 },
+/// #     material: topomech::mechanics::Material::default().into(),
+/// #     ops: Ops::Listed(vec![Op::Remove { tet: 0 }]),
+/// # };
+/// let v = generate(&recipe).unwrap();
+/// assert_eq!((v.initial.cells, v.initial.components), ([8, 19, 18, 6], 1));
+/// assert_eq!(v.steps.len(), 1);
+/// assert_eq!(v.steps[0].expect.darts, 5 * 24);
+/// ```
 pub fn generate(recipe: &Recipe) -> Result<Vector, ConformanceError> {
     generate_in(recipe, Path::new("."))
 }
@@ -136,6 +154,24 @@ fn vector(recipe: &Recipe, initial: Expect, steps: Vec<Step>) -> Vector {
 ///
 /// # Errors
 /// As [`replay_in`].
+///
+/// # Examples
+///
+/// ```
+/// use topomech::conformance::{generate, replay};
+/// # use topomech::conformance::{MeshSpec, Op, Ops, Recipe};
+/// # let recipe = Recipe {
+/// #     name: "one".into(),
+/// #     description: "remove a tet".into(),
+/// #     mesh: MeshSpec::KuhnCube { k: 1 },
+/// #     material: topomech::mechanics::Material::default().into(),
+/// #     ops: Ops::Listed(vec![Op::Remove { tet: 0 }]),
+/// # };
+/// let mut v = generate(&recipe).unwrap();
+/// assert!(replay(&v).is_ok());
+/// v.steps[0].expect.components = 2;
+/// assert!(replay(&v).is_err());
+/// ```
 pub fn replay(v: &Vector) -> Result<(), ConformanceError> {
     replay_in(v, Path::new("."))
 }
@@ -151,6 +187,26 @@ pub fn replay(v: &Vector) -> Result<(), ConformanceError> {
 /// The first problem: [`ConformanceError::Invalid`], [`ConformanceError::Mesh`],
 /// [`ConformanceError::BadOp`], [`ConformanceError::Mismatch`] (step, field, expected, got) or
 /// [`ConformanceError::Law`].
+///
+/// # Examples
+///
+/// ```
+/// use topomech::conformance::{generate, replay_in};
+/// use std::path::Path;
+/// # use topomech::conformance::{MeshSpec, Op, Ops, Recipe};
+/// # let recipe = Recipe {
+/// #     name: "one".into(),
+/// #     description: "remove a tet".into(),
+/// #     mesh: MeshSpec::KuhnCube { k: 1 },
+/// #     material: topomech::mechanics::Material::default().into(),
+/// #     ops: Ops::Listed(vec![Op::Remove { tet: 0 }]),
+/// # };
+/// let v = generate(&recipe).unwrap();
+/// assert!(replay_in(&v, Path::new("/no/such/root")).is_ok()); // the mesh is generated, no file read
+/// let mut bad = v.clone();
+/// bad.tolerance = -1.0;
+/// assert!(replay_in(&bad, Path::new(".")).is_err());
+/// ```
 pub fn replay_in(v: &Vector, root: &Path) -> Result<(), ConformanceError> {
     check_header(v)?;
     let mut r = Runner::new(&v.name, &v.mesh, v.material, root)?;

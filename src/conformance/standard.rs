@@ -20,6 +20,17 @@ use super::schema::{MeshSpec, Op, Vector};
 use super::ConformanceError;
 
 /// The recipes of the standard set, in file-name order. O(k³) for the cube meshes.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::conformance::standard::recipes;
+///
+/// let names: Vec<String> = recipes().into_iter().map(|r| r.name).collect();
+/// assert_eq!(names.len(), 8);
+/// assert!(names.windows(2).all(|w| w[0] < w[1])); // file-name order
+/// assert!(names.iter().any(|n| n == "single_tet_remove"));
+/// ```
 pub fn recipes() -> Vec<Recipe> {
     vec![
         chain_remove_middle(),
@@ -37,6 +48,18 @@ pub fn recipes() -> Vec<Recipe> {
 ///
 /// # Errors
 /// As [`generate_in`].
+///
+/// # Examples
+///
+/// ```
+/// use topomech::conformance::{replay_in, standard::generate_all};
+/// use std::path::Path;
+///
+/// let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+/// let vectors = generate_all(root).unwrap();
+/// assert_eq!(vectors.len(), 8);
+/// assert!(vectors.iter().all(|v| replay_in(v, root).is_ok()));
+/// ```
 pub fn generate_all(root: &std::path::Path) -> Result<Vec<Vector>, ConformanceError> {
     recipes().iter().map(|r| generate_in(r, root)).collect()
 }

@@ -30,6 +30,16 @@ pub const EDGES: [(usize, usize); 6] = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), 
 pub const G: Vec3 = [0.0, 0.0, -9.81];
 
 /// The material of the harness's bodies.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::ops::material;
+///
+/// let m = material();
+/// assert!(m.density > 0.0 && m.young > 0.0);
+/// assert_eq!(m, material());
+/// ```
 pub fn material() -> Material {
     Material { density: 1.7, young: 900.0, damping: 0.002, viscosity: 0.5 }
 }
@@ -40,10 +50,32 @@ pub struct Uf(Vec<usize>);
 
 impl Uf {
     /// n singletons. O(n).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::ops::Uf;
+    ///
+    /// let mut uf = Uf::new(4);
+    /// assert_ne!(uf.find(0), uf.find(1));
+    /// uf.union(0, 1);
+    /// assert_eq!(uf.find(0), uf.find(1));
+    /// ```
     pub fn new(n: usize) -> Self {
         Uf((0..n).collect())
     }
     /// The representative of x. O(α(n)) amortised.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::ops::Uf;
+    ///
+    /// let mut uf = Uf::new(3);
+    /// assert_eq!(uf.find(2), 2); // a singleton is its own representative
+    /// uf.union(2, 0);
+    /// assert_eq!(uf.find(2), uf.find(0));
+    /// ```
     pub fn find(&mut self, mut x: usize) -> usize {
         while self.0[x] != x {
             self.0[x] = self.0[self.0[x]];
@@ -52,6 +84,18 @@ impl Uf {
         x
     }
     /// Joins the classes of a and b. O(α(n)) amortised.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::ops::Uf;
+    ///
+    /// let mut uf = Uf::new(5);
+    /// uf.union(0, 1);
+    /// uf.union(3, 1);
+    /// assert_eq!(uf.find(3), uf.find(0));
+    /// assert_ne!(uf.find(4), uf.find(0));
+    /// ```
     pub fn union(&mut self, a: usize, b: usize) {
         let (a, b) = (self.find(a), self.find(b));
         self.0[a] = b;
@@ -77,6 +121,15 @@ pub struct Oracle {
 }
 
 /// Points of face f of a tet (the face opposite corner f), sorted. O(1).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::ops::face_points;
+///
+/// assert_eq!(face_points(&[7, 3, 5, 1], 0), [1, 3, 5]); // opposite corner 0 (point 7), sorted
+/// assert_eq!(face_points(&[7, 3, 5, 1], 3), [3, 5, 7]);
+/// ```
 pub fn face_points(tet: &[u32; 4], f: usize) -> [u32; 3] {
     let mut p = [0u32; 3];
     let mut k = 0;
@@ -92,6 +145,17 @@ pub fn face_points(tet: &[u32; 4], f: usize) -> [u32; 3] {
 
 impl Oracle {
     /// The uncut mesh. O(T).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::ops::{jittered_cube, Oracle};
+    ///
+    /// let (points, tets) = jittered_cube(1, 0);
+    /// let oracle = Oracle::new(points, tets);
+    /// assert_eq!(oracle.inner.len(), 6); // the Kuhn cube's 6 tets share 6 inner faces
+    /// assert!(oracle.alive.iter().all(|&a| a) && oracle.cut.is_empty());
+    /// ```
     pub fn new(points: Vec<Vec3>, tets: Vec<[u32; 4]>) -> Self {
         let mut seen: HashMap<[u32; 3], (usize, usize)> = HashMap::new();
         let mut inner = HashMap::new();
@@ -111,6 +175,18 @@ impl Oracle {
 
     /// Inner faces still glued (both tets alive, not dissociated), sorted for determinism.
     /// O(F log F).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::ops::{jittered_cube, Oracle};
+    ///
+    /// let (points, tets) = jittered_cube(1, 0);
+    /// let mut oracle = Oracle::new(points, tets);
+    /// let first = oracle.glued()[0].0;
+    /// oracle.cut.insert(first);
+    /// assert_eq!(oracle.glued().len(), 5);
+    /// ```
     pub fn glued(&self) -> Vec<Glued> {
         let mut v: Vec<_> = self
             .inner
@@ -123,11 +199,35 @@ impl Oracle {
     }
 
     /// Which face triple the face (t, f) is. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::ops::{face_points, jittered_cube, Oracle};
+    ///
+    /// let (points, tets) = jittered_cube(1, 0);
+    /// let oracle = Oracle::new(points, tets.clone());
+    /// assert_eq!(oracle.triple(2, 1), face_points(&tets[2], 1));
+    /// ```
     pub fn triple(&self, t: usize, f: usize) -> [u32; 3] {
         face_points(&self.tets[t], f)
     }
 
     /// Expected [V, E, F, T], boundary faces, components. O(T α(T)).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::ops::{jittered_cube, Oracle};
+    ///
+    /// let (points, tets) = jittered_cube(1, 0);
+    /// let mut oracle = Oracle::new(points, tets);
+    /// let ([v, e, f, t], boundary, comps) = oracle.counts();
+    /// assert_eq!(v as i64 - e as i64 + f as i64 - t as i64, 1); // a ball: χ = 1
+    /// assert_eq!((v, t, boundary, comps), (8, 6, 12, 1));
+    /// oracle.cut.extend(oracle.glued().iter().map(|g| g.0)); // dissociate every inner face
+    /// assert_eq!(oracle.counts(), ([24, 36, 24, 6], 24, 6));
+    /// ```
     pub fn counts(&self) -> ([usize; 4], usize, usize) {
         let n = self.tets.len();
         let (mut uv, mut ue, mut ut) = (Uf::new(4 * n), Uf::new(6 * n), Uf::new(n));
@@ -170,6 +270,16 @@ impl Oracle {
 
     /// Centroid of tet t computed as the cut module documents it: mean over its sorted vertices.
     /// O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::ops::Oracle;
+    ///
+    /// let points = vec![[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0], [0.0, 0.0, 4.0]];
+    /// let oracle = Oracle::new(points, vec![[0, 1, 2, 3]]);
+    /// assert_eq!(oracle.centroid(0), [1.0, 1.0, 1.0]);
+    /// ```
     pub fn centroid(&self, t: usize) -> Vec3 {
         let mut ids = self.tets[t];
         ids.sort_unstable();
@@ -224,6 +334,17 @@ pub struct Harness {
 }
 
 /// Σ k_e over the live edges of `body`. O(darts).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::ops::{jittered_cube, total_stiffness, Harness};
+///
+/// let (points, tets) = jittered_cube(1, 3);
+/// let h = Harness::new(points, tets).unwrap();
+/// assert!(total_stiffness(&h.body) > 0.0);
+/// assert_eq!(total_stiffness(&h.body), h.stiffness);
+/// ```
 pub fn total_stiffness(body: &Body) -> f64 {
     let map = body.map();
     map.one_dart_per_cell(1).into_iter().map(|d| body.attrs().edge_stiffness(map.cell_id(1, d))).sum()
@@ -239,6 +360,18 @@ impl Harness {
     ///
     /// # Errors
     /// The body could not be built (degenerate tet, non-finite point, bad mesh).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::ops::{jittered_cube, Harness};
+    ///
+    /// let (points, tets) = jittered_cube(1, 3);
+    /// let h = Harness::new(points.clone(), tets).unwrap();
+    /// assert_eq!(h.removed_mass, 0.0);
+    /// assert!(h.mass > 0.0 && h.check().is_ok());
+    /// assert!(Harness::new(points, vec![[0, 0, 1, 2]]).is_err()); // degenerate tet
+    /// ```
     pub fn new(points: Vec<Vec3>, tets: Vec<[u32; 4]>) -> Result<Self, crate::mechanics::ModelError> {
         let (body, _) = Body::from_tets(&points, &tets, material())?;
         let projection = Projection::build(&body, G);
@@ -254,6 +387,19 @@ impl Harness {
     ///
     /// # Errors
     /// A description of what went wrong (an operation failed or misbehaved).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::ops::{jittered_cube, Harness, Op};
+    ///
+    /// let (points, tets) = jittered_cube(1, 3);
+    /// let mut h = Harness::new(points, tets).unwrap();
+    /// h.apply(Op::Remove(0)).unwrap();
+    /// assert!(h.removed_mass > 0.0);
+    /// h.apply(Op::RemoveAgain(0)).unwrap(); // refused by the body, as it must be
+    /// assert_eq!(h.oracle.alive.iter().filter(|&&a| a).count(), 5);
+    /// ```
     pub fn apply(&mut self, op: Op) -> Result<(), String> {
         let mut touched = TouchedCells::default();
         match op {
@@ -363,6 +509,19 @@ impl Harness {
     ///
     /// # Errors
     /// A description of the first law found broken.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::ops::{jittered_cube, Harness, Op};
+    ///
+    /// let (points, tets) = jittered_cube(1, 3);
+    /// let mut h = Harness::new(points, tets).unwrap();
+    /// h.apply(Op::Dissociate(0)).unwrap();
+    /// assert_eq!(h.check(), Ok(()));
+    /// h.removed_mass += 1.0; // the bookkeeping no longer matches the body
+    /// assert!(h.check().unwrap_err().contains("mass"));
+    /// ```
     pub fn check(&self) -> Result<(), String> {
         let map = self.body.map();
         map.validate().map_err(|e| format!("validate: {e}"))?;
@@ -430,6 +589,17 @@ pub const MAX_OPS: usize = 24;
 /// tag mod 13 picks Dissociate (0–5), DissociateBoundary (6), Remove (7–8), RemoveAgain (9),
 /// Incise (10), Tear (11–12); lo + 256·hi is the index; dir packs a direction (3 bits x,
 /// 3 bits y, 2 bits z ∈ {0.1, 0.4, 0.7, 1}). A trailing partial group is ignored. O(len).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::ops::{decode, Op};
+///
+/// let s = decode(&[1, 9, 7, 2, 0, 0, 13, 1, 0, 0, 5]); // the trailing byte is a partial group
+/// assert_eq!((s.k, s.seed), (2, 9));
+/// assert_eq!(s.ops, vec![Op::Remove(2), Op::Dissociate(1)]);
+/// assert_eq!(decode(&[]).ops, vec![]);
+/// ```
 pub fn decode(bytes: &[u8]) -> Scenario {
     let k = 1 + (bytes.first().copied().unwrap_or(0) & 1) as usize;
     let seed = bytes.get(1).copied().unwrap_or(0) as u64;
@@ -454,6 +624,18 @@ fn decode_op([tag, lo, hi, dir]: [u8; 4]) -> Op {
 
 /// The Kuhn cube of side k with every point moved by up to ±0.1 per coordinate (seeded), so no
 /// centroid falls exactly on a cutting plane. O(k³).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::ops::jittered_cube;
+/// use topomech::generate::kuhn_cube;
+///
+/// let ((points, tets), (exact, exact_tets)) = (jittered_cube(1, 5), kuhn_cube(1));
+/// assert_eq!(tets, exact_tets);
+/// let moved = points.iter().zip(&exact).all(|(p, q)| (0..3).all(|c| (p[c] - q[c]).abs() <= 0.1));
+/// assert!(moved && points != exact);
+/// ```
 pub fn jittered_cube(k: usize, seed: u64) -> (Vec<Vec3>, Vec<[u32; 4]>) {
     let (mut points, tets) = kuhn_cube(k);
     let mut rng = SplitMix64(seed);
@@ -470,6 +652,17 @@ pub fn jittered_cube(k: usize, seed: u64) -> (Vec<Vec3>, Vec<[u32; 4]>) {
 ///
 /// # Errors
 /// The step and a description of the first failure.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::ops::{jittered_cube, run_ops, Harness, Op};
+///
+/// let (points, tets) = jittered_cube(1, 2);
+/// let mut h = Harness::new(points, tets).unwrap();
+/// let ops = [Op::Dissociate(3), Op::DissociateBoundary(0), Op::Incise(1, [0.0, 0.6, 0.8])];
+/// assert_eq!(run_ops(&mut h, &ops), Ok(()));
+/// ```
 pub fn run_ops(harness: &mut Harness, ops: &[Op]) -> Result<(), String> {
     harness.check().map_err(|e| format!("before any op: {e}"))?;
     for (i, &op) in ops.iter().enumerate() {
@@ -483,6 +676,16 @@ pub fn run_ops(harness: &mut Harness, ops: &[Op]) -> Result<(), String> {
 ///
 /// # Errors
 /// As [`run_ops`].
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::ops::run_bytes;
+///
+/// assert_eq!(run_bytes(&[]), Ok(()));
+/// // k = 1, seed 4: dissociate glued face 2, then remove live tet 0.
+/// assert_eq!(run_bytes(&[0, 4, 0, 2, 0, 0, 7, 0, 0, 0]), Ok(()));
+/// ```
 pub fn run_bytes(bytes: &[u8]) -> Result<(), String> {
     let s = decode(bytes);
     let (points, tets) = jittered_cube(s.k, s.seed);

@@ -47,11 +47,33 @@ pub struct CellArray<T> {
 
 impl<T: Clone> CellArray<T> {
     /// An array of `len` copies of `fill`. O(len).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::embedding::CellArray;
+    ///
+    /// let a = CellArray::filled(3, 7u8);
+    /// assert_eq!(a.as_slice(), &[7, 7, 7]);
+    /// assert!(CellArray::filled(0, 7u8).is_empty());
+    /// ```
     pub fn filled(len: usize, fill: T) -> Self {
         CellArray { values: vec![fill; len] }
     }
 
     /// Extends the array with `fill` up to `len` slots (never shrinks). Amortized O(growth).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::embedding::CellArray;
+    ///
+    /// let mut a = CellArray::from_vec(vec![1, 2]);
+    /// a.grow(4, 0);
+    /// assert_eq!(a.as_slice(), &[1, 2, 0, 0]);
+    /// a.grow(2, 9); // never shrinks nor overwrites
+    /// assert_eq!(a.as_slice(), &[1, 2, 0, 0]);
+    /// ```
     pub fn grow(&mut self, len: usize, fill: T) {
         if self.values.len() < len {
             self.values.resize(len, fill);
@@ -61,31 +83,90 @@ impl<T: Clone> CellArray<T> {
 
 impl<T> CellArray<T> {
     /// An array taking ownership of `values` (slot i = cell id i). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::embedding::CellArray;
+    /// use topomech::CellId;
+    ///
+    /// let a = CellArray::from_vec(vec!['a', 'b', 'c']);
+    /// assert_eq!((a.len(), a[CellId(2)]), (3, 'c'));
+    /// ```
     pub fn from_vec(values: Vec<T>) -> Self {
         CellArray { values }
     }
 
     /// Number of slots. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::embedding::CellArray;
+    ///
+    /// assert_eq!(CellArray::filled(5, 0.0).len(), 5);
+    /// assert_eq!(CellArray::<f64>::default().len(), 0);
+    /// ```
     pub fn len(&self) -> usize {
         self.values.len()
     }
 
     /// Whether there is no slot. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::embedding::CellArray;
+    ///
+    /// assert!(CellArray::<u32>::default().is_empty());
+    /// assert!(!CellArray::from_vec(vec![1u32]).is_empty());
+    /// ```
     pub fn is_empty(&self) -> bool {
         self.values.is_empty()
     }
 
     /// The attribute of `id`, or `None` past the end. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::embedding::CellArray;
+    /// use topomech::CellId;
+    ///
+    /// let a = CellArray::from_vec(vec![10, 20]);
+    /// assert_eq!(a.get(CellId(1)), Some(&20));
+    /// assert_eq!(a.get(CellId(2)), None); // past the end: no panic
+    /// ```
     pub fn get(&self, id: CellId) -> Option<&T> {
         self.values.get(id.index())
     }
 
     /// All slots as a slice (slot i = cell id i). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::embedding::CellArray;
+    ///
+    /// let a = CellArray::from_vec(vec![1.0, 2.0]);
+    /// assert_eq!(a.as_slice().iter().sum::<f64>(), 3.0);
+    /// ```
     pub fn as_slice(&self) -> &[T] {
         &self.values
     }
 
     /// All slots as a mutable slice. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::embedding::CellArray;
+    /// use topomech::CellId;
+    ///
+    /// let mut a = CellArray::filled(3, 1);
+    /// a.as_mut_slice().iter_mut().for_each(|x| *x *= 2);
+    /// assert_eq!(a[CellId(2)], 2);
+    /// ```
     pub fn as_mut_slice(&mut self) -> &mut [T] {
         &mut self.values
     }
@@ -194,17 +275,55 @@ impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
     }
 
     /// The map (read-only). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// assert_eq!(body.map().count_cells().0, vec![8, 19, 18, 6]);
+    /// assert_eq!(body.map().dart_count(), 6 * 24);
+    /// ```
     pub fn map(&self) -> &GMap<N> {
         &self.map
     }
 
     /// The attributes. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let total = body.attrs().total_vertex_mass(body.map());
+    /// assert!((total - Material::default().density).abs() < 1e-12); // the unit cube
+    /// ```
     pub fn attrs(&self) -> &E {
         &self.attrs
     }
 
     /// The attributes, mutable (state variables such as positions change every time step). The
     /// map stays untouchable. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    /// use topomech::CellId;
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// body.attrs_mut().position[CellId(0)] = [0.0, 0.0, -1.0];
+    /// assert_eq!(body.attrs().position[CellId(0)], [0.0, 0.0, -1.0]);
+    /// assert_eq!(body.version(), 0); // attributes are not topology
+    /// ```
     pub fn attrs_mut(&mut self) -> &mut E {
         &mut self.attrs
     }
@@ -236,6 +355,22 @@ impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
     /// # Errors
     /// [`EmbedError::Sew`] when the kernel refuses (nothing changed); [`EmbedError::Check`] under
     /// `expensive-checks` when the attributes fail their check afterwards.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+    /// let e = body.map().alpha::<3>(d);
+    /// body.unsew(3, d).unwrap();
+    /// assert!(body.sew(3, d, d).is_err()); // refused by the kernel
+    /// let changes = body.sew(3, d, e).unwrap();
+    /// assert!(changes.merges(0).count() > 0 && body.check().is_ok());
+    /// ```
     pub fn sew(&mut self, i: usize, d1: DartId, d2: DartId) -> Result<CellChanges, EmbedError<E::Error>> {
         let changes = self.map.sew_dyn(i, d1, d2)?;
         self.apply(&changes);

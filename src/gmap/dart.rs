@@ -25,6 +25,17 @@ pub struct DartId(pub u32);
 
 impl DartId {
     /// The index as `usize`, for indexing flat arrays.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::DartId;
+    ///
+    /// let mut seen = vec![false; 4];
+    /// seen[DartId(3).index()] = true;
+    /// assert_eq!(DartId(3).index(), 3);
+    /// assert_eq!(seen, [false, false, false, true]);
+    /// ```
     #[inline(always)]
     pub fn index(self) -> usize {
         self.0 as usize
@@ -65,6 +76,17 @@ pub struct CellId(pub u32);
 
 impl CellId {
     /// The index as `usize`, for indexing embedding arrays.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let mut darts_per_vertex = vec![0; map.cell_id_bound(0)];
+    /// map.darts().for_each(|d| darts_per_vertex[map.vertex_id(d).index()] += 1);
+    /// assert_eq!(darts_per_vertex, vec![6; 4]); // 6 darts around each corner of a tet
+    /// ```
     #[inline(always)]
     pub fn index(self) -> usize {
         self.0 as usize

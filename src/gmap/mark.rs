@@ -11,6 +11,18 @@ pub struct DartSet {
 
 impl DartSet {
     /// An empty set able to hold darts below `capacity` without growing.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::gmap::DartSet;
+    /// use topomech::DartId;
+    ///
+    /// let mut set = DartSet::with_capacity(100);
+    /// assert!(set.is_empty());
+    /// assert!(set.insert(DartId(99)));
+    /// assert_eq!(set.len(), 1);
+    /// ```
     pub fn with_capacity(capacity: usize) -> Self {
         DartSet { bits: vec![0; capacity.div_ceil(64)], count: 0 }
     }
@@ -92,16 +104,53 @@ impl DartSet {
     }
 
     /// Number of darts in the set. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::gmap::DartSet;
+    /// use topomech::DartId;
+    ///
+    /// let mut set = DartSet::with_capacity(8);
+    /// set.insert(DartId(1));
+    /// set.insert(DartId(1)); // already there
+    /// set.insert(DartId(5));
+    /// assert_eq!(set.len(), 2);
+    /// ```
     pub fn len(&self) -> usize {
         self.count
     }
 
     /// Whether the set is empty. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::gmap::DartSet;
+    /// use topomech::DartId;
+    ///
+    /// let mut set = DartSet::with_capacity(8);
+    /// assert!(set.is_empty());
+    /// set.insert(DartId(3));
+    /// assert!(!set.is_empty());
+    /// ```
     pub fn is_empty(&self) -> bool {
         self.count == 0
     }
 
     /// Empties the set. O(capacity / 64).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::gmap::DartSet;
+    /// use topomech::DartId;
+    ///
+    /// let mut set = DartSet::with_capacity(200);
+    /// (0..200).for_each(|k| drop(set.insert(DartId(k))));
+    /// set.clear();
+    /// assert!(set.is_empty() && !set.contains(DartId(150)));
+    /// ```
     pub fn clear(&mut self) {
         self.bits.iter_mut().for_each(|w| *w = 0);
         self.count = 0;
@@ -119,11 +168,40 @@ pub struct Mark {
 
 impl Mark {
     /// Marks d; returns whether it was unmarked. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let (mut map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+    /// let d = map.darts().next().unwrap();
+    /// let mut mark = map.reserve_mark();
+    /// assert!(mark.mark(d)); // newly marked
+    /// assert!(!mark.mark(d)); // already marked
+    /// assert!(mark.is_marked(d) && mark.count() == 1);
+    /// mark.unmark(d);
+    /// map.free_mark(mark);
+    /// ```
     pub fn mark(&mut self, d: DartId) -> bool {
         self.set.insert(d)
     }
 
     /// Unmarks d; returns whether it was marked. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let (mut map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+    /// let d = map.darts().next().unwrap();
+    /// let mut mark = map.reserve_mark();
+    /// assert!(!mark.unmark(d)); // was not marked
+    /// mark.mark(d);
+    /// assert!(mark.unmark(d) && !mark.is_marked(d));
+    /// map.free_mark(mark);
+    /// ```
     pub fn unmark(&mut self, d: DartId) -> bool {
         self.set.remove(d)
     }

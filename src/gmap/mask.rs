@@ -99,12 +99,32 @@ impl AlphaMask {
     }
 
     /// Whether αi is in the set.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::AlphaMask;
+    ///
+    /// let m = AlphaMask::of(&[0, 2]);
+    /// assert!(m.contains(0) && m.contains(2));
+    /// assert!(!m.contains(1) && !m.contains(3));
+    /// ```
     #[inline(always)]
     pub const fn contains(self, i: usize) -> bool {
         self.0 & (1 << i) != 0
     }
 
     /// The indices in the set, in increasing order.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::AlphaMask;
+    ///
+    /// assert_eq!(AlphaMask::of(&[3, 0, 1]).indices().collect::<Vec<_>>(), vec![0, 1, 3]);
+    /// assert_eq!(AlphaMask::all(2).indices().count(), 3);
+    /// assert_eq!(AlphaMask::EMPTY.indices().next(), None);
+    /// ```
     pub fn indices(self) -> impl Iterator<Item = usize> {
         (0..8).filter(move |&i| self.contains(i))
     }

@@ -104,6 +104,18 @@ impl SpringSystem {
 
     /// Appends a slot with mass `mass` (fixed when `fixed` or `mass <= 0`) and viscosity
     /// `viscosity`, with no spring; returns its index. O(1) amortised.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// assert_eq!(sys.push_slot(2.0, false, 0.1), 0);
+    /// assert_eq!(sys.push_slot(3.0, true, 0.0), 1); // fixed: infinite inertia
+    /// assert_eq!(sys.inv_mass, vec![0.5, 0.0]);
+    /// assert_eq!(sys.incident(1).count(), 0); // no spring yet
+    /// ```
     pub fn push_slot(&mut self, mass: f64, fixed: bool, viscosity: f64) -> usize {
         self.mass.push(0.0);
         self.inv_mass.push(0.0);
@@ -237,16 +249,54 @@ impl SpringSystem {
     ///
     /// # Errors
     /// [`IncidenceError`] naming the first slot found wrong.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// (0..3).for_each(|_| drop(sys.push_slot(1.0, false, 0.0)));
+    /// sys.push_spring([0, 1], 1.0, 1.0, 0.0);
+    /// sys.push_spring([1, 2], 1.0, 1.0, 0.0);
+    /// sys.swap_remove_spring(0);
+    /// assert!(sys.check_incidence().is_ok());
+    /// assert_eq!(sys.incident(0).count(), 0);
+    /// ```
     pub fn check_incidence(&self) -> Result<(), IncidenceError> {
         self.inc.check(self.slots(), &self.ends)
     }
 
     /// Number of vertex slots. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, Projection};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let p = Projection::build(&body, [0.0; 3]);
+    /// assert_eq!(p.system.slots(), 8); // one slot per vertex of the cube
+    /// ```
     pub fn slots(&self) -> usize {
         self.mass.len()
     }
 
     /// Number of springs. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// (0..3).for_each(|_| drop(sys.push_slot(1.0, false, 0.0)));
+    /// assert_eq!(sys.springs(), 0);
+    /// sys.push_spring([0, 2], 1.0, 1.0, 0.0);
+    /// assert_eq!((sys.springs(), sys.slots()), (1, 3));
+    /// ```
     pub fn springs(&self) -> usize {
         self.ends.len()
     }
@@ -325,6 +375,18 @@ impl SpringSystem {
     }
 
     /// Total force on slot i from gravity, viscosity and the springs (given F_s in `sf`). O(degree).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// sys.gravity = [0.0, 0.0, -10.0];
+    /// sys.push_slot(2.0, false, 0.5); // mass 2, viscosity 0.5, no spring
+    /// let (v, sf) = ([[1.0, 0.0, 0.0]], []);
+    /// assert_eq!(sys.vertex_force(0, &v, &sf), [-0.5, 0.0, -20.0]); // m·g − γ·v
+    /// ```
     #[inline(always)]
     pub fn vertex_force(&self, i: usize, v: &[Vec3], sf: &[Vec3]) -> Vec3 {
         let s = self.gather(i, sf);

@@ -228,6 +228,18 @@ impl Stepper {
     }
 
     /// The configuration. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::{Integrator, SpringSystem, StepConfig, Stepper};
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// sys.push_slot(1.0, false, 0.0);
+    /// let config = StepConfig { parallel: true, ..StepConfig::new(Integrator::Symplectic, 0.002) };
+    /// let stepper = Stepper::new(config, &sys, &[[0.0; 3]], &[[0.0; 3]]).unwrap();
+    /// assert_eq!(stepper.config(), &config);
+    /// ```
     pub fn config(&self) -> &StepConfig {
         &self.config
     }

@@ -208,6 +208,19 @@ impl Mechanics {
     }
 
     /// Young's modulus of volume `t`. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let material = Material { young: 1234.0, ..Material::default() };
+    /// let (body, _) = Body::from_tets(&points, &tets, material).unwrap();
+    /// let vols = body.map().one_dart_per_cell(3);
+    /// assert!(vols.iter().all(|&d| body.attrs().tet_young(body.map().cell_id(3, d)) == 1234.0));
+    /// ```
     pub fn tet_young(&self, t: CellId) -> f64 {
         self.tet_young[t]
     }

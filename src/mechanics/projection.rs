@@ -296,6 +296,21 @@ impl Projection {
     }
 
     /// The edge of spring s. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, Projection};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let p = Projection::build(&body, [0.0; 3]);
+    /// let mut edges: Vec<_> = (0..p.system.springs()).map(|s| p.edge_of_spring(s)).collect();
+    /// edges.sort_unstable();
+    /// edges.dedup();
+    /// assert_eq!(edges.len(), 19); // one spring per edge, every edge once
+    /// ```
     pub fn edge_of_spring(&self, s: usize) -> CellId {
         self.spring_edge[s]
     }
@@ -489,6 +504,20 @@ impl TouchedCells {
     }
 
     /// Whether nothing was recorded. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::dissociate_face;
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, TouchedCells};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// assert!(TouchedCells::default().is_empty());
+    /// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+    /// assert!(!dissociate_face(&mut body, d).unwrap().touched.is_empty());
+    /// ```
     pub fn is_empty(&self) -> bool {
         self.vertices.is_empty() && self.edges.is_empty()
     }

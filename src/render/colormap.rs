@@ -41,6 +41,17 @@ impl Colormap {
     }
 
     /// The colour of `value` on the scale `lo..=hi` (the middle colour when `lo == hi`). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::render::Colormap;
+    ///
+    /// let m = Colormap::Sequential;
+    /// assert_eq!(m.color_in(15.0, 10.0, 20.0), m.color(0.5));
+    /// assert_eq!(m.color_in(99.0, 10.0, 20.0), m.color(1.0)); // clamped
+    /// assert_eq!(m.color_in(3.0, 4.0, 4.0), m.color(0.5)); // empty scale: the middle colour
+    /// ```
     pub fn color_in(self, value: f64, lo: f64, hi: f64) -> [u8; 3] {
         let t = if hi > lo { (value - lo) / (hi - lo) } else { 0.5 };
         self.color(t)

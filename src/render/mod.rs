@@ -148,6 +148,15 @@ impl Camera {
     pub const FIT_FOV_Y_DEG: f64 = 30.0;
 
     /// A camera at `eye` looking at `target`. O(1); checked when used.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::render::Camera;
+    ///
+    /// let c = Camera::looking_at([0.0, -5.0, 0.0], [0.0; 3], [0.0, 0.0, 1.0], 40.0);
+    /// assert_eq!((c.eye[1], c.target, c.fov_y_deg), (-5.0, [0.0; 3], 40.0));
+    /// ```
     pub fn looking_at(eye: Vec3, target: Vec3, up: Vec3, fov_y_deg: f64) -> Camera {
         Camera { eye, target, up, fov_y_deg }
     }
@@ -199,18 +208,50 @@ pub struct Image {
 
 impl Image {
     /// A `width` × `height` image filled with `background`. O(pixels).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::render::Image;
+    ///
+    /// let img = Image::new(4, 2, [1, 2, 3]);
+    /// assert_eq!(img.rgb.len(), 3 * 4 * 2);
+    /// assert_eq!(img.pixel(3, 1), Some([1, 2, 3]));
+    /// ```
     pub fn new(width: u32, height: u32, background: [u8; 3]) -> Image {
         let n = width as usize * height as usize;
         Image { width, height, rgb: background.repeat(n) }
     }
 
     /// The colour of pixel (x, y), `None` outside the image. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::render::Image;
+    ///
+    /// let img = Image::new(4, 2, [9, 9, 9]);
+    /// assert_eq!(img.pixel(0, 0), Some([9, 9, 9]));
+    /// assert_eq!((img.pixel(4, 0), img.pixel(0, 2)), (None, None)); // outside
+    /// ```
     pub fn pixel(&self, x: u32, y: u32) -> Option<[u8; 3]> {
         let i = self.index(x, y)?;
         self.rgb.get(i..i + 3).map(|p| [p[0], p[1], p[2]])
     }
 
     /// Sets pixel (x, y); does nothing outside the image. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::render::Image;
+    ///
+    /// let mut img = Image::new(3, 3, [0; 3]);
+    /// img.set_pixel(1, 2, [255, 0, 0]);
+    /// img.set_pixel(7, 7, [255, 0, 0]); // outside: ignored
+    /// assert_eq!(img.pixel(1, 2), Some([255, 0, 0]));
+    /// assert_eq!(img.rgb.iter().filter(|&&b| b == 255).count(), 1);
+    /// ```
     pub fn set_pixel(&mut self, x: u32, y: u32, color: [u8; 3]) {
         if let Some(p) = self.index(x, y).and_then(|i| self.rgb.get_mut(i..i + 3)) {
             p.copy_from_slice(&color);
@@ -228,6 +269,20 @@ impl Image {
     /// # Errors
     /// [`RenderError::BadSize`] for a zero dimension; [`RenderError::BadBuffer`] when `rgb` does
     /// not hold 3 bytes per pixel.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::render::Image;
+    ///
+    /// let png = Image::new(5, 3, [0, 128, 255]).encode_png().unwrap();
+    /// assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    /// assert_eq!(&png[12..16], b"IHDR");
+    /// assert_eq!((&png[16..20], &png[20..24]), (&5u32.to_be_bytes()[..], &3u32.to_be_bytes()[..])); // width, height
+    /// assert!(Image::new(0, 3, [0; 3]).encode_png().is_err());
+    /// let broken = Image { width: 2, height: 2, rgb: vec![0; 5] };
+    /// assert!(broken.encode_png().is_err());
+    /// ```
     pub fn encode_png(&self) -> Result<Vec<u8>, RenderError> {
         if self.width == 0 || self.height == 0 || self.width > i32::MAX as u32 || self.height > i32::MAX as u32 {
             return Err(RenderError::BadSize { width: self.width, height: self.height });
@@ -243,6 +298,19 @@ impl Image {
     ///
     /// # Errors
     /// As [`Image::encode_png`]; [`RenderError::Write`] naming `path`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::render::Image;
+    ///
+    /// let img = Image::new(2, 2, [10, 20, 30]);
+    /// let path = std::env::temp_dir().join(format!("topomech_doc_{}.png", std::process::id()));
+    /// img.write_png(&path).unwrap();
+    /// assert_eq!(std::fs::read(&path).unwrap(), img.encode_png().unwrap());
+    /// std::fs::remove_file(&path).unwrap();
+    /// assert!(img.write_png(std::path::Path::new("/nonexistent-dir/x.png")).is_err());
+    /// ```
     pub fn write_png(&self, path: &Path) -> Result<(), RenderError> {
         let bytes = self.encode_png()?;
         crate::store::write_atomically(path, &bytes)
@@ -273,6 +341,18 @@ pub enum Shading {
 impl Shading {
     /// [`Shading::PerTriangle`] with `range` = (min, max) of the finite `values` ((0, 1) if there
     /// are none). O(values).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::render::{Colormap, Shading};
+    ///
+    /// let Shading::PerTriangle { range, .. } = Shading::by_values(vec![2.0, f64::NAN, -1.0], Colormap::Sequential)
+    /// else { panic!() };
+    /// assert_eq!(range, (-1.0, 2.0)); // NaN skipped
+    /// let Shading::PerTriangle { range, .. } = Shading::by_values(vec![], Colormap::Diverging) else { panic!() };
+    /// assert_eq!(range, (0.0, 1.0));
+    /// ```
     pub fn by_values(values: Vec<f64>, colormap: Colormap) -> Shading {
         let finite = values.iter().copied().filter(|v| v.is_finite());
         let range = finite.fold(None, |r: Option<(f64, f64)>, v| Some(r.map_or((v, v), |(a, b)| (a.min(v), b.max(v)))));
@@ -336,6 +416,22 @@ impl Default for Style {
 ///
 /// # Errors
 /// As [`render_styled`].
+///
+/// # Examples
+///
+/// ```
+/// use topomech::render::{render, Camera, Shading};
+/// use topomech::{generate::kuhn_cube, surface::boundary_surface_of_tets};
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let s = boundary_surface_of_tets(&points, &tets).unwrap();
+/// let camera = Camera::fit([0.0; 3], [1.0; 3], [0.0, 1.0, 0.0]);
+/// let img = render(&s, &Shading::Flat([200, 0, 0]), &camera, 32, 32).unwrap();
+/// assert_eq!(img.pixel(0, 0), Some([255, 255, 255])); // background in the corner
+/// let [r, g, b] = img.pixel(16, 16).unwrap(); // the cube's face in the middle, lit
+/// assert!(r > 0 && g == 0 && b == 0);
+/// assert!(render(&s, &Shading::Colors(vec![]), &camera, 32, 32).is_err()); // 0 colours for 12 triangles
+/// ```
 pub fn render(
     surface: &Surface,
     shading: &Shading,
@@ -358,6 +454,21 @@ pub fn render(
 /// [`RenderError::BadSize`], [`RenderError::BadCamera`], [`RenderError::BadTriangle`],
 /// [`RenderError::NonFinitePosition`], and for the shading [`RenderError::ValueCount`],
 /// [`RenderError::BadRange`], [`RenderError::NonFiniteValue`]. Nothing is drawn on error.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::render::{render_styled, Camera, Shading, Style};
+/// use topomech::{generate::kuhn_cube, surface::boundary_surface_of_tets};
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let s = boundary_surface_of_tets(&points, &tets).unwrap();
+/// let camera = Camera::fit([0.0; 3], [1.0; 3], [0.0, 1.0, 0.0]);
+/// let style = Style { background: [0, 0, 0], ambient: 1.0, legend: false };
+/// let img = render_styled(&s, &Shading::Flat([10, 200, 30]), &camera, 32, 32, &style).unwrap();
+/// assert_eq!(img.pixel(16, 16), Some([10, 200, 30])); // ambient 1: the base colour exactly
+/// assert_eq!(img.pixel(0, 0), Some([0, 0, 0]));
+/// ```
 pub fn render_styled(
     surface: &Surface,
     shading: &Shading,

@@ -64,6 +64,18 @@ pub fn adler32(bytes: &[u8]) -> u32 {
 
 /// The zlib stream (RFC 1950) of `data`: header 0x78 0x01, one fixed-Huffman DEFLATE block,
 /// Adler-32 of `data`. Any inflater returns `data` exactly. O(len · chain depth).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::render::png::{adler32, zlib_compress};
+///
+/// let data = vec![7u8; 10_000];
+/// let z = zlib_compress(&data);
+/// assert_eq!(&z[..2], &[0x78, 0x01]);
+/// assert_eq!(&z[z.len() - 4..], &adler32(&data).to_be_bytes()[..]);
+/// assert!(z.len() < 100); // one long run: a few back-references
+/// ```
 pub fn zlib_compress(data: &[u8]) -> Vec<u8> {
     let mut w = BitWriter { out: vec![0x78, 0x01], acc: 0, n: 0 };
     w.bits(1, 1); // BFINAL

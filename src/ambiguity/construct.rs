@@ -13,6 +13,20 @@ use crate::BuildError;
 /// A glued pair of sides (a, b) 2-sews start(a) to start(b) when `same_direction` (the word
 /// `… x … x …`, orientation-reversing for consistently walked polygons) or to end(b) otherwise
 /// (`… x … x⁻¹ …`). Unglued sides are boundary.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::construct::Gluing;
+///
+/// // The word (a b a b): both pairs of opposite sides glued the same direction, the real
+/// // projective plane (non-orientable, χ = 1).
+/// let rp2 = Gluing { sides: vec![4], pairs: vec![[0, 2, 1], [1, 3, 1]] };
+/// let map = rp2.build().unwrap();
+/// assert_eq!(rp2.word(), "(a b a b)");
+/// assert!(!map.is_orientable() && map.boundary_darts().count() == 0);
+/// assert_eq!(map.euler_characteristic(), 1);
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub struct Gluing {
     /// Number of sides of each polygon (1-gons and 2-gons are allowed in a G-map).
@@ -210,6 +224,17 @@ fn matchings_of(used: &mut [bool], prefix: &mut Vec<(u16, u16)>, out: &mut Vec<V
 
 /// A tetrahedral complex with some interior faces dissociated: `GMap::from_tets` then one
 /// `unsew::<3>` per cut, a cut naming the two tets whose common face is dissociated.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::construct::CutComplex;
+///
+/// let ring = CutComplex { points: 5, tets: vec![[0, 1, 2, 3], [0, 1, 3, 4], [0, 1, 4, 2]], cuts: vec![[0, 1]] };
+/// let map = ring.build().unwrap();
+/// assert_eq!(map.count_cells().0[0], 6); // point 3 split in two; the ring stays connected
+/// assert_eq!(map.components().len(), 1);
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub struct CutComplex {
     /// Number of points.

@@ -110,6 +110,21 @@ impl Why {
 }
 
 /// Isomorphism classes of the candidates added so far.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::finder::surfaces;
+/// use topomech::graph::{GraphKind, Multiplicity};
+///
+/// let finder = surfaces(4, 4);
+/// let groups = finder.groups(GraphKind::VertexEdge, Multiplicity::Ignore);
+/// assert!(!groups.is_empty());
+/// for g in groups {
+///     let (a, b) = (&finder.classes()[g.classes[0]].map, &finder.classes()[g.classes[1]].map);
+///     assert!(!a.is_isomorphic(b)); // different objects, one vertex–edge graph
+/// }
+/// ```
 #[derive(Debug, Default)]
 pub struct Finder<const N: usize> {
     classes: Vec<Candidate<N>>,

@@ -25,6 +25,19 @@ use crate::gmap::{DartId, GMap};
 use crate::BuildError;
 
 /// A tet list over `points` points, with the naive cut rule of the [module docs](self).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::indexed::IndexedModel;
+///
+/// // Three tets around the edge (0, 1): cutting one face separates point 3 only.
+/// let mut model = IndexedModel::new(5, &[[0, 1, 2, 3], [0, 1, 3, 4], [0, 1, 4, 2]]);
+/// let out = model.cut(0, 1).unwrap();
+/// assert_eq!(out.kept, vec![0, 1]);
+/// assert_eq!(out.duplicated, vec![(3, 5)]);
+/// assert_eq!(model.origin[5], 3);
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct IndexedModel {
     /// Number of points (grows when points are duplicated).

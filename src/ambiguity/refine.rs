@@ -20,6 +20,19 @@ use crate::ambiguity::indexed::IndexedModel;
 const PAIRS: [(usize, usize); 6] = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
 
 /// An [`IndexedModel`] with point positions and the edge → midpoint hash.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::refine::RefinedModel;
+///
+/// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 1.0]];
+/// let mut r = RefinedModel::new(&points, &[[0, 1, 2, 3], [1, 2, 3, 4]]);
+/// r.subdivide(0, None);
+/// r.subdivide(1, None); // then its neighbour (tet indices never change)
+/// assert_eq!(r.hanging_edges(), 0);
+/// assert_eq!(r.model.points, 5 + 9); // the shared face's three midpoints are reused
+/// ```
 #[derive(Debug, Clone)]
 pub struct RefinedModel {
     /// The tet list (cuts go through [`IndexedModel::cut`]).

@@ -78,6 +78,21 @@ pub struct Run {
 
 impl Run {
     /// The symptoms of this run, in [`Symptom::ALL`] order.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::{campaign::run_cuts, campaign::Symptom, construct::glued_faces};
+    /// use topomech::{generate, GMap};
+    ///
+    /// let run = run_cuts(5, &[[0, 1, 2, 3], [1, 2, 3, 4]], &[[0, 1]]).unwrap();
+    /// assert!(run.symptoms().is_empty()); // the three points of the face are duplicated: all fine
+    /// let (points, tets) = generate::kuhn_cube(2);
+    /// let (map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+    /// let runs = glued_faces(&map).into_iter().map(|f| run_cuts(points.len(), &tets, &[f]).unwrap());
+    /// let lost: Vec<_> = runs.filter(|r| r.symptoms().contains(&Symptom::FaceStillShared)).collect();
+    /// assert!(!lost.is_empty() && lost.iter().all(|r| r.symptoms().contains(&Symptom::GluingDiffers)));
+    /// ```
     pub fn symptoms(&self) -> Vec<Symptom> {
         let a = &self.audit;
         let flags = [
@@ -93,6 +108,18 @@ impl Run {
 
 /// Runs `cuts` on both models built from `complex` (its own `cuts` are ignored). O(tets + cuts ·
 /// (orbit + fans) + darts · n).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::campaign::{run_cuts, CampaignError};
+///
+/// let tets = [[0, 1, 2, 3], [1, 2, 3, 4]];
+/// let run = run_cuts(5, &tets, &[[0, 1]]).unwrap();
+/// assert_eq!(run.audit.gmap_vertices, 8);
+/// assert!(!run.audit.ambiguous() && !run.skeleton_unchanged); // the cut split vertices
+/// assert!(matches!(run_cuts(5, &tets, &[[0, 1], [0, 1]]), Err(CampaignError::Construct(_))));
+/// ```
 pub fn run_cuts(points: usize, tets: &[[u32; 4]], cuts: &[[u32; 2]]) -> Result<Run, CampaignError> {
     let (mut gmap, _) = GMap::<3>::from_tets(points, tets)?;
     let mut model = IndexedModel::new(points, tets);
@@ -109,6 +136,21 @@ pub fn run_cuts(points: usize, tets: &[[u32; 4]], cuts: &[[u32; 2]]) -> Result<R
 }
 
 /// `k` distinct faces of `faces`, uniformly (a partial Fisher–Yates shuffle). O(faces).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::campaign::random_cuts;
+/// use topomech::generate::SplitMix64;
+///
+/// let faces: Vec<[u32; 2]> = (0..10).map(|t| [t, t + 1]).collect();
+/// let mut picked = random_cuts(&faces, 4, &mut SplitMix64(1));
+/// assert!(picked.iter().all(|f| faces.contains(f)));
+/// picked.sort_unstable();
+/// picked.dedup();
+/// assert_eq!(picked.len(), 4);
+/// assert_eq!(random_cuts(&faces, 99, &mut SplitMix64(1)).len(), 10);
+/// ```
 pub fn random_cuts(faces: &[[u32; 2]], k: usize, rng: &mut SplitMix64) -> Vec<[u32; 2]> {
     let mut pool = faces.to_vec();
     let k = k.min(pool.len());
@@ -141,6 +183,20 @@ pub struct KStats {
 
 /// Runs `sequences` random sequences of `k` cuts on the mesh. The first run with each symptom is
 /// returned too. O(sequences · (tets + k · fans + darts)).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::campaign::{campaign_k, CampaignError};
+/// use topomech::generate::{self, SplitMix64};
+///
+/// let (points, tets) = generate::kuhn_cube(1);
+/// let (stats, firsts) = campaign_k(points.len(), &tets, 2, 5, &mut SplitMix64(1)).unwrap();
+/// assert_eq!((stats.sequences, stats.gmap_invalid), (5, 0));
+/// assert!(firsts.len() <= 5 && stats.wrong <= 5);
+/// let too_many = campaign_k(points.len(), &tets, 7, 1, &mut SplitMix64(1));
+/// assert_eq!(too_many.unwrap_err(), CampaignError::TooFewFaces { asked: 7, faces: 6 });
+/// ```
 pub fn campaign_k(
     points: usize,
     tets: &[[u32; 4]],
@@ -176,6 +232,17 @@ pub fn campaign_k(
 
 /// Delta debugging (ddmin): a 1-minimal sublist of `items` on which `test` still holds, assuming
 /// it holds on `items`. At most `budget` calls of `test`.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::campaign::ddmin;
+///
+/// let items: Vec<u32> = (0..20).collect();
+/// assert_eq!(ddmin(&items, 1000, &mut |s| s.contains(&13)), vec![13]);
+/// assert_eq!(ddmin(&items, 1000, &mut |s| s.contains(&2) && s.contains(&17)), vec![2, 17]);
+/// assert_eq!(ddmin(&items, 0, &mut |_| true), items); // no budget: unchanged
+/// ```
 pub fn ddmin<T: Clone>(items: &[T], budget: usize, test: &mut dyn FnMut(&[T]) -> bool) -> Vec<T> {
     let mut current = items.to_vec();
     let mut n = 2usize;
@@ -209,6 +276,18 @@ pub fn ddmin<T: Clone>(items: &[T], budget: usize, test: &mut dyn FnMut(&[T]) ->
 
 /// The complex restricted to the tets `keep` (indices into `c.tets`), points renumbered densely in
 /// order of first use, cuts renumbered; `None` if a cut names a dropped tet. O(tets + cuts).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::{campaign::sub_complex, construct::CutComplex};
+///
+/// let c = CutComplex { points: 5, tets: vec![[0, 1, 2, 3], [1, 2, 3, 4]], cuts: vec![[0, 1]] };
+/// let second = CutComplex { cuts: vec![], ..c.clone() };
+/// assert_eq!(sub_complex(&c, &[1]), None); // the cut names the dropped tet 0
+/// let alone = sub_complex(&second, &[1]).unwrap();
+/// assert_eq!((alone.points, alone.tets), (4, vec![[0, 1, 2, 3]]));
+/// ```
 pub fn sub_complex(c: &CutComplex, keep: &[usize]) -> Option<CutComplex> {
     let mut tet_map = vec![u32::MAX; c.tets.len()];
     let mut point_map = vec![u32::MAX; c.points];
@@ -238,6 +317,20 @@ pub fn sub_complex(c: &CutComplex, keep: &[usize]) -> Option<CutComplex> {
 
 /// Whether `symptom` shows after running the complex's cuts on both models (false when the
 /// complex does not build or a cut is impossible).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::campaign::{shows, Symptom};
+/// use topomech::ambiguity::construct::CutComplex;
+///
+/// let pair = CutComplex { points: 5, tets: vec![[0, 1, 2, 3], [1, 2, 3, 4]], cuts: vec![[0, 1]] };
+/// assert!(Symptom::ALL.iter().all(|&s| !shows(&pair, s)));
+/// let uncut = CutComplex { cuts: vec![], ..pair.clone() };
+/// assert!(shows(&uncut, Symptom::SkeletonUnchanged)); // no cut, nothing split
+/// let twice = CutComplex { cuts: vec![[0, 1], [0, 1]], ..pair };
+/// assert!(!shows(&twice, Symptom::SkeletonUnchanged)); // the second cut is impossible
+/// ```
 pub fn shows(c: &CutComplex, symptom: Symptom) -> bool {
     run_cuts(c.points, &c.tets, &c.cuts).is_ok_and(|run| run.symptoms().contains(&symptom))
 }
@@ -245,6 +338,22 @@ pub fn shows(c: &CutComplex, symptom: Symptom) -> bool {
 /// Shrinks a complex showing `symptom` to a 1-minimal one: first the cut list, then the tets
 /// (starting from the tets sharing a point with a cut face), each by [`ddmin`] within `budget`
 /// tests. Returns the input unchanged if it does not show the symptom.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::campaign::{shows, shrink, Symptom};
+/// use topomech::ambiguity::construct::{glued_faces, CutComplex};
+/// use topomech::{generate, GMap};
+///
+/// let (points, tets) = generate::kuhn_cube(2);
+/// let (map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+/// let one_cut = |f: [u32; 2]| CutComplex { points: points.len(), tets: tets.clone(), cuts: vec![f] };
+/// let big = glued_faces(&map).into_iter().map(one_cut).find(|c| shows(c, Symptom::FaceStillShared)).unwrap();
+/// let small = shrink(&big, Symptom::FaceStillShared, 500);
+/// assert!(shows(&small, Symptom::FaceStillShared));
+/// assert!(small.tets.len() < big.tets.len() && small.cuts.len() == 1);
+/// ```
 pub fn shrink(c: &CutComplex, symptom: Symptom, budget: usize) -> CutComplex {
     if !shows(c, symptom) {
         return c.clone();

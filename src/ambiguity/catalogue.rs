@@ -74,6 +74,18 @@ pub struct Catalogue {
 }
 
 /// Runs the exhaustive search within `bounds`. O(enumeration · (darts² + VF2)).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::catalogue::{catalogue, Bounds};
+///
+/// let cat = catalogue(Bounds::SMALL);
+/// assert!(cat.tried[0] > 0 && cat.tried[1] > 0);
+/// assert!(!cat.pairs.is_empty());
+/// assert!(cat.pairs.iter().all(|p| p.check().is_ok()));
+/// assert!(cat.counts.iter().all(|c| c.ambiguous_classes >= 2 * c.groups));
+/// ```
 pub fn catalogue(bounds: Bounds) -> Catalogue {
     let f2 = surfaces(bounds.max_sides, bounds.max_polygon);
     let f3 = complexes(bounds.points, bounds.max_tets, bounds.glue_tets, bounds.glue_pairs);
@@ -122,6 +134,15 @@ fn mult_name(m: Multiplicity) -> &'static str {
 }
 
 /// The snake-case name of a reason.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::{catalogue::why_name, finder::Why};
+///
+/// assert_eq!(why_name(Why::VertexIdentification), "vertex_identification");
+/// assert_eq!(why_name(Why::Gluing), "gluing");
+/// ```
 pub fn why_name(w: Why) -> &'static str {
     match w {
         Why::Orientation => "orientation",
@@ -138,6 +159,19 @@ fn describe<const N: usize>(a: &Candidate<N>, b: &Candidate<N>) -> String {
 }
 
 /// A construction in one line: a gluing word, or tets and cuts.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::catalogue::origin_text;
+/// use topomech::ambiguity::construct::{CutComplex, Gluing};
+/// use topomech::ambiguity::finder::Origin;
+///
+/// let torus = Gluing { sides: vec![4], pairs: vec![[0, 2, 0], [1, 3, 0]] };
+/// assert_eq!(origin_text(&Origin::Gluing(torus)), "(a b a' b')");
+/// let tet = CutComplex { points: 4, tets: vec![[0, 1, 2, 3]], cuts: vec![] };
+/// assert_eq!(origin_text(&Origin::Complex(tet)), "tets [[0, 1, 2, 3]] cut []");
+/// ```
 pub fn origin_text(o: &Origin) -> String {
     match o {
         Origin::Gluing(g) => g.word(),
@@ -149,6 +183,20 @@ pub fn origin_text(o: &Origin) -> String {
 /// The vectors of a campaign's first runs: for each symptom shown, the run shrunk to a 1-minimal
 /// complex; for the skeleton symptom also the pair (uncut map, cut map) sharing their vertex–edge
 /// graph. `budget` bounds the tests of each ddmin.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::{campaign::campaign_k, catalogue::campaign_vectors};
+/// use topomech::generate::{self, SplitMix64};
+///
+/// let (points, tets) = generate::kuhn_cube(2);
+/// let (_, firsts) = campaign_k(points.len(), &tets, 3, 20, &mut SplitMix64(7)).unwrap();
+/// let (indexed, pairs) = campaign_vectors(points.len(), &tets, &firsts, 200).unwrap();
+/// assert!(!indexed.is_empty());
+/// assert!(indexed.iter().all(|v| v.check().is_ok() && v.complex.tets.len() < tets.len()));
+/// assert!(pairs.iter().all(|p| p.check().is_ok()));
+/// ```
 pub fn campaign_vectors(
     points: usize,
     tets: &[[u32; 4]],
@@ -190,6 +238,15 @@ fn candidate(c: &CutComplex, name: &str) -> Result<Candidate<3>, VectorError> {
 }
 
 /// The snake-case name of a symptom.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::{campaign::Symptom, catalogue::symptom_name};
+///
+/// assert_eq!(symptom_name(Symptom::FaceStillShared), "face_still_shared");
+/// assert!(Symptom::ALL.iter().all(|&s| !symptom_name(s).contains(' ')));
+/// ```
 pub fn symptom_name(s: Symptom) -> &'static str {
     match s {
         Symptom::FaceStillShared => "face_still_shared",

@@ -13,6 +13,20 @@ use crate::BuildError;
 /// A glued pair of sides (a, b) 2-sews start(a) to start(b) when `same_direction` (the word
 /// `… x … x …`, orientation-reversing for consistently walked polygons) or to end(b) otherwise
 /// (`… x … x⁻¹ …`). Unglued sides are boundary.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::construct::Gluing;
+///
+/// // The word (a b a b): both pairs of opposite sides glued the same direction, the real
+/// // projective plane (non-orientable, χ = 1).
+/// let rp2 = Gluing { sides: vec![4], pairs: vec![[0, 2, 1], [1, 3, 1]] };
+/// let map = rp2.build().unwrap();
+/// assert_eq!(rp2.word(), "(a b a b)");
+/// assert!(!map.is_orientable() && map.boundary_darts().count() == 0);
+/// assert_eq!(map.euler_characteristic(), 1);
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub struct Gluing {
     /// Number of sides of each polygon (1-gons and 2-gons are allowed in a G-map).
@@ -48,12 +62,35 @@ pub enum ConstructError {
 
 impl Gluing {
     /// Total number of sides.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::construct::Gluing;
+    ///
+    /// let g = Gluing { sides: vec![4, 3], pairs: vec![[0, 4, 0]] };
+    /// assert_eq!(g.side_count(), 7);
+    /// assert_eq!(g.build().unwrap().dart_count(), 2 * 7);
+    /// ```
     pub fn side_count(&self) -> usize {
         self.sides.iter().map(|&s| s as usize).sum()
     }
 
     /// The 2-G-map (4 darts per side). Errors name the first bad side or refused sew.
     /// O(sides).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::construct::{ConstructError, Gluing};
+    ///
+    /// let torus = Gluing { sides: vec![4], pairs: vec![[0, 2, 0], [1, 3, 0]] };
+    /// let map = torus.build().unwrap();
+    /// assert_eq!(map.count_cells().0, vec![1, 2, 1]);
+    /// assert!(map.is_orientable() && map.boundary_darts().count() == 0);
+    /// let twice = Gluing { sides: vec![3], pairs: vec![[0, 1, 0], [1, 2, 0]] };
+    /// assert!(matches!(twice.build(), Err(ConstructError::BadSide { side: 1, .. })));
+    /// ```
     pub fn build(&self) -> Result<GMap<2>, ConstructError> {
         let total = self.side_count();
         let mut map = GMap::<2>::new();
@@ -91,6 +128,17 @@ impl Gluing {
 
     /// The gluing as a word per polygon: letters for glued sides (`x'` = x⁻¹), `·` for boundary
     /// sides, e.g. `(a b a' b')` for the torus. O(sides).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::construct::Gluing;
+    ///
+    /// let klein = Gluing { sides: vec![4], pairs: vec![[0, 2, 0], [1, 3, 1]] };
+    /// assert_eq!(klein.word(), "(a b a' b)");
+    /// let open = Gluing { sides: vec![3, 1], pairs: vec![] };
+    /// assert_eq!(open.word(), "(· · ·) (·)");
+    /// ```
     pub fn word(&self) -> String {
         let total = self.side_count();
         let mut label = vec!["·".to_string(); total];
@@ -113,6 +161,17 @@ impl Gluing {
 /// polygons in non-increasing size, every partial matching of sides with both directions.
 /// Connectedness is not required here (the finder drops disconnected maps). Bounded: for
 /// `max_sides` = 6 there are a few thousand. The recursion depth is at most `max_sides`.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::construct::gluings;
+///
+/// // Polygons (1), (2), (1 1): 1 + 3 + 3 gluings (none, or one pair in either direction).
+/// let all = gluings(2, 2);
+/// assert_eq!(all.len(), 7);
+/// assert!(all.iter().all(|g| g.side_count() <= 2 && g.build().is_ok()));
+/// ```
 pub fn gluings(max_sides: usize, max_polygon: usize) -> Vec<Gluing> {
     let mut out = Vec::new();
     let mut partitions = Vec::new();
@@ -165,6 +224,17 @@ fn matchings_of(used: &mut [bool], prefix: &mut Vec<(u16, u16)>, out: &mut Vec<V
 
 /// A tetrahedral complex with some interior faces dissociated: `GMap::from_tets` then one
 /// `unsew::<3>` per cut, a cut naming the two tets whose common face is dissociated.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::construct::CutComplex;
+///
+/// let ring = CutComplex { points: 5, tets: vec![[0, 1, 2, 3], [0, 1, 3, 4], [0, 1, 4, 2]], cuts: vec![[0, 1]] };
+/// let map = ring.build().unwrap();
+/// assert_eq!(map.count_cells().0[0], 6); // point 3 split in two; the ring stays connected
+/// assert_eq!(map.components().len(), 1);
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub struct CutComplex {
     /// Number of points.
@@ -178,6 +248,19 @@ pub struct CutComplex {
 impl CutComplex {
     /// The 3-G-map after the cuts. Errors: the build's, or a cut whose tets no longer share a
     /// glued face. O(tets + cuts).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::construct::{glued_faces, ConstructError, CutComplex};
+    ///
+    /// let c = CutComplex { points: 5, tets: vec![[0, 1, 2, 3], [1, 2, 3, 4]], cuts: vec![[0, 1]] };
+    /// let map = c.build().unwrap();
+    /// assert!(glued_faces(&map).is_empty());
+    /// assert_eq!(map.count_cells().0, vec![8, 12, 8, 2]);
+    /// let again = CutComplex { cuts: vec![[0, 1], [0, 1]], ..c };
+    /// assert!(matches!(again.build(), Err(ConstructError::NoSharedFace(0, 1))));
+    /// ```
     pub fn build(&self) -> Result<GMap<3>, ConstructError> {
         let (mut map, _) = GMap::<3>::from_tets(self.points, &self.tets)?;
         for &[t1, t2] in &self.cuts {
@@ -190,6 +273,19 @@ impl CutComplex {
 
 /// A dart of tet `t1` that is 3-sewn to tet `t2`, for maps laid out by `GMap::from_tets` (darts
 /// 24·t .. 24·t + 24; unsew does not move darts). O(24).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::{construct::shared_face_dart, indexed::dart_in_tet};
+/// use topomech::GMap;
+///
+/// let (map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [1, 2, 3, 4]]).unwrap();
+/// let d = shared_face_dart(&map, 0, 1).unwrap();
+/// assert!(dart_in_tet(d, 0) && dart_in_tet(map.alpha::<3>(d), 1));
+/// assert_eq!(shared_face_dart(&map, 0, 0), None);
+/// assert_eq!(shared_face_dart(&map, 5, 1), None);
+/// ```
 pub fn shared_face_dart(map: &GMap<3>, t1: u32, t2: u32) -> Option<DartId> {
     let first = 24 * t1 as usize;
     if first + 24 > map.capacity() {
@@ -201,6 +297,19 @@ pub fn shared_face_dart(map: &GMap<3>, t1: u32, t2: u32) -> Option<DartId> {
 }
 
 /// The pairs of tets sharing a glued face, `[t1, t2]` with t1 < t2, each once. O(darts).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::construct::glued_faces;
+/// use topomech::{generate, GMap};
+///
+/// let (points, tets) = generate::kuhn_cube(1);
+/// let (map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+/// let faces = glued_faces(&map);
+/// assert_eq!(faces.len(), 6); // the six tets around the cube's diagonal
+/// assert!(faces.iter().all(|&[a, b]| a < b));
+/// ```
 pub fn glued_faces(map: &GMap<3>) -> Vec<[u32; 2]> {
     let mut out: Vec<[u32; 2]> = map
         .sewn_pairs(3)
@@ -218,6 +327,18 @@ pub fn glued_faces(map: &GMap<3>) -> Vec<[u32; 2]> {
 /// [0, 1, 2, 3] and whose tets are in increasing lexicographic order, that builds (no face shared
 /// by three tets), with every subset of its glued faces cut. Bounded: C(C(points, 4) − 1,
 /// max_tets − 1) complexes times 2^(glued faces) cut sets.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::construct::cut_complexes;
+///
+/// // One tet, or [0, 1, 2, 3] plus one of the four other tets on 5 points (each shares a face
+/// // with it), with that face glued or cut: 1 + 4 · 2 complexes.
+/// let all = cut_complexes(5, 2);
+/// assert_eq!(all.len(), 9);
+/// assert!(all.iter().all(|c| c.tets[0] == [0, 1, 2, 3] && c.build().is_ok()));
+/// ```
 pub fn cut_complexes(points: usize, max_tets: usize) -> Vec<CutComplex> {
     let all: Vec<[u32; 4]> = combinations4(points as u32);
     let mut out = Vec::new();
@@ -296,6 +417,19 @@ pub struct FaceGluing {
 
 impl FaceGluing {
     /// The 3-G-map (24 darts per tet). Errors: a bad face index or a refused sew. O(tets).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::construct::{ConstructError, FaceGluing};
+    ///
+    /// let two = FaceGluing { tets: 2, pairs: vec![[0, 4, 0]] };
+    /// let map = two.build().unwrap();
+    /// assert_eq!(map.components().len(), 1);
+    /// assert_eq!(map.boundary_darts().count(), 48 - 12);
+    /// let bad = FaceGluing { tets: 2, pairs: vec![[0, 8, 0]] };
+    /// assert!(matches!(bad.build(), Err(ConstructError::BadSide { side: 8, sides: 8 })));
+    /// ```
     pub fn build(&self) -> Result<GMap<3>, ConstructError> {
         let n = self.tets as u32;
         let tets: Vec<[u32; 4]> = (0..n).map(|t| [4 * t, 4 * t + 1, 4 * t + 2, 4 * t + 3]).collect();
@@ -313,6 +447,17 @@ impl FaceGluing {
 
 /// Every gluing of the faces of 1..=`max_tets` tets with at most `max_pairs` glued pairs, in
 /// the six ways each. Bounded: for 2 tets and 2 pairs, about eight thousand.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::construct::face_gluings;
+///
+/// // One tet: no pair, or one of the C(4, 2) = 6 pairs of faces glued in one of six ways.
+/// let all = face_gluings(1, 1);
+/// assert_eq!(all.len(), 1 + 6 * 6);
+/// assert!(all.iter().all(|g| g.tets == 1 && g.pairs.len() <= 1));
+/// ```
 pub fn face_gluings(max_tets: u8, max_pairs: usize) -> Vec<FaceGluing> {
     let mut out = Vec::new();
     for tets in 1..=max_tets {

@@ -59,6 +59,18 @@ pub enum DartsError {
 
 impl DartsJson {
     /// The links of `map`, renumbered. O(darts · n).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::darts::DartsJson;
+    /// use topomech::GMap;
+    ///
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let json = DartsJson::of(&map);
+    /// assert_eq!((json.dim, json.alpha.len()), (3, 24));
+    /// assert!(json.alpha.iter().all(|row| row.len() == 4));
+    /// ```
     pub fn of<const N: usize>(map: &GMap<N>) -> Self {
         let mut rank = vec![u32::MAX; map.capacity()];
         for (r, d) in map.darts().enumerate() {
@@ -72,6 +84,19 @@ impl DartsJson {
     /// α1, …, αn in that order (when αi is sewn, the involutions αj with j ≤ i − 2 it must commute
     /// with are already in place and those with j ≥ i + 2 are still free, so every orbit sew
     /// links exactly the stored pairs). O(darts · n²).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::darts::{DartsError, DartsJson};
+    /// use topomech::GMap;
+    ///
+    /// let (map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [1, 2, 3, 4]]).unwrap();
+    /// let json = DartsJson::of(&map);
+    /// let back: GMap<3> = json.to_map().unwrap();
+    /// assert!(back.is_isomorphic(&map));
+    /// assert!(matches!(json.to_map::<2>(), Err(DartsError::Dimension { expected: 2, found: 3 })));
+    /// ```
     pub fn to_map<const N: usize>(&self) -> Result<GMap<N>, DartsError> {
         if self.dim != N {
             return Err(DartsError::Dimension { expected: N, found: self.dim });

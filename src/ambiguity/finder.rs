@@ -81,6 +81,18 @@ pub enum Why {
 
 impl Why {
     /// Classifies the difference between two non-isomorphic maps. O(darts · n²).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::{construct::Gluing, finder::Why};
+    ///
+    /// let torus = Gluing { sides: vec![4], pairs: vec![[0, 2, 0], [1, 3, 0]] }.build().unwrap();
+    /// let klein = Gluing { sides: vec![4], pairs: vec![[0, 2, 0], [1, 3, 1]] }.build().unwrap();
+    /// assert_eq!(Why::of(&torus, &klein), Why::Orientation);
+    /// let disc = Gluing { sides: vec![4], pairs: vec![] }.build().unwrap();
+    /// assert_eq!(Why::of(&torus, &disc), Why::VertexIdentification);
+    /// ```
     pub fn of<const N: usize>(a: &GMap<N>, b: &GMap<N>) -> Self {
         let (ca, cb) = (a.count_cells().0, b.count_cells().0);
         if a.is_orientable() != b.is_orientable() {
@@ -98,6 +110,21 @@ impl Why {
 }
 
 /// Isomorphism classes of the candidates added so far.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::finder::surfaces;
+/// use topomech::graph::{GraphKind, Multiplicity};
+///
+/// let finder = surfaces(4, 4);
+/// let groups = finder.groups(GraphKind::VertexEdge, Multiplicity::Ignore);
+/// assert!(!groups.is_empty());
+/// for g in groups {
+///     let (a, b) = (&finder.classes()[g.classes[0]].map, &finder.classes()[g.classes[1]].map);
+///     assert!(!a.is_isomorphic(b)); // different objects, one vertex–edge graph
+/// }
+/// ```
 #[derive(Debug, Default)]
 pub struct Finder<const N: usize> {
     classes: Vec<Candidate<N>>,
@@ -119,12 +146,35 @@ pub struct Group {
 
 impl<const N: usize> Finder<N> {
     /// An empty finder.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::finder::Finder;
+    ///
+    /// let finder = Finder::<2>::new();
+    /// assert!(finder.classes().is_empty());
+    /// assert_eq!(finder.tried(), 0);
+    /// ```
     pub fn new() -> Self {
         Finder { classes: Vec::new(), by_key: HashMap::new(), tried: 0 }
     }
 
     /// Adds a candidate if connected and not isomorphic to a class already known; returns
     /// whether it made a new class.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::construct::Gluing;
+    /// use topomech::ambiguity::finder::{Candidate, Finder, Origin};
+    ///
+    /// let mut finder = Finder::<2>::new();
+    /// let mut add = |g: Gluing| finder.add(Candidate { map: g.build().unwrap(), origin: Origin::Gluing(g) });
+    /// assert!(add(Gluing { sides: vec![4], pairs: vec![[0, 2, 0], [1, 3, 0]] }));
+    /// assert!(!add(Gluing { sides: vec![4], pairs: vec![[1, 3, 0], [0, 2, 0]] })); // isomorphic
+    /// assert!(!add(Gluing { sides: vec![3, 3], pairs: vec![] })); // disconnected
+    /// ```
     pub fn add(&mut self, candidate: Candidate<N>) -> bool {
         self.tried += 1;
         if candidate.map.dart_count() == 0 || candidate.map.components().len() != 1 {
@@ -141,17 +191,54 @@ impl<const N: usize> Finder<N> {
     }
 
     /// The classes found, in order of discovery.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::finder::surfaces;
+    ///
+    /// let finder = surfaces(2, 2);
+    /// let classes = finder.classes();
+    /// assert!(!classes.is_empty() && classes.len() < finder.tried());
+    /// assert!(classes.iter().all(|c| c.map.components().len() == 1));
+    /// ```
     pub fn classes(&self) -> &[Candidate<N>] {
         &self.classes
     }
 
     /// Candidates offered so far (including duplicates and disconnected ones).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::{construct::gluings, finder::surfaces};
+    ///
+    /// // Every gluing builds here, so every one is offered.
+    /// assert_eq!(surfaces(3, 3).tried(), gluings(3, 3).len());
+    /// ```
     pub fn tried(&self) -> usize {
         self.tried
     }
 
     /// The groups of classes sharing a graph of `kind`, each with ≥ 2 classes, in order of their
     /// first class.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::construct::Gluing;
+    /// use topomech::ambiguity::finder::{Candidate, Finder, Origin};
+    /// use topomech::graph::{GraphKind, Multiplicity};
+    ///
+    /// let mut finder = Finder::<2>::new();
+    /// for same in [0, 1] {
+    ///     let g = Gluing { sides: vec![4], pairs: vec![[0, 2, 0], [1, 3, same]] }; // torus, Klein bottle
+    ///     finder.add(Candidate { map: g.build().unwrap(), origin: Origin::Gluing(g) });
+    /// }
+    /// let groups = finder.groups(GraphKind::Incidence, Multiplicity::Match);
+    /// assert_eq!(groups.len(), 1);
+    /// assert_eq!(groups[0].classes, vec![0, 1]);
+    /// ```
     pub fn groups(&self, kind: GraphKind, multiplicity: Multiplicity) -> Vec<Group> {
         let graphs: Vec<CellGraph> = self.classes.iter().map(|c| graph_of(&c.map, kind)).collect();
         let mut buckets: HashMap<GraphInvariant, Vec<Vec<usize>>> = HashMap::new();
@@ -175,6 +262,19 @@ impl<const N: usize> Finder<N> {
 
 /// The 2D search: every connected gluing of at most `max_sides` sides (polygons of at most
 /// `max_polygon` sides), smallest first.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::finder::surfaces;
+/// use topomech::graph::{GraphKind, Multiplicity};
+///
+/// let finder = surfaces(4, 4);
+/// let groups = finder.groups(GraphKind::Incidence, Multiplicity::Match);
+/// assert!(!groups.is_empty()); // e.g. the torus and the Klein bottle
+/// let (a, b) = (&finder.classes()[groups[0].classes[0]], &finder.classes()[groups[0].classes[1]]);
+/// assert!(!a.map.is_isomorphic(&b.map));
+/// ```
 pub fn surfaces(max_sides: usize, max_polygon: usize) -> Finder<2> {
     let mut gluings = crate::ambiguity::construct::gluings(max_sides, max_polygon);
     gluings.sort_by_key(|g| (g.side_count(), g.sides.len(), g.pairs.len()));
@@ -190,6 +290,19 @@ pub fn surfaces(max_sides: usize, max_polygon: usize) -> Finder<2> {
 /// The 3D search: every connected complex of at most `max_tets` tets on `points` points with
 /// every subset of its interior faces dissociated, then every gluing of the faces of at most
 /// `glue_tets` tets with at most `glue_pairs` pairs; smallest first within each family.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::finder::complexes;
+///
+/// // Of the 9 complexes of at most 2 tets on 5 points, the cut pairs are disconnected and the
+/// // glued pairs all isomorphic: two classes, one tet and two glued tets.
+/// let finder = complexes(5, 2, 0, 0);
+/// assert_eq!(finder.tried(), 9);
+/// let volumes: Vec<usize> = finder.classes().iter().map(|c| c.map.count_cells().0[3]).collect();
+/// assert_eq!(volumes, vec![1, 2]);
+/// ```
 pub fn complexes(points: usize, max_tets: usize, glue_tets: u8, glue_pairs: usize) -> Finder<3> {
     let mut all = crate::ambiguity::construct::cut_complexes(points, max_tets);
     all.sort_by_key(|c| (c.tets.len(), c.points, c.cuts.len()));

@@ -48,6 +48,15 @@ pub const MAX_SUBDIVISIONS: usize = 12;
 /// The ops of the mixed mode (bytes after byte 0): b < 192 is `Op::Cut(b)`, b ≥ 192 is
 /// `Op::Subdivide(b − 192)`. At most [`MAX_CUTS`] ops; subdivisions past [`MAX_SUBDIVISIONS`]
 /// are dropped. O(bytes).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::{fuzz::decode_ops, mixed::Op};
+///
+/// assert_eq!(decode_ops(&[5, 191, 192, 255]), vec![Op::Cut(5), Op::Cut(191), Op::Subdivide(0), Op::Subdivide(63)]);
+/// assert_eq!(decode_ops(&[200; 20]).len(), 12); // at most MAX_SUBDIVISIONS subdivisions
+/// ```
 pub fn decode_ops(bytes: &[u8]) -> Vec<Op> {
     let mut subdivisions = 0;
     let mut ops = Vec::new();
@@ -65,6 +74,18 @@ pub fn decode_ops(bytes: &[u8]) -> Vec<Op> {
 /// The byte encoding of `ops` for the mixed mode on mesh `mesh` (0, 1 or 2), inverse of
 /// [`decode_ops`] for ops with small indices (cut indices are reduced modulo 192, subdivision
 /// indices modulo 64). O(ops).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::fuzz::{decode_ops, encode_ops, MIXED};
+/// use topomech::ambiguity::mixed::Op;
+///
+/// let ops = [Op::Cut(7), Op::Subdivide(2)];
+/// let bytes = encode_ops(2, &ops);
+/// assert_eq!(bytes, vec![MIXED + 2, 7, 194]);
+/// assert_eq!(decode_ops(&bytes[1..]), ops);
+/// ```
 pub fn encode_ops(mesh: u8, ops: &[Op]) -> Vec<u8> {
     let body = ops.iter().map(|op| match *op {
         Op::Cut(i) => (i % 192) as u8,
@@ -122,6 +143,18 @@ pub struct FuzzReport {
 }
 
 /// The mesh byte 0 selects: (point positions, tets).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::fuzz::mesh;
+///
+/// assert_eq!(mesh(0).1.len(), 6); // Kuhn cube, k = 1
+/// assert_eq!(mesh(1).1.len(), 48); // Kuhn cube, k = 2
+/// let (points, tets) = mesh(2); // three tets around the edge (0, 1)
+/// assert_eq!((points.len(), tets.len()), (5, 3));
+/// assert_eq!(mesh(3), mesh(0));
+/// ```
 pub fn mesh(selector: u8) -> (Vec<[f64; 3]>, Vec<[u32; 4]>) {
     match selector % 3 {
         0 => crate::generate::kuhn_cube(1),
@@ -134,6 +167,19 @@ pub fn mesh(selector: u8) -> (Vec<[f64; 3]>, Vec<[u32; 4]>) {
 }
 
 /// Decodes `bytes` and checks the invariants. O(cuts · darts · n²) plus one VF2 per check.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::fuzz::{check_bytes, encode_ops, FuzzReport};
+/// use topomech::ambiguity::mixed::Op;
+///
+/// assert_eq!(check_bytes(&[]), Ok(FuzzReport::default()));
+/// assert_eq!(check_bytes(&[0, 3, 1]).unwrap().cuts, 2); // two cuts on the Kuhn cube
+/// let mixed = check_bytes(&encode_ops(0, &[Op::Subdivide(0), Op::Cut(4)])).unwrap();
+/// assert_eq!((mixed.subdivisions, mixed.cuts), (1, 1));
+/// assert!(mixed.ambiguous); // a refined tet next to unrefined ones: hanging edges
+/// ```
 pub fn check_bytes(bytes: &[u8]) -> Result<FuzzReport, FuzzFailure> {
     let Some((&selector, rest)) = bytes.split_first() else { return Ok(FuzzReport::default()) };
     if selector >= MIXED {

@@ -25,6 +25,19 @@ use crate::gmap::{DartId, GMap};
 use crate::BuildError;
 
 /// A tet list over `points` points, with the naive cut rule of the [module docs](self).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::indexed::IndexedModel;
+///
+/// // Three tets around the edge (0, 1): cutting one face separates point 3 only.
+/// let mut model = IndexedModel::new(5, &[[0, 1, 2, 3], [0, 1, 3, 4], [0, 1, 4, 2]]);
+/// let out = model.cut(0, 1).unwrap();
+/// assert_eq!(out.kept, vec![0, 1]);
+/// assert_eq!(out.duplicated, vec![(3, 5)]);
+/// assert_eq!(model.origin[5], 3);
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct IndexedModel {
     /// Number of points (grows when points are duplicated).
@@ -90,11 +103,34 @@ impl Audit {
     /// Whether the indexed model's final state cannot stand for the topology the cuts made: a
     /// cut face it re-glued, a pinched point, a non-manifold edge, or a gluing that differs from
     /// the g-map's.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::indexed::Audit;
+    ///
+    /// assert!(!Audit::default().ambiguous());
+    /// let lost = Audit { faces_still_shared: 1, gluing_differs: true, ..Audit::default() };
+    /// assert!(lost.ambiguous() && lost.wrong());
+    /// let pinched = Audit { pinched_points: 1, ..Audit::default() };
+    /// assert!(pinched.ambiguous() && !pinched.wrong());
+    /// ```
     pub fn ambiguous(&self) -> bool {
         self.faces_still_shared > 0 || self.pinched_points > 0 || self.non_manifold_edges > 0 || self.gluing_differs
     }
 
     /// Whether the indexed model's state means a different object from the g-map.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::indexed::Audit;
+    ///
+    /// let same = Audit { gmap_vertices: 8, indexed_vertices: 8, ..Audit::default() };
+    /// assert!(!same.wrong());
+    /// let fewer = Audit { gmap_vertices: 8, indexed_vertices: 7, ..Audit::default() };
+    /// assert!(fewer.wrong() && !fewer.ambiguous());
+    /// ```
     pub fn wrong(&self) -> bool {
         self.gluing_differs || self.gmap_vertices != self.indexed_vertices
     }
@@ -102,6 +138,17 @@ impl Audit {
 
 impl IndexedModel {
     /// A model of `tets` over `points` points. O(tets).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::indexed::IndexedModel;
+    ///
+    /// let model = IndexedModel::new(5, &[[0, 1, 2, 3], [1, 2, 3, 4]]);
+    /// assert_eq!((model.points, model.tets.len()), (5, 2));
+    /// assert_eq!(model.origin, vec![0, 1, 2, 3, 4]);
+    /// assert_eq!(model.used_points(), 5);
+    /// ```
     pub fn new(points: usize, tets: &[[u32; 4]]) -> Self {
         let mut around = vec![Vec::new(); points];
         for (t, tet) in tets.iter().enumerate() {
@@ -125,6 +172,20 @@ impl IndexedModel {
     }
 
     /// Cuts the face between tets t1 and t2 by the rule of the [module docs](self).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::indexed::{IndexedError, IndexedModel};
+    ///
+    /// let mut model = IndexedModel::new(5, &[[0, 1, 2, 3], [1, 2, 3, 4]]);
+    /// let out = model.cut(0, 1).unwrap();
+    /// assert_eq!(out.duplicated.len(), 3);
+    /// assert!(out.kept.is_empty() && !out.face_still_shared);
+    /// assert_eq!(model.points, 8);
+    /// assert_eq!(model.cut(0, 1), Err(IndexedError::NoSharedFace(0, 1))); // nothing shared now
+    /// assert_eq!(model.cut(0, 9), Err(IndexedError::NoSuchTet { tet: 9, tets: 2 }));
+    /// ```
     pub fn cut(&mut self, t1: u32, t2: u32) -> Result<CutOutcome, IndexedError> {
         self.tet(t1)?;
         self.tet(t2)?;
@@ -184,6 +245,17 @@ impl IndexedModel {
     }
 
     /// Adds a point of its own (not a copy of another) and returns it. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::indexed::IndexedModel;
+    ///
+    /// let mut model = IndexedModel::new(4, &[[0, 1, 2, 3]]);
+    /// let p = model.add_point();
+    /// assert_eq!((p, model.points, model.origin[4]), (4, 5, 4));
+    /// assert!(!model.is_used(p));
+    /// ```
     pub fn add_point(&mut self) -> u32 {
         let p = self.points as u32;
         self.points += 1;
@@ -193,6 +265,17 @@ impl IndexedModel {
     }
 
     /// Replaces tet t by `tet` (t must exist, the points of `tet` too). O(tets around its points).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::indexed::IndexedModel;
+    ///
+    /// let mut model = IndexedModel::new(5, &[[0, 1, 2, 3]]);
+    /// model.set_tet(0, [1, 2, 3, 4]);
+    /// assert_eq!(model.tets, vec![[1, 2, 3, 4]]);
+    /// assert!(!model.is_used(0) && model.is_used(4));
+    /// ```
     pub fn set_tet(&mut self, t: u32, tet: [u32; 4]) {
         for p in self.tets[t as usize] {
             self.around[p as usize].retain(|&u| u != t);
@@ -204,6 +287,17 @@ impl IndexedModel {
     }
 
     /// Appends a tet over existing points and returns its index. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::indexed::IndexedModel;
+    ///
+    /// let mut model = IndexedModel::new(5, &[[0, 1, 2, 3]]);
+    /// assert_eq!(model.used_points(), 4);
+    /// assert_eq!(model.push_tet([1, 2, 3, 4]), 1);
+    /// assert_eq!(model.used_points(), 5);
+    /// ```
     pub fn push_tet(&mut self, tet: [u32; 4]) -> u32 {
         let t = self.tets.len() as u32;
         self.tets.push(tet);
@@ -214,11 +308,31 @@ impl IndexedModel {
     }
 
     /// Whether some tet uses point p. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::indexed::IndexedModel;
+    ///
+    /// let model = IndexedModel::new(6, &[[0, 1, 2, 3]]);
+    /// assert!(model.is_used(3));
+    /// assert!(!model.is_used(5) && !model.is_used(99));
+    /// ```
     pub fn is_used(&self, p: u32) -> bool {
         self.around.get(p as usize).is_some_and(|a| !a.is_empty())
     }
 
     /// The number of points some tet uses. O(points).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::indexed::IndexedModel;
+    ///
+    /// let mut model = IndexedModel::new(5, &[[0, 1, 2, 3], [1, 2, 3, 4]]);
+    /// model.cut(0, 1).unwrap();
+    /// assert_eq!(model.used_points(), 8); // the three points of the cut face are duplicated
+    /// ```
     pub fn used_points(&self) -> usize {
         self.around.iter().filter(|a| !a.is_empty()).count()
     }
@@ -227,6 +341,21 @@ impl IndexedModel {
     /// and cut by `unsew::<3>` on the same `cuts` (with `outcomes` the model's results of them).
     /// Errors: the tet list no longer builds (cannot happen with this cut rule: it never makes a
     /// face shared by three tets). O(tets + darts · n).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::construct::CutComplex;
+    /// use topomech::ambiguity::indexed::IndexedModel;
+    ///
+    /// let tets = [[0, 1, 2, 3], [1, 2, 3, 4]];
+    /// let mut model = IndexedModel::new(5, &tets);
+    /// let out = model.cut(0, 1).unwrap();
+    /// let gmap = CutComplex { points: 5, tets: tets.to_vec(), cuts: vec![[0, 1]] }.build().unwrap();
+    /// let audit = model.audit(&gmap, &[[0, 1]], &[out]).unwrap();
+    /// assert!(!audit.ambiguous() && !audit.wrong() && audit.gmap_valid);
+    /// assert_eq!((audit.gmap_vertices, audit.indexed_vertices), (8, 8));
+    /// ```
     pub fn audit(&self, gmap: &GMap<3>, cuts: &[[u32; 2]], outcomes: &[CutOutcome]) -> Result<Audit, BuildError> {
         let (rebuilt, report) = GMap::<3>::from_tets(self.points, &self.tets)?;
         let gluing_differs = gmap.capacity() != rebuilt.capacity()
@@ -246,6 +375,16 @@ impl IndexedModel {
 }
 
 /// Whether `d` (a dart of a map laid out by `from_tets`) lies in tet t. O(1).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::indexed::dart_in_tet;
+/// use topomech::gmap::DartId;
+///
+/// assert!(dart_in_tet(DartId(24), 1) && dart_in_tet(DartId(47), 1));
+/// assert!(!dart_in_tet(DartId(23), 1));
+/// ```
 pub fn dart_in_tet(d: DartId, t: u32) -> bool {
     d.index() / 24 == t as usize
 }

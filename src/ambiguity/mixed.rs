@@ -98,6 +98,17 @@ pub struct Compare {
 
 impl Compare {
     /// Whether the tet list fails to represent the g-map at this level.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::mixed::Compare;
+    ///
+    /// let same = Compare { gmap_vertices: 8, indexed_vertices: 8, ..Compare::default() };
+    /// assert!(!same.ambiguous());
+    /// assert!(Compare { hanging_edges: 1, ..same.clone() }.ambiguous());
+    /// assert!(Compare { indexed_vertices: 9, ..same }.ambiguous());
+    /// ```
     pub fn ambiguous(&self) -> bool {
         self.hanging_edges > 0
             || self.pinched_points > 0
@@ -140,6 +151,18 @@ pub struct MixedRun {
 
 impl MixedRun {
     /// Whether the indexed model ends unable to represent the g-map.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::mixed::{run_ops, Op};
+    /// use topomech::generate;
+    ///
+    /// let (points, tets) = generate::kuhn_cube(1);
+    /// assert!(!run_ops(&points, &tets, &[]).unwrap().ambiguous());
+    /// let refined = run_ops(&points, &tets, &[Op::Subdivide(0)]).unwrap();
+    /// assert!(refined.ambiguous() && refined.finest.hanging_edges > 0);
+    /// ```
     pub fn ambiguous(&self) -> bool {
         self.finest.ambiguous() || self.cuts_inexpressible > 0 || self.cuts_lost > 0
     }
@@ -165,6 +188,20 @@ struct Snapshot {
 ///
 /// Errors: [`MixedError::Build`] / [`MixedError::Pinched`] for a bad mesh; the other variants
 /// are bugs.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::mixed::{run_ops, Op};
+/// use topomech::generate;
+///
+/// let (points, tets) = generate::kuhn_cube(1);
+/// let ops: Vec<Op> = (0..6).map(Op::Subdivide).collect(); // every tet, one after the other
+/// let run = run_ops(&points, &tets, &ops).unwrap();
+/// assert_eq!((run.subdivisions, run.refused, run.levels.len()), (6, 0, 6));
+/// assert!(run.gmap_valid && run.level_law);
+/// assert!(!run.ambiguous()); // all refined: nothing hangs, both models agree
+/// ```
 pub fn run_ops(points: &[[f64; 3]], tets: &[[u32; 4]], ops: &[Op]) -> Result<MixedRun, MixedError> {
     let (map, report) = GMap::<3>::from_tets(points.len(), tets)?;
     if !report.pinched_vertices.is_empty() {
@@ -221,6 +258,19 @@ pub fn run_ops(points: &[[f64; 3]], tets: &[[u32; 4]], ops: &[Op]) -> Result<Mix
 }
 
 /// One dart per glued face of the finest map, in dart order. O(darts).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::{construct::glued_faces, mixed::glued_face_darts};
+/// use topomech::{generate, GMap};
+///
+/// let (points, tets) = generate::kuhn_cube(1);
+/// let (map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+/// let darts = glued_face_darts(&map);
+/// assert_eq!(darts.len(), glued_faces(&map).len());
+/// assert!(darts.iter().all(|&d| !map.is_free(3, d)));
+/// ```
 pub fn glued_face_darts(map: &GMap<3>) -> Vec<DartId> {
     let mut seen: FxHashSet<u32> = FxHashSet::default();
     map.darts().filter(|&d| !map.is_free(3, d) && seen.insert(map.cell_id(2, d).0)).collect()
@@ -303,6 +353,20 @@ fn volume_positions(lm: &LeveledMap<3>, d: DartId) -> Vec<[f64; 3]> {
 /// Compares the map the tet list of `model` means with `map`, tet t standing for the volume of
 /// `vol_dart[t]`. O(tets + darts · n), plus a VF2 when the maps differ but the graph invariants
 /// agree and the graphs have at most [`VF2_NODE_CAP`] nodes.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::{mixed::compare, refine::RefinedModel};
+/// use topomech::{DartId, GMap};
+///
+/// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let model = RefinedModel::new(&points, &[[0, 1, 2, 3]]);
+/// let c = compare(&map, &[DartId(0)], &model).unwrap();
+/// assert!(!c.map_differs && !c.ambiguous());
+/// assert_eq!((c.gmap_vertices, c.indexed_vertices, c.graph_pair), (4, 4, None));
+/// ```
 pub fn compare(map: &GMap<3>, vol_dart: &[DartId], model: &RefinedModel) -> Result<Compare, MixedError> {
     let (rebuilt, report) = GMap::<3>::from_tets(model.model.points, &model.model.tets)?;
     let map_differs = !same_by_pairing(&rebuilt, map, vol_dart);
@@ -354,6 +418,18 @@ fn graph_pair(a: &GMap<3>, b: &GMap<3>) -> Option<bool> {
 }
 
 /// `k` random ops, each a subdivision with probability `p_subdivide`, indices uniform in u32.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::mixed::{random_ops, Op};
+/// use topomech::generate::SplitMix64;
+///
+/// let mut rng = SplitMix64(5);
+/// assert!(random_ops(8, 0.0, &mut rng).iter().all(|op| matches!(op, Op::Cut(_))));
+/// assert!(random_ops(8, 1.0, &mut rng).iter().all(|op| matches!(op, Op::Subdivide(_))));
+/// assert_eq!(random_ops(3, 0.5, &mut SplitMix64(9)), random_ops(3, 0.5, &mut SplitMix64(9)));
+/// ```
 pub fn random_ops(k: usize, p_subdivide: f64, rng: &mut SplitMix64) -> Vec<Op> {
     (0..k)
         .map(|_| {
@@ -442,6 +518,19 @@ impl MixedStats {
 
 /// Runs `sequences` random mixed sequences of `k` ops. Returns the statistics and the first
 /// ambiguous run and the first run with a graph pair, if any. Cost: `sequences` × [`run_ops`].
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::mixed::campaign_mixed;
+/// use topomech::generate::{self, SplitMix64};
+///
+/// let (points, tets) = generate::kuhn_cube(1);
+/// let (stats, firsts) = campaign_mixed(&points, &tets, 3, 0.5, 4, &mut SplitMix64(2)).unwrap();
+/// assert_eq!(stats.sequences, 4);
+/// assert_eq!(stats.level_law_broken + stats.gmap_invalid, 0);
+/// assert!(firsts.len() <= 2 && stats.ambiguous <= 4);
+/// ```
 pub fn campaign_mixed(
     points: &[[f64; 3]],
     tets: &[[u32; 4]],

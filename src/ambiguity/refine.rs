@@ -20,6 +20,19 @@ use crate::ambiguity::indexed::IndexedModel;
 const PAIRS: [(usize, usize); 6] = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
 
 /// An [`IndexedModel`] with point positions and the edge → midpoint hash.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::refine::RefinedModel;
+///
+/// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 1.0]];
+/// let mut r = RefinedModel::new(&points, &[[0, 1, 2, 3], [1, 2, 3, 4]]);
+/// r.subdivide(0, None);
+/// r.subdivide(1, None); // then its neighbour (tet indices never change)
+/// assert_eq!(r.hanging_edges(), 0);
+/// assert_eq!(r.model.points, 5 + 9); // the shared face's three midpoints are reused
+/// ```
 #[derive(Debug, Clone)]
 pub struct RefinedModel {
     /// The tet list (cuts go through [`IndexedModel::cut`]).
@@ -33,6 +46,17 @@ pub struct RefinedModel {
 
 impl RefinedModel {
     /// The model of `tets` over `points` (one position per point). O(points + tets).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::refine::RefinedModel;
+    ///
+    /// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let r = RefinedModel::new(&points, &[[0, 1, 2, 3]]);
+    /// assert_eq!((r.model.points, r.model.tets.len()), (4, 1));
+    /// assert_eq!(r.hanging_edges(), 0);
+    /// ```
     pub fn new(points: &[[f64; 3]], tets: &[[u32; 4]]) -> Self {
         RefinedModel {
             model: IndexedModel::new(points.len(), tets),
@@ -42,6 +66,18 @@ impl RefinedModel {
     }
 
     /// The position of point p (the origin if unknown). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::refine::RefinedModel;
+    ///
+    /// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mut r = RefinedModel::new(&points, &[[0, 1, 2, 3]]);
+    /// assert_eq!(r.position(3), [0.0, 0.0, 1.0]);
+    /// r.subdivide(0, None);
+    /// assert_eq!(r.position(4), [0.5, 0.0, 0.0]); // the first midpoint: edge (0, 1)
+    /// ```
     pub fn position(&self, p: u32) -> [f64; 3] {
         let o = self.model.origin.get(p as usize).copied().unwrap_or(p);
         self.positions.get(o as usize).copied().unwrap_or([0.0; 3])
@@ -68,6 +104,20 @@ impl RefinedModel {
     /// take the same one), or along the shortest one when `diagonal` is `None`. Returns the
     /// children: t itself (now the corner tet at its first corner), then seven new indices.
     /// O(1) amortised plus the point lists of the corners. Panics if t does not exist.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::refine::RefinedModel;
+    /// use topomech::GMap;
+    ///
+    /// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mut r = RefinedModel::new(&points, &[[0, 1, 2, 3]]);
+    /// let kids = r.subdivide(0, None);
+    /// assert_eq!((kids[0], r.model.tets.len(), r.model.points), (0, 8, 10));
+    /// let (map, _) = GMap::<3>::from_tets(r.model.points, &r.model.tets).unwrap();
+    /// assert_eq!(map.count_cells().0, vec![10, 25, 24, 8]);
+    /// ```
     pub fn subdivide(&mut self, t: u32, diagonal: Option<[[f64; 3]; 2]>) -> [u32; 8] {
         let c = self.model.tets[t as usize];
         let m: Vec<u32> = PAIRS.iter().map(|&(x, y)| self.midpoint_of(c[x], c[y])).collect();
@@ -102,6 +152,17 @@ impl RefinedModel {
 
     /// Edges of some tet whose midpoint exists and is used by another tet: T-junctions the
     /// tet list cannot glue. O(tets).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::refine::RefinedModel;
+    ///
+    /// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 1.0]];
+    /// let mut r = RefinedModel::new(&points, &[[0, 1, 2, 3], [1, 2, 3, 4]]);
+    /// r.subdivide(0, None);
+    /// assert_eq!(r.hanging_edges(), 3); // the edges of the face shared with the unrefined tet
+    /// ```
     pub fn hanging_edges(&self) -> usize {
         let mut seen: Vec<(u32, u32)> = Vec::new();
         for tet in &self.model.tets {

@@ -40,6 +40,19 @@ pub struct MapFacts {
 
 impl MapFacts {
     /// The facts of `map`. O(darts · n²).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::vector::MapFacts;
+    /// use topomech::GMap;
+    ///
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let facts = MapFacts::of(&map);
+    /// assert_eq!((facts.darts, facts.boundary_darts, facts.euler_characteristic), (24, 24, 1));
+    /// assert_eq!(facts.cells, vec![4, 6, 4, 1]);
+    /// assert!(facts.orientable);
+    /// ```
     pub fn of<const N: usize>(map: &GMap<N>) -> Self {
         MapFacts {
             darts: map.dart_count(),
@@ -149,6 +162,19 @@ pub enum VectorError {
 
 impl PairVector {
     /// The vector of two candidates of one finder group. O(darts · n²).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::{construct::Gluing, finder::*, vector::PairVector};
+    /// use topomech::graph::{GraphKind, Multiplicity};
+    ///
+    /// let square = |same| Gluing { sides: vec![4], pairs: vec![[0, 2, 0], [1, 3, same]] };
+    /// let cand = |same| Candidate { map: square(same).build().unwrap(), origin: Origin::Gluing(square(same)) };
+    /// let v = PairVector::of("torus_klein", GraphKind::Incidence, Multiplicity::Match, &cand(0), &cand(1), "");
+    /// assert_eq!((v.dim, v.why), (2, Why::Orientation));
+    /// assert!(v.a.facts.orientable && !v.b.facts.orientable);
+    /// ```
     pub fn of<const N: usize>(
         name: &str,
         kind: GraphKind,
@@ -176,6 +202,20 @@ impl PairVector {
     }
 
     /// Replays the vector: see the [module docs](self). O(darts² + VF2).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::{construct::Gluing, finder::*, vector::PairVector};
+    /// use topomech::graph::{GraphKind, Multiplicity};
+    ///
+    /// let square = |same| Gluing { sides: vec![4], pairs: vec![[0, 2, 0], [1, 3, same]] };
+    /// let cand = |same| Candidate { map: square(same).build().unwrap(), origin: Origin::Gluing(square(same)) };
+    /// let v = PairVector::of("torus_klein", GraphKind::Incidence, Multiplicity::Match, &cand(0), &cand(1), "");
+    /// assert!(v.check().is_ok());
+    /// let same = PairVector::of("torus_twice", GraphKind::Incidence, Multiplicity::Match, &cand(0), &cand(0), "");
+    /// assert!(same.check().is_err()); // isomorphic maps are no ambiguity
+    /// ```
     pub fn check(&self) -> Result<(), VectorError> {
         match self.dim {
             2 => self.check_dim::<2>(),
@@ -240,6 +280,21 @@ fn construct_dyn<const N: usize>(origin: &Origin) -> Result<GMap<N>, String> {
 
 impl IndexedVector {
     /// The vector of a complex whose cuts show `symptom`. Errors: the complex does not run.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::{campaign::*, construct::*, vector::IndexedVector};
+    /// use topomech::{generate, GMap};
+    ///
+    /// let (points, tets) = generate::kuhn_cube(2);
+    /// let (map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+    /// let one_cut = |f| CutComplex { points: points.len(), tets: tets.clone(), cuts: vec![f] };
+    /// let lost = glued_faces(&map).into_iter().map(one_cut).find(|c| shows(c, Symptom::FaceStillShared)).unwrap();
+    /// let v = IndexedVector::of("lost_cut", Symptom::FaceStillShared, &lost, "a re-glued face").unwrap();
+    /// assert_eq!((v.audit.faces_still_shared, v.audit.cuts_without_duplication), (1, 1));
+    /// assert!(v.check().is_ok());
+    /// ```
     pub fn of(name: &str, symptom: Symptom, complex: &CutComplex, description: &str) -> Result<Self, VectorError> {
         let run = run_cuts(complex.points, &complex.tets, &complex.cuts).map_err(|e| VectorError::Construction {
             name: name.to_string(),
@@ -256,6 +311,19 @@ impl IndexedVector {
     }
 
     /// Reruns both models and compares the audit and the symptom.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::{campaign::Symptom, construct::CutComplex, vector::IndexedVector};
+    ///
+    /// let uncut = CutComplex { points: 5, tets: vec![[0, 1, 2, 3], [1, 2, 3, 4]], cuts: vec![] };
+    /// let v = IndexedVector::of("uncut", Symptom::SkeletonUnchanged, &uncut, "").unwrap();
+    /// assert!(v.check().is_ok());
+    /// let cut = CutComplex { cuts: vec![[0, 1]], ..uncut };
+    /// let w = IndexedVector::of("cut", Symptom::SkeletonUnchanged, &cut, "").unwrap();
+    /// assert!(w.check().is_err()); // that cut splits vertices: the symptom is not shown
+    /// ```
     pub fn check(&self) -> Result<(), VectorError> {
         let c = &self.complex;
         let fail = |check: String| VectorError::Check { name: self.name.clone(), check };
@@ -272,6 +340,17 @@ impl IndexedVector {
 
 impl Vector {
     /// The vector's name.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::{campaign::Symptom, construct::CutComplex, vector::*};
+    ///
+    /// let uncut = CutComplex { points: 4, tets: vec![[0, 1, 2, 3]], cuts: vec![] };
+    /// let i = IndexedVector::of("one_tet", Symptom::SkeletonUnchanged, &uncut, "").unwrap();
+    /// let v = Vector::Indexed(Box::new(i));
+    /// assert_eq!(v.name(), "one_tet");
+    /// ```
     pub fn name(&self) -> &str {
         match self {
             Vector::Pair(p) => &p.name,
@@ -280,6 +359,20 @@ impl Vector {
     }
 
     /// Replays the vector.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::{campaign::Symptom, construct::CutComplex, vector::*};
+    ///
+    /// let uncut = CutComplex { points: 4, tets: vec![[0, 1, 2, 3]], cuts: vec![] };
+    /// let i = IndexedVector::of("one_tet", Symptom::SkeletonUnchanged, &uncut, "").unwrap();
+    /// let v = Vector::Indexed(Box::new(i));
+    /// assert!(v.check().is_ok());
+    /// let j = IndexedVector::of("one_tet", Symptom::PinchedPoint, &uncut, "").unwrap();
+    /// let w = Vector::Indexed(Box::new(j));
+    /// assert!(matches!(w.check(), Err(VectorError::Check { .. })));
+    /// ```
     pub fn check(&self) -> Result<(), VectorError> {
         match self {
             Vector::Pair(p) => p.check(),
@@ -289,6 +382,19 @@ impl Vector {
 
     /// The vector made afresh from its constructions (same name, graph and description): equal
     /// to `self` as long as the builders and the kernel behave as when it was stored.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::ambiguity::{construct::Gluing, finder::*, vector::*};
+    /// use topomech::graph::{GraphKind, Multiplicity};
+    ///
+    /// let square = |same| Gluing { sides: vec![4], pairs: vec![[0, 2, 0], [1, 3, same]] };
+    /// let cand = |same| Candidate { map: square(same).build().unwrap(), origin: Origin::Gluing(square(same)) };
+    /// let p = PairVector::of("torus_klein", GraphKind::Incidence, Multiplicity::Match, &cand(0), &cand(1), "");
+    /// let v = Vector::Pair(Box::new(p));
+    /// assert_eq!(v.recompute().unwrap(), v);
+    /// ```
     pub fn recompute(&self) -> Result<Vector, VectorError> {
         match self {
             Vector::Pair(p) => match p.dim {

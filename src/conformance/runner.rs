@@ -91,7 +91,7 @@ pub fn generate(recipe: &Recipe) -> Result<Vector, ConformanceError> {
 }
 
 /// [`generate`] with mesh files relative to `root`. The laws are checked after every step, and
-/// incision planes must keep [`PLANE_MARGIN`] from every centroid.
+/// incision planes must keep `PLANE_MARGIN` (10⁻⁶ of the bounding-box diagonal) from every centroid.
 ///
 /// # Errors
 /// [`ConformanceError::Mesh`], [`ConformanceError::BadOp`], [`ConformanceError::Law`],

@@ -37,7 +37,7 @@ pub enum MeshSpec {
         /// Tets as four point indices; tet t is `tets[t]`.
         tets: Vec<[u32; 4]>,
     },
-    /// The Kuhn cube [0,k]³ of [`kuhn_cube`](crate::generate::kuhn_cube) (k ≤ 16).
+    /// The Kuhn cube \[0, k\]³ of [`kuhn_cube`](crate::generate::kuhn_cube) (k ≤ 16).
     KuhnCube {
         /// Cubes per side.
         k: usize,

@@ -357,9 +357,10 @@ impl TetMesh {
     /// let points = vec![[1.0, 1.0, 1.0], [0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
     /// let mesh = TetMesh { points, tets: vec![[0, 1, 2, 3]], ..Default::default() };
     /// let (ordered, new_of_old) = mesh.spatially_ordered();
-    /// assert_eq!(new_of_old, vec![3, 0, 1, 2]); // the origin first, (1, 1, 1) last
+    /// // Z-order interleaves the bits x, y, z from the top: (0,0,0) < (0,1,0) < (1,0,0) < (1,1,1).
+    /// assert_eq!(new_of_old, vec![3, 0, 2, 1]);
     /// assert_eq!(ordered.points[0], [0.0, 0.0, 0.0]);
-    /// assert_eq!(ordered.tets, vec![[3, 0, 1, 2]]);
+    /// assert_eq!(ordered.tets, vec![[3, 0, 2, 1]]);
     /// ```
     pub fn spatially_ordered(&self) -> (TetMesh, Vec<u32>) {
         let (lo, hi) = bounding_box(&self.points);

@@ -3,8 +3,10 @@
 //! time per tet. Prints one line and one JSON object.
 //!
 //!     cargo run --release --example bench_refine -- 10
+//!     cargo run --release --example bench_refine -- --2d 100     # triangle 1→4 on an n×n grid
 //!
-//! Pair it with `target/cgal_bench K --red --no-subdiv3d` in the same run (see docs/BENCHMARKS.md).
+//! Pair it with `target/cgal_bench K --red` (3D) or `target/cgal_bench 1 --no-3d --n2d=N` (2D) in
+//! the same run (see docs/BENCHMARKS.md).
 
 use std::time::Instant;
 
@@ -22,8 +24,39 @@ fn thread_cpu_seconds() -> Option<f64> {
     Some((utime + stime) / 100.0)
 }
 
+/// Uniform triangle 1→4 of every face of `grid_triangles(n)` at level 1, CPU time per triangle.
+fn bench_2d(n: usize) {
+    let (points, tris) = topomech::generate::grid_triangles(n);
+    let (map, _) = GMap::<2>::from_triangles(points.len(), &tris).expect("the grid builds");
+    let mut m = LeveledMap::new(map, points);
+    let faces = m.map().one_dart_per_cell(2);
+    let (cpu0, wall0) = (thread_cpu_seconds(), Instant::now());
+    for d in faces {
+        m.subdivide_triangle(d, 1).expect("an unsplit triangle");
+    }
+    let (cpu1, wall) = (thread_cpu_seconds(), wall0.elapsed().as_secs_f64());
+    let cpu = match (cpu0, cpu1) {
+        (Some(a), Some(b)) => b - a,
+        _ => wall,
+    };
+    m.check_all().expect("every law holds after the refinement");
+    let t = tris.len() as f64;
+    println!(
+        "[refine2d] n={n} triangles={} -> {}: {:.0} ns/triangle CPU ({:.0} ns wall)",
+        tris.len(),
+        m.map().count_cells().0[2],
+        1e9 * cpu / t,
+        1e9 * wall / t
+    );
+}
+
 fn main() {
-    let k: usize = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(10);
+    let args: Vec<String> = std::env::args().collect();
+    if args.get(1).map(String::as_str) == Some("--2d") {
+        bench_2d(args.get(2).and_then(|s| s.parse().ok()).unwrap_or(100));
+        return;
+    }
+    let k: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(10);
     let (points, tets) = kuhn_cube(k);
     let (map, _) = GMap::<3>::from_tets(points.len(), &tets).expect("the Kuhn cube builds");
     let mut m = LeveledMap::new(map, points);

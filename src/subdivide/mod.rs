@@ -56,6 +56,20 @@ struct LinkChange {
 }
 
 /// Per-dart resolution levels (seed 004, §4.3): μa, μf, μt.
+///
+/// # Examples
+///
+/// ```
+/// # use topomech::subdivide::LeveledMap;
+/// # use topomech::GMap;
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let mut m = LeveledMap::new(map, vec![]);
+/// let d = m.map().darts().next().unwrap();
+/// m.subdivide_tet(d, 1).unwrap();
+/// let mu = m.mu(d);
+/// assert!(mu.tet <= mu.face && mu.face <= mu.edge);
+/// assert_eq!(mu.tet, 1);
+/// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Mu {
     /// Edge resolution level μa.
@@ -67,6 +81,20 @@ pub struct Mu {
 }
 
 /// Errors of the subdivision operations. The map is unchanged when one is returned.
+///
+/// # Examples
+///
+/// ```
+/// # use topomech::subdivide::{LeveledMap, SubdivideError};
+/// # use topomech::GMap;
+/// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+/// let mut m = LeveledMap::new(map, vec![]);
+/// let d = m.map().darts().next().unwrap();
+/// assert!(matches!(m.split_edge(d, 251), Err(SubdivideError::LevelTooHigh(251))));
+/// m.subdivide_triangle(d, 2).unwrap();
+/// let e = m.subdivide_triangle(d, 1).unwrap_err();
+/// assert!(matches!(e, SubdivideError::LevelBelowMax { level: 1, max_level: 2 }));
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum SubdivideError {
     /// The dart is not live.
@@ -134,6 +162,18 @@ pub enum SubdivideError {
 }
 
 /// Violations of the level laws found by [`LeveledMap::check_levels`] and [`LeveledMap::check_all`].
+///
+/// # Examples
+///
+/// ```
+/// # use topomech::subdivide::{LevelError, LeveledMap, Mu};
+/// # use topomech::{DartId, GMap};
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let m = LeveledMap::new(map, vec![]);
+/// assert!(m.check_all().is_ok()); // a fresh level-0 map keeps every law
+/// let e = LevelError::MuOrder { dart: DartId(0), mu: Mu { edge: 0, face: 1, tet: 0 } };
+/// assert!(e.to_string().contains("μt ≤ μf ≤ μa"));
+/// ```
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum LevelError {
     /// μt ≤ μf ≤ μa is broken at a dart.
@@ -184,6 +224,20 @@ pub enum LevelError {
 }
 
 /// An extracted level G_i together with the ids its darts have in the leveled map.
+///
+/// # Examples
+///
+/// ```
+/// # use topomech::subdivide::LeveledMap;
+/// # use topomech::GMap;
+/// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+/// let mut m = LeveledMap::new(map, vec![]);
+/// let d = m.map().darts().next().unwrap();
+/// m.subdivide_triangle(d, 1).unwrap();
+/// let v = m.level(0).unwrap();
+/// assert_eq!(v.darts.len(), v.map.dart_count());
+/// assert!(v.darts.iter().all(|&x| m.dart_level(x) == 0));
+/// ```
 #[derive(Clone, Debug)]
 pub struct LevelView<const N: usize> {
     /// G_i as a G-map of its own (dart k of `map` is dart `darts[k]` of the leveled map).
@@ -193,6 +247,20 @@ pub struct LevelView<const N: usize> {
 }
 
 /// A G-map with adaptive resolution levels. See the [module docs](self).
+///
+/// # Examples
+///
+/// ```
+/// # use topomech::subdivide::LeveledMap;
+/// # use topomech::GMap;
+/// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+/// let mut m = LeveledMap::new(map, vec![[0.0; 3], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]]);
+/// let d = m.map().darts().next().unwrap();
+/// m.subdivide_triangle(d, 1).unwrap();
+/// assert_eq!(m.map().count_cells().0[2], 4);
+/// assert_eq!(m.level(0).unwrap().map.count_cells().0[2], 1);
+/// assert!(m.check_all().is_ok());
+/// ```
 #[derive(Clone, Debug)]
 pub struct LeveledMap<const N: usize> {
     map: GMap<N>,

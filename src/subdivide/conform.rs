@@ -47,6 +47,21 @@ const CONVEX_TOL: f64 = 1e-9;
 
 /// A conforming tetrahedral mesh of the finest level of a [`LeveledMap<3>`]
 /// ([`LeveledMap::conforming_tets`]).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::subdivide::LeveledMap;
+/// use topomech::GMap;
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+/// let mut m = LeveledMap::new(map, pts);
+/// let c = m.conforming_tets().unwrap();
+/// assert_eq!((c.kept, c.closed, c.tets.len()), (1, 0, 1));
+/// let d = m.map().darts().next().unwrap();
+/// m.subdivide_tet(d, 1).unwrap();
+/// assert_eq!(m.conforming_tets().unwrap().tets.len(), 8);
+/// ```
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ConformingMesh {
     /// Positions: the leveled map's points (keyed by vertex id), then one Steiner point per

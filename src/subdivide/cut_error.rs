@@ -18,6 +18,21 @@ use crate::gmap::AlphaMask;
 use crate::mechanics::Body;
 
 /// The geometric error of a cut surface against its plane (module docs).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::Plane;
+/// use topomech::mechanics::{Body, Material};
+/// use topomech::subdivide::cut_error;
+/// let (points, tets) = topomech::generate::kuhn_cube(1);
+/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// // The diagonal plane x = y is made of mesh faces.
+/// let plane = Plane { point: [0.0; 3], normal: [1.0, -1.0, 0.0] };
+/// let e = cut_error(&mut body, &plane, None).unwrap();
+/// assert_eq!(e.measured, e.faces);
+/// assert!(e.faces > 0 && e.max < 1e-12 && e.mean <= e.max);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CutSurfaceError {
     /// Faces the incision dissociated.

@@ -29,6 +29,16 @@ pub const MAX_FUZZ_LEVEL: u8 = 3;
 pub const MAX_DARTS: usize = 5_000;
 
 /// The mesh an input starts from.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::subdivide::fuzz::{decode, Mesh};
+/// // The first byte modulo 3 picks the mesh.
+/// assert_eq!(decode(&[0]).0, Mesh::Grid);
+/// assert_eq!(decode(&[4]).0, Mesh::Cube);
+/// assert_eq!(decode(&[2]).0, Mesh::Tet);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Mesh {
     /// `grid_triangles(2)`: 8 triangles (2D).
@@ -40,6 +50,15 @@ pub enum Mesh {
 }
 
 /// One decoded operation.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::subdivide::fuzz::{decode, Op};
+/// let (_, ops) = decode(&[2, 0x82, 0, 3]);
+/// assert_eq!(ops, vec![Op::Tet { pick: 3, up: true }]);
+/// assert!(matches!(decode(&[0, 0x80, 0, 1]).1[..], [Op::SplitEdge { pick: 1, .. }]));
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Op {
     /// `split_edge` of the edge of dart pick % darts.
@@ -73,6 +92,16 @@ pub enum Op {
 }
 
 /// What [`run_bytes`] did.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::subdivide::fuzz::run_bytes;
+/// // A grid, then one edge split one level up.
+/// let r = run_bytes(&[0, 0x80, 0, 0]).unwrap();
+/// assert_eq!((r.applied + r.refused, r.max_level), (1, r.applied as u8));
+/// assert!(r.darts >= 8 * 6);
+/// ```
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Report {
     /// Operations accepted.

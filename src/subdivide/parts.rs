@@ -9,6 +9,20 @@ use crate::gmap::{DartId, GMap, InvariantViolation};
 
 /// One recorded link change: before level `level`, αj(d) was `old` (see the module docs of
 /// [`crate::subdivide`]).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::subdivide::LeveledMap;
+/// use topomech::GMap;
+/// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+/// let mut m = LeveledMap::new(map, vec![]);
+/// let d = m.map().darts().next().unwrap();
+/// let old = m.map().alpha_dyn(0, d);
+/// m.split_edge(d, 1).unwrap();
+/// let h = &m.to_parts().darts[d.index()].history;
+/// assert!(h.iter().any(|e| e.level == 1 && e.j == 0 && e.old == old.0));
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct HistoryEntry {
     /// The level of the operation that changed the link (1..=max level in practice).
@@ -20,6 +34,21 @@ pub struct HistoryEntry {
 }
 
 /// The level records of one dart slot.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::subdivide::LeveledMap;
+/// use topomech::GMap;
+/// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+/// let mut m = LeveledMap::new(map, vec![]);
+/// let d = m.map().darts().next().unwrap();
+/// let mid = m.split_edge(d, 1).unwrap();
+/// let parts = m.to_parts();
+/// let r = &parts.darts[mid.index()];
+/// assert_eq!((r.level, r.mu), (m.dart_level(mid), m.mu(mid)));
+/// assert!(r.flat); // the midpoint is an inserted vertex of the triangle's side
+/// ```
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct DartLevels {
     /// The level at which the dart was created.
@@ -36,6 +65,20 @@ pub struct DartLevels {
 ///
 /// Invariant checked by [`LeveledMap::from_parts`]: `darts` has one record per dart slot of the
 /// map (dead slots: ignored, rebuilt as defaults).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::subdivide::LeveledMap;
+/// use topomech::GMap;
+/// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+/// let mut m = LeveledMap::new(map, vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+/// let d = m.map().darts().next().unwrap();
+/// m.subdivide_triangle(d, 1).unwrap();
+/// let parts = m.to_parts();
+/// assert_eq!((parts.max_level, parts.darts.len()), (1, m.map().capacity()));
+/// assert_eq!(parts.points.len(), 6);
+/// ```
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct LevelParts {
     /// The largest level any operation used (k ≤ [`MAX_LEVEL`]).
@@ -47,6 +90,19 @@ pub struct LevelParts {
 }
 
 /// Why [`LeveledMap::from_parts`] refused its input.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::subdivide::{LevelPartsError, LeveledMap};
+/// use topomech::GMap;
+/// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+/// let m = LeveledMap::new(map, vec![]);
+/// let mut parts = m.to_parts();
+/// parts.max_level = 251;
+/// let e = LeveledMap::from_parts(m.map().clone(), parts).unwrap_err();
+/// assert!(matches!(e, LevelPartsError::MaxLevelTooHigh(251)));
+/// ```
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum LevelPartsError {
     /// The number of dart records is not the map's dart capacity.

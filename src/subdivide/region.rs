@@ -22,6 +22,19 @@ use super::{LeveledMap, SubdivideError};
 use crate::gmap::{CellId, DartId};
 
 /// One mass per volume id of a [`LeveledMap<3>`] (index = volume cell id).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::subdivide::{LeveledMap, TetMasses};
+/// use topomech::GMap;
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+/// let m = LeveledMap::new(map, pts);
+/// let masses = TetMasses::from_density(&m, 6.0).unwrap(); // volume 1/6
+/// let t = m.map().cell_id(3, m.map().darts().next().unwrap());
+/// assert!((masses.mass[t.index()] - 1.0).abs() < 1e-12);
+/// ```
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TetMasses {
     /// `mass[t]`: the mass of volume t (0 for ids no volume uses).
@@ -29,6 +42,20 @@ pub struct TetMasses {
 }
 
 /// What [`LeveledMap::refine_around`] did.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::subdivide::{LeveledMap, TetMasses};
+/// use topomech::GMap;
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+/// let mut m = LeveledMap::new(map, pts);
+/// let mut masses = TetMasses::from_density(&m, 1.0).unwrap();
+/// let r = m.refine_around([0.1; 3], 10.0, 1, &mut masses).unwrap();
+/// assert_eq!(r.subdivided_per_level, vec![0, 1]);
+/// assert!((r.total_mass_after - r.total_mass_before).abs() < 1e-12);
+/// ```
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Refinement {
     /// Tets subdivided at each level (index 0 unused, always 0).

@@ -17,6 +17,17 @@ use crate::gmap::GMap;
 use crate::BuildError;
 
 /// Why a campaign could not run.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::campaign::{run_cuts, CampaignError};
+/// let tets = [[0, 1, 2, 3], [1, 2, 3, 4]];
+/// // Tets 0 and 0 share no face.
+/// assert!(matches!(run_cuts(5, &tets, &[[0, 0]]), Err(CampaignError::Construct(_))));
+/// // A point id past the point count does not build.
+/// assert!(matches!(run_cuts(4, &tets, &[]), Err(CampaignError::Build(_))));
+/// ```
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CampaignError {
     /// The mesh does not build.
@@ -39,6 +50,16 @@ pub enum CampaignError {
 }
 
 /// A symptom found after a cut sequence.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::campaign::{run_cuts, Symptom};
+/// assert_eq!(Symptom::ALL.len(), 5);
+/// let run = run_cuts(5, &[[0, 1, 2, 3], [1, 2, 3, 4]], &[]).unwrap();
+/// // Nothing cut: the vertex–edge graph is that of the uncut map.
+/// assert_eq!(run.symptoms(), vec![Symptom::SkeletonUnchanged]);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Symptom {
@@ -66,6 +87,16 @@ impl Symptom {
 }
 
 /// The outcome of one cut sequence.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::campaign::run_cuts;
+/// let run = run_cuts(5, &[[0, 1, 2, 3], [1, 2, 3, 4]], &[[0, 1]]).unwrap();
+/// assert_eq!(run.cuts, vec![[0, 1]]);
+/// assert!(run.audit.gmap_valid && !run.skeleton_unchanged);
+/// assert!(run.symptoms().is_empty());
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
 pub struct Run {
     /// The cuts `[t1, t2]`.
@@ -163,6 +194,18 @@ pub fn random_cuts(faces: &[[u32; 2]], k: usize, rng: &mut SplitMix64) -> Vec<[u
 }
 
 /// Counts over the sequences of one length k.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::campaign::campaign_k;
+/// use topomech::generate::{self, SplitMix64};
+/// let (points, tets) = generate::kuhn_cube(1);
+/// let (s, _) = campaign_k(points.len(), &tets, 1, 4, &mut SplitMix64(7)).unwrap();
+/// assert_eq!((s.k, s.sequences, s.gmap_invalid), (1, 4, 0));
+/// assert_eq!(s.symptoms.len(), 5);
+/// assert!(s.symptoms.iter().all(|&(_, n)| n <= s.sequences) && s.wrong <= s.sequences);
+/// ```
 #[derive(Debug, Clone, Default, PartialEq, Eq, serde::Serialize)]
 pub struct KStats {
     /// Cuts per sequence.

@@ -18,6 +18,15 @@ pub const STUDIED: [(GraphKind, Multiplicity); 4] = [
 ];
 
 /// Bounds of the exhaustive search.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::catalogue::Bounds;
+/// let (s, c) = (Bounds::SMALL, Bounds::CATALOGUE);
+/// assert!(s.max_sides <= c.max_sides && s.points <= c.points && s.max_tets <= c.max_tets);
+/// assert!(s.glue_tets <= c.glue_tets);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 pub struct Bounds {
     /// 2D: most sides in total.
@@ -44,6 +53,16 @@ impl Bounds {
 }
 
 /// How many ambiguities one graph has in one dimension.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::catalogue::{catalogue, Bounds};
+/// let cat = catalogue(Bounds::SMALL);
+/// assert!(cat.counts.iter().all(|c| c.dim == 2 || c.dim == 3));
+/// assert!(cat.counts.iter().all(|c| c.ambiguous_classes <= c.classes));
+/// assert!(cat.counts.iter().any(|c| c.groups > 0));
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
 pub struct GroupCount {
     /// 2 or 3.
@@ -61,6 +80,16 @@ pub struct GroupCount {
 }
 
 /// The result of the exhaustive search.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::catalogue::{catalogue, Bounds};
+/// let cat = catalogue(Bounds::SMALL);
+/// assert_eq!(cat.bounds, Bounds::SMALL);
+/// assert!(cat.tried.iter().all(|&n| n > 0));
+/// assert!(cat.pairs.iter().all(|p| p.check().is_ok()));
+/// ```
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Catalogue {
     /// The bounds used.

@@ -36,6 +36,16 @@ pub struct Gluing {
 }
 
 /// Why a construction could not be turned into a map.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::construct::{ConstructError, FaceGluing};
+/// let bad = FaceGluing { tets: 1, pairs: vec![[0, 9, 0]] };
+/// let e = bad.build().unwrap_err();
+/// assert!(matches!(e, ConstructError::BadSide { side: 9, sides: 4 }));
+/// assert!(e.to_string().contains("side 9"));
+/// ```
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ConstructError {
     /// A side index past the last side, a side glued twice or to itself.
@@ -407,6 +417,16 @@ fn points_connected(tets: &[[u32; 4]]) -> bool {
 /// [`Gluing`]): tet t has darts 24·t + 6·f + k as laid out by `GMap::from_tets` (face f, flag k);
 /// a glued pair `[a, b, k]` of faces (global index 4·t + f) 3-sews dart 0 of face a to dart k of
 /// face b, one of the six ways to match two triangles.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::construct::FaceGluing;
+/// let none = FaceGluing { tets: 2, pairs: vec![] };
+/// assert_eq!(none.build().unwrap().components().len(), 2);
+/// let glued = FaceGluing { tets: 2, pairs: vec![[1, 6, 0]] };
+/// assert_eq!(glued.build().unwrap().components().len(), 1);
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub struct FaceGluing {
     /// Number of tetrahedra.

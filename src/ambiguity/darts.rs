@@ -5,6 +5,18 @@ use crate::gmap::{DartId, GMap, SewError};
 
 /// The darts of an n-G-map with their α links: `alpha[d][i]` = αi(d), darts numbered densely in
 /// increasing order of the map's own ids. Cell ids are not stored (they are derived data).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::darts::DartsJson;
+/// use topomech::GMap;
+/// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+/// let json = DartsJson::of(&map);
+/// assert_eq!((json.dim, json.alpha.len()), (2, 6));
+/// // Each αi is an involution on the renumbered darts.
+/// assert!((0..6).all(|d| (0..3).all(|i| json.alpha[json.alpha[d][i] as usize][i] == d as u32)));
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct DartsJson {
     /// The dimension n.
@@ -14,6 +26,15 @@ pub struct DartsJson {
 }
 
 /// Why a [`DartsJson`] does not describe a valid n-G-map.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::darts::{DartsError, DartsJson};
+/// let bad = DartsJson { dim: 2, alpha: vec![vec![0, 0, 5]] };
+/// let e = bad.to_map::<2>().unwrap_err();
+/// assert!(matches!(e, DartsError::BadRow { dart: 0, darts: 1, .. }));
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum DartsError {
     /// The stored dimension is not the one asked for.

@@ -15,6 +15,20 @@ use crate::gmap::GMap;
 use crate::graph::{graph_of, graphs_isomorphic, CellGraph, GraphInvariant, GraphKind, Multiplicity};
 
 /// How a candidate map was made.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::construct::Gluing;
+/// use topomech::ambiguity::finder::{surfaces, Origin};
+/// let finder = surfaces(2, 2);
+/// // Every 2D class comes from a polygon gluing that rebuilds its map.
+/// for c in finder.classes() {
+///     let Origin::Gluing(g) = &c.origin else { panic!("2D classes are gluings") };
+///     assert!(g.build().unwrap().is_isomorphic(&c.map));
+/// }
+/// assert!(matches!(Origin::Gluing(Gluing { sides: vec![3], pairs: vec![] }), Origin::Gluing(_)));
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(tag = "type", rename_all = "snake_case")]
 pub enum Origin {
@@ -27,6 +41,17 @@ pub enum Origin {
 }
 
 /// A map and how it was made.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::construct::Gluing;
+/// use topomech::ambiguity::finder::{Candidate, Origin};
+/// let g = Gluing { sides: vec![4], pairs: vec![[0, 2, 0], [1, 3, 0]] };
+/// let c = Candidate { map: g.build().unwrap(), origin: Origin::Gluing(g.clone()) };
+/// assert_eq!(c.map.dart_count(), 8);
+/// assert_eq!(c.origin, Origin::Gluing(g));
+/// ```
 #[derive(Debug, Clone)]
 pub struct Candidate<const N: usize> {
     /// The map.
@@ -64,6 +89,17 @@ impl MapKey {
 }
 
 /// Why two maps of a pair differ, the first reason found in this order.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::{construct::Gluing, finder::Why};
+/// let disc = Gluing { sides: vec![4], pairs: vec![] }.build().unwrap();
+/// let torus = Gluing { sides: vec![4], pairs: vec![[0, 2, 0], [1, 3, 0]] }.build().unwrap();
+/// assert_eq!(Why::of(&disc, &torus), Why::VertexIdentification);
+/// assert_eq!(Why::of(&torus, &disc), Why::VertexIdentification);
+/// assert_eq!(Why::of(&torus, &torus), Why::Gluing); // nothing else tells them apart
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Why {
@@ -134,6 +170,17 @@ pub struct Finder<const N: usize> {
 
 /// One ambiguity: classes (indices into [`Finder::classes`]) whose graphs of `kind` are
 /// isomorphic, smallest first.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::finder::surfaces;
+/// use topomech::graph::{GraphKind, Multiplicity};
+/// let finder = surfaces(4, 4);
+/// let groups = finder.groups(GraphKind::VertexEdge, Multiplicity::Ignore);
+/// assert!(groups.iter().all(|g| g.kind == GraphKind::VertexEdge && g.classes.len() >= 2));
+/// assert!(groups.iter().all(|g| g.classes.iter().all(|&c| c < finder.classes().len())));
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Group {
     /// The graph.

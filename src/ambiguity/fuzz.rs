@@ -94,6 +94,16 @@ pub fn encode_ops(mesh: u8, ops: &[Op]) -> Vec<u8> {
     std::iter::once(MIXED + mesh % 3).chain(body).collect()
 }
 /// An invariant of the [module docs](self) that failed.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::fuzz::{check_bytes, FuzzFailure};
+/// // The invariants hold on every input tried here: no failure.
+/// assert!((0..4u8).all(|b| check_bytes(&[b, 1, 2]).is_ok()));
+/// let f = FuzzFailure::Invalid { cut: 2, detail: "α3 not an involution".into() };
+/// assert!(f.to_string().contains("after cut 2"));
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum FuzzFailure {
     /// Invariant 1.
@@ -130,6 +140,14 @@ pub enum FuzzFailure {
 }
 
 /// What one input did.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::fuzz::check_bytes;
+/// let r = check_bytes(&[0, 0, 0, 0]).unwrap(); // three cuts on the Kuhn cube
+/// assert_eq!((r.cuts, r.subdivisions), (3, 0));
+/// ```
 #[derive(Debug, Clone, Default, PartialEq, Eq, serde::Serialize)]
 pub struct FuzzReport {
     /// Cuts made.

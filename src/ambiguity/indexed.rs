@@ -51,6 +51,17 @@ pub struct IndexedModel {
 }
 
 /// What one cut did to the indexed model.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::indexed::IndexedModel;
+/// let mut model = IndexedModel::new(5, &[[0, 1, 2, 3], [1, 2, 3, 4]]);
+/// let out = model.cut(0, 1).unwrap();
+/// assert_eq!(out.duplicated.len(), 3); // the three points of the shared face
+/// assert!(out.kept.is_empty() && !out.face_still_shared);
+/// assert_eq!(model.points, 8);
+/// ```
 #[derive(Debug, Clone, Default, PartialEq, Eq, serde::Serialize)]
 pub struct CutOutcome {
     /// Points duplicated: (old point, new point).
@@ -62,6 +73,15 @@ pub struct CutOutcome {
 }
 
 /// Why the indexed model could not perform a cut.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::indexed::{IndexedError, IndexedModel};
+/// let mut model = IndexedModel::new(6, &[[0, 1, 2, 3], [2, 3, 4, 5]]);
+/// assert_eq!(model.cut(0, 7), Err(IndexedError::NoSuchTet { tet: 7, tets: 2 }));
+/// assert!(matches!(model.cut(0, 1), Err(IndexedError::NoSharedFace(0, 1))));
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum IndexedError {
     /// A tet index past the end.
@@ -78,6 +98,17 @@ pub enum IndexedError {
 }
 
 /// The comparison of an indexed model with the g-map cut the same way.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::campaign::run_cuts;
+/// let run = run_cuts(5, &[[0, 1, 2, 3], [1, 2, 3, 4]], &[[0, 1]]).unwrap();
+/// let a = run.audit;
+/// assert!(a.gmap_valid && a.cuts_without_duplication == 0);
+/// assert_eq!((a.gmap_vertices, a.indexed_vertices), (8, 8));
+/// assert!(!a.ambiguous() && !a.wrong());
+/// ```
 #[derive(Debug, Clone, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Audit {
     /// Cuts that duplicated no point (each is also a face still shared unless a later cut

@@ -42,6 +42,18 @@ pub const VF2_NODE_CAP: usize = 4000;
 pub const SKELETON_CHECK_DARTS: usize = 6000;
 
 /// One operation; the index is reduced modulo the number of candidates when applied.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::mixed::{run_ops, Op};
+/// use topomech::generate;
+/// let (points, tets) = generate::kuhn_cube(1);
+/// // Indices wrap around the candidates: Subdivide(6) refines tet 0 of six.
+/// let run = run_ops(&points, &tets, &[Op::Subdivide(6), Op::Cut(0)]).unwrap();
+/// assert_eq!((run.subdivisions, run.cuts), (1, 1));
+/// assert_eq!(run.ops, vec![Op::Subdivide(6), Op::Cut(0)]);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Op {
@@ -52,6 +64,16 @@ pub enum Op {
 }
 
 /// Why a mixed sequence could not run (every case but `Build` is a bug of topomech).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::mixed::{run_ops, MixedError};
+/// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+/// // Point 4 does not exist: the mesh does not build.
+/// let e = run_ops(&points, &[[0, 1, 2, 4]], &[]).unwrap_err();
+/// assert!(matches!(e, MixedError::Build(_)));
+/// ```
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MixedError {
     /// The input mesh does not build, or the tet list after the ops does not.
@@ -75,6 +97,19 @@ pub enum MixedError {
 }
 
 /// The comparison of the indexed model with the g-map at one level (or the finest).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::mixed::{run_ops, Op};
+/// use topomech::generate;
+/// let (points, tets) = generate::kuhn_cube(1);
+/// let run = run_ops(&points, &tets, &[Op::Subdivide(0)]).unwrap();
+/// let c = &run.finest;
+/// assert!(c.hanging_edges > 0 && c.ambiguous());
+/// assert_eq!(run.levels[0].level, 0);
+/// assert!(!run.levels[0].ambiguous()); // level 0 is the uncut, unrefined cube
+/// ```
 #[derive(Debug, Clone, Default, PartialEq, Eq, serde::Serialize)]
 pub struct Compare {
     /// The level (the finest for the final comparison).
@@ -119,6 +154,17 @@ impl Compare {
 }
 
 /// The outcome of one mixed sequence.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::mixed::{run_ops, Op};
+/// use topomech::generate;
+/// let (points, tets) = generate::kuhn_cube(1);
+/// let run = run_ops(&points, &tets, &[Op::Cut(0), Op::Cut(0)]).unwrap();
+/// assert_eq!((run.cuts, run.subdivisions, run.refused), (2, 0, 0));
+/// assert!(run.gmap_valid && run.level_law && run.levels.is_empty());
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
 pub struct MixedRun {
     /// The operations as given.
@@ -445,6 +491,18 @@ pub fn random_ops(k: usize, p_subdivide: f64, rng: &mut SplitMix64) -> Vec<Op> {
 }
 
 /// Counts over the mixed sequences of one length k.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::mixed::campaign_mixed;
+/// use topomech::generate::{self, SplitMix64};
+/// let (points, tets) = generate::kuhn_cube(1);
+/// let (s, _) = campaign_mixed(&points, &tets, 2, 1.0, 3, &mut SplitMix64(5)).unwrap();
+/// assert_eq!((s.k, s.sequences, s.cuts), (2, 3, 0)); // p = 1: subdivisions only
+/// assert_eq!(s.subdivisions + s.refused, 6);
+/// assert_eq!(s.level_law_broken + s.gmap_invalid, 0);
+/// ```
 #[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
 pub struct MixedStats {
     /// Ops per sequence.

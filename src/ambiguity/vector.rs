@@ -14,6 +14,17 @@ use crate::gmap::GMap;
 use crate::graph::{graph_of, graphs_isomorphic, GraphJson, GraphJsonError, GraphKind, Multiplicity};
 
 /// A test vector of either kind.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::{campaign::Symptom, construct::CutComplex, vector::*};
+/// let uncut = CutComplex { points: 4, tets: vec![[0, 1, 2, 3]], cuts: vec![] };
+/// let i = IndexedVector::of("one_tet", Symptom::SkeletonUnchanged, &uncut, "").unwrap();
+/// let v = Vector::Indexed(Box::new(i));
+/// assert!(v.check().is_ok() && v.name() == "one_tet");
+/// assert_eq!(v.recompute().unwrap(), v);
+/// ```
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(tag = "type", rename_all = "snake_case")]
 pub enum Vector {
@@ -24,6 +35,17 @@ pub enum Vector {
 }
 
 /// Characteristics of a map, stored for the reader (and checked on replay).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::vector::MapFacts;
+/// use topomech::GMap;
+/// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+/// let f = MapFacts::of(&map);
+/// assert_eq!((f.darts, f.cells.clone(), f.boundary_darts), (6, vec![3, 3, 1], 6));
+/// assert_eq!(f.euler_characteristic, 3 - 3 + 1);
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct MapFacts {
     /// Live darts.
@@ -65,6 +87,18 @@ impl MapFacts {
 }
 
 /// One map of a pair.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::{construct::Gluing, finder::*, vector::PairVector};
+/// use topomech::graph::{GraphKind, Multiplicity};
+/// let square = |same| Gluing { sides: vec![4], pairs: vec![[0, 2, 0], [1, 3, same]] };
+/// let cand = |same| Candidate { map: square(same).build().unwrap(), origin: Origin::Gluing(square(same)) };
+/// let v = PairVector::of("t_k", GraphKind::Incidence, Multiplicity::Match, &cand(0), &cand(1), "");
+/// assert_eq!(v.a.origin, Origin::Gluing(square(0)));
+/// assert_eq!((v.a.facts.darts, v.a.darts.alpha.len()), (8, 8));
+/// ```
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct MapEntry {
     /// How it was made.
@@ -76,6 +110,19 @@ pub struct MapEntry {
 }
 
 /// Two non-isomorphic maps with isomorphic graphs of one kind.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::{construct::Gluing, finder::*, vector::PairVector};
+/// use topomech::graph::{GraphKind, Multiplicity};
+/// let square = |same| Gluing { sides: vec![4], pairs: vec![[0, 2, 0], [1, 3, same]] };
+/// let cand = |same| Candidate { map: square(same).build().unwrap(), origin: Origin::Gluing(square(same)) };
+/// let v = PairVector::of("t_k", GraphKind::Incidence, Multiplicity::Match, &cand(0), &cand(1), "");
+/// assert_eq!((v.name.as_str(), v.graph_kind), ("t_k", GraphKind::Incidence));
+/// assert_ne!(v.a.facts, v.b.facts);
+/// assert!(v.check().is_ok());
+/// ```
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PairVector {
     /// File stem and snapshot name.
@@ -99,6 +146,16 @@ pub struct PairVector {
 }
 
 /// A cut sequence after which the indexed model shows a symptom.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::{campaign::Symptom, construct::CutComplex, vector::IndexedVector};
+/// let cut = CutComplex { points: 5, tets: vec![[0, 1, 2, 3], [1, 2, 3, 4]], cuts: vec![[0, 1]] };
+/// let v = IndexedVector::of("two_tets", Symptom::PinchedPoint, &cut, "").unwrap();
+/// assert_eq!((v.complex.cuts.len(), v.audit.gmap_vertices), (1, 8));
+/// assert!(v.check().is_err()); // the cut shows no pinched point
+/// ```
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct IndexedVector {
     /// File stem and snapshot name.
@@ -114,6 +171,16 @@ pub struct IndexedVector {
 }
 
 /// Why a vector does not replay.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::{campaign::Symptom, construct::CutComplex, vector::*};
+/// let bad = CutComplex { points: 4, tets: vec![[0, 1, 2, 3]], cuts: vec![[0, 0]] };
+/// let e = IndexedVector::of("bad", Symptom::PinchedPoint, &bad, "").unwrap_err();
+/// assert!(matches!(e, VectorError::Construction { .. }));
+/// assert!(e.to_string().contains("bad"));
+/// ```
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum VectorError {
     /// A dimension other than 2 or 3.

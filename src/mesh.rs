@@ -29,6 +29,21 @@ use std::fmt;
 pub const DEGENERACY_TOLERANCE: f64 = 1e-12;
 
 /// A tetrahedral volume mesh with 0-based indices into `points`.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mesh::TetMesh;
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let mesh = TetMesh { points, tets, ..Default::default() };
+/// assert_eq!((mesh.points.len(), mesh.tets.len()), (8, 6)); // the unit cube in 6 tets
+/// assert!(mesh.tets.iter().flatten().all(|&i| (i as usize) < mesh.points.len()));
+/// let report = mesh.check().unwrap();
+/// assert!(report.zero_volume_tets.is_empty() && report.unreferenced_points.is_empty());
+/// assert!((mesh.total_volume() - 1.0).abs() < 1e-12);
+/// ```
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct TetMesh {
     /// Point coordinates.
@@ -44,6 +59,19 @@ pub struct TetMesh {
 }
 
 /// A triangle surface mesh with 0-based indices into `points`.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate::grid_triangles;
+/// use topomech::mesh::TriMesh;
+///
+/// let (points, triangles) = grid_triangles(1);
+/// let mesh = TriMesh { points, triangles };
+/// assert_eq!((mesh.points.len(), mesh.triangles.len()), (4, 2)); // a unit square, two halves
+/// assert!(mesh.check().unwrap().is_clean());
+/// assert!((mesh.total_area() - 1.0).abs() < 1e-12);
+/// ```
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct TriMesh {
     /// Point coordinates.
@@ -53,6 +81,18 @@ pub struct TriMesh {
 }
 
 /// The kind of cell an error is about.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mesh::{CellKind, MeshError, TriMesh};
+///
+/// let mesh = TriMesh { points: vec![[0.0; 3]; 3], triangles: vec![[0, 1, 7]] };
+/// let err = mesh.check().unwrap_err();
+/// assert!(matches!(err, MeshError::IndexOutOfRange { kind: CellKind::Triangle, corner: 2, value: 7, .. }));
+/// assert_eq!(CellKind::Tet.to_string(), "tet");
+/// assert_eq!(CellKind::BoundaryTriangle.to_string(), "boundary triangle");
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum CellKind {
     /// An entry of [`TetMesh::tets`].
@@ -153,6 +193,19 @@ fn tag_suffix(tag: &Option<u64>) -> String {
 
 /// Warnings found by [`TetMesh::check`]: the mesh is usable, but these may indicate a problem.
 /// All ids are sorted ascending.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mesh::TetMesh;
+///
+/// let unit = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [5.0; 3]];
+/// let mesh = TetMesh { points: unit, tets: vec![[0, 1, 2, 3]], ..Default::default() };
+/// let report = mesh.check().unwrap();
+/// assert_eq!(report.unreferenced_points, vec![4]); // point 4 belongs to no tet
+/// assert!(report.inverted_tets.is_empty() && report.zero_volume_tets.is_empty());
+/// assert!(!report.is_clean());
+/// ```
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct MeshReport {
     /// Tets whose volume is zero up to [`DEGENERACY_TOLERANCE`].
@@ -189,6 +242,19 @@ impl MeshReport {
 }
 
 /// Warnings found by [`TriMesh::check`]. All ids are sorted ascending.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mesh::TriMesh;
+///
+/// let points = vec![[0.0; 3], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+/// let mesh = TriMesh { points, triangles: vec![[0, 1, 2], [0, 1, 3]] };
+/// let report = mesh.check().unwrap();
+/// assert_eq!(report.zero_area_triangles, vec![0]); // collinear corners
+/// assert_eq!(report.unreferenced_points, Vec::<usize>::new());
+/// assert!(!report.is_clean());
+/// ```
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct TriMeshReport {
     /// Triangles whose area is zero up to [`DEGENERACY_TOLERANCE`].

@@ -12,6 +12,19 @@ use crate::mechanics::{Body, Vec3};
 use crate::{AlphaMask, CellId};
 
 /// Errors of the VTK writers.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::vtk::{Frame, VtkError};
+///
+/// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+/// let short = [[0.0; 3]; 2];
+/// let frame = Frame { points: &points, tets: &[[0, 1, 2, 3]], vectors: vec![("force", &short[..])] };
+/// let err = frame.to_vtu().unwrap_err();
+/// assert!(matches!(&err, VtkError::BadArray { name, got: 2, expected: 4 } if name == "force"));
+/// assert!(err.to_string().contains("force"));
+/// ```
 #[derive(Debug, thiserror::Error)]
 pub enum VtkError {
     /// The file could not be written.
@@ -35,6 +48,20 @@ pub enum VtkError {
 }
 
 /// One frame: points, tets and named per-point vectors.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate::kuhn_cube;
+/// use topomech::vtk::Frame;
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let zero = vec![[0.0; 3]; points.len()];
+/// let frame = Frame { points: &points, tets: &tets, vectors: vec![("velocity", &zero[..])] };
+/// assert_eq!(frame.vectors[0].1.len(), frame.points.len()); // one vector per point
+/// let xml = frame.to_vtu().unwrap();
+/// assert!(xml.contains("NumberOfPoints=\"8\" NumberOfCells=\"6\""));
+/// ```
 #[derive(Clone, Debug, Default)]
 pub struct Frame<'a> {
     /// Point coordinates.
@@ -134,6 +161,22 @@ fn write_file(path: &Path, text: &str) -> Result<(), VtkError> {
 }
 
 /// A `.pvd` collection being written: frames are recorded as they are saved.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::vtk::{Frame, Series};
+///
+/// let dir = std::env::temp_dir().join(format!("topomech-doc-series-{}", std::process::id()));
+/// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+/// let frame = Frame { points: &points, tets: &[[0, 1, 2, 3]], vectors: vec![] };
+/// let mut series = Series::new(&dir, "drop").unwrap();
+/// for step in 0..3 {
+///     assert!(series.push(step as f64 * 0.1, &frame).unwrap().exists());
+/// }
+/// assert_eq!(std::fs::read_to_string(series.pvd_path()).unwrap().matches("<DataSet").count(), 3);
+/// std::fs::remove_dir_all(&dir).unwrap();
+/// ```
 #[derive(Clone, Debug)]
 pub struct Series {
     dir: PathBuf,

@@ -192,6 +192,27 @@ impl<T> std::ops::IndexMut<CellId> for CellArray<T> {
 ///
 /// Every method receives the map *after* the topological operation, so both resulting cells can
 /// be walked.
+///
+/// # Examples
+///
+/// ```
+/// use std::convert::Infallible;
+/// use topomech::embedding::{CellRules, Embedded};
+/// use topomech::{CellId, DartId, GMap};
+///
+/// struct SplitCount(usize); // counts cell splits, keeps no attribute
+/// impl CellRules<3> for SplitCount {
+///     type Error = Infallible;
+///     fn grow_to(&mut self, _: &GMap<3>) {}
+///     fn on_split(&mut self, _: &GMap<3>, _: usize, _: CellId, _: CellId, _: DartId, _: DartId) { self.0 += 1 }
+///     fn on_merge(&mut self, _: &GMap<3>, _: usize, _: CellId, _: CellId) {}
+/// }
+/// let (map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+/// let d = map.darts().find(|&d| !map.is_free(3, d)).unwrap();
+/// let mut e = Embedded::new(map, SplitCount(0));
+/// let changes = e.unsew(3, d).unwrap();
+/// assert_eq!(e.attrs().0, changes.changes.len());
+/// ```
 pub trait CellRules<const N: usize> {
     /// What [`CellRules::check`] reports.
     type Error: std::error::Error + 'static;
@@ -224,6 +245,22 @@ pub trait CellRules<const N: usize> {
 }
 
 /// Errors of the embedding-aware mutators.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::embedding::EmbedError;
+/// use topomech::gmap::SewError;
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Material};
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let d = body.map().darts().find(|&d| body.map().is_free(3, d)).unwrap(); // a boundary dart
+/// let err = body.unsew(3, d).unwrap_err();
+/// assert!(matches!(err, EmbedError::Sew(SewError::AlreadyFree { i: 3, .. })));
+/// assert_eq!(body.version(), 0); // refused: nothing changed
+/// ```
 #[derive(Debug, thiserror::Error)]
 pub enum EmbedError<E: std::error::Error + 'static> {
     /// The topological operation was refused; map and attributes are unchanged.
@@ -246,6 +283,21 @@ pub enum EmbedError<E: std::error::Error + 'static> {
 /// The map is only reachable read-only from outside, so every topological change goes through
 /// [`Embedded::sew`] / [`Embedded::unsew`] and the rules cannot be bypassed. [`Embedded::version`]
 /// counts topological changes; projections built from the map remember it to detect staleness.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Material};
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+/// body.unsew(3, d).unwrap(); // topology and attributes change together
+/// assert_eq!(body.version(), 1);
+/// assert!(body.map().is_free(3, d));
+/// assert!(body.check().is_ok());
+/// ```
 #[derive(Clone, Debug)]
 pub struct Embedded<const N: usize, E> {
     map: GMap<N>,

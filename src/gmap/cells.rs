@@ -5,6 +5,18 @@ use super::orbit::{generators, union_smaller_root};
 use super::{AlphaMask, DartId, DartSet, GMap};
 
 /// Number of i-cells for each i in 0..=n.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::GMap;
+///
+/// let (map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+/// let counts = map.count_cells();
+/// assert_eq!(counts.0, vec![5, 9, 7, 2]); // vertices, edges, faces, volumes
+/// assert_eq!(counts, map.count_cells_by_traversal());
+/// assert_eq!(counts.euler_characteristic(), 5 - 9 + 7 - 2);
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
 pub struct CellCounts(pub Vec<usize>);
 

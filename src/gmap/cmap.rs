@@ -7,6 +7,19 @@
 use super::{DartId, GMap};
 
 /// An n-map: darts 0..len, β1 a permutation, βi for i ≥ 2 partial involutions.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::GMap;
+///
+/// let (tet, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let cmap = tet.to_combinatorial_map().unwrap();
+/// assert!(cmap.is_valid());
+/// assert_eq!(cmap.origin.len(), tet.dart_count() / 2); // one colour of the orientation
+/// assert_eq!(cmap.beta.len(), 2); // β2 and β3
+/// assert!(cmap.origin.iter().all(|&d| tet.contains(d)));
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct CombinatorialMap {
     /// For each combinatorial dart, the G-map dart it came from.

@@ -3,6 +3,22 @@
 use super::{DartId, GMap};
 
 /// A set of darts as a bit set with a count. Grows on demand. Insert, remove and test are O(1).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::gmap::DartSet;
+/// use topomech::GMap;
+///
+/// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+/// let first = map.darts().next().unwrap();
+/// let mut set = DartSet::with_capacity(map.dart_count());
+/// for d in map.darts().filter(|&d| map.vertex_id(d) == map.vertex_id(first)) {
+///     assert!(set.insert(d));
+/// }
+/// assert_eq!(set.len(), 2); // a triangle corner holds two darts
+/// assert!(set.contains(first));
+/// ```
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct DartSet {
     bits: Vec<u64>,
@@ -161,6 +177,20 @@ impl DartSet {
 ///
 /// Give it back with [`GMap::free_mark`] once every dart is unmarked again; a mark released or
 /// dropped while darts are still marked is a bug in the caller's algorithm and asserts.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::{AlphaMask, GMap};
+///
+/// let (mut map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+/// let d = map.darts().next().unwrap();
+/// let mut mark = map.reserve_mark();
+/// map.mark_orbit(&mut mark, d, AlphaMask::of(&[0, 1]));
+/// assert_eq!(mark.count(), 6); // the whole triangle
+/// map.unmark_orbit(&mut mark, d, AlphaMask::of(&[0, 1]));
+/// map.free_mark(mark); // clean again: can go back to the pool
+/// ```
 #[derive(Debug)]
 pub struct Mark {
     set: DartSet,

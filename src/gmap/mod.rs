@@ -69,6 +69,19 @@ impl IdAlloc {
 }
 
 /// Errors of dart creation and deletion.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::gmap::DartError;
+/// use topomech::{DartId, GMap};
+///
+/// let mut map = GMap::<2>::new();
+/// let d = map.create_dart().unwrap();
+/// assert!(matches!(map.delete_dart(DartId(7)), Err(DartError::NoSuchDart(DartId(7)))));
+/// map.delete_dart(d).unwrap();
+/// assert!(matches!(map.delete_dart(d), Err(DartError::NoSuchDart(x)) if x == d));
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum DartError {
     /// The id is past the end of the map or names a deleted dart.
@@ -90,6 +103,19 @@ pub enum DartError {
 }
 
 /// An n-dimensional generalized map with exact cell ids. See the [module docs](self).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::GMap;
+///
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// assert_eq!(map.dimension(), 3);
+/// assert_eq!(map.dart_count(), 24); // 4 faces × 3 edges × 2 ends
+/// assert_eq!(map.count_cells().0, vec![4, 6, 4, 1]);
+/// assert!(map.darts().all(|d| map.is_free(3, d))); // a lone tet: all on the boundary
+/// assert_eq!(map.validate(), Ok(()));
+/// ```
 #[derive(Clone, Debug)]
 pub struct GMap<const N: usize> {
     alpha: Vec<u32>,

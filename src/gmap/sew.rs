@@ -18,6 +18,20 @@ use rustc_hash::FxHashMap;
 use super::{AlphaMask, CellId, DartId, GMap};
 
 /// Why a sew or unsew was refused. The map is unchanged when one is returned.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::gmap::SewError;
+/// use topomech::GMap;
+///
+/// let mut map = GMap::<2>::new();
+/// let (a, b) = (map.create_dart().unwrap(), map.create_dart().unwrap());
+/// assert!(matches!(map.unsew::<0>(a), Err(SewError::AlreadyFree { i: 0, .. })));
+/// map.sew::<0>(a, b).unwrap();
+/// assert!(matches!(map.sew::<0>(a, b), Err(SewError::NotFree { dart, i: 0, partner }) if (dart, partner) == (a, b)));
+/// assert!(matches!(map.sew_dyn(5, a, b), Err(SewError::BadIndex { i: 5, n: 2 })));
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum SewError {
     /// A dart id that is not live in this map.
@@ -78,6 +92,21 @@ pub enum SewError {
 }
 
 /// One change of cell identity made by a sew or an unsew.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::gmap::CellChange;
+/// use topomech::GMap;
+///
+/// let (mut map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+/// let d = map.darts().find(|&d| !map.is_free(3, d)).unwrap();
+/// let changes = map.unsew::<3>(d).unwrap();
+/// // the shared triangle becomes two faces, one per tet
+/// let face_split = changes.changes.iter().any(|c| matches!(c, CellChange::Split { dim: 2, .. }));
+/// assert!(face_split);
+/// assert_eq!(map.count_cells().0[2], 8);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum CellChange {
     /// Two `dim`-cells became one: `absorbed` no longer exists, its darts now carry `kept`.
@@ -106,6 +135,19 @@ pub enum CellChange {
 }
 
 /// Everything a sew or unsew changed in cell identities, in the order it happened.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::GMap;
+///
+/// let (mut map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+/// let d = map.darts().find(|&d| !map.is_free(3, d)).unwrap();
+/// let changes = map.unsew::<3>(d).unwrap();
+/// assert_eq!(changes.pairs.len(), 6); // the 6 darts of one side of the shared triangle
+/// assert!(changes.pairs.iter().all(|&(a, b)| map.is_free(3, a) && map.is_free(3, b)));
+/// assert_eq!(changes.merges(2).count(), 0); // an unsew only splits
+/// ```
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct CellChanges {
     /// The changes.

@@ -20,6 +20,19 @@ use super::orbit::{generators, VisitBits};
 use super::{AlphaMask, CellId, DartId, DartSet, GMap};
 
 /// The law a violation breaks.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::gmap::Law;
+/// use topomech::{CellId, DartId, InvariantViolation};
+///
+/// let v = InvariantViolation::CellIdOrphan { dim: 0, id: CellId(9) };
+/// assert_eq!(v.law(), Law::CellIdUnique);
+/// let w = InvariantViolation::DanglingLink { dart: DartId(0), i: 2, target: DartId(99) };
+/// assert_eq!(w.law(), Law::Involution);
+/// assert_ne!(Law::CellIdConstant, Law::CellIdUnique);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Law {
     /// Each αi is an involution on the live darts.
@@ -33,6 +46,17 @@ pub enum Law {
 }
 
 /// A broken law, naming the dart(s), the indices and the law.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::{generate, GMap, InvariantViolation};
+///
+/// let (points, tets) = generate::kuhn_cube(1);
+/// let (map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+/// let verdict: Result<(), InvariantViolation> = map.validate();
+/// assert_eq!(verdict, Ok(())); // maps built through the public API keep every law
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum InvariantViolation {
     /// αi(d) is not a live dart.

@@ -36,6 +36,19 @@ use petgraph::Undirected;
 use crate::gmap::{AlphaMask, DartSet, GMap};
 
 /// A node of a cell graph: a cell of dimension `dim` with the map's cell id `id`.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::graph::incidence_graph;
+/// use topomech::GMap;
+///
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let g = incidence_graph(&map);
+/// let volumes: Vec<_> = g.node_weights().filter(|n| n.dim == 3).collect();
+/// assert_eq!(volumes.len(), 1);
+/// assert_eq!(volumes[0].id, map.cell_id(3, map.darts().next().unwrap()).0);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize)]
 pub struct CellNode {
     /// Dimension of the cell (0 = vertex).
@@ -45,6 +58,19 @@ pub struct CellNode {
 }
 
 /// An undirected cell graph whose edge weights are multiplicities (≥ 1).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::graph::{dual_graph, CellGraph};
+/// use topomech::GMap;
+///
+/// let (map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+/// let g: CellGraph = dual_graph(&map);
+/// assert_eq!((g.node_count(), g.edge_count()), (2, 1)); // two tets through one face
+/// assert!(g.node_weights().all(|n| n.dim == 3));
+/// assert!(g.edge_weights().all(|&m| m == 1)); // multiplicities
+/// ```
 pub type CellGraph = Graph<CellNode, u32, Undirected>;
 
 /// Which adjacency graph to export (see the [module docs](self)).
@@ -98,6 +124,17 @@ impl fmt::Display for GraphKind {
 }
 
 /// Whether graph comparison matches edge weights (multiplicities) or only the simple relation.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::graph::{graphs_isomorphic, GraphJson, GraphKind, Multiplicity};
+///
+/// let graph = |m| GraphJson { kind: GraphKind::Dual, nodes: vec![3, 3], edges: vec![[0, 1, m]] }.to_graph().unwrap();
+/// let (once, twice) = (graph(1), graph(2)); // glued along one face, or along two
+/// assert!(graphs_isomorphic(&once, &twice, Multiplicity::Ignore));
+/// assert!(!graphs_isomorphic(&once, &twice, Multiplicity::Match));
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Multiplicity {
@@ -315,10 +352,38 @@ pub fn graphs_isomorphic(a: &CellGraph, b: &CellGraph, multiplicity: Multiplicit
 /// A cheap isomorphism invariant of a cell graph: the sorted multiset of (dimension, loop weight,
 /// sorted neighbour (dimension, weight) list) over nodes. Equal for isomorphic graphs; used to
 /// bucket graphs before VF2. O(nodes + edges · log).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::graph::{dual_graph, GraphInvariant, Multiplicity};
+/// use topomech::GMap;
+///
+/// let (a, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+/// let (b, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [1, 2, 3, 4]]).unwrap();
+/// let (c, _) = GMap::<3>::from_tets(8, &[[0, 1, 2, 3], [4, 5, 6, 7]]).unwrap();
+/// let inv = |m: &GMap<3>| GraphInvariant::of(&dual_graph(m), Multiplicity::Ignore);
+/// assert_eq!(inv(&a), inv(&b)); // both: two volumes, one shared face
+/// assert_ne!(inv(&a), inv(&c)); // two separate tets
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct GraphInvariant(Vec<InvariantRow>);
 
 /// One node of a [`GraphInvariant`]: (dimension, loop weight, sorted (neighbour dimension, weight)).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::graph::{incidence_graph, InvariantRow};
+/// use topomech::GMap;
+///
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let g = incidence_graph(&map);
+/// // the row of a vertex of a lone tet: dimension 0, no loop, three edges of weight 1
+/// let row: InvariantRow = (0, 0, vec![(1, 1); 3]);
+/// let v = g.node_indices().find(|&n| g[n].dim == 0).unwrap();
+/// assert_eq!(g.neighbors(v).count(), row.2.len());
+/// ```
 pub type InvariantRow = (u8, u32, Vec<(u8, u32)>);
 
 impl GraphInvariant {
@@ -360,6 +425,19 @@ impl GraphInvariant {
 
 /// A cell graph in a canonical-looking, id-free JSON form for snapshots and test vectors: nodes
 /// renumbered by (dimension, id), edges as `[a, b, weight]` with a ≤ b, sorted.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::graph::{dual_graph, GraphJson, GraphKind};
+/// use topomech::GMap;
+///
+/// let (map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+/// let json = GraphJson::of(&dual_graph(&map), GraphKind::Dual);
+/// assert_eq!(json.kind, GraphKind::Dual);
+/// assert_eq!(json.nodes, vec![3, 3]);
+/// assert_eq!(json.edges, vec![[0, 1, 1]]); // ranks, not map ids
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct GraphJson {
     /// Which graph.
@@ -435,6 +513,16 @@ impl GraphJson {
 }
 
 /// Why a [`GraphJson`] does not describe a graph.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::graph::{GraphJson, GraphJsonError, GraphKind};
+///
+/// let json = GraphJson { kind: GraphKind::VertexEdge, nodes: vec![0, 0], edges: vec![[0, 1, 1], [1, 2, 1]] };
+/// let err = json.to_graph().unwrap_err();
+/// assert!(matches!(err, GraphJsonError::BadEndpoint { edge: 1, nodes: 2 }));
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum GraphJsonError {
     /// An edge names a node that does not exist.

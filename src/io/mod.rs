@@ -28,6 +28,20 @@ mod tetgen;
 use build::MeshBuilder;
 
 /// Where in a file a problem is.
+///
+/// # Examples
+///
+/// ```
+/// use std::path::Path;
+/// use topomech::io::{parse_msh, Location, ReadError};
+///
+/// let msh = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n1\n1 0 0 zz\n$EndNodes\n";
+/// match parse_msh(msh.as_bytes(), Path::new("bad.msh")).unwrap_err() {
+///     ReadError::Garbage { at, .. } => assert_eq!(at, Location::Line(6)),
+///     other => panic!("unexpected {other}"),
+/// }
+/// assert_eq!(Location::Byte(12).to_string(), "byte 12");
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Location {
     /// 1-based line number (text files).

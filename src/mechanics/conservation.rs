@@ -20,6 +20,20 @@ use super::model::{distinct, stiffness_contribution, Mechanics};
 pub const TOLERANCE: f64 = 1e-12;
 
 /// A conservation law that does not hold, naming the cell.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{check_conservation, Body, ConservationError, Material};
+/// use topomech::CellId;
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// body.attrs_mut().rest_position[CellId(0)][0] += 0.1; // rest lengths at vertex 0 no longer match
+/// let err = check_conservation(body.map(), body.attrs()).unwrap_err();
+/// assert!(matches!(err, ConservationError::RestLength { .. }), "{err}");
+/// ```
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ConservationError {
     /// m_v ≠ Σ_{t ∋ v} m_t / 4.

@@ -13,6 +13,21 @@ use super::model::{stiffness_contribution, Material, ModelError};
 use crate::build::BuildError;
 
 /// A flat mass/spring model: its [`SpringSystem`] and its own state arrays.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{FlatModel, Material};
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let pinned = [true, false, false, false, false, false, false, false];
+/// let flat = FlatModel::from_tets(&points, &tets, Material::default(), [0.0; 3], &pinned).unwrap();
+/// assert_eq!(flat.rest_position, flat.position); // starts at rest
+/// assert!(flat.velocity.iter().all(|v| *v == [0.0; 3]));
+/// assert_eq!(flat.system.inv_mass[0], 0.0); // the pinned point does not move
+/// assert!(flat.system.inv_mass[1] > 0.0);
+/// ```
 #[derive(Clone, Debug)]
 pub struct FlatModel {
     /// The arrays the step loop reads.

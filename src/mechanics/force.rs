@@ -41,6 +41,20 @@ pub const PARALLEL_CHUNK: usize = 4096;
 /// Vertices are *slots* `0..slots()`: positions and velocities are passed in as slices of that
 /// length. A slot with `inv_mass == 0` does not move (pinned, dead or massless). Equality compares
 /// the arrays and, per slot, the incident lists in order (not where they sit in memory).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mechanics::SpringSystem;
+///
+/// let mut sys = SpringSystem::default();
+/// let (a, b) = (sys.push_slot(2.0, false, 0.0), sys.push_slot(1.0, true, 0.0));
+/// let s = sys.push_spring([a as u32, b as u32], 1.0, 50.0, 0.1);
+/// assert_eq!((sys.slots(), sys.springs()), (2, 1));
+/// assert_eq!((sys.inv_mass[a], sys.inv_mass[b]), (0.5, 0.0)); // slot b is fixed
+/// assert_eq!(sys.incident(a).map(|(spring, _)| spring).collect::<Vec<_>>(), vec![s]);
+/// assert!(sys.check_incidence().is_ok());
+/// ```
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct SpringSystem {
     /// Spring end slots (a, b).
@@ -620,6 +634,18 @@ fn spring_scale(dx: f64, dy: f64, dz: f64, dvx: f64, dvy: f64, dvz: f64, rest: f
 }
 
 /// Why [`SpringSystem::check_incidence`] failed.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mechanics::{IncidenceError, SpringSystem};
+///
+/// let mut sys = SpringSystem::default();
+/// (0..3).for_each(|_| drop(sys.push_slot(1.0, false, 0.0)));
+/// sys.push_spring([0, 1], 1.0, 1.0, 0.0);
+/// sys.ends[0] = [0, 2]; // bypasses the mutators: the incidence lists are now stale
+/// assert!(matches!(sys.check_incidence(), Err(IncidenceError::Lists { .. })));
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum IncidenceError {
     /// The per-slot table does not have one entry per slot.

@@ -1,6 +1,18 @@
 //! Small 3-vector helpers used by the mechanics (no dependency needed for these few lines).
 
 /// A point or vector of R³.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::Vec3;
+///
+/// let (points, _) = kuhn_cube(1);
+/// let top: Vec<Vec3> = points.into_iter().filter(|p| p[2] == 1.0).collect();
+/// assert_eq!(top.len(), 4);
+/// assert!(top.iter().all(|&[x, y, _]| (x == 0.0 || x == 1.0) && (y == 0.0 || y == 1.0)));
+/// ```
 pub type Vec3 = [f64; 3];
 
 #[inline(always)]

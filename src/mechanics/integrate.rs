@@ -25,6 +25,17 @@ use super::force::{SpringSystem, PARALLEL_CHUNK};
 use super::geom::{dot, norm, sub, Vec3};
 
 /// The time integration scheme.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mechanics::Integrator;
+///
+/// assert_eq!("rk4".parse::<Integrator>(), Ok(Integrator::Rk4));
+/// assert_eq!("Semi-Implicit".parse::<Integrator>(), Ok(Integrator::Symplectic)); // alias, any case
+/// assert_eq!("backward-euler".parse::<Integrator>(), Ok(Integrator::Implicit));
+/// assert_eq!(Integrator::Euler.name(), "euler");
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Integrator {
     /// Explicit (forward) Euler.
@@ -60,6 +71,17 @@ impl Integrator {
 }
 
 /// An integrator name that is not one of the four.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mechanics::integrate::UnknownIntegrator;
+/// use topomech::mechanics::Integrator;
+///
+/// let err = "leapfrog".parse::<Integrator>().unwrap_err();
+/// assert_eq!(err, UnknownIntegrator("leapfrog".to_string()));
+/// assert!(err.to_string().contains("\"leapfrog\"") && err.to_string().contains("rk4"));
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error("unknown integrator {0:?} (expected euler, symplectic, rk4 or implicit)")]
 pub struct UnknownIntegrator(pub String);
@@ -78,6 +100,20 @@ impl FromStr for Integrator {
 }
 
 /// What went wrong in a step.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mechanics::{Integrator, SpringSystem, StepConfig, StepError, Stepper};
+///
+/// let mut sys = SpringSystem::default();
+/// sys.push_slot(1.0, false, 0.0);
+/// let (x, v) = (vec![[0.0; 3]], vec![[0.0; 3]]);
+/// let nan = Stepper::new(StepConfig::new(Integrator::Rk4, f64::NAN), &sys, &x, &v);
+/// assert!(matches!(nan, Err(StepError::BadTimeStep(dt)) if dt.is_nan()));
+/// let short = Stepper::new(StepConfig::new(Integrator::Rk4, 0.1), &sys, &x, &[]);
+/// assert!(matches!(short, Err(StepError::SizeMismatch { expected: 1, got: 0 })));
+/// ```
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum StepError {
     /// The state became non-finite or its energy ran away; the simulation must stop.
@@ -114,6 +150,19 @@ pub enum StepError {
 }
 
 /// Parameters of the stepping.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mechanics::{Integrator, SpringSystem, StepConfig, Stepper};
+///
+/// let config = StepConfig { cg_tolerance: 1e-6, cg_max_iterations: 50, ..StepConfig::new(Integrator::Implicit, 0.01) };
+/// assert_eq!((config.integrator, config.dt, config.parallel), (Integrator::Implicit, 0.01, false));
+/// let mut sys = SpringSystem::default();
+/// sys.push_slot(1.0, false, 0.0);
+/// let stepper = Stepper::new(config, &sys, &[[0.0; 3]], &[[0.0; 3]]).unwrap();
+/// assert_eq!(stepper.config().cg_max_iterations, 50);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StepConfig {
     /// The scheme.
@@ -158,6 +207,21 @@ impl StepConfig {
 }
 
 /// The integrator's scratch buffers and step counter; reused every step (no allocation).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mechanics::{Integrator, SpringSystem, StepConfig, Stepper};
+///
+/// let mut sys = SpringSystem::default();
+/// sys.gravity = [0.0, 0.0, -10.0];
+/// sys.push_slot(1.0, false, 0.0);
+/// let (mut x, mut v) = (vec![[0.0; 3]], vec![[0.0; 3]]);
+/// let mut stepper = Stepper::new(StepConfig::new(Integrator::Symplectic, 0.1), &sys, &x, &v).unwrap();
+/// (0..10).for_each(|_| stepper.step(&sys, &mut x, &mut v).unwrap());
+/// assert_eq!(stepper.steps_done(), 10);
+/// assert!((v[0][2] + 10.0).abs() < 1e-12); // free fall for 1 s: v = g t
+/// ```
 #[derive(Clone, Debug)]
 pub struct Stepper {
     config: StepConfig,

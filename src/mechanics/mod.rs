@@ -32,6 +32,18 @@ pub use projection::{forces_by_coverage, Projection, ProjectionMismatch, Touched
 use crate::CellId;
 
 /// Errors of a map-driven simulation.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Integrator, Material, SimError, Simulation, StepConfig, StepError};
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let err = Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Euler, 0.0)).unwrap_err();
+/// assert!(matches!(err, SimError::Step(StepError::BadTimeStep(dt)) if dt == 0.0));
+/// ```
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SimError {
     /// A step failed; for a body, the slot is the vertex id.
@@ -48,6 +60,20 @@ pub enum SimError {
 }
 
 /// Which vertices to fix, by rest position or id.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::PinSpec;
+/// use topomech::CellId;
+///
+/// let (points, _) = kuhn_cube(1);
+/// let box_pins = PinSpec { inside: Some(([0.0; 3], [1.0, 1.0, 0.0])), ..Default::default() };
+/// let fixed: Vec<u32> = (0..8).filter(|&v| box_pins.pins(CellId(v), points[v as usize])).collect();
+/// assert_eq!(fixed, vec![0, 1, 2, 3]); // the bottom face, bounds included
+/// assert!(PinSpec::default().ids.is_empty() && !PinSpec::default().pins(CellId(0), [0.0; 3]));
+/// ```
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PinSpec {
     /// Vertex ids (points of the input mesh for a fresh body).
@@ -81,6 +107,21 @@ impl PinSpec {
 
 /// A map-driven simulation: the projection of a body and a stepper that advances the body's own
 /// position and velocity embeddings.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Integrator, Material, Simulation, StepConfig};
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let mut sim = Simulation::new(&mut body, [0.0, 0.0, -9.81], StepConfig::new(Integrator::Symplectic, 1e-3)).unwrap();
+/// (0..10).for_each(|_| sim.step(&mut body).unwrap());
+/// assert_eq!(sim.stepper.steps_done(), 10);
+/// assert!(sim.projection.is_current(&body));
+/// assert!(body.attrs().position.as_slice().iter().all(|p| p[2] < 1.0 + 1e-12)); // falling
+/// ```
 #[derive(Clone, Debug)]
 pub struct Simulation {
     /// The indexed projection the step loop runs on.

@@ -79,6 +79,19 @@ impl Default for Material {
 }
 
 /// Why a body could not be built.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mechanics::{Body, Material, ModelError};
+///
+/// let flat = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]];
+/// let err = Body::from_tets(&flat, &[[0, 1, 2, 3]], Material::default()).unwrap_err();
+/// assert!(matches!(err, ModelError::DegenerateTet { tet: 0 }));
+/// let nan = [[f64::NAN, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+/// let err = Body::from_tets(&nan, &[[0, 1, 2, 3]], Material::default()).unwrap_err();
+/// assert!(matches!(err, ModelError::NonFinitePoint { point: 0, .. }));
+/// ```
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ModelError {
     /// The map could not be built from the tetrahedra.
@@ -115,6 +128,21 @@ pub enum ModelError {
 /// State variables (positions, velocities, forces, pins) are public fields: the simulation writes
 /// them every step. Parameters bound by the laws (masses, stiffnesses) are private and change only
 /// through the split/merge rules, so the laws cannot be broken from outside.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Material};
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let m = body.attrs();
+/// assert_eq!(m.position.as_slice(), m.rest_position.as_slice()); // built at rest
+/// assert!(m.velocity.as_slice().iter().all(|v| *v == [0.0; 3]));
+/// assert!(!m.pinned.as_slice().iter().any(|&p| p));
+/// assert!((m.total_tet_mass(body.map()) - 1.0).abs() < 1e-12); // density 1, unit cube
+/// ```
 #[derive(Clone, Debug)]
 pub struct Mechanics {
     pub(crate) material: Material,
@@ -145,9 +173,37 @@ pub struct Mechanics {
 }
 
 /// A mechanical body: a 3-G-map whose sew/unsew keep the [`Mechanics`] attributes lawful.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Material};
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let (mut body, _): (Body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+/// body.unsew3(d).unwrap();
+/// assert_eq!(body.version(), 1);
+/// assert!(body.check().is_ok()); // the mechanical laws still hold
+/// ```
 pub type Body = Embedded<3, Mechanics>;
 
 /// Errors of the body's topological operations.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::embedding::EmbedError;
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, BodyError, Material};
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let d = body.map().darts().find(|&d| body.map().is_free(3, d)).unwrap();
+/// let err: BodyError = body.unsew3(d).unwrap_err(); // nothing to unsew on the boundary
+/// assert!(matches!(err, EmbedError::Sew(_)));
+/// ```
 pub type BodyError = crate::embedding::EmbedError<ConservationError>;
 
 impl Mechanics {

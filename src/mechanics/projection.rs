@@ -43,6 +43,21 @@ use super::geom::Vec3;
 use super::model::{Body, Mechanics};
 
 /// See the [module docs](self).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Material, Projection};
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let p = Projection::build(&body, [0.0, 0.0, -9.81]);
+/// let cells = body.map().count_cells();
+/// assert_eq!((p.system.slots(), p.system.springs()), (cells.0[0], cells.0[1])); // vertices, edges
+/// assert_eq!(p.system.gravity, [0.0, 0.0, -9.81]);
+/// assert_eq!(p.version(), body.version());
+/// ```
 #[derive(Clone, Debug)]
 pub struct Projection {
     /// The arrays the step loop reads.
@@ -385,6 +400,19 @@ impl Projection {
 }
 
 /// How two projections of the same body differ ([`Projection::equivalent`]).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Material, Projection, ProjectionMismatch};
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let a = Projection::build(&body, [0.0; 3]);
+/// let b = Projection::build(&body, [0.0, 0.0, -1.0]);
+/// assert!(matches!(a.equivalent(&b), Err(ProjectionMismatch::Sizes { slots: (8, 8), .. })));
+/// ```
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ProjectionMismatch {
     /// Different numbers of slots or springs, or different gravity.
@@ -416,6 +444,21 @@ pub enum ProjectionMismatch {
 /// time it was recorded (`None`: the cell was deleted or absorbed). Records accumulate over a
 /// batch of operations; [`Projection::update`] keeps, per id, the latest record whose dart still
 /// carries that id (no valid dart: the cell is gone).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Material, TouchedCells};
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+/// let changes = body.unsew3(d).unwrap();
+/// let mut touched = TouchedCells::default();
+/// touched.record(body.map(), &changes);
+/// assert!(touched.vertices.iter().all(|&(v, dart)| dart.map_or(true, |d| body.map().vertex_id(d) == v)));
+/// ```
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TouchedCells {
     /// Vertex ids and a dart of each.

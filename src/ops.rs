@@ -32,6 +32,19 @@ pub const MAX_DARTS: usize = 4096;
 
 /// One operation on a map. Dart and index fields are raw numbers: [`apply`] reduces dart numbers
 /// modulo the capacity and the index modulo n + 2 (so an out-of-range index is tried too).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ops::{decode, encode, run_ops, KernelOp, Seed};
+/// use topomech::GMap;
+///
+/// let ops = vec![KernelOp::Grow { kind: Seed::Structured, seed: 1 }, KernelOp::Unsew { i: 3, a: 40 }];
+/// assert_eq!(decode(&encode(&ops)), ops);
+/// let mut map = GMap::<3>::new();
+/// assert_eq!(run_ops(&mut map, &ops), Ok(())); // every law holds after each op
+/// assert!(map.dart_count() > 0);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum KernelOp {
     /// `create_dart()`.
@@ -74,6 +87,17 @@ pub enum KernelOp {
 }
 
 /// Families of seeded maps added by [`KernelOp::Grow`], for each dimension.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ops::{from_alpha_table, seeded_table, Seed};
+///
+/// let table = seeded_table::<3>(Seed::Structured, 0).unwrap(); // the Kuhn cube k = 1
+/// assert_eq!(table.len(), 6 * 24);
+/// let map = from_alpha_table::<3>(&table).unwrap();
+/// assert_eq!(map.count_cells().0, [8, 19, 18, 6]);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Seed {
     /// n = 3: the Kuhn cube k = 1 (6 tets); n = 2: a triangle grid of side 1..=3; n = 1: a closed
@@ -204,6 +228,18 @@ pub fn encode(ops: &[KernelOp]) -> Vec<u8> {
 }
 
 /// An operation with its dart numbers resolved against a map: what [`apply`] actually runs.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ops::{resolve, KernelOp, Resolved};
+/// use topomech::{DartId, GMap};
+///
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let op = KernelOp::Sew { i: 7, a: 25, b: 2 }; // 24 darts, indices modulo n + 2 = 5
+/// assert_eq!(resolve(&map, &op), Resolved::Sew { i: 2, a: DartId(1), b: DartId(2) });
+/// assert_eq!(resolve(&map, &KernelOp::CreateDart), Resolved::Create);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Resolved {
     /// Create a dart.
@@ -276,6 +312,19 @@ pub fn resolve<const N: usize>(map: &GMap<N>, op: &KernelOp) -> Resolved {
 }
 
 /// What a successful [`apply`] did.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ops::{apply, Applied, KernelOp};
+/// use topomech::GMap;
+///
+/// let (mut map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let Ok(Applied::Unsewn { i, a, partner, .. }) = apply(&mut map, &KernelOp::Unsew { i: 0, a: 3 }) else { panic!() };
+/// assert_eq!(i, 0);
+/// assert!(map.is_free(0, a) && map.is_free(0, partner) && a != partner);
+/// assert_eq!(apply(&mut GMap::<3>::new(), &KernelOp::DeleteDart(0)), Ok(Applied::Nothing));
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Applied {
     /// A dart was created.
@@ -311,6 +360,19 @@ pub enum Applied {
 }
 
 /// Why [`apply`] did not change the map (or, for [`OpError::Rebuild`], failed half way).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ops::{apply, from_alpha_table, KernelOp, OpError};
+/// use topomech::GMap;
+///
+/// let (mut map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// assert!(matches!(apply(&mut map, &KernelOp::DeleteDart(0)), Err(OpError::Dart(_)))); // not isolated
+/// assert!(matches!(apply(&mut map, &KernelOp::Sew { i: 0, a: 0, b: 5 }), Err(OpError::Sew(_))));
+/// let table = vec![vec![1, 0, 0, 0]]; // α0 sends dart 0 to a row that does not exist
+/// assert!(matches!(from_alpha_table::<3>(&table), Err(OpError::BadTable { row: 0, .. })));
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum OpError {
     /// The kernel refused a dart creation or deletion.
@@ -391,6 +453,19 @@ pub fn apply<const N: usize>(map: &mut GMap<N>, op: &KernelOp) -> Result<Applied
 }
 
 /// An alpha table: row r lists αi of dart rank r for i = 0..=n, as ranks.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ops::{alpha_table, from_alpha_table, AlphaTable};
+/// use topomech::GMap;
+///
+/// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+/// let table: AlphaTable = alpha_table(&map);
+/// assert_eq!((table.len(), table[0].len()), (6, 3)); // 6 darts, α0..α2
+/// assert!(table.iter().enumerate().all(|(r, row)| row[2] as usize == r)); // one triangle: 2-free
+/// assert!(from_alpha_table::<2>(&table).unwrap().is_isomorphic(&map));
+/// ```
 pub type AlphaTable = Vec<Vec<u32>>;
 
 /// The alpha table of a map, darts ranked in increasing id order. O(darts · n).
@@ -1083,6 +1158,19 @@ pub fn run_bytes(bytes: &[u8]) -> Result<(), String> {
 }
 
 /// One deliberate corruption of a map, below the kernel's laws (for proofs of `validate()`).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ops::{check_map_laws, raw_edit_unchecked, RawEdit};
+/// use topomech::{DartId, GMap};
+///
+/// let (mut map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// assert!(check_map_laws(&map).is_ok());
+/// assert!(raw_edit_unchecked(&mut map, RawEdit::SetCell { dim: 0, d: DartId(0), id: 3 }));
+/// assert!(check_map_laws(&map).is_err()); // the vertex orbit of dart 0 no longer has one id
+/// assert!(!raw_edit_unchecked(&mut map, RawEdit::Unlink { i: 9, a: DartId(0) })); // i > n: refused
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum RawEdit {
     /// Set αi(a) = b and αi(b) = a, nothing else (b may be a dead slot).

@@ -27,6 +27,19 @@ use crate::mechanics::{Body, Vec3};
 use crate::DartId;
 
 /// Errors of the surface extraction and of the OBJ writer.
+///
+/// # Examples
+///
+/// ```
+/// use std::path::Path;
+/// use topomech::surface::{boundary_surface_of_tets, SurfaceError};
+///
+/// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+/// let bad = boundary_surface_of_tets(&points, &[[0, 1, 2, 7]]);
+/// assert!(matches!(bad, Err(SurfaceError::PointOutOfRange { tet: 0, point: 7, points: 4 })));
+/// let s = boundary_surface_of_tets(&points, &[[0, 1, 2, 3]]).unwrap();
+/// assert!(matches!(s.write_obj(Path::new("/nonexistent-dir/x.obj")), Err(SurfaceError::Write { .. })));
+/// ```
 #[derive(Debug, thiserror::Error)]
 pub enum SurfaceError {
     /// A tetrahedron refers to a point index outside the point array.
@@ -56,6 +69,19 @@ pub enum SurfaceError {
 /// compacted); `vertex_ids.len() == positions.len()` and `face_volumes.len() == triangles.len()`;
 /// each triangle is oriented outward, i.e. its normal (b − a) × (c − a) points away from the
 /// fourth vertex of the tetrahedron behind it (measured at rest for a body).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate::kuhn_cube;
+/// use topomech::surface::boundary_surface_of_tets;
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let s = boundary_surface_of_tets(&points, &tets).unwrap();
+/// assert_eq!((s.positions.len(), s.vertex_ids.len(), s.face_volumes.len()), (8, 8, 12));
+/// assert!(s.triangles.iter().flatten().all(|&i| (i as usize) < s.positions.len()));
+/// assert!(s.face_volumes.iter().all(|&t| (t as usize) < tets.len()));
+/// ```
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Surface {
     /// Position of each surface vertex.

@@ -38,6 +38,21 @@ pub const TOLERANCE: f64 = 1e-9;
 
 /// Why a vector could not be read, generated or replayed. Every variant that concerns a vector
 /// names it; those that concern a step carry its index (`None` = the initial state).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::conformance::{generate, ConformanceError, MeshSpec, Op, Ops, Recipe, Vector};
+///
+/// let e = Vector::from_json("{", "x.json").unwrap_err();
+/// assert!(matches!(e, ConformanceError::Json { ref origin, .. } if origin == "x.json"));
+/// let recipe = Recipe {
+///     name: "bad".into(), description: "a tet that is not there".into(), mesh: MeshSpec::KuhnCube { k: 1 },
+///     material: topomech::mechanics::Material::default().into(), ops: Ops::Listed(vec![Op::Remove { tet: 6 }]),
+/// };
+/// let e = generate(&recipe).unwrap_err();
+/// assert!(matches!(e, ConformanceError::BadOp { step: Some(0), .. }));
+/// ```
 #[derive(Debug, thiserror::Error)]
 pub enum ConformanceError {
     /// A file could not be read or written.

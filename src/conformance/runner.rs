@@ -14,6 +14,22 @@ use super::schema::{Expect, MaterialSpec, MeshSpec, Op, Refusal, Step, Vector};
 use super::{ConformanceError, FORMAT, TOLERANCE, VERSION};
 
 /// How a [`Recipe`] gives its operations.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::conformance::{generate, replay, MeshSpec, Ops, Recipe};
+///
+/// let recipe = Recipe {
+///     name: "shared".into(), description: "fuzz bytes".into(), mesh: MeshSpec::KuhnCube { k: 1 },
+///     material: topomech::mechanics::Material::default().into(),
+///     ops: Ops::Shared(vec![0, 0, 7, 0, 0, 0]), // one op: remove live tet 0
+/// };
+/// let v = generate(&recipe).unwrap();
+/// assert_eq!(v.steps.len(), 1);
+/// assert_eq!(v.steps[0].expect.cells[3], 5);
+/// replay(&v).unwrap();
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub enum Ops {
     /// These operations, in order.
@@ -27,6 +43,21 @@ pub enum Ops {
 }
 
 /// What [`generate`] needs: a name, a description, a mesh, a material and the operations.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::conformance::{generate, MeshSpec, Op, Ops, Recipe};
+///
+/// let recipe = Recipe {
+///     name: "halves".into(), description: "cut the cube at z = 0.4".into(), mesh: MeshSpec::KuhnCube { k: 1 },
+///     material: topomech::mechanics::Material::default().into(),
+///     ops: Ops::Listed(vec![Op::Incise { point: [0.0, 0.0, 0.4], normal: [0.0, 0.0, 1.0] }]),
+/// };
+/// let v = generate(&recipe).unwrap();
+/// assert_eq!((v.name.as_str(), v.description.as_str()), ("halves", "cut the cube at z = 0.4"));
+/// assert!(!v.steps[0].expect.dissociated.is_empty());
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct Recipe {
     /// File stem.

@@ -3,6 +3,18 @@
 use crate::mechanics::{Material, Vec3};
 
 /// One conformance vector: a mesh, a material, the expected initial state and the steps.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::conformance::{generate, standard::recipes, Vector, FORMAT, TOLERANCE, VERSION};
+///
+/// let recipe = recipes().into_iter().find(|r| r.name == "single_tet_remove").unwrap();
+/// let v: Vector = generate(&recipe).unwrap();
+/// assert_eq!((v.format.as_str(), v.version, v.tolerance), (FORMAT, VERSION, TOLERANCE));
+/// assert_eq!(v.name, recipe.name);
+/// assert_eq!(Vector::from_json(&v.to_json(), "mem").unwrap(), v);
+/// ```
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Vector {
@@ -27,6 +39,20 @@ pub struct Vector {
 }
 
 /// The input mesh: inline, generated, or a file of the repository.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::conformance::{generate, MeshSpec, Ops, Recipe};
+///
+/// let inline = MeshSpec::Inline {
+///     points: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+///     tets: vec![[0, 1, 2, 3]],
+/// };
+/// let material = topomech::mechanics::Material::default().into();
+/// let recipe = Recipe { name: "t".into(), description: "one tet".into(), mesh: inline, material, ops: Ops::Listed(vec![]) };
+/// assert_eq!(generate(&recipe).unwrap().initial.cells, [4, 6, 4, 1]);
+/// ```
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum MeshSpec {
@@ -54,6 +80,17 @@ pub enum MeshSpec {
 }
 
 /// The material constants (the fields of [`Material`]).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::conformance::MaterialSpec;
+/// use topomech::mechanics::Material;
+///
+/// let spec = MaterialSpec::from(Material::default());
+/// assert_eq!(spec.density, Material::default().density);
+/// assert_eq!(Material::from(spec), Material::default()); // lossless both ways
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialSpec {
@@ -80,6 +117,20 @@ impl From<MaterialSpec> for Material {
 }
 
 /// One operation and the state after it.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::conformance::{generate, MeshSpec, Op, Ops, Recipe};
+///
+/// let recipe = Recipe {
+///     name: "one".into(), description: "remove a tet".into(), mesh: MeshSpec::KuhnCube { k: 1 },
+///     material: topomech::mechanics::Material::default().into(), ops: Ops::Listed(vec![Op::Remove { tet: 2 }]),
+/// };
+/// let step = &generate(&recipe).unwrap().steps[0];
+/// assert_eq!(step.op, Op::Remove { tet: 2 });
+/// assert_eq!((step.expect.darts, step.expect.refused), (5 * 24, None));
+/// ```
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Step {
@@ -90,6 +141,20 @@ pub struct Step {
 }
 
 /// A cutting operation, naming things by input tet and point indices.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::conformance::{generate, MeshSpec, Op, Ops, Recipe};
+///
+/// let points = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
+/// let mesh = MeshSpec::Inline { points, tets: vec![[0, 1, 2, 3], [0, 1, 2, 4]] };
+/// let op = Op::Dissociate { tets: [0, 1], face: [0, 1, 2] };
+/// let material = topomech::mechanics::Material::default().into();
+/// let recipe = Recipe { name: "d".into(), description: "split".into(), mesh, material, ops: Ops::Listed(vec![op]) };
+/// let after = &generate(&recipe).unwrap().steps[0].expect;
+/// assert_eq!((after.dissociated.clone(), after.components), (vec![[0, 1]], 2));
+/// ```
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Op {
@@ -126,6 +191,19 @@ pub enum Op {
 }
 
 /// Why an operation was refused (the state is then unchanged).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::conformance::{generate, MeshSpec, Op, Ops, Recipe, Refusal};
+///
+/// let ops = Ops::Listed(vec![Op::Remove { tet: 0 }, Op::Remove { tet: 0 }]);
+/// let material = topomech::mechanics::Material::default().into();
+/// let recipe = Recipe { name: "r".into(), description: "twice".into(), mesh: MeshSpec::KuhnCube { k: 1 }, material, ops };
+/// let v = generate(&recipe).unwrap();
+/// assert_eq!(v.steps[1].expect.refused, Some(Refusal::RemovedTet));
+/// assert_eq!(v.steps[1].expect.cells, v.steps[0].expect.cells); // state unchanged
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Refusal {
@@ -136,6 +214,19 @@ pub enum Refusal {
 }
 
 /// The state of the body at one point of the sequence.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::conformance::{generate, standard::recipes};
+///
+/// let v = generate(&recipes().into_iter().find(|r| r.name == "single_tet_remove").unwrap()).unwrap();
+/// let e = &v.initial;
+/// let [vs, es, fs, ts] = e.cells;
+/// assert_eq!(e.euler, vs as i64 - es as i64 + fs as i64 - ts as i64);
+/// assert_eq!((e.darts, e.component_masses.len()), (24 * ts, e.components));
+/// assert!((e.component_masses.iter().sum::<f64>() - e.total_mass).abs() <= 1e-12 * e.total_mass);
+/// ```
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Expect {

@@ -5,6 +5,21 @@ use crate::mechanics::Body;
 use crate::DartId;
 
 /// One connected component (orbit of all involutions).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::components;
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Material};
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let parts = components(&body);
+/// assert_eq!(parts.len(), 1);
+/// assert_eq!((parts[0].volumes, parts[0].vertices), (6, 8));
+/// assert!(parts[0].mass > 0.0);
+/// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct Component {
     /// Its smallest dart.

@@ -8,6 +8,21 @@ use super::CutError;
 
 /// One cell that a dissociation split in two: `kept` stays with the side of `dart_kept`, the
 /// darts on the side of `dart_new` now carry the fresh id `new`.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::dissociate_face;
+/// use topomech::mechanics::{Body, Material};
+///
+/// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
+/// let (mut body, _) = Body::from_tets(&points, &[[0, 1, 2, 3], [0, 1, 2, 4]], Material::default()).unwrap();
+/// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+/// for s in dissociate_face(&mut body, d).unwrap().vertices {
+///     assert_ne!(s.kept, s.new);
+///     assert_eq!((body.map().vertex_id(s.dart_kept), body.map().vertex_id(s.dart_new)), (s.kept, s.new));
+/// }
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SplitCell {
     /// Id of the side that kept it.
@@ -21,6 +36,21 @@ pub struct SplitCell {
 }
 
 /// What one face dissociation did.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::dissociate_face;
+/// use topomech::mechanics::{Body, Material};
+///
+/// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
+/// let (mut body, _) = Body::from_tets(&points, &[[0, 1, 2, 3], [0, 1, 2, 4]], Material::default()).unwrap();
+/// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+/// let cut = dissociate_face(&mut body, d).unwrap();
+/// assert_eq!(cut.dart, d);
+/// assert!(body.map().is_free(3, cut.dart) && body.map().is_free(3, cut.opposite));
+/// assert_ne!(cut.faces.0, cut.faces.1);
+/// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct Dissociation {
     /// The dart the face was named by.

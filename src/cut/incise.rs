@@ -7,6 +7,17 @@ use crate::{CellId, DartId};
 use super::{dissociate_face, CutError, Dissociation};
 
 /// A cutting plane through `point` with normal `normal` (any length but zero).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::Plane;
+///
+/// // The plane z = 1, positive side above.
+/// let plane = Plane { point: [0.0, 0.0, 1.0], normal: [0.0, 0.0, 1.0] };
+/// assert!(plane.positive([0.3, 0.7, 2.0]));
+/// assert!(!plane.positive([0.3, 0.7, 0.0]));
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Plane {
     /// A point of the plane.
@@ -42,6 +53,20 @@ impl Plane {
 }
 
 /// What an incision did.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::{components, incise_plane, Plane};
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Material};
+///
+/// let (points, tets) = kuhn_cube(2);
+/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let cut = incise_plane(&mut body, &Plane { point: [0.0, 0.0, 1.0], normal: [0.0, 0.0, 1.0] }).unwrap();
+/// assert!(!cut.dissociations.is_empty());
+/// assert_eq!(components(&body).len(), 2); // the plane z = 1 crosses the whole cube
+/// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct Incision {
     /// One dissociation per cut face, in face order.

@@ -40,6 +40,22 @@ pub use crate::mechanics::TouchedCells;
 /// Why a cutting operation was refused or failed. When it is refused (every variant but
 /// [`CutError::Body`], [`CutError::Kernel`], [`CutError::Dart`] and [`CutError::Sim`]) the body is
 /// unchanged.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::{incise_plane, remove_volume, tear_vertex, CutError, Plane};
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Material};
+/// use topomech::CellId;
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// assert!(matches!(remove_volume(&mut body, CellId(6)), Err(CutError::NoSuchVolume(CellId(6)))));
+/// assert!(matches!(tear_vertex(&mut body, CellId(99), [1.0, 0.0, 0.0], None), Err(CutError::NoSuchVertex(_))));
+/// let flat = Plane { point: [0.0; 3], normal: [0.0; 3] };
+/// assert!(matches!(incise_plane(&mut body, &flat), Err(CutError::BadPlane { .. })));
+/// ```
 #[derive(Debug, thiserror::Error)]
 pub enum CutError {
     /// A dart id that is not live in the body's map.

@@ -45,6 +45,18 @@ pub fn material() -> Material {
 }
 
 /// Union-find with path halving (the oracle's engine).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::ops::Uf;
+///
+/// let mut uf = Uf::new(4);
+/// uf.union(0, 2);
+/// uf.union(1, 3);
+/// assert_eq!(uf.find(2), uf.find(0));
+/// assert_ne!(uf.find(0), uf.find(3));
+/// ```
 #[derive(Clone, Debug)]
 pub struct Uf(Vec<usize>);
 
@@ -103,9 +115,33 @@ impl Uf {
 }
 
 /// A glued inner face: its sorted points and the two (tet, local face) sharing it.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::ops::{face_points, jittered_cube, Glued, Oracle};
+///
+/// let (points, tets) = jittered_cube(1, 0);
+/// let oracle = Oracle::new(points, tets.clone());
+/// let (triple, sides): Glued = oracle.glued()[0];
+/// for (t, f) in sides {
+///     assert_eq!(face_points(&tets[t], f), triple); // both tets name the same face
+/// }
+/// ```
 pub type Glued = ([u32; 3], [(usize, usize); 2]);
 
 /// The cut mesh as the tet list sees it.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::ops::{jittered_cube, Oracle};
+///
+/// let (points, tets) = jittered_cube(1, 0);
+/// let oracle = Oracle::new(points, tets);
+/// assert!(oracle.alive.iter().all(|&a| a) && oracle.cut.is_empty());
+/// assert_eq!(oracle.inner.len(), 6); // the six inner faces of the Kuhn cube
+/// ```
 #[derive(Clone, Debug)]
 pub struct Oracle {
     /// Input points.
@@ -298,6 +334,19 @@ fn sorted2(a: u32, b: u32) -> [u32; 2] {
 }
 
 /// One step of a random cut sequence; the numbers pick among what the oracle offers.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::ops::{jittered_cube, Harness, Op};
+///
+/// let (points, tets) = jittered_cube(1, 1);
+/// let mut h = Harness::new(points, tets).unwrap();
+/// h.apply(Op::Dissociate(0)).unwrap();
+/// h.apply(Op::DissociateBoundary(0)).unwrap(); // refused by the body, as it must be
+/// assert_eq!(h.oracle.cut.len(), 1);
+/// assert!(h.check().is_ok());
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Op {
     /// Dissociate the k-th glued face.
@@ -315,6 +364,19 @@ pub enum Op {
 }
 
 /// The body, its incrementally updated projection, the oracle and the running totals.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::ops::{jittered_cube, Harness, Op};
+///
+/// let (points, tets) = jittered_cube(1, 3);
+/// let mut h = Harness::new(points, tets).unwrap();
+/// assert!(h.stiffness > 0.0 && h.removed_stiffness == 0.0);
+/// h.apply(Op::Remove(2)).unwrap();
+/// assert!(h.removed_mass > 0.0 && h.removed_mass < h.mass);
+/// assert!(h.check().is_ok());
+/// ```
 #[derive(Clone, Debug)]
 pub struct Harness {
     /// The body under test.
@@ -569,6 +631,16 @@ impl Harness {
 }
 
 /// A decoded byte string: a jittered Kuhn cube of side `k` and the ops to run on it.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::ops::{decode, Op, Scenario};
+///
+/// let s: Scenario = decode(&[0, 3, 9, 1, 0, 0]);
+/// assert_eq!((s.k, s.seed), (1, 3));
+/// assert_eq!(s.ops, vec![Op::RemoveAgain(1)]);
+/// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scenario {
     /// Kuhn cube resolution (1 or 2).

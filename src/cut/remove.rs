@@ -8,6 +8,21 @@ use crate::{CellId, DartId, GMap};
 use super::{dissociate_face, CutError, Dissociation};
 
 /// What one volume removal did.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::remove_volume;
+/// use topomech::mechanics::{Body, Material};
+/// use topomech::CellId;
+///
+/// let p = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 1.0], [2.0, 2.0, 0.0]];
+/// let (mut body, _) = Body::from_tets(&p, &[[0, 1, 2, 3], [1, 2, 3, 4], [2, 3, 4, 5]], Material::default()).unwrap();
+/// let removal = remove_volume(&mut body, CellId(1)).unwrap();
+/// assert_eq!(removal.volume, CellId(1));
+/// assert_eq!(removal.dissociations.len(), 2); // the middle tet had two inner faces
+/// assert!(removal.removed_mass > 0.0 && removal.removed_stiffness > 0.0);
+/// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct Removal {
     /// The removed volume id (now free).

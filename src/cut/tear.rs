@@ -16,6 +16,22 @@ use super::{dissociate_face, CutError, Dissociation};
 /// The tensile stress at a vertex: the largest principal value of σ_v = Σ_s T_s n_s n_sᵀ over the
 /// springs at v, with T_s = max(0, k_s (l_s − L_s)) the spring's tension and n_s its unit
 /// direction, and the principal direction.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::principal_stress;
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Integrator, Material, Simulation, StepConfig};
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let sim = Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Euler, 1e-3)).unwrap();
+/// body.attrs_mut().position.as_mut_slice()[7][0] += 0.5; // pull a corner along x
+/// let s = principal_stress(&body, &sim)[7];
+/// let norm = s.direction.iter().map(|c| c * c).sum::<f64>().sqrt();
+/// assert!(s.magnitude > 0.0 && (norm - 1.0).abs() < 1e-9);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Stress {
     /// The largest eigenvalue of σ_v (a force: the "inner force" compared with the threshold).
@@ -25,6 +41,21 @@ pub struct Stress {
 }
 
 /// What tearing one vertex did.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::tear_vertex;
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Material};
+/// use topomech::CellId;
+///
+/// let (points, tets) = kuhn_cube(2);
+/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let tear = tear_vertex(&mut body, CellId(13), [0.0, 0.0, 1.0], None).unwrap();
+/// assert_eq!(tear.vertex, CellId(13));
+/// assert!(tear.split && tear.dissociations.len() <= tear.fan.len());
+/// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct Tear {
     /// The vertex torn.
@@ -40,6 +71,21 @@ pub struct Tear {
 }
 
 /// What [`tear_step`] did.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::{tear_step, TearStep};
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Integrator, Material, Simulation, StepConfig};
+///
+/// let (points, tets) = kuhn_cube(2);
+/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let mut sim = Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Euler, 1e-4)).unwrap();
+/// assert_eq!(tear_step(&mut body, &mut sim, 1.0, 4).unwrap(), TearStep::default()); // nothing at rest
+/// body.attrs_mut().position.as_mut_slice()[13][0] += 0.5;
+/// assert_eq!(tear_step(&mut body, &mut sim, 1.0, 1).unwrap().tears[0].vertex.0, 13);
+/// ```
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TearStep {
     /// One entry per torn vertex.

@@ -5,6 +5,17 @@
 /// Both maps are piecewise linear between five control points chosen so that lightness changes
 /// monotonically (sequential) or symmetrically about the middle (diverging), which keeps equal
 /// steps of the scalar roughly equally visible.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::render::Colormap;
+///
+/// assert_eq!(Colormap::default(), Colormap::Sequential);
+/// let (seq, div) = (Colormap::Sequential, Colormap::Diverging);
+/// assert_ne!(seq.color(0.0), seq.color(1.0));
+/// assert_eq!(div.color(0.5), div.color(f64::NAN)); // NaN maps to the middle
+/// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Colormap {
     /// Dark blue-violet → teal → green → yellow: for magnitudes (stress, level).

@@ -43,6 +43,21 @@ use raster::{cross, dot, norm, sub, Target, View};
 pub const MAX_PIXELS: u64 = 1 << 26;
 
 /// Errors of the renderer and of the PNG writer.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::render::{render, Camera, RenderError, Shading};
+/// use topomech::{generate::kuhn_cube, surface::boundary_surface_of_tets};
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let s = boundary_surface_of_tets(&points, &tets).unwrap();
+/// let camera = Camera::fit([0.0; 3], [1.0; 3], [0.0, 1.0, 0.0]);
+/// let flat = Shading::Flat([0; 3]);
+/// assert!(matches!(render(&s, &flat, &camera, 0, 8), Err(RenderError::BadSize { width: 0, height: 8 })));
+/// let blind = Camera { target: camera.eye, ..camera };
+/// assert!(matches!(render(&s, &flat, &blind, 8, 8), Err(RenderError::BadCamera { .. })));
+/// ```
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
     /// A zero or too large image size.
@@ -131,6 +146,18 @@ pub enum RenderError {
 ///
 /// Invariant checked by [`render`] (a [`RenderError::BadCamera`] otherwise): finite coordinates,
 /// `eye != target`, `up` not parallel to the view direction, `0 < fov_y_deg < 180`.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::render::Camera;
+///
+/// let c = Camera { eye: [0.0, -4.0, 0.0], target: [0.0; 3], up: [0.0, 0.0, 1.0], fov_y_deg: 45.0 };
+/// assert_eq!(c, Camera::looking_at([0.0, -4.0, 0.0], [0.0; 3], [0.0, 0.0, 1.0], 45.0));
+/// let fitted = Camera::fit([-1.0; 3], [1.0; 3], [0.0, 0.0, -1.0]); // looking down
+/// assert_eq!(fitted.target, [0.0; 3]);
+/// assert!(fitted.eye[2] > 1.0 && fitted.fov_y_deg > 0.0 && fitted.fov_y_deg < 180.0);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
     /// Centre of projection.
@@ -196,6 +223,17 @@ impl Camera {
 /// An 8-bit RGB picture, rows top to bottom.
 ///
 /// Invariant (checked by [`Image::encode_png`]): `rgb.len() == 3 · width · height`.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::render::Image;
+///
+/// let mut img = Image::new(3, 2, [0; 3]);
+/// img.set_pixel(2, 1, [7, 8, 9]);
+/// assert_eq!(img.rgb.len(), 3 * img.width as usize * img.height as usize);
+/// assert_eq!(&img.rgb[3 * (1 * 3 + 2)..][..3], &[7, 8, 9]); // row-major, rows top to bottom
+/// ```
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Image {
     /// Width in pixels.
@@ -319,6 +357,22 @@ impl Image {
 }
 
 /// How the triangles are coloured (before lighting).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::render::{render, Camera, Colormap, Shading};
+/// use topomech::{generate::kuhn_cube, surface::boundary_surface_of_tets};
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let s = boundary_surface_of_tets(&points, &tets).unwrap();
+/// let camera = Camera::fit([0.0; 3], [1.0; 3], [0.0, 1.0, 0.0]);
+/// let per_face = Shading::Colors(vec![[0, 0, 200]; s.triangles.len()]);
+/// let [r, _, b] = render(&s, &per_face, &camera, 16, 16).unwrap().pixel(8, 8).unwrap();
+/// assert!(r == 0 && b > 0);
+/// let scalar = Shading::PerTriangle { values: vec![0.0; 12], range: (1.0, 0.0), colormap: Colormap::Sequential };
+/// assert!(render(&s, &scalar, &camera, 16, 16).is_err()); // reversed range
+/// ```
 #[derive(Clone, Debug, PartialEq)]
 pub enum Shading {
     /// One colour for the whole surface.
@@ -394,6 +448,18 @@ impl Shading {
 }
 
 /// Picture settings besides the camera and the colours.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::render::Style;
+///
+/// let style = Style::default();
+/// assert_eq!(style.background, [255, 255, 255]);
+/// assert!(style.legend && (0.0..=1.0).contains(&style.ambient));
+/// let dark = Style { background: [0, 0, 0], ..style };
+/// assert_ne!(dark, style);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Style {
     /// Colour where no triangle is seen.

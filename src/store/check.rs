@@ -9,6 +9,20 @@ use super::raw::RawMap;
 use super::Document;
 
 /// One broken law found by [`check_all_laws`].
+///
+/// # Examples
+///
+/// ```
+/// use topomech::store::{check_all_laws, Document, Finding};
+/// use topomech::GMap;
+///
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let mut doc = Document::from_map(&map);
+/// doc.map.alpha[0] = doc.map.alpha[1]; // α0(0) := α1(0): α0 is no longer an involution
+/// let report = check_all_laws(&doc, 10);
+/// assert!(matches!(report.findings[0], Finding::Map(_)));
+/// assert!(!report.findings[0].to_string().is_empty());
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub enum Finding {
     /// A law of n-G-maps (involution, quasi-manifold, cell ids), with the darts involved.
@@ -39,6 +53,21 @@ impl std::fmt::Display for Finding {
 }
 
 /// What [`check_all_laws`] found.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::store::{check_all_laws, Document};
+/// use topomech::GMap;
+///
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let mut doc = Document::from_map(&map);
+/// let clean = check_all_laws(&doc, 10);
+/// assert!(clean.valid && clean.findings.is_empty() && !clean.truncated);
+/// doc.map.alpha[0] = doc.map.alpha[1];
+/// let first = check_all_laws(&doc, 1);
+/// assert!(!first.valid && first.findings.len() == 1 && first.truncated);
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct CheckReport {
     /// Verdict: no law is broken. For n ≤ 3 this is the kernel's own `validate()` (and

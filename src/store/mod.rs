@@ -70,6 +70,19 @@ pub const BINARY_MAGIC: [u8; 8] = *b"TMAPB\0\r\n";
 pub const MAX_DIMENSION: usize = 7;
 
 /// Which of the two forms.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::store::{self, Document, Format};
+/// use topomech::GMap;
+///
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let doc = Document::from_map(&map);
+/// let (text, bin) = (store::encode(&doc, Format::Text).unwrap(), store::encode(&doc, Format::Binary).unwrap());
+/// assert!(std::str::from_utf8(&text).is_ok() && bin.starts_with(&store::BINARY_MAGIC));
+/// assert_eq!(store::decode(&text).unwrap(), store::decode(&bin).unwrap()); // same document
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Format {
     /// `.tmap`: one line per dart, floats in Rust's shortest round-trip notation.
@@ -99,6 +112,20 @@ impl Format {
 }
 
 /// Where in a file a problem is: a line of the text form or a byte offset of the binary form.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::store::{self, Document, Format, StoreError, Where};
+/// use topomech::GMap;
+///
+/// assert_eq!((Where::Line(3).to_string(), Where::Byte(0).to_string()), ("line 3".into(), "byte 0".into()));
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let mut text = store::encode(&Document::from_map(&map), Format::Text).unwrap();
+/// text.extend_from_slice(b"junk\n");
+/// let e = store::decode(&text).unwrap_err();
+/// assert!(matches!(e, StoreError::TrailingData { at: Where::Line(_) } | StoreError::Syntax { at: Where::Line(_), .. }));
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Where {
     /// 1-based line of the text form.
@@ -117,6 +144,19 @@ impl fmt::Display for Where {
 }
 
 /// Why a file could not be written, read, or accepted.
+///
+/// # Examples
+///
+/// ```
+/// use std::path::Path;
+/// use topomech::store::{self, Document, StoreError};
+/// use topomech::GMap;
+///
+/// assert!(matches!(store::decode(b"hello"), Err(StoreError::BadMagic { .. })));
+/// assert!(matches!(store::load_body(Path::new("/nonexistent-dir/x.tmap")), Err(StoreError::Io { .. })));
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// assert!(matches!(Document::from_map(&map).into_body(), Err(StoreError::NoMechanics)));
+/// ```
 #[derive(Debug, thiserror::Error)]
 pub enum StoreError {
     /// The operating system refused (open, write, fsync, rename).
@@ -251,6 +291,20 @@ pub enum StoreError {
 }
 
 /// A decoded file: the raw map and, for a body, its attributes. Not checked against the laws.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mechanics::{Body, Material};
+/// use topomech::store::{self, Document, Format};
+///
+/// let (points, tets) = topomech::generate::kuhn_cube(1);
+/// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let doc = Document::from_body(&body);
+/// assert_eq!((doc.map.dimension, doc.map.capacity), (3, 6 * 24));
+/// assert!(doc.mechanics.is_some() && doc.levels.is_none());
+/// assert_eq!(store::decode(&store::encode(&doc, Format::Binary).unwrap()).unwrap(), doc);
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct Document {
     /// Every dart slot, link, cell id and allocator.

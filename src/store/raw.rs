@@ -8,6 +8,20 @@ use super::StoreError;
 
 /// The allocator of one cell dimension: ids `0..next` were handed out, those in `free` are dead
 /// (the last one is reused first).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::store::RawMap;
+/// use topomech::GMap;
+///
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let raw = RawMap::from_map(&map);
+/// assert_eq!(raw.ids.len(), 4); // one allocator per cell dimension 0..=3
+/// let nexts: Vec<u32> = raw.ids.iter().map(|a| a.next).collect();
+/// assert_eq!(nexts, vec![4, 6, 4, 1]); // a tet: 4 vertices, 6 edges, 4 faces, 1 volume
+/// assert!(raw.ids.iter().all(|a| a.free.is_empty()));
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub struct IdAllocRecord {
     /// One past the largest id ever handed out.
@@ -20,6 +34,20 @@ pub struct IdAllocRecord {
 ///
 /// Row d of `alpha` / `cell` is `[d·(n+1), (d+1)·(n+1))`. A dead slot (listed in `free_darts`)
 /// has `alpha = d` and `cell = u32::MAX` in every column.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::store::RawMap;
+/// use topomech::GMap;
+///
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let raw = RawMap::from_map(&map);
+/// let n1 = raw.dimension + 1;
+/// assert_eq!((raw.alpha.len(), raw.cell.len()), (24 * n1, 24 * n1));
+/// let d = 5;
+/// assert_eq!(raw.alpha[raw.alpha[d * n1] as usize * n1], d as u32); // α0 is an involution
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct RawMap {
     /// The dimension n.
@@ -181,6 +209,20 @@ impl RawMap {
 }
 
 /// The attributes of one vertex id.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mechanics::{Body, Material};
+/// use topomech::store::RawMechanics;
+///
+/// let (points, tets) = topomech::generate::kuhn_cube(1);
+/// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let raw = RawMechanics::from_mechanics(body.attrs());
+/// let v = raw.vertices[7];
+/// assert_eq!((v.rest, v.position, v.velocity), (points[7], points[7], [0.0; 3])); // at rest
+/// assert!(v.mass > 0.0 && !v.pinned);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct VertexRecord {
     /// Rest position.
@@ -200,6 +242,20 @@ pub struct VertexRecord {
 }
 
 /// Every mechanical attribute of a body, one record per cell id (live or dead).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mechanics::{Body, Material};
+/// use topomech::store::RawMechanics;
+///
+/// let (points, tets) = topomech::generate::kuhn_cube(1);
+/// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let raw = RawMechanics::from_mechanics(body.attrs());
+/// assert_eq!(raw.material[0], Material::default().density);
+/// assert_eq!((raw.vertices.len(), raw.volumes.len()), (8, 6));
+/// assert_eq!(raw.faces.iter().filter(|f| f.0).count(), 12); // boundary faces
+/// ```
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct RawMechanics {
     /// Density ρ, Young's modulus E, damping β, viscosity ν.

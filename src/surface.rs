@@ -18,6 +18,7 @@
 //! assert!((s.enclosed_volume() - 8.0).abs() < 1e-12);
 //! ```
 
+use crate::mechanics::geom::{cross, dot, norm, sub};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -356,20 +357,4 @@ impl Surface {
         crate::store::write_atomically(path, self.to_obj().as_bytes())
             .map_err(|source| SurfaceError::Write { path: path.to_path_buf(), source })
     }
-}
-
-fn sub(a: Vec3, b: Vec3) -> Vec3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: Vec3, b: Vec3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: Vec3, b: Vec3) -> Vec3 {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-
-fn norm(a: Vec3) -> f64 {
-    dot(a, a).sqrt()
 }

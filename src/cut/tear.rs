@@ -8,6 +8,7 @@
 //! comes back to d0, or before an α3 that is free (the surface); in that case it starts again from
 //! α1(d0) to collect the other half of the fan.
 
+use crate::mechanics::geom::{cross, dot, sub};
 use crate::mechanics::{Body, Simulation, TouchedCells, Vec3};
 use crate::{AlphaMask, CellId, DartId, GMap};
 
@@ -333,18 +334,6 @@ pub fn tear_step(
         sim.update(body, &touched)?;
     }
     Ok(out)
-}
-
-fn sub(a: Vec3, b: Vec3) -> Vec3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: Vec3, b: Vec3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: Vec3, b: Vec3) -> Vec3 {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 
 fn mul(m: &[[f64; 3]; 3], v: Vec3) -> Vec3 {

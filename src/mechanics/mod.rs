@@ -16,7 +16,7 @@
 pub mod conservation;
 pub mod flat;
 pub mod force;
-mod geom;
+pub(crate) mod geom;
 pub mod integrate;
 pub mod model;
 pub mod projection;

@@ -34,6 +34,7 @@
 //! clipping (k is 3 for a plain face and small otherwise). Output: Σ_{closed tets} Σ_faces (k − 2)
 //! cone tets, one Steiner point per closed tet.
 
+use crate::mechanics::geom::{cross, dot, norm, sub};
 use std::collections::hash_map::Entry;
 
 use rustc_hash::{FxHashMap, FxHashSet};
@@ -73,22 +74,6 @@ pub struct ConformingMesh {
     pub kept: usize,
     /// Volumes with inserted vertices, each replaced by a cone of tets around a Steiner point.
     pub closed: usize,
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-
-fn norm(a: [f64; 3]) -> f64 {
-    dot(a, a).sqrt()
 }
 
 /// Newell's normal of a closed polygon (twice its vector area). O(k).

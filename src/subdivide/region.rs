@@ -20,6 +20,7 @@
 
 use super::{LeveledMap, SubdivideError};
 use crate::gmap::{CellId, DartId};
+use crate::mechanics::geom::{cross, dot, sub};
 
 /// One mass per volume id of a [`LeveledMap<3>`] (index = volume cell id).
 ///
@@ -139,18 +140,6 @@ impl TetMasses {
         }
         Ok(out)
     }
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 
 /// Distance from `p` to the segment [a, b]. O(1).

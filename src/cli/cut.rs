@@ -8,7 +8,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use topomech::cut::{self, Plane};
+use topomech::cut::{self, Plane, PolylineSweep};
 use topomech::load;
 use topomech::mechanics::{check_conservation, Body, Integrator, Material, Simulation, StepConfig, Vec3};
 use topomech::vtk::{body_tets, Frame};
@@ -39,8 +39,14 @@ pub struct CutArgs {
     #[command(flatten)]
     pub common: CommonArgs,
     /// The plane: a point and a normal, `PX,PY,PZ,NX,NY,NZ`.
-    #[arg(long, value_parser = parse_numbers::<6>, allow_hyphen_values = true)]
-    pub plane: [f64; 6],
+    #[arg(long, value_parser = parse_numbers::<6>, allow_hyphen_values = true, required_unless_present = "polyline")]
+    pub plane: Option<[f64; 6]>,
+    /// Instead of a plane, a scalpel path `X,Y,Z;X,Y,Z;…` swept along `--sweep` (a bounded cut).
+    #[arg(long, value_parser = parse_polyline, allow_hyphen_values = true, conflicts_with = "plane", requires = "sweep")]
+    pub polyline: Option<Polyline>,
+    /// The depth vector `WX,WY,WZ` the polyline is swept along (its length is the cut depth).
+    #[arg(long, value_parser = parse_numbers::<3>, allow_hyphen_values = true, requires = "polyline")]
+    pub sweep: Option<[f64; 3]>,
 }
 
 /// Arguments of `topomech remove`.
@@ -150,9 +156,21 @@ pub fn stats(body: &Body, removed_mass: f64) -> BodyStats {
 pub fn run(args: CutArgs) -> Result<(), CliError> {
     let (mut body, load_us) = load_body(&args.common)?;
     let before = stats(&body, 0.0);
-    let [px, py, pz, nx, ny, nz] = args.plane;
     let t = Instant::now();
-    let inc = cut::incise_plane(&mut body, &Plane { point: [px, py, pz], normal: [nx, ny, nz] }).map_err(other)?;
+    let inc = match (args.plane, args.polyline) {
+        (Some([px, py, pz, nx, ny, nz]), _) => {
+            cut::incise_plane(&mut body, &Plane { point: [px, py, pz], normal: [nx, ny, nz] })
+        }
+        // A missing --sweep is a zero sweep, which the library refuses with a clear error.
+        (None, points) => {
+            let surface = PolylineSweep {
+                points: points.map(|p| p.0).unwrap_or_default(),
+                sweep: args.sweep.unwrap_or_default(),
+            };
+            cut::incise_sweep(&mut body, &surface)
+        }
+    }
+    .map_err(other)?;
     let cut_us = t.elapsed().as_micros() as u64;
     let timings = BTreeMap::from([("load".to_string(), load_us), ("cut".to_string(), cut_us)]);
     finish(&args.common, &body, before, 0.0, inc.cut_faces(), timings)
@@ -286,6 +304,15 @@ fn parse_numbers<const K: usize>(s: &str) -> Result<[f64; K], String> {
         .map(|t| t.trim().parse::<f64>().map_err(|e| format!("bad number {t:?}: {e}")))
         .collect::<Result<_, _>>()?;
     <[f64; K]>::try_from(parts.as_slice()).map_err(|_| format!("expected {K} comma-separated numbers, got {s:?}"))
+}
+
+/// The points of `--polyline` (one clap value).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Polyline(pub Vec<Vec3>);
+
+/// `X,Y,Z;X,Y,Z;…` → points (the cut checks their number and shape).
+fn parse_polyline(s: &str) -> Result<Polyline, String> {
+    s.split(';').filter(|t| !t.trim().is_empty()).map(parse_numbers::<3>).collect::<Result<_, _>>().map(Polyline)
 }
 
 fn other(e: impl std::error::Error + Send + Sync + 'static) -> CliError {

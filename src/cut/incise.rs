@@ -113,8 +113,14 @@ impl Incision {
 /// assert_eq!(sides.iter().filter(|s| **s == Some(false)).count(), 24);
 /// ```
 pub fn tet_sides(body: &Body, plane: &Plane) -> Vec<Option<bool>> {
+    tet_centroids(body).into_iter().map(|c| c.map(|c| plane.positive(c))).collect()
+}
+
+/// For every volume id, the centroid of the live volume (mean of its distinct vertices' current
+/// positions), `None` for dead ids. O(darts).
+pub(crate) fn tet_centroids(body: &Body) -> Vec<Option<Vec3>> {
     let (map, mech) = (body.map(), body.attrs());
-    let mut side = vec![None; map.cell_id_bound(3)];
+    let mut centroid = vec![None; map.cell_id_bound(3)];
     for d in map.one_dart_per_cell(3) {
         let mut ids: Vec<CellId> = map.cell_darts(3, d).into_iter().map(|x| map.vertex_id(x)).collect();
         ids.sort_unstable();
@@ -125,9 +131,9 @@ pub fn tet_sides(body: &Body, plane: &Plane) -> Vec<Option<bool>> {
                 *c += p / ids.len() as f64;
             }
         }
-        side[map.cell_id(3, d).index()] = Some(plane.positive(c));
+        centroid[map.cell_id(3, d).index()] = Some(c);
     }
-    side
+    centroid
 }
 
 /// Dissociates every inner face whose two tets' centroids lie on opposite sides of `plane`

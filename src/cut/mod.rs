@@ -8,6 +8,8 @@
 //!   remove_volume     dissociate the tet's inner faces, then delete its 24 darts; report the
 //!                     mass and stiffness that left with it
 //!   incise_plane      dissociate every inner face whose two tets' centroids lie on opposite sides
+//!   incise_sweep      the same along a polyline swept by a depth vector (a bounded, bent cut):
+//!                     every inner face whose tets' centroid segment crosses the swept surface
 //!   tear_vertex       the closed fan of faces around a vertex (walk α2 α3 α2 α1), dissociated
 //!   components        connected parts and their masses
 //!   ops               one generator of cut sequences (decoder, oracle, law checks) for the
@@ -23,12 +25,14 @@ mod dissociate;
 mod incise;
 pub mod ops;
 mod remove;
+mod sweep;
 mod tear;
 
 pub use connectivity::{components, Component};
 pub use dissociate::{dissociate_face, dissociate_face_id, face_dart, Dissociation, SplitCell};
 pub use incise::{incise_plane, tet_sides, Incision, Plane};
 pub use remove::{remove_volume, volume_dart, Removal};
+pub use sweep::{incise_sweep, sweep_faces, PolylineSweep};
 pub use tear::{fan_darts, principal_stress, tear_step, tear_vertex, Stress, Tear, TearStep};
 
 use crate::gmap::{DartError, SewError};
@@ -95,6 +99,13 @@ pub enum CutError {
         point: [f64; 3],
         /// Normal.
         normal: [f64; 3],
+    },
+    /// A polyline sweep that is not a well-formed cut surface (too few points, non-finite,
+    /// repeated points, zero sweep, a segment along the sweep).
+    #[error("bad polyline sweep: {reason}")]
+    BadSweep {
+        /// What is wrong, naming the point or segment.
+        reason: String,
     },
     /// The embedding layer refused or its check failed (a bug if the check failed).
     #[error(transparent)]

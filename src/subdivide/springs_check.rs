@@ -147,9 +147,19 @@ pub enum SpringLawError {
     },
 }
 
-/// |a − b| ≤ TOLERANCE · max(|a|, |b|).
+/// a = b, or both finite with |a − b| ≤ TOLERANCE · max(|a|, |b|).
 fn close(a: f64, b: f64) -> bool {
-    (a - b).abs() <= TOLERANCE * a.abs().max(b.abs())
+    a == b || (a.is_finite() && b.is_finite() && (a - b).abs() <= TOLERANCE * a.abs().max(b.abs()))
+}
+
+/// The series sum of a chain and the root's value: (Σ 1/x_i, 1/root) for a positive root, else
+/// (Σ x_i, 0) (a zero spring splits into zero halves).
+fn series(values: impl Iterator<Item = f64>, root: f64) -> (f64, f64) {
+    if root > 0.0 {
+        (values.map(|x| 1.0 / x).sum(), 1.0 / root)
+    } else {
+        (values.sum(), 0.0)
+    }
 }
 
 impl LeveledMechanics {
@@ -225,17 +235,10 @@ impl LeveledMechanics {
                 Some(c) => c,
                 None => return Err(SpringLawError::MissingSpring { a, b }),
             };
-            let sum = |f: &dyn Fn(&super::Spring) -> f64| chain.iter().map(|s| f(s)).sum::<f64>();
             let laws = [
-                (sum(&|s| 1.0 / s.stiffness), 1.0 / root.stiffness),
-                (sum(&|s| s.rest), root.rest),
-                (sum(&|s| if root.damping > 0.0 { 1.0 / s.damping } else { s.damping }), {
-                    if root.damping > 0.0 {
-                        1.0 / root.damping
-                    } else {
-                        0.0
-                    }
-                }),
+                series(chain.iter().map(|s| s.stiffness), root.stiffness),
+                series(chain.iter().map(|s| s.damping), root.damping),
+                (chain.iter().map(|s| s.rest).sum(), root.rest),
             ];
             for (compliance, expected) in laws {
                 if !close(compliance, expected) {

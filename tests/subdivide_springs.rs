@@ -168,10 +168,10 @@ fn deformed(p: Vec3, v: usize) -> Vec3 {
 
 #[test]
 fn the_test_deformation_stretches_every_edge() {
-    for a in 0..4 {
-        for b in a + 1..4 {
-            let len = |p: Vec3, q: Vec3| (0..3).map(|k| (p[k] - q[k]).powi(2)).sum::<f64>().sqrt();
-            assert!(len(deformed(TET[a], a), deformed(TET[b], b)) > 1.05 * len(TET[a], TET[b]), "edge ({a}, {b})");
+    let len = |p: Vec3, q: Vec3| (0..3).map(|k| (p[k] - q[k]).powi(2)).sum::<f64>().sqrt();
+    for (a, &pa) in TET.iter().enumerate() {
+        for (b, &pb) in TET.iter().enumerate().skip(a + 1) {
+            assert!(len(deformed(pa, a), deformed(pb, b)) > 1.05 * len(pa, pb), "edge ({a}, {b})");
         }
     }
 }
@@ -180,8 +180,8 @@ fn the_test_deformation_stretches_every_edge() {
 fn split_edges_interpolated_after_deformation_are_in_equilibrium_with_the_coarse_reactions() {
     let mut m = leveled(TET.to_vec(), &[[0, 1, 2, 3]]);
     let mut mech = LeveledMechanics::new(&m, material()).unwrap();
-    for v in 0..4 {
-        mech.position[v] = deformed(TET[v], v);
+    for (v, &p) in TET.iter().enumerate() {
+        mech.position[v] = deformed(p, v);
     }
     let coarse = mech.spring_system(&m, [0.0; 3], &[true; 4]);
     let f_coarse = spring_forces(&coarse, &mech.position);
@@ -208,8 +208,8 @@ fn a_relaxed_refined_chain_network_has_the_coarse_static_response() {
     let heavy = Material { viscosity: 200.0, ..material() };
     let mut mech = LeveledMechanics::new(&m, heavy).unwrap();
     split_all_edges(&mut mech, &mut m, 2);
-    for v in 0..4 {
-        mech.position[v] = deformed(TET[v], v);
+    for (v, &p) in TET.iter().enumerate() {
+        mech.position[v] = deformed(p, v);
     }
     for v in 4..mech.position.len() {
         let j = jitter(7 * v as u64);
@@ -218,9 +218,11 @@ fn a_relaxed_refined_chain_network_has_the_coarse_static_response() {
     let coarse = LeveledMechanics::new(&leveled(TET.to_vec(), &[[0, 1, 2, 3]]), heavy).unwrap();
     let mut x_coarse = coarse.position.clone();
     (0..4).for_each(|v| x_coarse[v] = mech.position[v]);
-    let f_coarse = spring_forces(&coarse.spring_system(&leveled(TET.to_vec(), &[[0, 1, 2, 3]]), [0.0; 3], &[]), &x_coarse);
+    let f_coarse =
+        spring_forces(&coarse.spring_system(&leveled(TET.to_vec(), &[[0, 1, 2, 3]]), [0.0; 3], &[]), &x_coarse);
     let sys = mech.spring_system(&m, [0.0; 3], &[true; 4]);
-    let mut stepper = Stepper::new(StepConfig::new(Integrator::Implicit, 1e-2), &sys, &mech.position, &mech.velocity).unwrap();
+    let mut stepper =
+        Stepper::new(StepConfig::new(Integrator::Implicit, 1e-2), &sys, &mech.position, &mech.velocity).unwrap();
     for _ in 0..3000 {
         stepper.step(&sys, &mut mech.position, &mut mech.velocity).unwrap();
     }
@@ -284,7 +286,8 @@ fn a_refined_zone_simulates_from_the_projection_without_a_tet_list() {
     mech.refine_around(&mut m, [1.0, 1.0, 2.0], 0.4, 2).unwrap();
     let fixed: Vec<bool> = m.points().iter().map(|p| p[2] == 0.0).collect();
     let sys = mech.spring_system(&m, [0.0, 0.0, -9.81], &fixed);
-    let mut stepper = Stepper::new(StepConfig::new(Integrator::Implicit, 1e-3), &sys, &mech.position, &mech.velocity).unwrap();
+    let mut stepper =
+        Stepper::new(StepConfig::new(Integrator::Implicit, 1e-3), &sys, &mech.position, &mech.velocity).unwrap();
     for _ in 0..200 {
         stepper.step(&sys, &mut mech.position, &mut mech.velocity).unwrap();
     }
@@ -293,6 +296,9 @@ fn a_refined_zone_simulates_from_the_projection_without_a_tet_list() {
     assert!(top.clone().all(|(x, p)| x[2] < p[2]), "the top sags under gravity");
     assert!(mech.position.iter().zip(&fixed).filter(|(_, &f)| f).all(|(x, _)| x[2] == 0.0));
 }
+
+type Tamper = Box<dyn Fn(&mut LeveledMechanics)>;
+type Expect = Box<dyn Fn(&SpringLawError) -> bool>;
 
 #[test]
 fn tampering_is_flagged_naming_the_edge_or_vertex() {
@@ -305,7 +311,7 @@ fn tampering_is_flagged_naming_the_edge_or_vertex() {
     let (half, _) = mech.springs().find(|&((a, b), _)| a < 8 && b >= 8).unwrap();
     let (coarse, _) = mech.springs().find(|&((a, b), _)| b < 8 && mech.root(a, b).is_none()).unwrap();
     let (inner, _) = mech.springs().find(|&((a, _), _)| a >= 8).unwrap();
-    let cases: Vec<(Box<dyn Fn(&mut LeveledMechanics)>, Box<dyn Fn(&SpringLawError) -> bool>)> = vec![
+    let cases: Vec<(Tamper, Expect)> = vec![
         (
             Box::new(move |x| x.spring_mut(coarse.0, coarse.1).unwrap().stiffness *= 1.0 + 1e-9),
             Box::new(move |e| matches!(e, &SpringLawError::Stiffness { a, b, .. } if (a, b) == coarse)),
@@ -342,4 +348,33 @@ fn tampering_is_flagged_naming_the_edge_or_vertex() {
     let d = m.map().darts().find(|&d| m.mu(d).edge == 0).unwrap();
     m.split_edge(d, 1).unwrap();
     assert!(matches!(mech.check(&m), Err(SpringLawError::OutOfSync { applied: _, logged: _ })));
+}
+
+#[test]
+fn the_refine_command_reports_the_spring_coupling_with_springs() {
+    let liver = format!("{}/data/liver_547_v22.msh", env!("CARGO_MANIFEST_DIR"));
+    let args = ["refine", &liver, "--around", "-2.2,3.2,0.6", "--radius", "0.5", "--levels", "1", "--json"];
+    let run = |extra: &[&str]| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_topomech")).args(args).args(extra).output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+    };
+    let (plain, coupled) = (run(&[]), run(&["--springs"]));
+    assert!(plain.get("springs_after").is_none(), "the keys exist only with --springs: {plain}");
+    for key in ["volumes", "darts", "tets_per_level", "subdivided_per_level"] {
+        assert_eq!(plain[key], coupled[key], "the coupling does not change the refinement ({key})");
+    }
+    let (before, after) = (coupled["springs_before"].as_u64().unwrap(), coupled["springs_after"].as_u64().unwrap());
+    assert!(after > before, "{coupled}");
+    assert_eq!(coupled["stiffness_series_ok"], true);
+    assert_eq!(coupled["spring_laws_ok"], true);
+    let (a, b) = (coupled["total_mass_before"].as_f64().unwrap(), coupled["total_mass_after"].as_f64().unwrap());
+    assert!((a - b).abs() <= 1e-12 * a);
+    // One spring per distinct edge of the input tets.
+    let tets = topomech::load::load_builtin().unwrap().mesh.tets;
+    let edges: std::collections::BTreeSet<(u32, u32)> = tets
+        .iter()
+        .flat_map(|t| [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)].map(|(i, j)| (t[i].min(t[j]), t[i].max(t[j]))))
+        .collect();
+    assert_eq!(before as usize, edges.len());
 }

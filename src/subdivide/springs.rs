@@ -378,6 +378,7 @@ impl LeveledMechanics {
         self.in_sync(m)?;
         let mid = m.split_edge(d, level)?;
         self.follow(m, &[], &[])?;
+        self.expensive_check(m);
         Ok(mid)
     }
 
@@ -411,6 +412,7 @@ impl LeveledMechanics {
         self.in_sync(m)?;
         let faces = m.subdivide_triangle(d, level)?;
         self.follow(m, &faces, &[])?;
+        self.expensive_check(m);
         Ok(faces)
     }
 
@@ -437,6 +439,13 @@ impl LeveledMechanics {
     /// mech.check(&m).unwrap();
     /// ```
     pub fn subdivide_tet(&mut self, m: &mut LeveledMap<3>, d: DartId, level: u8) -> Result<[DartId; 8], CouplingError> {
+        let children = self.split_tet(m, d, level)?;
+        self.expensive_check(m);
+        Ok(children)
+    }
+
+    /// [`Self::subdivide_tet`] without the expensive check.
+    fn split_tet(&mut self, m: &mut LeveledMap<3>, d: DartId, level: u8) -> Result<[DartId; 8], CouplingError> {
         self.in_sync(m)?;
         let children = m.subdivide_tet_with_mass(d, level, &mut self.masses)?;
         self.follow(m, &[], &children)?;
@@ -448,7 +457,8 @@ impl LeveledMechanics {
     /// O(Σ_L (volumes + refined · touched)).
     ///
     /// Errors: those of [`Self::subdivide_tet`] (the operations before the error stay done, map and
-    /// coupling in step); [`SubdivideError::LevelTooHigh`] for `levels` above the maximum.
+    /// coupling in step); [`SubdivideError::LevelTooHigh`] for `levels` above the maximum. With
+    /// `expensive-checks`, [`Self::check`] runs once at the end (not after each tet).
     ///
     /// # Examples
     ///
@@ -476,10 +486,11 @@ impl LeveledMechanics {
         let mut per_level = vec![0; levels as usize + 1];
         for level in m.max_level().max(1)..=levels {
             for d in m.zone_tets(level - 1, center, radius)? {
-                self.subdivide_tet(m, d, level)?;
+                self.split_tet(m, d, level)?;
                 per_level[level as usize] += 1;
             }
         }
+        self.expensive_check(m);
         let after = self.masses.total(m);
         Ok(Refinement { subdivided_per_level: per_level, total_mass_before: before, total_mass_after: after })
     }
@@ -510,11 +521,17 @@ impl LeveledMechanics {
             let t = m.tet_vertices(c)?;
             self.add_tet(m, t);
         }
+        Ok(())
+    }
+
+    /// With the `expensive-checks` feature, [`Self::check`] after a public operation (a bug of this
+    /// module panics, as the map's own checks do). O(1) without the feature.
+    fn expensive_check(&self, m: &LeveledMap<3>) {
         #[cfg(feature = "expensive-checks")]
         if let Err(e) = self.check(m) {
             panic!("topomech bug: the spring coupling broke a law: {e}");
         }
-        Ok(())
+        let _ = m;
     }
 
     /// The series rule for the insertion of vertex v on the edge (a, b), and v's state.
@@ -610,7 +627,8 @@ impl LeveledMechanics {
 
 /// The distinct vertex ids of the volume of `t` in the finest map. O(volume).
 pub(super) fn volume_vertices(m: &LeveledMap<3>, t: DartId) -> Vec<u32> {
-    let mut vs: Vec<u32> = m.map().orbit(t, AlphaMask::of(&[0, 1, 2])).iter().map(|&x| m.map().vertex_id(x).0).collect();
+    let mut vs: Vec<u32> =
+        m.map().orbit(t, AlphaMask::of(&[0, 1, 2])).iter().map(|&x| m.map().vertex_id(x).0).collect();
     vs.sort_unstable();
     vs.dedup();
     vs

@@ -227,8 +227,28 @@ impl LeveledMechanics {
         }
     }
 
-    /// Law 4.
-    fn check_series(&self) -> Result<(), SpringLawError> {
+    /// Law 4 alone (the series rule along every split spring), without the map. O(E log E).
+    ///
+    /// Errors: [`SpringLawError::MissingSpring`] (a link of a chain has no spring) or
+    /// [`SpringLawError::Series`], naming the root edge.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::Material;
+    /// use topomech::subdivide::{LeveledMap, LeveledMechanics, SpringLawError};
+    /// use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mut m = LeveledMap::new(map, pts);
+    /// let mut mech = LeveledMechanics::new(&m, Material::default()).unwrap();
+    /// let d = m.map().darts().find(|&d| m.map().vertex_id(d).0 == 0 && m.map().vertex_id(m.map().alpha_dyn(0, d)).0 == 1).unwrap();
+    /// mech.split_edge(&mut m, d, 1).unwrap();
+    /// assert!(mech.check_series().is_ok());
+    /// mech.spring_mut(0, 4).unwrap().rest *= 1.1;
+    /// assert!(matches!(mech.check_series(), Err(SpringLawError::Series { a: 0, b: 1, .. })));
+    /// ```
+    pub fn check_series(&self) -> Result<(), SpringLawError> {
         for (&(a, b), root) in &self.roots {
             let chain: Vec<_> = self.chain(a, b).into_iter().map(|(p, q)| self.springs.get(&key(p, q))).collect();
             let chain: Vec<_> = match chain.into_iter().collect::<Option<Vec<_>>>() {
@@ -291,12 +311,15 @@ impl LeveledMechanics {
         }
         let scattered = self.vertex_masses(m);
         for d in map.one_dart_per_cell(0) {
-            let mut volumes: Vec<_> = map.orbit(d, AlphaMask::cell(3, 0)).iter().map(|&x| (map.cell_id(3, x), x)).collect();
+            let mut volumes: Vec<_> =
+                map.orbit(d, AlphaMask::cell(3, 0)).iter().map(|&x| (map.cell_id(3, x), x)).collect();
             volumes.sort_unstable_by_key(|&(id, _)| id);
             volumes.dedup_by_key(|&mut (id, _)| id);
             let gathered: f64 = volumes
                 .iter()
-                .map(|&(id, x)| self.masses.mass.get(id.index()).copied().unwrap_or(0.0) / volume_vertices(m, x).len() as f64)
+                .map(|&(id, x)| {
+                    self.masses.mass.get(id.index()).copied().unwrap_or(0.0) / volume_vertices(m, x).len() as f64
+                })
                 .sum();
             let vertex = map.vertex_id(d).0;
             let s = scattered[vertex as usize];

@@ -344,6 +344,10 @@ fn tampering_is_flagged_naming_the_edge_or_vertex() {
         let e = bad.check(&m).unwrap_err();
         assert!(expect(&e), "case {k}: {e}");
     }
+    // A map without geometry cannot carry springs.
+    let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    let e = LeveledMechanics::new(&LeveledMap::new(map, vec![]), material()).unwrap_err();
+    assert_eq!(e, CouplingError::NoGeometry(0));
     // An operation done on the map alone is seen.
     let d = m.map().darts().find(|&d| m.mu(d).edge == 0).unwrap();
     m.split_edge(d, 1).unwrap();

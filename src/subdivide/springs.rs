@@ -25,8 +25,11 @@
 //!   plain tet, the seed's m_t/4; more when neighbours inserted vertices on its sides, which then
 //!   get a share), so Σ_v m_v = Σ_t m_t.
 //!
-//! Consequence: refinement never softens the body (every chain is as stiff as its root) and the new
-//! inner springs stiffen the refined zone by the children's contributions.
+//! Consequences: a chain in tension, its midpoints at equilibrium (equal links), stores exactly its
+//! root's energy, so edge splits alone keep the static response; the inner springs of a 1→8 add
+//! stiffness (the refined zone is stiffer by the children's contributions). A midpoint has no
+//! stiffness across its chain until inner springs hold it, so a chain of free midpoints under
+//! compression can buckle sideways: a zone refined by edge splits alone is softer in compression.
 
 use std::collections::{BTreeMap, BTreeSet};
 

@@ -1,5 +1,5 @@
 //! `topomech refine MESH --around X,Y,Z --radius R --levels L [--conforming]
-//! [--cut PX,PY,PZ,NX,NY,NZ] [--density D] [--out DIR] [--json]`:
+//! [--cut PX,PY,PZ,NX,NY,NZ] [--springs] [--density D] [--out DIR] [--json]`:
 //! adaptive 1→8 refinement of the tets meeting a ball, level by level (issue 5, seed 004), with
 //! tet masses shared among the children by rest volume; every law checked at the end.
 //! `--conforming` builds the conforming closure (a tet mesh without hanging vertices) and a

@@ -1,10 +1,12 @@
 //! `topomech refine MESH --around X,Y,Z --radius R --levels L [--conforming]
-//! [--cut PX,PY,PZ,NX,NY,NZ] [--density D] [--out DIR] [--json]`:
+//! [--cut PX,PY,PZ,NX,NY,NZ] [--springs] [--density D] [--out DIR] [--json]`:
 //! adaptive 1→8 refinement of the tets meeting a ball, level by level (issue 5, seed 004), with
 //! tet masses shared among the children by rest volume; every law checked at the end.
 //! `--conforming` builds the conforming closure (a tet mesh without hanging vertices) and a
 //! mechanical body on it; `--cut` also incises the unrefined and the refined bodies along the
 //! plane and reports the distance of the cut faces to the plane inside the zone, before and after.
+//! `--springs` refines through the spring coupling (`subdivide::LeveledMechanics`: series rule on
+//! split edges, springs for new edges) and reports its springs and laws.
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -13,7 +15,9 @@ use std::time::Instant;
 use topomech::cut::Plane;
 use topomech::load;
 use topomech::mechanics::{check_conservation, Body, Material, Vec3};
-use topomech::subdivide::{cut_error, ConformingMesh, CutSurfaceError, LevelError, LeveledMap, TetMasses};
+use topomech::subdivide::{
+    cut_error, ConformingMesh, CutSurfaceError, LevelError, LeveledMap, LeveledMechanics, Refinement, TetMasses,
+};
 use topomech::vtk::Frame;
 
 use super::{print_warnings, CliError};
@@ -43,6 +47,10 @@ pub struct RefineArgs {
     /// `--conforming`).
     #[arg(long, value_parser = parse_plane, allow_hyphen_values = true)]
     pub cut: Option<[f64; 6]>,
+    /// Refine through the spring coupling and report `springs_before`, `springs_after`,
+    /// `stiffness_series_ok`, `spring_laws_ok` (`refine_ms` then includes the coupling).
+    #[arg(long)]
+    pub springs: bool,
     /// Write `refined.vtu` (the finest level; with `--conforming` also `conforming.vtu`) into this
     /// directory.
     #[arg(long)]
@@ -104,6 +112,18 @@ pub struct RefineJson {
     /// The same on the refined body (`--cut`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cut_error_mean_after: Option<f64>,
+    /// Springs (edges) before the refinement (`--springs`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub springs_before: Option<usize>,
+    /// Springs after: one per edge of the finest level (`--springs`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub springs_after: Option<usize>,
+    /// Every split spring's chain has Σ 1/k_i = 1/k, Σ 1/c_i = 1/c, Σ L_i = L (`--springs`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stiffness_series_ok: Option<bool>,
+    /// Every law of `LeveledMechanics::check` holds (`--springs`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub spring_laws_ok: Option<bool>,
 }
 
 fn parse_point(s: &str) -> Result<Vec3, String> {
@@ -162,12 +182,9 @@ pub fn run(args: RefineArgs) -> Result<(), CliError> {
         None => None,
     };
     let mut m = LeveledMap::new(loaded.map, loaded.mesh.points);
-    let mut masses = TetMasses::from_density(&m, args.density).map_err(|e| other(e.to_string()))?;
-    let start = Instant::now();
-    let refinement = m.refine_around(args.around, args.radius, args.levels, &mut masses);
-    let refine_ms = start.elapsed().as_secs_f64() * 1e3;
-    let refinement = refinement.map_err(|e| other(format!("{}: refinement refused: {e}", args.mesh.display())))?;
+    let (refinement, masses, mech, refine_ms) = refine(&args, &mut m, material)?;
     let mut report = report(&m, &masses, &refinement, refine_ms)?;
+    let spring_laws = mech.as_ref().map(|(before, x)| fill_springs(&mut report, *before, x, &m));
     let closure = if args.conforming || args.cut.is_some() {
         let c = m.conforming_tets().map_err(|e| other(format!("{}: conforming closure: {e}", args.mesh.display())))?;
         report.conforming_tets = Some(c.tets.len());
@@ -193,10 +210,48 @@ pub fn run(args: RefineArgs) -> Result<(), CliError> {
         write_table(&mut out, &report)?;
     }
     out.flush()?;
+    if let Some(Err(e)) = spring_laws {
+        return Err(other(format!("{}: the spring coupling breaks a law (a topomech bug): {e}", args.mesh.display())));
+    }
     match m.check_all() {
         Ok(()) => Ok(()),
         Err(e) => Err(other(format!("{}: the refined map breaks a law (a topomech bug): {e}", args.mesh.display()))),
     }
+}
+
+/// What [`refine`] returns: the refinement, the tet masses, the coupling with its spring count
+/// before (`--springs`), and the wall time in ms.
+type Refined = (Refinement, TetMasses, Option<(usize, LeveledMechanics)>, f64);
+
+/// Refines `m` as `args` says, through the spring coupling with `--springs`.
+fn refine(args: &RefineArgs, m: &mut LeveledMap<3>, material: Material) -> Result<Refined, CliError> {
+    let refused = |e: String| other(format!("{}: refinement refused: {e}", args.mesh.display()));
+    let mut masses = TetMasses::from_density(m, args.density).map_err(|e| other(e.to_string()))?;
+    let start = Instant::now();
+    if args.springs {
+        let mut mech = LeveledMechanics::new(m, material).map_err(|e| refused(e.to_string()))?;
+        let before = mech.springs().count();
+        let r = mech.refine_around(m, args.around, args.radius, args.levels).map_err(|e| refused(e.to_string()))?;
+        let ms = start.elapsed().as_secs_f64() * 1e3;
+        return Ok((r, mech.masses.clone(), Some((before, mech)), ms));
+    }
+    let r = m.refine_around(args.around, args.radius, args.levels, &mut masses).map_err(|e| refused(e.to_string()))?;
+    Ok((r, masses, None, start.elapsed().as_secs_f64() * 1e3))
+}
+
+/// The `--springs` keys; returns the result of the full check.
+fn fill_springs(
+    r: &mut RefineJson,
+    before: usize,
+    mech: &LeveledMechanics,
+    m: &LeveledMap<3>,
+) -> Result<(), topomech::subdivide::SpringLawError> {
+    let laws = mech.check(m);
+    r.springs_before = Some(before);
+    r.springs_after = Some(mech.springs().count());
+    r.stiffness_series_ok = Some(mech.check_series().is_ok());
+    r.spring_laws_ok = Some(laws.is_ok());
+    laws
 }
 
 /// Builds a body on `tets`, incises it along `plane` and measures the cut in the zone of `args`;
@@ -271,6 +326,10 @@ fn report(
         cut_error_max_after: None,
         cut_error_mean_before: None,
         cut_error_mean_after: None,
+        springs_before: None,
+        springs_after: None,
+        stiffness_series_ok: None,
+        spring_laws_ok: None,
     })
 }
 
@@ -287,6 +346,10 @@ fn write_table(out: &mut dyn Write, r: &RefineJson) -> std::io::Result<()> {
         "total mass", r.total_mass_before, r.total_mass_after
     )?;
     writeln!(out, "  {:<26}{:.3} ms", "refine time", r.refine_ms)?;
+    if let (Some(b), Some(a)) = (r.springs_before, r.springs_after) {
+        let ok = (r.stiffness_series_ok.unwrap_or(false), r.spring_laws_ok.unwrap_or(false));
+        writeln!(out, "  {:<26}{b} -> {a} (series rule {}, all laws {})", "springs", ok.0, ok.1)?;
+    }
     if let Some(n) = r.conforming_tets {
         writeln!(out, "  {:<26}{n}", "conforming tets")?;
     }

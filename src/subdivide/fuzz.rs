@@ -18,10 +18,14 @@
 //! - refused op: only the documented refusals (`AlreadyAtLevel`, `NotATriangle`,
 //!   `NotATetrahedron`, `FaceRefinedTooFar`, `OpenEdge`), and the map is unchanged (same darts,
 //!   isomorphic, same maximum level).
+//! - 3D: every op goes through a [`LeveledMechanics`] (springs and masses follow the map); after an
+//!   accepted op its laws hold ([`LeveledMechanics::check`]), after a refused one it is unchanged.
 
-use super::{tet_distance, LeveledMap, SubdivideError, TetMasses};
+use super::TetMasses;
+use super::{tet_distance, CouplingError, LeveledMap, LeveledMechanics, SubdivideError};
 use crate::generate::{grid_triangles, kuhn_cube};
 use crate::gmap::{DartId, GMap};
+use crate::mechanics::Material;
 
 /// Highest level an op may reach.
 pub const MAX_FUZZ_LEVEL: u8 = 3;
@@ -174,14 +178,21 @@ pub fn run_bytes(bytes: &[u8]) -> Result<Report, String> {
                 (vec![[0.0, 0.0, 0.0], [1.0, 0.1, 0.0], [0.2, 1.0, 0.1], [0.1, 0.3, 1.0]], vec![[0, 1, 2, 3]])
             };
             let (map, _) = GMap::<3>::from_tets(points.len(), &tets).map_err(|e| e.to_string())?;
-            run(LeveledMap::new(map, points), &ops, apply_3d)
+            let m = LeveledMap::new(map, points);
+            let mut mech = LeveledMechanics::new(&m, Material::default()).map_err(|e| e.to_string())?;
+            run(m, &ops, |m, op| apply_3d(m, &mut mech, op))
         }
     }
 }
 
-type Apply<const N: usize> = fn(&mut LeveledMap<N>, Op) -> Result<Result<(), SubdivideError>, String>;
+/// What applying one op gives: `Err` for a broken law, `Ok(Err)` for a refusal.
+type Applied = Result<Result<(), SubdivideError>, String>;
 
-fn run<const N: usize>(mut m: LeveledMap<N>, ops: &[Op], apply: Apply<N>) -> Result<Report, String> {
+fn run<const N: usize>(
+    mut m: LeveledMap<N>,
+    ops: &[Op],
+    mut apply: impl FnMut(&mut LeveledMap<N>, Op) -> Applied,
+) -> Result<Report, String> {
     let chi = m.map().euler_characteristic();
     let mut report = Report::default();
     for (k, &op) in ops.iter().enumerate() {
@@ -219,7 +230,7 @@ fn pick_dart<const N: usize>(m: &LeveledMap<N>, pick: u16) -> DartId {
     m.map().darts().nth(pick as usize % n).expect("a live dart")
 }
 
-fn apply_2d(m: &mut LeveledMap<2>, op: Op) -> Result<Result<(), SubdivideError>, String> {
+fn apply_2d(m: &mut LeveledMap<2>, op: Op) -> Applied {
     Ok(match op {
         Op::SplitEdge { pick, up } => m.split_edge(pick_dart(m, pick), level_of(m, up)).map(drop),
         Op::Triangle { pick, up } | Op::Tet { pick, up } => {
@@ -232,30 +243,41 @@ fn apply_2d(m: &mut LeveledMap<2>, op: Op) -> Result<Result<(), SubdivideError>,
     })
 }
 
-fn apply_3d(m: &mut LeveledMap<3>, op: Op) -> Result<Result<(), SubdivideError>, String> {
-    Ok(match op {
-        Op::SplitEdge { pick, up } => m.split_edge(pick_dart(m, pick), level_of(m, up)).map(drop),
-        Op::Triangle { pick, up } => m.subdivide_triangle(pick_dart(m, pick), level_of(m, up)).map(drop),
-        Op::Tet { pick, up } => m.subdivide_tet(pick_dart(m, pick), level_of(m, up)).map(drop),
-        Op::Around { center, radius } => return around(m, center, radius),
-    })
+/// An op through the coupling; its laws after an accepted op, unchanged after a refused one.
+fn apply_3d(m: &mut LeveledMap<3>, mech: &mut LeveledMechanics, op: Op) -> Applied {
+    let before = mech.clone();
+    let result = match op {
+        Op::SplitEdge { pick, up } => mech.split_edge(m, pick_dart(m, pick), level_of(m, up)).map(drop),
+        Op::Triangle { pick, up } => mech.subdivide_triangle(m, pick_dart(m, pick), level_of(m, up)).map(drop),
+        Op::Tet { pick, up } => mech.subdivide_tet(m, pick_dart(m, pick), level_of(m, up)).map(drop),
+        Op::Around { center, radius } => return around(m, mech, center, radius),
+    };
+    match result {
+        Ok(()) => mech.check(m).map(Ok).map_err(|e| format!("spring laws: {e}")),
+        Err(CouplingError::Subdivide(e)) if *mech == before => Ok(Err(e)),
+        Err(CouplingError::Subdivide(e)) => Err(format!("refused ({e}) but the spring coupling changed")),
+        Err(e) => Err(format!("spring coupling: {e}")),
+    }
 }
 
-/// `refine_around` with the mass and zone laws checked. Tets created by hand-ordered ops may not
-/// be refinable by a ball (`FaceRefinedTooFar` after a face was split twice): that is a refusal.
-fn around(m: &mut LeveledMap<3>, center: [u8; 2], radius: u8) -> Result<Result<(), SubdivideError>, String> {
+/// `refine_around` with the mass, zone and spring laws checked. Tets created by hand-ordered ops
+/// may not be refinable by a ball (`FaceRefinedTooFar` after a face was split twice): that is a
+/// refusal.
+fn around(m: &mut LeveledMap<3>, mech: &mut LeveledMechanics, center: [u8; 2], radius: u8) -> Applied {
     let c = [f64::from(center[0]) / 255.0, f64::from(center[1]) / 255.0, 0.5];
     let r = f64::from(radius) / 255.0;
     let levels = level_of(m, true);
-    let mut masses = TetMasses::from_density(m, 2.0).map_err(|e| format!("masses of the tets: {e}"))?;
-    let before = m.clone();
-    let result = m.refine_around(c, r, levels, &mut masses);
-    if let Err(e) = result {
+    let (before, mech_before) = (m.clone(), mech.clone());
+    let expected = masses_total(m)?;
+    if let Err(e) = mech.refine_around(m, c, r, levels) {
         // refine_around keeps the ops done before a refusal; the fuzz checks want all or nothing.
-        *m = before;
-        return Ok(Err(e));
+        (*m, *mech) = (before, mech_before);
+        return match e {
+            CouplingError::Subdivide(e) => Ok(Err(e)),
+            e => Err(format!("spring coupling: {e}")),
+        };
     }
-    let (total, expected) = (masses.total(m), masses_total(&before)?);
+    let total = mech.masses.total(m);
     if (total - expected).abs() > 1e-12 * expected.max(1.0) {
         return Err(format!("Σ tet mass {total} after, {expected} before"));
     }
@@ -265,11 +287,12 @@ fn around(m: &mut LeveledMap<3>, center: [u8; 2], radius: u8) -> Result<Result<(
             return Err(format!("the tet of {d} meets the ball but stayed at level {}", m.mu(d).tet));
         }
     }
-    Ok(Ok(()))
+    mech.check(m).map(Ok).map_err(|e| format!("spring laws: {e}"))
 }
 
+/// Σ ρ·V over the tets of `m` (ρ of the default material: every tet keeps m_t = ρ·V_t).
 fn masses_total(m: &LeveledMap<3>) -> Result<f64, String> {
-    let masses = TetMasses::from_density(m, 2.0).map_err(|e| e.to_string())?;
+    let masses = TetMasses::from_density(m, Material::default().density).map_err(|e| e.to_string())?;
     Ok(masses.total(m))
 }
 

@@ -34,6 +34,8 @@ pub mod fuzz;
 mod ops;
 mod parts;
 mod region;
+mod springs;
+mod springs_check;
 mod tet;
 mod tri;
 
@@ -41,6 +43,8 @@ pub use conform::{triangulate_polygon, ConformingMesh};
 pub use cut_error::{cut_error, measure_cut, CutSurfaceError};
 pub use parts::{record_errors, DartLevels, HistoryEntry, LevelParts, LevelPartsError};
 pub use region::{tet_distance, Refinement, TetMasses};
+pub use springs::{CouplingError, LeveledMechanics, Spring};
+pub use springs_check::SpringLawError;
 
 use crate::gmap::{AlphaMask, DartId, GMap, InvariantViolation};
 
@@ -272,6 +276,8 @@ pub struct LeveledMap<const N: usize> {
     history: Vec<Vec<LinkChange>>,
     max_level: u8,
     points: Vec<[f64; 3]>,
+    /// Every inserted vertex as [new vertex id, end vertex ids] (see [`LeveledMap::split_log`]).
+    splits: Vec<[u32; 3]>,
     op: ops::OpLog,
 }
 
@@ -302,6 +308,7 @@ impl<const N: usize> LeveledMap<N> {
             history: vec![Vec::new(); cap],
             max_level: 0,
             points,
+            splits: Vec::new(),
             op: ops::OpLog::default(),
         }
     }
@@ -394,6 +401,29 @@ impl<const N: usize> LeveledMap<N> {
     /// ```
     pub fn points(&self) -> &[[f64; 3]] {
         &self.points
+    }
+
+    /// Every vertex inserted on an edge since this map was created or loaded, in insertion order, as
+    /// `[new vertex id, end vertex id, end vertex id]` (the ends of the edge it split; vertex ids
+    /// never change, so the entries stay valid). [`LeveledMechanics`] follows the map with it.
+    /// Not saved by [`LeveledMap::to_parts`]. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::subdivide::LeveledMap;
+    /// # use topomech::GMap;
+    /// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+    /// let mut m = LeveledMap::new(map, vec![[0.0; 3], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]]);
+    /// let d = m.map().darts().next().unwrap();
+    /// let (a, b) = (m.map().vertex_id(d).0, m.map().vertex_id(m.map().alpha_dyn(0, d)).0);
+    /// let mid = m.split_edge(d, 1).unwrap();
+    /// assert_eq!(m.split_log(), &[[m.map().vertex_id(mid).0, a, b]]);
+    /// m.subdivide_triangle(d, 2).unwrap(); // two more sides split
+    /// assert_eq!(m.split_log().len(), 3);
+    /// ```
+    pub fn split_log(&self) -> &[[u32; 3]] {
+        &self.splits
     }
 
     /// Position of the vertex of dart `d` (the origin if no geometry was given). O(1).

@@ -125,6 +125,8 @@ impl<const N: usize> LeveledMap<N> {
         for (m, a, b) in midpoints {
             let (pa, pb) = (self.position(a), self.position(b));
             let v = self.map.vertex_id(m).index();
+            let ends = [self.map.vertex_id(a).0, self.map.vertex_id(b).0];
+            self.splits.push([v as u32, ends[0], ends[1]]);
             if !self.points.is_empty() {
                 if self.points.len() <= v {
                     self.points.resize(v + 1, [0.0; 3]);

@@ -354,7 +354,7 @@ impl LeveledMap<3> {
     }
 
     /// One dart of every tet with μt = `lt` meeting the ball. O(darts).
-    fn zone_tets(&self, lt: u8, center: [f64; 3], radius: f64) -> Result<Vec<DartId>, SubdivideError> {
+    pub(super) fn zone_tets(&self, lt: u8, center: [f64; 3], radius: f64) -> Result<Vec<DartId>, SubdivideError> {
         let mut out = Vec::new();
         for d in self.map.one_dart_per_cell(3) {
             if self.mu[d.index()].tet == lt && self.tet_in_ball(d, center, radius)? {

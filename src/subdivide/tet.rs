@@ -109,6 +109,13 @@ impl LeveledMap<3> {
         }
         let corners = self.tet_corners(d, cell_level)?;
         let unsplit = self.check_tet_faces(d, &corners)?;
+        // The face splits below must all succeed: an unsplit face already at the level is refused
+        // here, before any change (found by the spring-coupling proptest: the map was left with
+        // some faces split).
+        if let Some(&f) = unsplit.iter().find(|f| self.mu[f.index()].face >= level) {
+            let cell_level = self.mu[f.index()].face;
+            return Err(SubdivideError::AlreadyAtLevel { dart: f, dim: 2, cell_level, level });
+        }
         for f in unsplit {
             self.subdivide_triangle(f, level)?;
         }

@@ -1,0 +1,638 @@
+//! The mass/spring state of a [`LeveledMap<3>`] carried through every subdivision operation
+//! (issue 5, "mechanics coupling"; beyond seed 004, which stops at the topology).
+//!
+//! [`LeveledMechanics`] keys everything by cell ids of the finest map: one [`Spring`] per edge,
+//! keyed by the sorted pair of its vertex ids (vertex ids never change under subdivision), one mass
+//! per volume id ([`TetMasses`]), position and velocity per vertex id. Its operations call the
+//! map's and then apply the rules below; [`LeveledMechanics::check`] states them as laws.
+//!
+//! # Rules
+//! - **Edge split** (any operation that inserts a midpoint m on an edge (a, b) with spring
+//!   (L, k, c)): two springs (a, m), (m, b) with L/2, 2k, 2c. Two springs in series have
+//!   compliance 1/k₁ + 1/k₂ = 1/(2k) + 1/(2k) = 1/k: the chain is exactly as stiff (and as damped,
+//!   dampers in series add the same way) as the spring it replaces. The first time a spring that
+//!   is not itself a half is split, it is kept as the *root* of its chain.
+//! - **New vertex**: rest position = midpoint of the rest positions (the map's `points()`);
+//!   position and velocity = the mean of the ends' position and velocity (linear interpolation).
+//! - **New edge** (the inner edges of a face split 1→4, the octahedron diagonal): a spring with
+//!   L = the distance of the rest positions, k = 0, c = 0; then every child tet t of a 1→8 adds
+//!   k_{t,e} = E · V_t / L_e² (law 2 of docs/MECHANICS.md) and β · k_{t,e} to each of its six edges
+//!   that is **not a half** of a split edge (halves follow the series rule only). A face split on
+//!   its own (outside a 1→8) leaves its inner springs at k = 0 until a tet on either side is split.
+//! - **Masses**: a tet of mass m split 1→8 gives child k the mass m · V_k / ΣV
+//!   ([`LeveledMap::subdivide_tet_with_mass`]); vertex masses are derived, never stored:
+//!   m_v = Σ_{volumes t ∋ v} m_t / n_t, n_t the number of vertices of t in the finest map (4 for a
+//!   plain tet, the seed's m_t/4; more when neighbours inserted vertices on its sides, which then
+//!   get a share), so Σ_v m_v = Σ_t m_t.
+//!
+//! Consequences: a chain in tension, its midpoints at equilibrium (equal links), stores exactly its
+//! root's energy, so edge splits alone keep the static response; the inner springs of a 1→8 add
+//! stiffness (the refined zone is stiffer by the children's contributions). A midpoint has no
+//! stiffness across its chain until inner springs hold it, so a chain of free midpoints under
+//! compression can buckle sideways: a zone refined by edge splits alone is softer in compression.
+
+use std::collections::{BTreeMap, BTreeSet};
+
+use super::{LeveledMap, Refinement, SubdivideError, TetMasses};
+use crate::gmap::{AlphaMask, DartId};
+use crate::mechanics::geom::{norm, sub, Vec3};
+use crate::mechanics::model::stiffness_contribution;
+use crate::mechanics::{Material, SpringSystem};
+
+/// One spring: rest length L, stiffness k, damping c.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::subdivide::Spring;
+/// let s = Spring { rest: 2.0, stiffness: 10.0, damping: 0.5 };
+/// let half = s.half();
+/// assert_eq!((half.rest, half.stiffness, half.damping), (1.0, 20.0, 1.0));
+/// assert_eq!(1.0 / half.stiffness + 1.0 / half.stiffness, 1.0 / s.stiffness); // in series
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Spring {
+    /// Rest length L.
+    pub rest: f64,
+    /// Stiffness k.
+    pub stiffness: f64,
+    /// Damping c.
+    pub damping: f64,
+}
+
+impl Spring {
+    /// One of the two halves of this spring split at its midpoint: L/2, 2k, 2c (module docs). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::subdivide::Spring;
+    /// let s = Spring { rest: 1.0, stiffness: 3.0, damping: 0.0 }.half().half();
+    /// assert_eq!((s.rest, s.stiffness), (0.25, 12.0));
+    /// ```
+    pub fn half(self) -> Spring {
+        Spring { rest: self.rest / 2.0, stiffness: 2.0 * self.stiffness, damping: 2.0 * self.damping }
+    }
+}
+
+/// Errors of the coupled operations.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::subdivide::{CouplingError, LeveledMap, LeveledMechanics};
+/// use topomech::mechanics::Material;
+/// use topomech::GMap;
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+/// let mut m = LeveledMap::new(map, pts);
+/// let mut mech = LeveledMechanics::new(&m, Material::default()).unwrap();
+/// let d = m.map().darts().next().unwrap();
+/// m.split_edge(d, 1).unwrap(); // behind the coupling's back
+/// let e = mech.split_edge(&mut m, d, 2).unwrap_err();
+/// assert!(matches!(e, CouplingError::OutOfSync { applied: 0, logged: 1 }));
+/// assert!(LeveledMechanics::new(&m, Material::default()).is_err()); // not at level 0
+/// ```
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CouplingError {
+    /// The map refused the operation (map and mechanics unchanged).
+    #[error(transparent)]
+    Subdivide(#[from] SubdivideError),
+    /// The coupling starts from a map with no operation done (level 0).
+    #[error("the map is at level {0}: a coupling starts from a level-0 map")]
+    NotLevelZero(u8),
+    /// A vertex has no rest position (the map was built without geometry).
+    #[error("vertex {0} has no rest position: the leveled map needs its points")]
+    NoGeometry(u32),
+    /// The map inserted vertices the coupling did not see (an operation called on the map alone).
+    #[error("the coupling applied {applied} vertex insertions but the map logged {logged}")]
+    OutOfSync {
+        /// Insertions the coupling followed.
+        applied: usize,
+        /// Insertions in [`LeveledMap::split_log`].
+        logged: usize,
+    },
+    /// The map split an edge that has no spring (a bug, or a tampered coupling).
+    #[error("edge ({0}, {1}) was split but has no spring")]
+    NoSpring(u32, u32),
+}
+
+/// Springs, masses and vertex state of a [`LeveledMap<3>`] following its subdivision (module docs).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::Material;
+/// use topomech::subdivide::{LeveledMap, LeveledMechanics};
+/// use topomech::GMap;
+/// let (points, tets) = kuhn_cube(1);
+/// let (map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+/// let mut m = LeveledMap::new(map, points);
+/// let mut mech = LeveledMechanics::new(&m, Material::default()).unwrap();
+/// assert_eq!(mech.springs().count(), 19);
+/// mech.refine_around(&mut m, [0.2, 0.2, 0.2], 0.1, 1).unwrap();
+/// mech.check(&m).unwrap();
+/// assert_eq!(mech.springs().count(), m.map().count_cells().0[1]); // one spring per edge
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct LeveledMechanics {
+    /// The material (ρ, E, β, ν) of every tet.
+    pub material: Material,
+    /// One mass per volume id.
+    pub masses: TetMasses,
+    /// Position per vertex id.
+    pub position: Vec<Vec3>,
+    /// Velocity per vertex id.
+    pub velocity: Vec<Vec3>,
+    pub(super) springs: BTreeMap<(u32, u32), Spring>,
+    /// Springs that were split and were not halves themselves: their value before the split.
+    pub(super) roots: BTreeMap<(u32, u32), Spring>,
+    /// Every edge ever split → its midpoint.
+    pub(super) split_at: BTreeMap<(u32, u32), u32>,
+    /// Halves produced by splits.
+    pub(super) halves: BTreeSet<(u32, u32)>,
+    /// The level-0 tets (their springs come from law 2 over them).
+    pub(super) tets0: Vec<[u32; 4]>,
+    /// Entries of the map's split log already followed.
+    pub(super) applied: usize,
+    /// Σ m_t when the coupling was built.
+    pub(super) total_mass: f64,
+}
+
+/// The key of the edge between vertices a and b: the sorted pair.
+pub(super) fn key(a: u32, b: u32) -> (u32, u32) {
+    (a.min(b), a.max(b))
+}
+
+impl LeveledMechanics {
+    /// The coupling of a level-0 map: masses ρ·V_t, springs from law 2 (k_e = Σ_{t ∋ e} E V_t / L_e²,
+    /// c_e = β k_e, L_e the rest distance), at rest with zero velocity. O(darts + E log E).
+    ///
+    /// Errors: [`CouplingError::NotLevelZero`], [`CouplingError::NoGeometry`], and the errors of
+    /// [`LeveledMap::tet_vertices`] for a volume that is not a tet.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::Material;
+    /// use topomech::subdivide::{LeveledMap, LeveledMechanics};
+    /// use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let m = LeveledMap::new(map, pts);
+    /// let mech = LeveledMechanics::new(&m, Material { young: 6.0, ..Material::default() }).unwrap();
+    /// let s = mech.spring(0, 1).unwrap();
+    /// assert!((s.stiffness - 1.0).abs() < 1e-12); // E V / L² = 6 · (1/6) / 1
+    /// ```
+    pub fn new(m: &LeveledMap<3>, material: Material) -> Result<Self, CouplingError> {
+        if m.max_level() != 0 {
+            return Err(CouplingError::NotLevelZero(m.max_level()));
+        }
+        let nv = m.map().cell_id_bound(0);
+        if m.points().len() < nv {
+            return Err(CouplingError::NoGeometry(m.points().len() as u32));
+        }
+        let masses = TetMasses::from_density(m, material.density)?;
+        let tets0: Vec<[u32; 4]> = m.finest_tets()?.into_iter().map(|(t, _, _)| t).collect();
+        let mut mech = LeveledMechanics {
+            material,
+            total_mass: masses.total(m),
+            masses,
+            position: m.points()[..nv].to_vec(),
+            velocity: vec![[0.0; 3]; nv],
+            springs: BTreeMap::new(),
+            roots: BTreeMap::new(),
+            split_at: BTreeMap::new(),
+            halves: BTreeSet::new(),
+            tets0: Vec::new(),
+            applied: m.split_log().len(),
+        };
+        for t in &tets0 {
+            mech.add_tet(m, *t);
+        }
+        mech.tets0 = tets0;
+        Ok(mech)
+    }
+
+    /// The spring of the edge between vertices a and b (either order), if any. O(log E).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::Material;
+    /// use topomech::subdivide::{LeveledMap, LeveledMechanics};
+    /// use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mech = LeveledMechanics::new(&LeveledMap::new(map, pts), Material::default()).unwrap();
+    /// assert_eq!(mech.spring(1, 0).unwrap().rest, 2.0);
+    /// assert!(mech.spring(0, 0).is_none());
+    /// ```
+    pub fn spring(&self, a: u32, b: u32) -> Option<Spring> {
+        self.springs.get(&key(a, b)).copied()
+    }
+
+    /// Mutable access to a spring (for tests and tools; [`Self::check`] says whether the laws still
+    /// hold). O(log E).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::Material;
+    /// use topomech::subdivide::{LeveledMap, LeveledMechanics, SpringLawError};
+    /// use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let m = LeveledMap::new(map, pts);
+    /// let mut mech = LeveledMechanics::new(&m, Material::default()).unwrap();
+    /// mech.spring_mut(2, 3).unwrap().stiffness *= 1.5;
+    /// assert!(matches!(mech.check(&m), Err(SpringLawError::Stiffness { a: 2, b: 3, .. })));
+    /// ```
+    pub fn spring_mut(&mut self, a: u32, b: u32) -> Option<&mut Spring> {
+        self.springs.get_mut(&key(a, b))
+    }
+
+    /// Every spring as ((a, b), spring), a < b, in increasing order of the pair. O(1) per item.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::Material;
+    /// use topomech::subdivide::{LeveledMap, LeveledMechanics};
+    /// use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mech = LeveledMechanics::new(&LeveledMap::new(map, pts), Material::default()).unwrap();
+    /// let pairs: Vec<(u32, u32)> = mech.springs().map(|(e, _)| e).collect();
+    /// assert_eq!(pairs, vec![(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]);
+    /// ```
+    pub fn springs(&self) -> impl Iterator<Item = ((u32, u32), Spring)> + '_ {
+        self.springs.iter().map(|(&e, &s)| (e, s))
+    }
+
+    /// The finest springs along the edge (a, b) of some level, in order from a to b: the edge itself
+    /// if it was never split, else the chains of its two halves. O(chain · log E).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::Material;
+    /// use topomech::subdivide::{LeveledMap, LeveledMechanics};
+    /// use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mut m = LeveledMap::new(map, pts);
+    /// let mut mech = LeveledMechanics::new(&m, Material::default()).unwrap();
+    /// let d = m.map().darts().find(|&d| m.map().vertex_id(d).0 == 0 && m.map().vertex_id(m.map().alpha_dyn(0, d)).0 == 1).unwrap();
+    /// mech.split_edge(&mut m, d, 1).unwrap();
+    /// assert_eq!(mech.chain(0, 1), vec![(0, 4), (4, 1)]);
+    /// let compliance: f64 = mech.chain(0, 1).iter().map(|&(a, b)| 1.0 / mech.spring(a, b).unwrap().stiffness).sum();
+    /// assert!((compliance * mech.root(0, 1).unwrap().stiffness - 1.0).abs() < 1e-12);
+    /// ```
+    pub fn chain(&self, a: u32, b: u32) -> Vec<(u32, u32)> {
+        match self.split_at.get(&key(a, b)) {
+            Some(&m) => {
+                let mut out = self.chain(a, m);
+                out.extend(self.chain(m, b));
+                out
+            }
+            None => vec![(a, b)],
+        }
+    }
+
+    /// The spring the edge (a, b) had when it was first split, if it was a root (a spring that was not
+    /// itself a half). O(log E).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::Material;
+    /// use topomech::subdivide::{LeveledMap, LeveledMechanics};
+    /// use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mut m = LeveledMap::new(map, pts);
+    /// let mut mech = LeveledMechanics::new(&m, Material::default()).unwrap();
+    /// let before = mech.spring(0, 1);
+    /// let d = m.map().darts().next().unwrap();
+    /// mech.subdivide_tet(&mut m, d, 1).unwrap();
+    /// assert_eq!(mech.root(0, 1), before);
+    /// assert!(mech.spring(0, 1).is_none()); // no longer an edge of the finest level
+    /// ```
+    pub fn root(&self, a: u32, b: u32) -> Option<Spring> {
+        self.roots.get(&key(a, b)).copied()
+    }
+
+    /// Adds law 2's contribution of the tet with corners `t` to its six edges that are not halves.
+    fn add_tet(&mut self, m: &LeveledMap<3>, t: [u32; 4]) {
+        let p = t.map(|v| m.points()[v as usize]);
+        let volume = crate::mesh::signed_volume(p[0], p[1], p[2], p[3]);
+        for (i, j) in [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)] {
+            let e = key(t[i], t[j]);
+            if self.halves.contains(&e) {
+                continue;
+            }
+            let rest = norm(sub(p[j], p[i]));
+            let k = stiffness_contribution(self.material.young, volume, rest);
+            let s = self.springs.entry(e).or_insert(Spring { rest, stiffness: 0.0, damping: 0.0 });
+            s.stiffness += k;
+            s.damping += self.material.damping * k;
+        }
+    }
+
+    /// Errors unless every vertex insertion of the map was followed.
+    fn in_sync(&self, m: &LeveledMap<3>) -> Result<(), CouplingError> {
+        let logged = m.split_log().len();
+        if logged != self.applied {
+            return Err(CouplingError::OutOfSync { applied: self.applied, logged });
+        }
+        Ok(())
+    }
+}
+
+impl LeveledMechanics {
+    /// [`LeveledMap::split_edge`] with the series rule on the edge's spring and the new vertex
+    /// interpolated (module docs). Returns the map's result. O(edge · n + log E).
+    ///
+    /// Errors: [`CouplingError::OutOfSync`], the map's refusals (both unchanged), or
+    /// [`CouplingError::NoSpring`] (the map changed; a tampered coupling).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::Material;
+    /// use topomech::subdivide::{LeveledMap, LeveledMechanics};
+    /// use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mut m = LeveledMap::new(map, pts);
+    /// let mut mech = LeveledMechanics::new(&m, Material::default()).unwrap();
+    /// mech.velocity[0] = [2.0, 0.0, 0.0];
+    /// let d = m.map().darts().find(|&d| m.map().vertex_id(d).0 == 0 && m.map().vertex_id(m.map().alpha_dyn(0, d)).0 == 1).unwrap();
+    /// let k = mech.spring(0, 1).unwrap().stiffness;
+    /// let mid = mech.split_edge(&mut m, d, 1).unwrap();
+    /// let v = m.map().vertex_id(mid).0;
+    /// assert_eq!(mech.spring(0, v).unwrap().stiffness, 2.0 * k);
+    /// assert_eq!((mech.position[v as usize], mech.velocity[v as usize]), ([0.5, 0.0, 0.0], [1.0, 0.0, 0.0]));
+    /// mech.check(&m).unwrap();
+    /// ```
+    pub fn split_edge(&mut self, m: &mut LeveledMap<3>, d: DartId, level: u8) -> Result<DartId, CouplingError> {
+        self.in_sync(m)?;
+        let mid = m.split_edge(d, level)?;
+        self.follow(m, &[], &[])?;
+        self.expensive_check(m);
+        Ok(mid)
+    }
+
+    /// [`LeveledMap::subdivide_triangle`] with the series rule on its split sides and zero-stiffness
+    /// springs on its three inner edges (no tet is split; module docs). O(face + touched + log E).
+    ///
+    /// Errors: as [`Self::split_edge`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::Material;
+    /// use topomech::subdivide::{LeveledMap, LeveledMechanics};
+    /// use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mut m = LeveledMap::new(map, pts);
+    /// let mut mech = LeveledMechanics::new(&m, Material::default()).unwrap();
+    /// let d = m.map().darts().next().unwrap();
+    /// mech.subdivide_triangle(&mut m, d, 1).unwrap();
+    /// assert_eq!(mech.springs().count(), 6 + 3 + 3); // 3 sides split, 3 inner edges
+    /// assert_eq!(mech.springs().filter(|(_, s)| s.stiffness == 0.0).count(), 3);
+    /// mech.check(&m).unwrap();
+    /// ```
+    pub fn subdivide_triangle(
+        &mut self,
+        m: &mut LeveledMap<3>,
+        d: DartId,
+        level: u8,
+    ) -> Result<[DartId; 4], CouplingError> {
+        self.in_sync(m)?;
+        let faces = m.subdivide_triangle(d, level)?;
+        self.follow(m, &faces, &[])?;
+        self.expensive_check(m);
+        Ok(faces)
+    }
+
+    /// [`LeveledMap::subdivide_tet_with_mass`] with the series rule on the split edges, new springs
+    /// on the new edges and law 2's contributions of the eight children (module docs).
+    /// O(volume + touched + log E).
+    ///
+    /// Errors: as [`Self::split_edge`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::Material;
+    /// use topomech::subdivide::{LeveledMap, LeveledMechanics};
+    /// use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mut m = LeveledMap::new(map, pts);
+    /// let mut mech = LeveledMechanics::new(&m, Material::default()).unwrap();
+    /// let d = m.map().darts().next().unwrap();
+    /// mech.subdivide_tet(&mut m, d, 1).unwrap();
+    /// assert_eq!(mech.springs().count(), 25); // 12 halves, 12 face edges, 1 diagonal
+    /// assert!(mech.springs().all(|(_, s)| s.stiffness > 0.0));
+    /// mech.check(&m).unwrap();
+    /// ```
+    pub fn subdivide_tet(&mut self, m: &mut LeveledMap<3>, d: DartId, level: u8) -> Result<[DartId; 8], CouplingError> {
+        let children = self.split_tet(m, d, level)?;
+        self.expensive_check(m);
+        Ok(children)
+    }
+
+    /// [`Self::subdivide_tet`] without the expensive check.
+    fn split_tet(&mut self, m: &mut LeveledMap<3>, d: DartId, level: u8) -> Result<[DartId; 8], CouplingError> {
+        self.in_sync(m)?;
+        let children = m.subdivide_tet_with_mass(d, level, &mut self.masses)?;
+        self.follow(m, &[], &children)?;
+        Ok(children)
+    }
+
+    /// [`LeveledMap::refine_around`] through [`Self::subdivide_tet`]: level by level, every tet with
+    /// μt = L − 1 meeting the ball B(center, radius) is split 1→8 with its springs and masses.
+    /// O(Σ_L (volumes + refined · touched)).
+    ///
+    /// Errors: those of [`Self::subdivide_tet`] (the operations before the error stay done, map and
+    /// coupling in step); [`SubdivideError::LevelTooHigh`] for `levels` above the maximum. With
+    /// `expensive-checks`, [`Self::check`] runs once at the end (not after each tet).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::Material;
+    /// use topomech::subdivide::{LeveledMap, LeveledMechanics};
+    /// use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mut m = LeveledMap::new(map, pts);
+    /// let mut mech = LeveledMechanics::new(&m, Material::default()).unwrap();
+    /// let r = mech.refine_around(&mut m, [0.1; 3], 10.0, 2).unwrap();
+    /// assert_eq!(r.subdivided_per_level, vec![0, 1, 8]);
+    /// mech.check(&m).unwrap();
+    /// ```
+    pub fn refine_around(
+        &mut self,
+        m: &mut LeveledMap<3>,
+        center: [f64; 3],
+        radius: f64,
+        levels: u8,
+    ) -> Result<Refinement, CouplingError> {
+        m.check_op_level(levels)?;
+        let before = self.masses.total(m);
+        let mut per_level = vec![0; levels as usize + 1];
+        for level in m.max_level().max(1)..=levels {
+            for d in m.zone_tets(level - 1, center, radius)? {
+                self.split_tet(m, d, level)?;
+                per_level[level as usize] += 1;
+            }
+        }
+        self.expensive_check(m);
+        let after = self.masses.total(m);
+        Ok(Refinement { subdivided_per_level: per_level, total_mass_before: before, total_mass_after: after })
+    }
+
+    /// Applies the rules after an operation of the map: series splits from the new entries of the
+    /// split log, zero springs on the new edges of `faces` and `children`, law 2 from `children`.
+    fn follow(&mut self, m: &LeveledMap<3>, faces: &[DartId], children: &[DartId]) -> Result<(), CouplingError> {
+        let log = m.split_log();
+        for &[v, a, b] in &log[self.applied..] {
+            self.split_spring(m, v, a, b)?;
+        }
+        self.applied = log.len();
+        let mut region: Vec<DartId> = Vec::new();
+        for &f in faces {
+            region.extend(m.map().orbit(f, AlphaMask::of(&[0, 1])));
+        }
+        for &c in children {
+            region.extend(m.map().orbit(c, AlphaMask::of(&[0, 1, 2])));
+        }
+        for d in region {
+            let (a, b) = (m.map().vertex_id(d).0, m.map().vertex_id(m.map().alpha_dyn(0, d)).0);
+            if a != b {
+                let rest = norm(sub(m.points()[b as usize], m.points()[a as usize]));
+                self.springs.entry(key(a, b)).or_insert(Spring { rest, stiffness: 0.0, damping: 0.0 });
+            }
+        }
+        for &c in children {
+            let t = m.tet_vertices(c)?;
+            self.add_tet(m, t);
+        }
+        Ok(())
+    }
+
+    /// With the `expensive-checks` feature, [`Self::check`] after a public operation (a bug of this
+    /// module panics, as the map's own checks do). O(1) without the feature.
+    fn expensive_check(&self, m: &LeveledMap<3>) {
+        #[cfg(feature = "expensive-checks")]
+        if let Err(e) = self.check(m) {
+            panic!("topomech bug: the spring coupling broke a law: {e}");
+        }
+        let _ = m;
+    }
+
+    /// The series rule for the insertion of vertex v on the edge (a, b), and v's state.
+    fn split_spring(&mut self, m: &LeveledMap<3>, v: u32, a: u32, b: u32) -> Result<(), CouplingError> {
+        let e = key(a, b);
+        let s = self.springs.remove(&e).ok_or(CouplingError::NoSpring(e.0, e.1))?;
+        if !self.halves.contains(&e) {
+            self.roots.insert(e, s);
+        }
+        self.split_at.insert(e, v);
+        for h in [key(a, v), key(v, b)] {
+            self.springs.insert(h, s.half());
+            self.halves.insert(h);
+        }
+        let n = m.map().cell_id_bound(0).max(v as usize + 1);
+        self.position.resize(n, [0.0; 3]);
+        self.velocity.resize(n, [0.0; 3]);
+        let mean = |x: &[Vec3]| [0, 1, 2].map(|k| 0.5 * (x[a as usize][k] + x[b as usize][k]));
+        let (x, u) = (mean(&self.position), mean(&self.velocity));
+        self.position[v as usize] = x;
+        self.velocity[v as usize] = u;
+        Ok(())
+    }
+}
+
+impl LeveledMechanics {
+    /// Vertex masses m_v = Σ_{volumes t ∋ v} m_t / n_t (n_t: vertices of t in the finest map), by
+    /// vertex id: a scatter from the volumes. Σ_v m_v = Σ_t m_t. O(darts).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::Material;
+    /// use topomech::subdivide::{LeveledMap, LeveledMechanics};
+    /// use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mut m = LeveledMap::new(map, pts);
+    /// let mut mech = LeveledMechanics::new(&m, Material { density: 6.0, ..Material::default() }).unwrap();
+    /// let d = m.map().darts().next().unwrap();
+    /// mech.split_edge(&mut m, d, 1).unwrap(); // one tet with 5 vertices: 1/5 each
+    /// assert!(mech.vertex_masses(&m).iter().all(|&x| (x - 0.2).abs() < 1e-12));
+    /// ```
+    pub fn vertex_masses(&self, m: &LeveledMap<3>) -> Vec<f64> {
+        let map = m.map();
+        let mut out = vec![0.0; map.cell_id_bound(0)];
+        for t in map.one_dart_per_cell(3) {
+            let vertices = volume_vertices(m, t);
+            let share = self.masses.mass.get(map.cell_id(3, t).index()).copied().unwrap_or(0.0) / vertices.len() as f64;
+            for v in vertices {
+                out[v as usize] += share;
+            }
+        }
+        out
+    }
+
+    /// The finest level as a flat [`SpringSystem`] with slots = vertex ids (so [`Self::position`] and
+    /// [`Self::velocity`] are its state arrays): springs in pair order, masses from
+    /// [`Self::vertex_masses`], viscosity ν·m_v, `fixed[v]` pinning vertex v (missing entries:
+    /// free). No tet list is rebuilt. O(darts + E).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::{Integrator, Material, StepConfig, Stepper};
+    /// use topomech::subdivide::{LeveledMap, LeveledMechanics};
+    /// use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mut m = LeveledMap::new(map, pts);
+    /// let mut mech = LeveledMechanics::new(&m, Material::default()).unwrap();
+    /// let d = m.map().darts().next().unwrap();
+    /// mech.subdivide_tet(&mut m, d, 1).unwrap();
+    /// let sys = mech.spring_system(&m, [0.0, 0.0, -9.81], &[true, true, true]);
+    /// assert_eq!((sys.slots(), sys.springs()), (10, 25));
+    /// let mut stepper = Stepper::new(StepConfig::new(Integrator::Symplectic, 1e-4), &sys, &mech.position, &mech.velocity).unwrap();
+    /// let (x, v) = (&mut mech.position, &mut mech.velocity);
+    /// stepper.step(&sys, x, v).unwrap();
+    /// assert!(mech.position[3][2] < 1.0 && mech.position[0] == [0.0; 3]); // falls, pinned stays
+    /// ```
+    pub fn spring_system(&self, m: &LeveledMap<3>, gravity: Vec3, fixed: &[bool]) -> SpringSystem {
+        let mass = self.vertex_masses(m);
+        let n = mass.len();
+        let pinned: Vec<bool> = (0..n).map(|v| fixed.get(v).copied().unwrap_or(false)).collect();
+        let viscosity = mass.iter().map(|x| self.material.viscosity * x).collect();
+        let ends = self.springs.keys().map(|&(a, b)| [a, b]).collect();
+        let rest = self.springs.values().map(|s| s.rest).collect();
+        let stiffness = self.springs.values().map(|s| s.stiffness).collect();
+        let damping = self.springs.values().map(|s| s.damping).collect();
+        SpringSystem::new(ends, rest, stiffness, damping, mass, &pinned, viscosity, gravity)
+    }
+}
+
+/// The distinct vertex ids of the volume of `t` in the finest map. O(volume).
+pub(super) fn volume_vertices(m: &LeveledMap<3>, t: DartId) -> Vec<u32> {
+    let mut vs: Vec<u32> =
+        m.map().orbit(t, AlphaMask::of(&[0, 1, 2])).iter().map(|&x| m.map().vertex_id(x).0).collect();
+    vs.sort_unstable();
+    vs.dedup();
+    vs
+}

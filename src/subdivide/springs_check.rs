@@ -1,0 +1,332 @@
+//! The laws of the subdivided spring network ([`LeveledMechanics::check`]), recomputed from the map
+//! and the rest positions; only the roots (the springs as they were when first split) and the level-0
+//! tets are trusted.
+//!
+//! 1. the coupling followed every vertex insertion of the map, and has a state for every vertex;
+//! 2. every edge of the finest map has exactly one spring and every spring is an edge of the finest
+//!    map (so its ends are vertices of the finest level); no two edges join the same vertices;
+//! 3. L_s = |P_a − P_b| on the rest positions;
+//! 4. series: along every root (a, b), the chain of finest springs has Σ 1/k_i = 1/k_root,
+//!    Σ 1/c_i = 1/c_root and Σ L_i = L_root;
+//! 5. every spring that is not a half of a split: k = Σ_{t ∋ e} E V_t / L_e² over the level-0 tets
+//!    and the finest tets of level μt ≥ 1 that have e among their six corner edges, and c = β k;
+//! 6. Σ_t m_t equals its value when the coupling was built, and every vertex mass gathered from the
+//!    volumes around the vertex (m_v = Σ m_t / n_t) equals the scatter of
+//!    [`LeveledMechanics::vertex_masses`], so Σ_v m_v = Σ_t m_t.
+//!
+//! Every comparison is to a relative 1e-12 ([`TOLERANCE`]).
+
+use std::collections::{BTreeMap, BTreeSet};
+
+use super::springs::{key, volume_vertices};
+use super::{LeveledMap, LeveledMechanics};
+use crate::gmap::AlphaMask;
+use crate::mechanics::geom::{norm, sub};
+use crate::mechanics::model::stiffness_contribution;
+
+/// Relative tolerance of every comparison of [`LeveledMechanics::check`].
+const TOLERANCE: f64 = 1e-12;
+
+/// A law of the subdivided spring network that does not hold, naming the edge (vertex ids a < b)
+/// or the vertex.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::subdivide::SpringLawError;
+/// let e = SpringLawError::Series { a: 0, b: 1, compliance: 0.2, expected: 0.1 };
+/// assert!(e.to_string().contains("(0, 1)"));
+/// ```
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SpringLawError {
+    /// The map inserted vertices the coupling did not follow.
+    #[error("the coupling followed {applied} vertex insertions, the map logged {logged}")]
+    OutOfSync {
+        /// Followed.
+        applied: usize,
+        /// Logged by the map.
+        logged: usize,
+    },
+    /// Position or velocity arrays shorter than the vertex ids.
+    #[error("the vertex state covers {states} vertex ids, the map has {vertices}")]
+    MissingState {
+        /// Vertex id bound of the map.
+        vertices: usize,
+        /// Entries of the shortest state array.
+        states: usize,
+    },
+    /// Two edges of the finest map join the same two vertices.
+    #[error("two edges join vertices ({a}, {b})")]
+    DuplicateEdge {
+        /// Smaller vertex id.
+        a: u32,
+        /// Larger vertex id.
+        b: u32,
+    },
+    /// An edge of the finest map has no spring.
+    #[error("edge ({a}, {b}) has no spring")]
+    MissingSpring {
+        /// Smaller vertex id.
+        a: u32,
+        /// Larger vertex id.
+        b: u32,
+    },
+    /// A spring joins two vertices that no edge of the finest map joins.
+    #[error("spring ({a}, {b}) is not an edge of the finest level")]
+    StraySpring {
+        /// Smaller vertex id.
+        a: u32,
+        /// Larger vertex id.
+        b: u32,
+    },
+    /// The rest length differs from the distance of the rest positions.
+    #[error("spring ({a}, {b}) has rest length {stored}, its ends are {measured} apart at rest")]
+    RestLength {
+        /// Smaller vertex id.
+        a: u32,
+        /// Larger vertex id.
+        b: u32,
+        /// Stored L.
+        stored: f64,
+        /// Measured distance.
+        measured: f64,
+    },
+    /// The chain along a split edge breaks the series rule (stiffness, damping or length).
+    #[error("the chain along ({a}, {b}) has compliance {compliance}, the split spring {expected}")]
+    Series {
+        /// Smaller vertex id.
+        a: u32,
+        /// Larger vertex id.
+        b: u32,
+        /// Σ 1/k_i (or Σ 1/c_i, or Σ L_i) of the chain.
+        compliance: f64,
+        /// 1/k (or 1/c, or L) of the root.
+        expected: f64,
+    },
+    /// A spring that is not a half has k ≠ the sum of its tets' contributions.
+    #[error("spring ({a}, {b}) has stiffness {stored}, its tets give {expected}")]
+    Stiffness {
+        /// Smaller vertex id.
+        a: u32,
+        /// Larger vertex id.
+        b: u32,
+        /// Stored k.
+        stored: f64,
+        /// Σ E V_t / L².
+        expected: f64,
+    },
+    /// A spring that is not a half has c ≠ β k.
+    #[error("spring ({a}, {b}) has damping {stored}, β k = {expected}")]
+    Damping {
+        /// Smaller vertex id.
+        a: u32,
+        /// Larger vertex id.
+        b: u32,
+        /// Stored c.
+        stored: f64,
+        /// β k.
+        expected: f64,
+    },
+    /// Σ m_t changed.
+    #[error("the tets weigh {after} in total, {before} when the coupling was built")]
+    TotalMass {
+        /// Σ m_t at construction.
+        before: f64,
+        /// Σ m_t now.
+        after: f64,
+    },
+    /// A vertex mass gathered around the vertex differs from the scatter.
+    #[error("vertex {vertex}: mass {scattered} scattered from the tets, {gathered} gathered around it")]
+    VertexMass {
+        /// The vertex id.
+        vertex: u32,
+        /// From [`LeveledMechanics::vertex_masses`].
+        scattered: f64,
+        /// Σ m_t / n_t over the volumes around it.
+        gathered: f64,
+    },
+}
+
+/// a = b, or both finite with |a − b| ≤ TOLERANCE · max(|a|, |b|).
+fn close(a: f64, b: f64) -> bool {
+    a == b || (a.is_finite() && b.is_finite() && (a - b).abs() <= TOLERANCE * a.abs().max(b.abs()))
+}
+
+/// The series sum of a chain and the root's value: (Σ 1/x_i, 1/root) for a positive root, else
+/// (Σ x_i, 0) (a zero spring splits into zero halves).
+fn series(values: impl Iterator<Item = f64>, root: f64) -> (f64, f64) {
+    if root > 0.0 {
+        (values.map(|x| 1.0 / x).sum(), 1.0 / root)
+    } else {
+        (values.sum(), 0.0)
+    }
+}
+
+impl LeveledMechanics {
+    /// Checks every law of the module docs of `springs_check` against `m` (the map this coupling
+    /// follows). O(darts · volume + E log E).
+    ///
+    /// Errors: the first [`SpringLawError`] found, naming the edge or vertex.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::Material;
+    /// use topomech::subdivide::{LeveledMap, LeveledMechanics, SpringLawError};
+    /// use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mut m = LeveledMap::new(map, pts);
+    /// let mut mech = LeveledMechanics::new(&m, Material::default()).unwrap();
+    /// let d = m.map().darts().next().unwrap();
+    /// mech.subdivide_tet(&mut m, d, 1).unwrap();
+    /// assert!(mech.check(&m).is_ok());
+    /// let (e, _) = mech.springs().find(|&((a, b), _)| a < 4 && b >= 4).unwrap(); // a half
+    /// mech.spring_mut(e.0, e.1).unwrap().stiffness *= 2.0;
+    /// assert!(matches!(mech.check(&m), Err(SpringLawError::Series { .. })));
+    /// ```
+    pub fn check(&self, m: &LeveledMap<3>) -> Result<(), SpringLawError> {
+        self.check_state(m)?;
+        self.check_edges(m)?;
+        self.check_series()?;
+        self.check_tet_law(m)?;
+        self.check_masses(m)
+    }
+
+    /// Law 1.
+    fn check_state(&self, m: &LeveledMap<3>) -> Result<(), SpringLawError> {
+        let logged = m.split_log().len();
+        if logged != self.applied {
+            return Err(SpringLawError::OutOfSync { applied: self.applied, logged });
+        }
+        let (vertices, states) = (m.map().cell_id_bound(0), self.position.len().min(self.velocity.len()));
+        if states < vertices || m.points().len() < vertices {
+            return Err(SpringLawError::MissingState { vertices, states: states.min(m.points().len()) });
+        }
+        Ok(())
+    }
+
+    /// Laws 2 and 3.
+    fn check_edges(&self, m: &LeveledMap<3>) -> Result<(), SpringLawError> {
+        let map = m.map();
+        let mut edges = BTreeSet::new();
+        for d in map.one_dart_per_cell(1) {
+            let (a, b) = key(map.vertex_id(d).0, map.vertex_id(map.alpha_dyn(0, d)).0);
+            if !edges.insert((a, b)) {
+                return Err(SpringLawError::DuplicateEdge { a, b });
+            }
+            let s = self.springs.get(&(a, b)).ok_or(SpringLawError::MissingSpring { a, b })?;
+            let measured = norm(sub(m.points()[b as usize], m.points()[a as usize]));
+            if !close(s.rest, measured) {
+                return Err(SpringLawError::RestLength { a, b, stored: s.rest, measured });
+            }
+        }
+        match self.springs.keys().find(|e| !edges.contains(e)) {
+            Some(&(a, b)) => Err(SpringLawError::StraySpring { a, b }),
+            None => Ok(()),
+        }
+    }
+
+    /// Law 4 alone (the series rule along every split spring), without the map. O(E log E).
+    ///
+    /// Errors: [`SpringLawError::MissingSpring`] (a link of a chain has no spring) or
+    /// [`SpringLawError::Series`], naming the root edge.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::Material;
+    /// use topomech::subdivide::{LeveledMap, LeveledMechanics, SpringLawError};
+    /// use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mut m = LeveledMap::new(map, pts);
+    /// let mut mech = LeveledMechanics::new(&m, Material::default()).unwrap();
+    /// let d = m.map().darts().find(|&d| m.map().vertex_id(d).0 == 0 && m.map().vertex_id(m.map().alpha_dyn(0, d)).0 == 1).unwrap();
+    /// mech.split_edge(&mut m, d, 1).unwrap();
+    /// assert!(mech.check_series().is_ok());
+    /// mech.spring_mut(0, 4).unwrap().rest *= 1.1;
+    /// assert!(matches!(mech.check_series(), Err(SpringLawError::Series { a: 0, b: 1, .. })));
+    /// ```
+    pub fn check_series(&self) -> Result<(), SpringLawError> {
+        for (&(a, b), root) in &self.roots {
+            let chain: Vec<_> = self.chain(a, b).into_iter().map(|(p, q)| self.springs.get(&key(p, q))).collect();
+            let chain: Vec<_> = match chain.into_iter().collect::<Option<Vec<_>>>() {
+                Some(c) => c,
+                None => return Err(SpringLawError::MissingSpring { a, b }),
+            };
+            let laws = [
+                series(chain.iter().map(|s| s.stiffness), root.stiffness),
+                series(chain.iter().map(|s| s.damping), root.damping),
+                (chain.iter().map(|s| s.rest).sum(), root.rest),
+            ];
+            for (compliance, expected) in laws {
+                if !close(compliance, expected) {
+                    return Err(SpringLawError::Series { a, b, compliance, expected });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Law 5.
+    fn check_tet_law(&self, m: &LeveledMap<3>) -> Result<(), SpringLawError> {
+        let mut expected: BTreeMap<(u32, u32), f64> = BTreeMap::new();
+        let mut add = |t: [u32; 4]| {
+            let p = t.map(|v| m.points()[v as usize]);
+            let volume = crate::mesh::signed_volume(p[0], p[1], p[2], p[3]);
+            for (i, j) in [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)] {
+                let k = stiffness_contribution(self.material.young, volume, norm(sub(p[j], p[i])));
+                *expected.entry(key(t[i], t[j])).or_insert(0.0) += k;
+            }
+        };
+        self.tets0.iter().for_each(|&t| add(t));
+        for d in m.map().one_dart_per_cell(3) {
+            if m.mu(d).tet >= 1 {
+                // Checked by the map's own laws; a volume that is not a tet contributes nothing.
+                if let Ok(t) = m.tet_vertices(d) {
+                    add(t);
+                }
+            }
+        }
+        for (&(a, b), s) in self.springs.iter().filter(|(e, _)| !self.halves.contains(e)) {
+            let k = expected.get(&(a, b)).copied().unwrap_or(0.0);
+            if !close(s.stiffness, k) {
+                return Err(SpringLawError::Stiffness { a, b, stored: s.stiffness, expected: k });
+            }
+            let c = self.material.damping * s.stiffness;
+            if !close(s.damping, c) {
+                return Err(SpringLawError::Damping { a, b, stored: s.damping, expected: c });
+            }
+        }
+        Ok(())
+    }
+
+    /// Law 6.
+    fn check_masses(&self, m: &LeveledMap<3>) -> Result<(), SpringLawError> {
+        let map = m.map();
+        let after = self.masses.total(m);
+        if !close(after, self.total_mass) {
+            return Err(SpringLawError::TotalMass { before: self.total_mass, after });
+        }
+        let scattered = self.vertex_masses(m);
+        for d in map.one_dart_per_cell(0) {
+            let mut volumes: Vec<_> =
+                map.orbit(d, AlphaMask::cell(3, 0)).iter().map(|&x| (map.cell_id(3, x), x)).collect();
+            volumes.sort_unstable_by_key(|&(id, _)| id);
+            volumes.dedup_by_key(|&mut (id, _)| id);
+            let gathered: f64 = volumes
+                .iter()
+                .map(|&(id, x)| {
+                    self.masses.mass.get(id.index()).copied().unwrap_or(0.0) / volume_vertices(m, x).len() as f64
+                })
+                .sum();
+            let vertex = map.vertex_id(d).0;
+            let s = scattered[vertex as usize];
+            if !close(s, gathered) {
+                return Err(SpringLawError::VertexMass { vertex, scattered: s, gathered });
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,7 +1,7 @@
 //! Global characteristics: cell counts, components, boundary, Euler characteristic,
 //! orientability.
 
-use super::orbit::{generators, union_smaller_root};
+use super::orbit::{generators, join_with_smaller};
 use super::{AlphaMask, DartId, DartSet, GMap};
 
 /// Number of i-cells for each i in 0..=n.
@@ -106,22 +106,60 @@ impl<const N: usize> GMap<N> {
     /// assert_eq!(map.count_cells_by_traversal(), map.count_cells()); // ids and orbits agree
     /// ```
     pub fn count_cells_by_traversal(&self) -> CellCounts {
-        let gens: Vec<([usize; 8], usize)> = (0..=N).map(|i| generators(N, AlphaMask::cell(N, i))).collect();
-        let mut forests: Vec<Vec<u32>> = (0..=N).map(|_| (0..self.capacity() as u32).collect()).collect();
-        let mut joins = vec![0usize; N + 1];
+        self.count_orbits_in_one_sweep(false, |_, _| {}).0
+    }
+
+    /// Number of i-cells for every i and number of connected components, found by walking
+    /// orbits (independent of cell ids) in one sweep: what CGAL's `count_all_cells` computes.
+    /// O(darts · n² · α(darts)).
+    ///
+    /// Same sweep as [`Self::count_cells_by_traversal`] with one more union-find forest, over
+    /// all n + 1 involutions, for the components.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let (map, _) = GMap::<3>::from_tets(8, &[[0, 1, 2, 3], [4, 5, 6, 7]]).unwrap();
+    /// let (cells, components) = map.count_all_cells_by_traversal();
+    /// assert_eq!(cells.0, vec![8, 12, 8, 2]);
+    /// assert_eq!(components, 2);
+    /// assert_eq!((cells, components), (map.count_cells_by_traversal(), map.components().len()));
+    /// ```
+    pub fn count_all_cells_by_traversal(&self) -> (CellCounts, usize) {
+        let (cells, components) = self.count_orbits_in_one_sweep(true, |_, _| {});
+        (cells, components.unwrap_or(0))
+    }
+
+    /// The sweep behind the two counts above: n + 1 forests (one per cell dimension), plus one
+    /// over every involution if `components`. Each dart's row is read once; a dart joins the
+    /// trees of its neighbours below it with [`join_with_smaller`]. `unjoined(dim, d)` is called
+    /// for each dart d that joined no tree of forest dim: these darts include the smallest dart
+    /// of every orbit (a dart that joins becomes a child), so they meet every orbit.
+    pub(crate) fn count_orbits_in_one_sweep(
+        &self,
+        components: bool,
+        mut unjoined: impl FnMut(usize, u32),
+    ) -> (CellCounts, Option<usize>) {
+        let mut gens: Vec<([usize; 8], usize)> = (0..=N).map(|i| generators(N, AlphaMask::cell(N, i))).collect();
+        if components {
+            gens.push(generators(N, AlphaMask::all(N)));
+        }
+        let mut forests: Vec<Vec<u32>> = gens.iter().map(|_| (0..self.capacity() as u32).collect()).collect();
+        let mut joins = vec![0usize; gens.len()];
         self.for_each_live(|d| {
             let row = self.alpha_row(d);
-            for (dim, forest) in forests.iter_mut().enumerate() {
-                let (g, len) = &gens[dim];
-                for &j in &g[..*len] {
-                    let y = row[j];
-                    if y < d {
-                        joins[dim] += union_smaller_root(forest, d, y) as usize;
-                    }
+            for (dim, ((forest, (g, len)), joins)) in forests.iter_mut().zip(&gens).zip(joins.iter_mut()).enumerate() {
+                let joined = join_with_smaller(forest, d, row, &g[..*len]);
+                if joined == 0 {
+                    unjoined(dim, d);
                 }
+                *joins += joined;
             }
         });
-        CellCounts(joins.iter().map(|&j| self.dart_count() - j).collect())
+        let counts: Vec<usize> = joins.iter().map(|&j| self.dart_count() - j).collect();
+        (CellCounts(counts[..=N].to_vec()), counts.get(N + 1).copied())
     }
 
     /// Number of distinct orbits ⟨mask⟩ over all live darts. O(darts · n).

@@ -6,15 +6,19 @@
 //! edge, found by matching sorted vertex pairs.
 //!
 //! Cell ids: volume id = tet index, face ids in order of first appearance, edge ids in order of
-//! a flood fill. The vertex id of a g-map vertex is the index of its input point, so arrays of
+//! a flood fill over the darts in increasing order (so, scanning darts in increasing order, new
+//! face and edge ids appear as 0, 1, 2, …). The vertex id of a g-map vertex is the index of its input point, so arrays of
 //! points index vertex embeddings directly. Where the input is not a manifold at a point (the
 //! tets around it form several fans joined only at the point) or along an edge, the g-map has
 //! several vertices or edges there: the first keeps the point's index, the others get fresh ids,
 //! and [`BuildReport`] lists them. Unreferenced points leave free vertex ids.
 //!
-//! Cost: O(tets + points) for tetrahedra (faces matched by a counting sort on their smallest
-//! point; edges and vertices labelled by floods over the 6 edges and 4 corners of each tet rather
-//! than over its 24 darts); O(triangles) expected for triangles (one hash-map look-up per edge).
+//! Cost: O(tets · α(tets) + points) for tetrahedra: faces matched by a counting sort on their
+//! smallest point, which also records where each corner of a face lands in the neighbouring tet;
+//! edges and vertices labelled by a union-find over the 6 edges and 4 corners of each tet (not
+//! over its 24 darts) that reads only the face matching, never the neighbour's points; every
+//! dart's α row and cell row written once, in order. O(triangles) expected for triangles (one
+//! hash-map look-up per edge).
 
 use rustc_hash::FxHashMap;
 

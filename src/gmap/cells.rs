@@ -106,7 +106,8 @@ impl<const N: usize> GMap<N> {
     /// assert_eq!(map.count_cells_by_traversal(), map.count_cells()); // ids and orbits agree
     /// ```
     pub fn count_cells_by_traversal(&self) -> CellCounts {
-        self.count_orbits_in_one_sweep(false, |_, _| {}).0
+        let masks: Vec<AlphaMask> = (0..=N).map(|i| AlphaMask::cell(N, i)).collect();
+        CellCounts(self.count_orbits_in_one_sweep(&masks))
     }
 
     /// Number of i-cells for every i and number of connected components, found by walking
@@ -128,38 +129,27 @@ impl<const N: usize> GMap<N> {
     /// assert_eq!((cells, components), (map.count_cells_by_traversal(), map.components().len()));
     /// ```
     pub fn count_all_cells_by_traversal(&self) -> (CellCounts, usize) {
-        let (cells, components) = self.count_orbits_in_one_sweep(true, |_, _| {});
-        (cells, components.unwrap_or(0))
+        let mut masks: Vec<AlphaMask> = (0..=N).map(|i| AlphaMask::cell(N, i)).collect();
+        masks.push(AlphaMask::all(N));
+        let mut counts = self.count_orbits_in_one_sweep(&masks);
+        let components = counts.pop().unwrap_or(0);
+        (CellCounts(counts), components)
     }
 
-    /// The sweep behind the two counts above: n + 1 forests (one per cell dimension), plus one
-    /// over every involution if `components`. Each dart's row is read once; a dart joins the
-    /// trees of its neighbours below it with [`join_with_smaller`]. `unjoined(dim, d)` is called
-    /// for each dart d that joined no tree of forest dim: these darts include the smallest dart
-    /// of every orbit (a dart that joins becomes a child), so they meet every orbit.
-    pub(crate) fn count_orbits_in_one_sweep(
-        &self,
-        components: bool,
-        mut unjoined: impl FnMut(usize, u32),
-    ) -> (CellCounts, Option<usize>) {
-        let mut gens: Vec<([usize; 8], usize)> = (0..=N).map(|i| generators(N, AlphaMask::cell(N, i))).collect();
-        if components {
-            gens.push(generators(N, AlphaMask::all(N)));
-        }
+    /// The number of orbits of each mask, from one sweep with one union-find forest per mask:
+    /// each dart's row is read once, and a dart joins the trees of its neighbours below it with
+    /// [`join_with_smaller`]. O(darts · Σ|mask| · α(darts)).
+    pub(crate) fn count_orbits_in_one_sweep(&self, masks: &[AlphaMask]) -> Vec<usize> {
+        let gens: Vec<([usize; 8], usize)> = masks.iter().map(|&mask| generators(N, mask)).collect();
         let mut forests: Vec<Vec<u32>> = gens.iter().map(|_| (0..self.capacity() as u32).collect()).collect();
         let mut joins = vec![0usize; gens.len()];
         self.for_each_live(|d| {
             let row = self.alpha_row(d);
-            for (dim, ((forest, (g, len)), joins)) in forests.iter_mut().zip(&gens).zip(joins.iter_mut()).enumerate() {
-                let joined = join_with_smaller(forest, d, row, &g[..*len]);
-                if joined == 0 {
-                    unjoined(dim, d);
-                }
-                *joins += joined;
+            for ((forest, (g, len)), joins) in forests.iter_mut().zip(&gens).zip(joins.iter_mut()) {
+                *joins += join_with_smaller(forest, d, row, &g[..*len]);
             }
         });
-        let counts: Vec<usize> = joins.iter().map(|&j| self.dart_count() - j).collect();
-        (CellCounts(counts[..=N].to_vec()), counts.get(N + 1).copied())
+        joins.iter().map(|&j| self.dart_count() - j).collect()
     }
 
     /// Number of distinct orbits ⟨mask⟩ over all live darts. O(darts · n).

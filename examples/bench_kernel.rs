@@ -137,7 +137,8 @@ fn main() {
     let build = median_timing(reps, || measure(|| (), |()| GMap::<3>::from_tets(points.len(), &tets)));
     let validate = median_timing(reps, || measure(|| (), |()| map.validate()));
     let by_traversal = median_timing(reps, || measure(|| (), |()| map.count_cells_by_traversal()));
-    let count_all =
+    let count_all = median_timing(reps, || measure(|| (), |()| map.count_all_cells_by_traversal()));
+    let count_all_separate =
         median_timing(reps, || measure(|| (), |()| (map.count_cells_by_traversal(), map.components().len())));
     let count_o1 = median_timing(reps, || measure(|| (), |()| map.count_cells()));
     let vertex_darts = map.one_dart_per_cell(0);
@@ -162,6 +163,7 @@ fn main() {
     row("validate", validate);
     row("count_cells_by_traversal", by_traversal);
     row("count_all (+ components)", count_all);
+    row("count_by_trav + components()", count_all_separate);
     println!("  count_cells (O(1))           {:>9.1} ns per call wall", 1e9 * count_o1.wall);
     row("orbit (every vertex)", orbit);
     for (i, t) in per_dim.iter().enumerate() {
@@ -181,6 +183,7 @@ fn main() {
         "build_ns_per_dart": ns(build), "validate_ns_per_dart": ns(validate),
         "count_by_traversal_ns_per_dart": ns(by_traversal), "count_o1_ns": 1e9 * count_o1.wall,
         "count_all_ns_per_dart": ns(count_all),
+        "count_all_separate_ns_per_dart": ns(count_all_separate),
         "orbit_ns_per_dart": ns(orbit),
         "one_dart_per_cell_ns_per_dart": per_dim.iter().map(|&t| ns(t)).collect::<Vec<_>>(),
         "unsew_ns_per_op": per_op(unsew), "sew_ns_per_op": per_op(sew), "cut_faces": cut.len(),

@@ -65,6 +65,9 @@ for key in cgal:
     c, t = cgal[key], ours[key]
     print(f"{key:<28}{c:>12.1f}{t:>12.1f}{c / t:>15.2f}")
 print(f"{'count_by_traversal (4 dims)':<28}{'':>12}{tm('count_by_traversal_ns_per_dart'):>12.1f}")
+if all("count_all_separate_ns_per_dart" in r for r in runs):
+    sep = tm("count_all_separate_ns_per_dart")
+    print(f"{'count 4 dims + components()':<28}{cgal['count_all_cells']:>12.1f}{sep:>12.1f}{cgal['count_all_cells'] / sep:>15.2f}")
 print(f"{'count_cells O(1) (ns, wall)':<28}{'':>12}{tm('count_o1_ns'):>12.1f}")
 print(f"{'orbit, every vertex':<28}{'':>12}{tm('orbit_ns_per_dart'):>12.1f}")
 print(f"{'sew<3> back (ns/op)':<28}{'':>12}{tm('sew_ns_per_op'):>12.1f}")

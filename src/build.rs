@@ -6,19 +6,23 @@
 //! edge, found by matching sorted vertex pairs.
 //!
 //! Cell ids: volume id = tet index, face ids in order of first appearance, edge ids in order of
-//! a flood fill. The vertex id of a g-map vertex is the index of its input point, so arrays of
+//! a flood fill over the darts in increasing order (so, scanning darts in increasing order, new
+//! face and edge ids appear as 0, 1, 2, …). The vertex id of a g-map vertex is the index of its input point, so arrays of
 //! points index vertex embeddings directly. Where the input is not a manifold at a point (the
 //! tets around it form several fans joined only at the point) or along an edge, the g-map has
 //! several vertices or edges there: the first keeps the point's index, the others get fresh ids,
 //! and [`BuildReport`] lists them. Unreferenced points leave free vertex ids.
 //!
-//! Cost: O(tets + points) for tetrahedra (faces matched by a counting sort on their smallest
-//! point; edges and vertices labelled by floods over the 6 edges and 4 corners of each tet rather
-//! than over its 24 darts); O(triangles) expected for triangles (one hash-map look-up per edge).
+//! Cost: O(tets · α(tets) + points) for tetrahedra: faces matched by a counting sort on their
+//! smallest point, which also records where each corner of a face lands in the neighbouring tet;
+//! edges and vertices labelled by a union-find over the 6 edges and 4 corners of each tet (not
+//! over its 24 darts) that reads only the face matching, never the neighbour's points; every
+//! dart's α row and cell row written once, in order. O(triangles) expected for triangles (one
+//! hash-map look-up per edge).
 
 use rustc_hash::FxHashMap;
 
-use crate::gmap::{AlphaMask, DartId, GMap};
+use crate::gmap::{find_root, join_with_smaller, AlphaMask, DartId, GMap};
 
 /// Why a mesh could not be turned into a map. Nothing is built when one is returned.
 ///
@@ -195,85 +199,44 @@ impl GMap<3> {
         check_elements(points, tets)?;
         let darts = tets.len().checked_mul(24).filter(|&n| n < u32::MAX as usize - 1);
         let darts = darts.ok_or(BuildError::TooLarge(tets.len().saturating_mul(24)))?;
-        let partner = match_tet_faces(points, tets)?;
-        let mut map = GMap::<3>::new();
-        map.alloc_darts_raw(darts);
+        let faces = match_tet_faces(points, tets)?;
+        let (face_of, face_count) = number_tet_faces(&faces.partner);
+        let (edge_of, edges) = label_tet_edges(&faces);
+        let (corner_of, vertex_ids, orbits_of) = label_tet_corners(points, tets, &faces);
+        let mut alpha = Vec::with_capacity(darts * 4);
+        let mut cell = Vec::with_capacity(darts * 4);
         for t in 0..tets.len() {
-            map.link_tet_template(t);
-        }
-        let faces = map.link_tet_faces(tets, &partner);
-        map.set_id_alloc_raw(2, faces, Vec::new());
-        map.set_id_alloc_raw(3, tets.len() as u32, Vec::new());
-        let (edge_of, edges) = label_tet_edges(tets, &partner);
-        let (corner_of, vertex_ids, orbits_of) = label_tet_corners(points, tets, &partner);
-        for t in 0..tets.len() {
-            for (k, (&v, &e)) in TET.vertex.iter().zip(&TET_DART_EDGE).enumerate() {
-                let d = DartId((t * 24 + k) as u32);
-                map.set_cell_raw(0, d, corner_of[t * 4 + v as usize]);
-                map.set_cell_raw(1, d, edge_of[t * 6 + e as usize]);
+            let base = (t * 24) as u32;
+            for f in 0..4 {
+                let tf = t * 4 + f;
+                let alpha3 = faces.alpha3(tf);
+                for (j, &a3) in alpha3.iter().enumerate() {
+                    let k = f * 6 + j;
+                    let [a0, a1, a2] = TET_LINKS[k];
+                    alpha.extend_from_slice(&[base + a0, base + a1, base + a2, a3]);
+                    let v = corner_of[t * 4 + TET.vertex[k] as usize];
+                    let e = edge_of[t * 6 + TET_DART_EDGE[k] as usize];
+                    cell.extend_from_slice(&[v, e, face_of[tf], t as u32]);
+                }
             }
         }
+        let mut map = GMap::<3>::from_rows_raw(alpha, cell);
         map.set_id_alloc_raw(1, edges, Vec::new());
+        map.set_id_alloc_raw(2, face_count, Vec::new());
+        map.set_id_alloc_raw(3, tets.len() as u32, Vec::new());
         let mut report = vertex_report(&orbits_of);
         map.set_id_alloc_raw(0, vertex_ids, report.unreferenced_points.clone());
         report.split_edges = split_edges(edge_points(tets, &edge_of, edges));
         map.after_build();
         Ok((map, report))
     }
-
-    /// α0, α1, α2 and the volume id of the 24 darts of tet t.
-    fn link_tet_template(&mut self, t: usize) {
-        let base = t * 24;
-        for f in 0..4 {
-            for k in 0..6 {
-                let d = DartId((base + f * 6 + k) as u32);
-                self.link_raw(0, d, DartId((base + f * 6 + FLAG_ALPHA0[k]) as u32));
-                self.link_raw(1, d, DartId((base + f * 6 + FLAG_ALPHA1[k]) as u32));
-                self.link_raw(2, d, DartId((base + TET.alpha2[f * 6 + k] as usize) as u32));
-                self.set_cell_raw(3, d, t as u32);
-            }
-        }
-    }
-
-    /// 3-links the tet faces paired in `partner` and labels faces in order of first appearance;
-    /// returns the number of faces. O(tets).
-    fn link_tet_faces(&mut self, tets: &[[u32; 4]], partner: &[u32]) -> u32 {
-        let mut faces = 0u32;
-        for (tf, &other) in partner.iter().enumerate() {
-            let tf = tf as u32;
-            if other == NO_FACE || other > tf {
-                self.label_face(tf, faces);
-                faces += 1;
-            } else {
-                self.sew_tet_faces(tets, other, tf);
-            }
-        }
-        faces
-    }
-
-    fn label_face(&mut self, tf: u32, id: u32) {
-        for k in 0..6 {
-            self.set_cell_raw(2, DartId(tf * 6 + k), id);
-        }
-    }
-
-    /// α3-links face `a` (= 4·tet + local face) with face `b` dart by dart, matching each dart's
-    /// (point, other point of its edge), and gives b the face id of a.
-    fn sew_tet_faces(&mut self, tets: &[[u32; 4]], a: u32, b: u32) {
-        let face_points = |tf: u32| face_corners(tf as usize % 4).map(|k| tets[tf as usize / 4][k]);
-        let (pa, pb) = (face_points(a), face_points(b));
-        let perm = pa.map(|p| pb.iter().position(|&q| q == p).expect("faces with equal point sets"));
-        let id = self.cell_id(2, DartId(a * 6)).0;
-        for k in 0..6 {
-            let kb = FLAG_OF[perm[FLAG_VERTEX[k]]][perm[FLAG_OTHER[k]]] as u32;
-            self.link_raw(3, DartId(a * 6 + k as u32), DartId(b * 6 + kb));
-            self.set_cell_raw(2, DartId(b * 6 + kb), id);
-        }
-    }
 }
 
 /// Marks a tet face with no partner (a boundary face).
 const NO_FACE: u32 = u32::MAX;
+
+/// Marks "no related item" in the lists of `label_orbits`.
+const NONE_ITEM: u32 = u32::MAX;
 
 /// The flag k of a face with (vertex, other end of its edge) = (local corners v, o): the inverse
 /// of (FLAG_VERTEX, FLAG_OTHER). The diagonal is unused.
@@ -305,6 +268,18 @@ const TET_DART_EDGE: [u8; 24] = {
     e
 };
 
+/// α0, α1 and α2 of each of the 24 darts of a tet, as offsets from the tet's first dart.
+const TET_LINKS: [[u32; 3]; 24] = {
+    let mut links = [[0u32; 3]; 24];
+    let mut k = 0;
+    while k < 24 {
+        let (f, j) = (k / 6, k % 6);
+        links[k] = [(f * 6 + FLAG_ALPHA0[j]) as u32, (f * 6 + FLAG_ALPHA1[j]) as u32, TET.alpha2[k] as u32];
+        k += 1;
+    }
+    links
+};
+
 /// The `count` local items (corners or edges) of a tet sorted by the smallest dart that carries
 /// them, given the item of each dart: labelling items in this order within each tet, tets in
 /// order, gives the ids a flood over darts in increasing order would give.
@@ -318,38 +293,86 @@ fn items_by_first_dart(count: usize, item_of_dart: impl Fn(usize) -> usize) -> V
     items
 }
 
-/// The position of point p among the corners of tet (p must be one of them).
-#[inline]
-fn corner_of_point(tet: &[u32; 4], p: u32) -> usize {
-    tet.iter().position(|&q| q == p).expect("neighbouring tets share the face's points")
+/// The matched faces of a tet mesh: for every tet face 4t + f, the tet face with the same three
+/// points (`NO_FACE` on the boundary), and where each local corner of t lands in the partner's
+/// tet. With the corner map, sewing and labelling never read the partner tet's points.
+struct FaceMatch {
+    /// The partner tet face of every tet face, or `NO_FACE`.
+    partner: Vec<u32>,
+    /// Two bits per local corner v ≠ f of tet t: the local corner of the partner's tet that
+    /// carries the same point (0 for boundary faces and for v = f).
+    corner_map: Vec<u8>,
 }
 
-/// For every tet face 4t + f, the other tet face with the same three points, or `NO_FACE`.
-/// Faces are bucketed by their smallest point (a counting sort) and sorted within each bucket,
-/// so no hashing is needed. O(tets + points).
+impl FaceMatch {
+    /// The tet face partnered with tet face tf and, for local corner v of tf's tet, the local
+    /// corner of the partner's tet with the same point; `None` on the boundary.
+    #[inline(always)]
+    fn across(&self, tf: usize) -> Option<(u32, u8)> {
+        let g = self.partner[tf];
+        (g != NO_FACE).then(|| (g, self.corner_map[tf]))
+    }
+
+    /// α3 of the six darts 6·tf + j of tet face tf: themselves on the boundary, else the dart of
+    /// the partner face with the same (point, other point of its edge).
+    #[inline(always)]
+    fn alpha3(&self, tf: usize) -> [u32; 6] {
+        let own = (tf * 6) as u32;
+        let Some((g, map)) = self.across(tf) else {
+            return std::array::from_fn(|j| own + j as u32);
+        };
+        let corners = face_corners(tf % 4);
+        let fg = g as usize % 4;
+        // Position of the partner's local corner w among the corners of its face fg.
+        let position = |v: usize| {
+            let w = corner_across(map, v);
+            w - usize::from(w > fg)
+        };
+        std::array::from_fn(|j| {
+            let kb = FLAG_OF[position(corners[FLAG_VERTEX[j]])][position(corners[FLAG_OTHER[j]])];
+            g * 6 + u32::from(kb)
+        })
+    }
+}
+
+/// The partner tet's local corner of local corner v, from a face's corner map.
+#[inline(always)]
+fn corner_across(map: u8, v: usize) -> usize {
+    usize::from(map >> (2 * v)) & 3
+}
+
+/// For every tet face 4t + f, the other tet face with the same three points (`NO_FACE` if none)
+/// and the corner map between the two tets. Faces are bucketed by their smallest point (a
+/// counting sort) and sorted within each bucket, so no hashing is needed. O(tets + points).
 ///
 /// Errors: [`BuildError::NonManifold`] for the first face (in input order) seen a third time.
-fn match_tet_faces(points: usize, tets: &[[u32; 4]]) -> Result<Vec<u32>, BuildError> {
-    let key = |tet: &[u32; 4], f: usize| sorted(face_corners(f).map(|k| tet[k]));
+fn match_tet_faces(points: usize, tets: &[[u32; 4]]) -> Result<FaceMatch, BuildError> {
+    // The face's points in increasing order, and the local corners that carry them (2 bits each).
+    let key = |tet: &[u32; 4], f: usize| {
+        let mut pc = face_corners(f).map(|k| (tet[k], k as u8));
+        pc.sort_unstable();
+        (pc.map(|x| x.0), pc[0].1 | (pc[1].1 << 2) | (pc[2].1 << 4))
+    };
     let mut start = vec![0u32; points + 1];
     for tet in tets {
         for f in 0..4 {
-            start[key(tet, f)[0] as usize + 1] += 1;
+            start[face_corners(f).iter().map(|&k| tet[k]).min().expect("three corners") as usize + 1] += 1;
         }
     }
     for p in 0..points {
         start[p + 1] += start[p];
     }
     let mut fill = start.clone();
-    let mut bucket = vec![(0u64, 0u32); tets.len() * 4];
+    let mut bucket = vec![(0u64, 0u32, 0u8); tets.len() * 4];
     for (t, tet) in tets.iter().enumerate() {
         for f in 0..4 {
-            let [a, b, c] = key(tet, f);
-            bucket[fill[a as usize] as usize] = ((u64::from(b) << 32) | u64::from(c), (t * 4 + f) as u32);
+            let ([a, b, c], corners) = key(tet, f);
+            bucket[fill[a as usize] as usize] = ((u64::from(b) << 32) | u64::from(c), (t * 4 + f) as u32, corners);
             fill[a as usize] += 1;
         }
     }
     let mut partner = vec![NO_FACE; tets.len() * 4];
+    let mut corner_map = vec![0u8; tets.len() * 4];
     // (third face, points, first face, second face) of the earliest face seen three times.
     let mut third: Option<(u32, [u32; 3], u32, u32)> = None;
     for a in 0..points {
@@ -358,11 +381,16 @@ fn match_tet_faces(points: usize, tets: &[[u32; 4]]) -> Result<Vec<u32>, BuildEr
         for run in faces.chunk_by(|x, y| x.0 == y.0) {
             match run {
                 [_] => {}
-                [(_, f1), (_, f2)] => {
+                [(_, f1, c1), (_, f2, c2)] => {
                     partner[*f1 as usize] = *f2;
                     partner[*f2 as usize] = *f1;
+                    for i in 0..3 {
+                        let (v1, v2) = ((c1 >> (2 * i)) & 3, (c2 >> (2 * i)) & 3);
+                        corner_map[*f1 as usize] |= v2 << (2 * v1);
+                        corner_map[*f2 as usize] |= v1 << (2 * v2);
+                    }
                 }
-                [(bc, f1), (_, f2), (_, f3), ..] => {
+                [(bc, f1, _), (_, f2, _), (_, f3, _), ..] => {
                     if third.is_none_or(|w| *f3 < w.0) {
                         third = Some((*f3, [a as u32, (bc >> 32) as u32, *bc as u32], *f1, *f2));
                     }
@@ -372,7 +400,7 @@ fn match_tet_faces(points: usize, tets: &[[u32; 4]]) -> Result<Vec<u32>, BuildEr
         }
     }
     match third {
-        None => Ok(partner),
+        None => Ok(FaceMatch { partner, corner_map }),
         Some((f3, points, f1, f2)) => Err(BuildError::NonManifold {
             what: "face",
             points: points.to_vec(),
@@ -381,80 +409,112 @@ fn match_tet_faces(points: usize, tets: &[[u32; 4]]) -> Result<Vec<u32>, BuildEr
     }
 }
 
-/// Edge ids of every (tet, local edge) pair, by a flood over tet edges joined through shared
-/// faces: the edge orbits ⟨α0, α2, α3⟩ of the built map, numbered as a flood over darts in
-/// increasing order would. Returns the ids (6 per tet) and the number of edges. O(tets).
-fn label_tet_edges(tets: &[[u32; 4]], partner: &[u32]) -> (Vec<u32>, u32) {
-    let order = items_by_first_dart(6, |k| TET_DART_EDGE[k] as usize);
-    let mut label = vec![u32::MAX; tets.len() * 6];
-    let mut stack = Vec::new();
-    let mut next = 0u32;
-    for t in 0..tets.len() {
-        for &e in &order {
-            if label[t * 6 + e] != u32::MAX {
-                continue;
-            }
-            label[t * 6 + e] = next;
-            stack.push(t * 6 + e);
-            while let Some(x) = stack.pop() {
-                let (tx, [u, w]) = (x / 6, TET_EDGES[x % 6]);
-                let (pu, pw) = (tets[tx][u], tets[tx][w]);
-                for f in (0..4).filter(|&f| f != u && f != w) {
-                    let other = partner[tx * 4 + f];
-                    if other == NO_FACE {
-                        continue;
-                    }
-                    let ty = other as usize / 4;
-                    let y = ty * 6 + tet_edge_index(corner_of_point(&tets[ty], pu), corner_of_point(&tets[ty], pw));
-                    if label[y] == u32::MAX {
-                        label[y] = next;
-                        stack.push(y);
-                    }
-                }
-            }
-            next += 1;
+/// Face ids of every tet face in order of first appearance (a matched pair shares the id of its
+/// first face), and the number of faces. O(tets).
+fn number_tet_faces(partner: &[u32]) -> (Vec<u32>, u32) {
+    let mut face_of = vec![0u32; partner.len()];
+    let mut faces = 0u32;
+    for (tf, &other) in partner.iter().enumerate() {
+        if other == NO_FACE || other as usize > tf {
+            face_of[tf] = faces;
+            faces += 1;
+        } else {
+            face_of[tf] = face_of[other as usize];
         }
     }
+    (face_of, faces)
+}
+
+/// Labels `per_tet` local items of every tet (edges or corners) by the orbits of a relation
+/// that joins items of tets sharing a face. `neighbours(t, item)` lists the related items of
+/// earlier tets (`NONE_ITEM` for none; each relation is met once, from its later tet).
+///
+/// A union-find forest over the items is built in one sweep, each item joining the trees of
+/// its related items below it (roots are the smallest item of their tree, so the root of an
+/// orbit is its item in its first tet); then items are visited
+/// tet by tet, in `order` within a tet, and `new_id(item)` names each orbit at its root. Since
+/// an orbit has at most one item per tet, this numbers orbits exactly as a flood started at each
+/// unlabelled item in that visiting order would. Returns the id of every item. O(items · α).
+fn label_orbits(
+    tets: usize,
+    per_tet: usize,
+    order: &[usize],
+    neighbours: impl Fn(usize, usize) -> [u32; 3],
+    mut new_id: impl FnMut(usize) -> u32,
+) -> Vec<u32> {
+    let mut forest: Vec<u32> = (0..(tets * per_tet) as u32).collect();
+    for t in 0..tets {
+        for item in 0..per_tet {
+            let x = (t * per_tet + item) as u32;
+            // NONE_ITEM is never below x, so it is skipped.
+            join_with_smaller(&mut forest, x, &neighbours(t, item), &[0, 1, 2]);
+        }
+    }
+    let mut label = vec![u32::MAX; tets * per_tet];
+    for t in 0..tets {
+        for &item in order {
+            let x = t * per_tet + item;
+            let root = find_root(&mut forest, x as u32) as usize;
+            label[x] = if root == x { new_id(x) } else { label[root] };
+        }
+    }
+    label
+}
+
+/// Edge ids of every (tet, local edge) pair: the edge orbits ⟨α0, α2, α3⟩ of the built map
+/// (tet edges joined across shared faces), numbered as a flood over darts in increasing order
+/// would. Returns the ids (6 per tet) and the number of edges. O(tets · α).
+fn label_tet_edges(faces: &FaceMatch) -> (Vec<u32>, u32) {
+    let tets = faces.partner.len() / 4;
+    let order = items_by_first_dart(6, |k| TET_DART_EDGE[k] as usize);
+    let mut next = 0u32;
+    let neighbours = |t: usize, e: usize| {
+        let [u, w] = TET_EDGES[e];
+        let mut out = [NONE_ITEM; 3];
+        for (slot, f) in (0..4).filter(|&f| f != u && f != w).enumerate() {
+            if let Some((g, map)) = faces.across(t * 4 + f) {
+                let tg = g as usize / 4;
+                if tg < t {
+                    out[slot] = (tg * 6 + tet_edge_index(corner_across(map, u), corner_across(map, w))) as u32;
+                }
+            }
+        }
+        out
+    };
+    let label = label_orbits(tets, 6, &order, neighbours, |_| (next, next += 1).0);
     (label, next)
 }
 
-/// Vertex ids of every (tet, corner) pair, by a flood over tet corners joined through shared
-/// faces (the vertex orbits ⟨α1, α2, α3⟩): the first orbit of point p gets id p, any further one
-/// a fresh id, in the order of a flood over darts in increasing order. Returns the ids (4 per
-/// tet), the id bound, and the number of orbits of each point. O(tets + points).
-fn label_tet_corners(points: usize, tets: &[[u32; 4]], partner: &[u32]) -> (Vec<u32>, u32, Vec<usize>) {
+/// Vertex ids of every (tet, corner) pair: the vertex orbits ⟨α1, α2, α3⟩ (tet corners joined
+/// across shared faces); the first orbit of point p gets id p, any further one a fresh id, in
+/// the order of a flood over darts in increasing order. Returns the ids (4 per tet), the id
+/// bound, and the number of orbits of each point. O(tets · α + points).
+fn label_tet_corners(points: usize, tets: &[[u32; 4]], faces: &FaceMatch) -> (Vec<u32>, u32, Vec<usize>) {
     let order = items_by_first_dart(4, |k| TET.vertex[k] as usize);
-    let mut label = vec![u32::MAX; tets.len() * 4];
     let mut orbits_of = vec![0usize; points];
     let mut next = points as u32;
-    let mut stack = Vec::new();
-    for t in 0..tets.len() {
-        for &v in &order {
-            if label[t * 4 + v] != u32::MAX {
-                continue;
-            }
-            let p = tets[t][v];
-            let id = if orbits_of[p as usize] == 0 { p } else { (next, next += 1).0 };
-            orbits_of[p as usize] += 1;
-            label[t * 4 + v] = id;
-            stack.push(t * 4 + v);
-            while let Some(x) = stack.pop() {
-                let (tx, vx) = (x / 4, x % 4);
-                for f in (0..4).filter(|&f| f != vx) {
-                    let other = partner[tx * 4 + f];
-                    if other == NO_FACE {
-                        continue;
-                    }
-                    let ty = other as usize / 4;
-                    let y = ty * 4 + corner_of_point(&tets[ty], p);
-                    if label[y] == u32::MAX {
-                        label[y] = id;
-                        stack.push(y);
-                    }
+    let neighbours = |t: usize, v: usize| {
+        let mut out = [NONE_ITEM; 3];
+        for (slot, f) in (0..4).filter(|&f| f != v).enumerate() {
+            if let Some((g, map)) = faces.across(t * 4 + f) {
+                let tg = g as usize / 4;
+                if tg < t {
+                    out[slot] = (tg * 4 + corner_across(map, v)) as u32;
                 }
             }
         }
-    }
+        out
+    };
+    let new_id = |x: usize| {
+        let p = tets[x / 4][x % 4];
+        orbits_of[p as usize] += 1;
+        if orbits_of[p as usize] == 1 {
+            p
+        } else {
+            (next, next += 1).0
+        }
+    };
+    let label = label_orbits(tets.len(), 4, &order, neighbours, new_id);
     (label, next, orbits_of)
 }
 

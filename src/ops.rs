@@ -827,6 +827,16 @@ pub fn check_map_laws<const N: usize>(map: &GMap<N>) -> Result<(), String> {
     if map.components().len() != map.count_orbits(AlphaMask::all(N)) {
         return Err("components() disagrees with count_orbits(all)".into());
     }
+    let (all_cells, components) = map.count_all_cells_by_traversal();
+    if all_cells != walked || components != map.component_labels().1 {
+        return Err(format!(
+            "count_all_cells_by_traversal() = ({:?}, {components}) but the traversal counts are {:?} and the \
+             component flood finds {}",
+            all_cells.0,
+            walked.0,
+            map.component_labels().1
+        ));
+    }
     if let Some(colour) = map.orientation() {
         let bad = map.darts().find(|&d| {
             (0..=N).any(|i| map.alpha_dyn(i, d) != d && colour[map.alpha_dyn(i, d).index()] == colour[d.index()])

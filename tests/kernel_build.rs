@@ -92,3 +92,47 @@ fn unsewing_every_face_of_a_cube_gives_free_tets_and_sewing_back_is_isomorphic()
     assert_eq!(map.count_cells(), original.count_cells());
     let _ = AlphaMask::all(3);
 }
+
+/// The id numbering `from_tets` documents, on Kuhn cubes with tets removed (pinched vertices,
+/// split edges): scanning darts in increasing order, face, edge and fresh vertex ids first
+/// appear in increasing order (faces in order of first appearance, edges and extra vertex
+/// orbits in the order of a flood over darts); the volume id is the tet index; a vertex id below
+/// the point count is that point's first orbit; the report's pinched points account for every
+/// fresh id; and ids are exactly the orbits (`validate`).
+#[test]
+fn ids_follow_the_documented_numbering_on_pinched_inputs() {
+    use topomech::generate::SplitMix64;
+    let (points, tets) = kuhn_cube(4);
+    for (seed, percent) in [(1u64, 0usize), (2, 30), (3, 60), (4, 85)] {
+        let mut rng = SplitMix64(seed);
+        let kept: Vec<[u32; 4]> = tets.iter().copied().filter(|_| rng.below(100) >= percent).collect();
+        let (map, report) = GMap::<3>::from_tets(points.len(), &kept).unwrap();
+        map.validate().unwrap();
+        let mut next_seen = [0u32, 0, 0];
+        let mut next_fresh = points.len() as u32;
+        for d in map.darts() {
+            assert_eq!(map.cell_id(3, d).index(), d.index() / 24, "volume id = tet index");
+            for (slot, dim) in [(1usize, 1usize), (2, 2)] {
+                let id = map.cell_id(dim, d).0;
+                assert!(id <= next_seen[slot], "{dim}-id {id} at {d:?} skips ahead of {}", next_seen[slot]);
+                next_seen[slot] = next_seen[slot].max(id + 1);
+            }
+            let v = map.vertex_id(d).0;
+            if v >= points.len() as u32 {
+                assert!(v <= next_fresh, "fresh vertex id {v} at {d:?} skips ahead of {next_fresh}");
+                next_fresh = next_fresh.max(v + 1);
+            } else {
+                assert!(kept[d.index() / 24].contains(&v), "vertex id {v} at {d:?} is not a point of its tet");
+            }
+        }
+        let fresh: usize = report.pinched_vertices.iter().map(|&(_, orbits)| orbits - 1).sum();
+        assert_eq!(map.cell_id_bound(0), points.len() + fresh, "{percent}%: fresh ids = extra orbits");
+        assert_eq!(next_fresh as usize, map.cell_id_bound(0));
+        let used = points.len() - report.unreferenced_points.len();
+        assert_eq!(map.count_cells().0[0], used + fresh);
+        assert_eq!(map.count_cells_by_traversal(), map.count_cells());
+        if percent >= 30 {
+            assert!(!report.pinched_vertices.is_empty() && !report.split_edges.is_empty(), "{percent}%");
+        }
+    }
+}

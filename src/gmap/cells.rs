@@ -1,7 +1,7 @@
 //! Global characteristics: cell counts, components, boundary, Euler characteristic,
 //! orientability.
 
-use super::orbit::{generators, union_smaller_root};
+use super::orbit::{generators, join_with_smaller};
 use super::{AlphaMask, DartId, DartSet, GMap};
 
 /// Number of i-cells for each i in 0..=n.
@@ -106,22 +106,50 @@ impl<const N: usize> GMap<N> {
     /// assert_eq!(map.count_cells_by_traversal(), map.count_cells()); // ids and orbits agree
     /// ```
     pub fn count_cells_by_traversal(&self) -> CellCounts {
-        let gens: Vec<([usize; 8], usize)> = (0..=N).map(|i| generators(N, AlphaMask::cell(N, i))).collect();
-        let mut forests: Vec<Vec<u32>> = (0..=N).map(|_| (0..self.capacity() as u32).collect()).collect();
-        let mut joins = vec![0usize; N + 1];
+        let masks: Vec<AlphaMask> = (0..=N).map(|i| AlphaMask::cell(N, i)).collect();
+        CellCounts(self.count_orbits_in_one_sweep(&masks))
+    }
+
+    /// Number of i-cells for every i and number of connected components, found by walking
+    /// orbits (independent of cell ids) in one sweep: what CGAL's `count_all_cells` computes.
+    /// O(darts · n² · α(darts)).
+    ///
+    /// Same sweep as [`Self::count_cells_by_traversal`] with one more union-find forest, over
+    /// all n + 1 involutions, for the components.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let (map, _) = GMap::<3>::from_tets(8, &[[0, 1, 2, 3], [4, 5, 6, 7]]).unwrap();
+    /// let (cells, components) = map.count_all_cells_by_traversal();
+    /// assert_eq!(cells.0, vec![8, 12, 8, 2]);
+    /// assert_eq!(components, 2);
+    /// assert_eq!((cells, components), (map.count_cells_by_traversal(), map.components().len()));
+    /// ```
+    pub fn count_all_cells_by_traversal(&self) -> (CellCounts, usize) {
+        let mut masks: Vec<AlphaMask> = (0..=N).map(|i| AlphaMask::cell(N, i)).collect();
+        masks.push(AlphaMask::all(N));
+        let mut counts = self.count_orbits_in_one_sweep(&masks);
+        let components = counts.pop().unwrap_or(0);
+        (CellCounts(counts), components)
+    }
+
+    /// The number of orbits of each mask, from one sweep with one union-find forest per mask:
+    /// each dart's row is read once, and a dart joins the trees of its neighbours below it with
+    /// [`join_with_smaller`]. O(darts · Σ|mask| · α(darts)).
+    pub(crate) fn count_orbits_in_one_sweep(&self, masks: &[AlphaMask]) -> Vec<usize> {
+        let gens: Vec<([usize; 8], usize)> = masks.iter().map(|&mask| generators(N, mask)).collect();
+        let mut forests: Vec<Vec<u32>> = gens.iter().map(|_| (0..self.capacity() as u32).collect()).collect();
+        let mut joins = vec![0usize; gens.len()];
         self.for_each_live(|d| {
             let row = self.alpha_row(d);
-            for (dim, forest) in forests.iter_mut().enumerate() {
-                let (g, len) = &gens[dim];
-                for &j in &g[..*len] {
-                    let y = row[j];
-                    if y < d {
-                        joins[dim] += union_smaller_root(forest, d, y) as usize;
-                    }
-                }
+            for ((forest, (g, len)), joins) in forests.iter_mut().zip(&gens).zip(joins.iter_mut()) {
+                *joins += join_with_smaller(forest, d, row, &g[..*len]);
             }
         });
-        CellCounts(joins.iter().map(|&j| self.dart_count() - j).collect())
+        joins.iter().map(|&j| self.dart_count() - j).collect()
     }
 
     /// Number of distinct orbits ⟨mask⟩ over all live darts. O(darts · n).

@@ -37,6 +37,8 @@ pub use mask::AlphaMask;
 pub use sew::{CellChange, CellChanges, SewError};
 pub use validate::{InvariantViolation, Law};
 
+pub(crate) use orbit::{find_root, join_with_smaller};
+
 use dart::NONE;
 
 /// Allocator of the ids of one cell dimension: dense ids, a free list, and a count of live ids.
@@ -556,6 +558,18 @@ impl<const N: usize> GMap<N> {
         }
         self.n_alive += count;
         first as u32
+    }
+
+    /// A map whose darts are the rows of `alpha` and `cell` (n + 1 entries per dart), all live:
+    /// the end of a bulk build, which sets the id allocators next and must leave every law true.
+    pub(crate) fn from_rows_raw(alpha: Vec<u32>, cell: Vec<u32>) -> Self {
+        debug_assert_eq!(alpha.len(), cell.len());
+        let darts = alpha.len() / (N + 1);
+        let mut alive = vec![u64::MAX; darts / 64];
+        if darts % 64 != 0 {
+            alive.push((1u64 << (darts % 64)) - 1);
+        }
+        GMap { alpha, cell, alive, n_alive: darts, ..Self::new() }
     }
 
     /// Sets the id allocator of dimension i to "ids 0..next are used but those in `free`".

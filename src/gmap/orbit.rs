@@ -304,13 +304,7 @@ impl<const N: usize> GMap<N> {
         let (gens, len) = generators(N, mask);
         let mut forest: Vec<u32> = (0..self.capacity() as u32).collect();
         self.for_each_live(|d| {
-            let row = self.alpha_row(d);
-            for &j in &gens[..len] {
-                let y = row[j];
-                if y < d {
-                    union_smaller_root(&mut forest, d, y);
-                }
-            }
+            join_with_smaller(&mut forest, d, self.alpha_row(d), &gens[..len]);
         });
         let mut count = 0;
         self.for_each_live(|d| {
@@ -429,15 +423,29 @@ pub(crate) fn find_root(forest: &mut [u32], mut x: u32) -> u32 {
     }
 }
 
-/// Joins the trees of a and b under the smaller root (so every root is the smallest element of
-/// its tree); returns whether they were distinct trees. Amortised O(α(len)).
+/// Joins dart d with the trees of its neighbours αj(d) < d (j in `gens`, `row` = d's α row) in
+/// a union-find forest whose roots are the smallest elements of their trees; returns the number
+/// of successful joins. O(|gens| · α(len)).
+///
+/// Precondition: no element points to d yet. It holds when darts are swept in increasing order
+/// and every join is made by this function: a join links the larger of two roots under the
+/// smaller, and both are below the dart being swept. So d is its own root on entry and the only
+/// root to track is the current one: one `find_root` per neighbour instead of two per join.
 #[inline(always)]
-pub(crate) fn union_smaller_root(forest: &mut [u32], a: u32, b: u32) -> bool {
-    let (ra, rb) = (find_root(forest, a), find_root(forest, b));
-    if ra == rb {
-        return false;
+pub(crate) fn join_with_smaller(forest: &mut [u32], d: u32, row: &[u32], gens: &[usize]) -> usize {
+    let mut root = d;
+    let mut joins = 0;
+    for &j in gens {
+        let y = row[j];
+        if y < d {
+            let other = find_root(forest, y);
+            if other != root {
+                let (lo, hi) = if other < root { (other, root) } else { (root, other) };
+                forest[hi as usize] = lo;
+                root = lo;
+                joins += 1;
+            }
+        }
     }
-    let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
-    forest[hi as usize] = lo;
-    true
+    joins
 }

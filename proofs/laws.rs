@@ -64,6 +64,15 @@ pub fn check_sew<const N: usize>(map: &GMap<N>, i: usize, a: DartId, b: DartId) 
     if result.is_ok() != map.is_sewable_dyn(i, a, b) {
         return Err(format!("is_sewable({i}, {a:?}, {b:?}) disagrees with sew: {result:?}"));
     }
+    // The compile-time-index version gives the same answer (i = 0, 1 exist for every n ≥ 1).
+    let fixed = match i {
+        0 => Some(map.is_sewable::<0>(a, b)),
+        1 => Some(map.is_sewable::<1>(a, b)),
+        _ => None,
+    };
+    if fixed.is_some_and(|f| f != result.is_ok()) {
+        return Err(format!("is_sewable::<{i}>({a:?}, {b:?}) disagrees with sew: {result:?}"));
+    }
     ops::check_after_op(map, &after, &op, &result)
 }
 

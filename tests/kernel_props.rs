@@ -111,3 +111,53 @@ fn same_counts_different_structure_is_not_isomorphic() {
     assert!(!a.is_isomorphic(&b) && !b.is_isomorphic(&a));
     assert!(a.is_isomorphic(&ops::permuted_copy(&a, &[2, 0, 3, 1]).unwrap()));
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+
+    /// `DartSet` behaves as a set: after any sequence of inserts and removes (darts up to 1 000,
+    /// so several 64-bit words), membership, the return values and the length agree with a
+    /// `BTreeSet` model.
+    #[test]
+    fn dart_set_agrees_with_a_model_set(ops in prop::collection::vec((any::<bool>(), 0u32..1000), 0..300)) {
+        let (mut set, mut model) = (topomech::gmap::DartSet::with_capacity(64), std::collections::BTreeSet::new());
+        for (insert, d) in ops {
+            if insert {
+                prop_assert_eq!(set.insert(DartId(d)), model.insert(d), "insert {}", d);
+            } else {
+                prop_assert_eq!(set.remove(DartId(d)), model.remove(&d), "remove {}", d);
+            }
+            prop_assert_eq!(set.len(), model.len());
+            prop_assert_eq!(set.is_empty(), model.is_empty());
+        }
+        for d in 0..1000 {
+            prop_assert_eq!(set.contains(DartId(d)), model.contains(&d), "contains {}", d);
+        }
+    }
+
+    /// Reusable marks behave as sets too, and `count` and `unmark` agree with a model.
+    #[test]
+    fn marks_agree_with_a_model_set(ops in prop::collection::vec((any::<bool>(), 0u32..200), 0..200)) {
+        let mut map = GMap::<2>::new();
+        for _ in 0..200 {
+            map.create_dart().unwrap();
+        }
+        let mut mark = map.reserve_mark();
+        let mut model = std::collections::BTreeSet::new();
+        for (set, d) in ops {
+            if set {
+                prop_assert_eq!(mark.mark(DartId(d)), model.insert(d));
+            } else {
+                prop_assert_eq!(mark.unmark(DartId(d)), model.remove(&d));
+            }
+            prop_assert_eq!(mark.count(), model.len());
+        }
+        for d in 0..200 {
+            prop_assert_eq!(mark.is_marked(DartId(d)), model.contains(&d));
+        }
+        for d in std::mem::take(&mut model) {
+            mark.unmark(DartId(d));
+        }
+        map.free_mark(mark);
+    }
+}

@@ -25,7 +25,9 @@
 //! ```
 //!
 //! See `docs/ARCHITECTURE.md` for the map from the seed paper's definitions to modules.
-#![forbid(unsafe_code)]
+// No unsafe code, but for the one audited exception: `mechanics::simd::Kernel::run` (calls into
+// `#[target_feature]` functions after run-time detection).
+#![deny(unsafe_code)]
 #![warn(missing_docs)]
 
 pub mod ambiguity;

@@ -20,6 +20,7 @@ pub(crate) mod geom;
 pub mod integrate;
 pub mod model;
 pub mod projection;
+pub mod simd;
 
 pub use conservation::{check_conservation, conservation_violations, ConservationError};
 pub use flat::FlatModel;
@@ -28,6 +29,7 @@ pub use geom::Vec3;
 pub use integrate::{Integrator, StepConfig, StepError, Stepper};
 pub use model::{Body, BodyError, Material, Mechanics, ModelError};
 pub use projection::{forces_by_coverage, Projection, ProjectionMismatch, TouchedCells};
+pub use simd::Kernel;
 
 use crate::CellId;
 

@@ -9,6 +9,8 @@
 //!   detection;
 //! - [`projection`]: the indexed projection of a body (seed §5.2) and the orbit-walk reference;
 //! - [`flat`]: the same model built from the tet list without a map (oracle and baseline).
+//! - [`simd`]: [`Kernel`], the run-time choice of instruction set (SSE2, AVX2, AVX-512) for the
+//!   hot loops, all giving the same bits.
 //!
 //! [`Simulation`] ties a body, its projection and a stepper together. `docs/MECHANICS.md` states
 //! every law with its formula and where the code checks it.

@@ -711,11 +711,11 @@ pub(crate) type Rec4 = [f64; 4];
 
 multiversion! {
     /// [`spring_pass`] on padded records.
-    pub(crate) fn spring_pass4(springs: Springs<'_>, x: &[Rec4], v: &[Rec4], out: &mut [Rec4]) = spring_pass4_body;
+    pub(crate) fn spring_pass4(springs: Springs<'_>, x: &[Rec4], v: &[Rec4], out: &mut [Vec3]) = spring_pass4_body;
 }
 
 #[inline(always)]
-fn spring_pass4_body(springs: Springs<'_>, x: &[Rec4], v: &[Rec4], out: &mut [Rec4]) {
+fn spring_pass4_body(springs: Springs<'_>, x: &[Rec4], v: &[Rec4], out: &mut [Vec3]) {
     let mut d = [[0.0f64; 4]; BLOCK];
     let mut dv = [[0.0f64; 4]; BLOCK];
     let mut s = [0.0f64; BLOCK];
@@ -743,7 +743,7 @@ fn spring_pass4_body(springs: Springs<'_>, x: &[Rec4], v: &[Rec4], out: &mut [Re
         }
         for (j, f) in out[first..first + n].iter_mut().enumerate() {
             let e = dd[j];
-            *f = [s[j] * e[0], s[j] * e[1], s[j] * e[2], s[j] * e[3]];
+            *f = [s[j] * e[0], s[j] * e[1], s[j] * e[2]];
         }
         first += n;
     }
@@ -751,7 +751,7 @@ fn spring_pass4_body(springs: Springs<'_>, x: &[Rec4], v: &[Rec4], out: &mut [Re
 
 impl SpringSystem {
     /// Pass 1 on padded records (the RK4 stepper's layout).
-    pub(crate) fn spring_forces4(&self, kernel: Kernel, x: &[Rec4], v: &[Rec4], sf: &mut [Rec4], parallel: bool) {
+    pub(crate) fn spring_forces4(&self, kernel: Kernel, x: &[Rec4], v: &[Rec4], sf: &mut [Vec3], parallel: bool) {
         let n = self.springs();
         assert!(sf.len() == n, "spring force buffer has {} entries for {n} springs", sf.len());
         if parallel && n > PARALLEL_CHUNK {
@@ -766,7 +766,7 @@ impl SpringSystem {
 
     /// [`SpringSystem::acceleration`] from padded spring forces.
     #[inline(always)]
-    pub(crate) fn acceleration4(&self, i: usize, vi: Vec3, sf: &[Rec4]) -> Vec3 {
+    pub(crate) fn acceleration4(&self, i: usize, vi: Vec3, sf: &[Vec3]) -> Vec3 {
         let (heads, tails) = self.inc.lists(i);
         let mut t = [0.0; 3];
         // Spring ids are < sf.len() (an invariant, and no spring means empty lists): clamping

@@ -229,8 +229,7 @@ pub struct Stepper {
     step: u64,
     energy_scale: f64,
     sf: Vec<Vec3>,
-    /// Spring forces and stage state (xs, vs) of RK4, padded to 4 lanes (vector loads/stores).
-    sf4: Vec<Rec4>,
+    /// Stage state (xs, vs) of RK4, padded to 4 lanes (one vector load per spring end).
     xs: Vec<Rec4>,
     vs: Vec<Rec4>,
     acc: Vec<Vec3>,
@@ -287,7 +286,6 @@ impl Stepper {
             step: 0,
             energy_scale: energy_scale(sys, x, v),
             sf: z(s),
-            sf4: vec![[0.0; 4]; s],
             xs: vec![[0.0; 4]; n],
             vs: vec![[0.0; 4]; n],
             acc: z(n),
@@ -446,8 +444,8 @@ impl Stepper {
             (*xs, *vs) = (pad(*xi), pad(*vi));
         }
         for stage in stages {
-            sys.spring_forces4(kernel, &self.xs, &self.vs, &mut self.sf4, par);
-            let sf: &[Rec4] = &self.sf4;
+            sys.spring_forces4(kernel, &self.xs, &self.vs, &mut self.sf, par);
+            let sf: &[Vec3] = &self.sf;
             let state = Rk4State {
                 x: &mut *x,
                 v: &mut *v,
@@ -579,11 +577,11 @@ impl Rk4State<'_> {
 
 multiversion! {
     /// One RK4 stage over the slots `first..` of `s` (see [`Stage`]); spring forces in `sf`.
-    fn rk4_stage(sys: &SpringSystem, sf: &[Rec4], stage: Stage, first: usize, s: Rk4State<'_>) -> Probe = rk4_stage_body;
+    fn rk4_stage(sys: &SpringSystem, sf: &[Vec3], stage: Stage, first: usize, s: Rk4State<'_>) -> Probe = rk4_stage_body;
 }
 
 #[inline(always)]
-fn rk4_stage_body(sys: &SpringSystem, sf: &[Rec4], stage: Stage, first: usize, s: Rk4State<'_>) -> Probe {
+fn rk4_stage_body(sys: &SpringSystem, sf: &[Vec3], stage: Stage, first: usize, s: Rk4State<'_>) -> Probe {
     let n = s.x.len();
     let (x, v, xs, vs, ax, av) = (s.x, &mut s.v[..n], &mut s.xs[..n], &mut s.vs[..n], &mut s.ax[..n], &mut s.av[..n]);
     let mut probe = Probe::default();

@@ -398,6 +398,26 @@ impl SpringSystem {
         f
     }
 
+    /// [`SpringSystem::gather`] for an `sf` of exactly one entry per spring (checked by the
+    /// callers): the spring ids are then < sf.len() (and no spring means empty lists), so
+    /// clamping them to sf.len() − 1 is a no-op that spares a bounds check per entry.
+    #[inline(always)]
+    fn gather_full(&self, i: usize, sf: &[Vec3]) -> Vec3 {
+        let (heads, tails) = self.inc.lists(i);
+        let mut f = [0.0; 3];
+        if let Some(last) = sf.len().checked_sub(1) {
+            for &s in heads {
+                let g = sf[(s as usize).min(last)];
+                f = [f[0] + g[0], f[1] + g[1], f[2] + g[2]];
+            }
+            for &s in tails {
+                let g = sf[(s as usize).min(last)];
+                f = [f[0] - g[0], f[1] - g[1], f[2] - g[2]];
+            }
+        }
+        f
+    }
+
     /// Total force on slot i from gravity, viscosity and the springs (given F_s in `sf`). O(degree).
     ///
     /// # Examples
@@ -508,11 +528,11 @@ impl SpringSystem {
         }
     }
 
-    /// a_i = f_i / m_i (zero on a fixed slot) from the spring forces `sf`, with `vi` the velocity
-    /// of slot i; the same arithmetic as [`SpringSystem::vertex_force`] then the scaling.
+    /// a_i = f_i / m_i (zero on a fixed slot) from the spring forces `sf` (one per spring), with
+    /// `vi` the velocity of slot i; the same arithmetic as [`SpringSystem::vertex_force`] then the scaling.
     #[inline(always)]
     pub(crate) fn acceleration(&self, i: usize, vi: Vec3, sf: &[Vec3]) -> Vec3 {
-        let s = self.gather(i, sf);
+        let s = self.gather_full(i, sf);
         let (m, g, w) = (self.mass[i], self.viscosity[i], self.inv_mass[i]);
         let f = [
             s[0] + m * self.gravity[0] - g * vi[0],
@@ -762,32 +782,6 @@ impl SpringSystem {
         } else {
             spring_pass4(kernel, self.spring_view(0..n), x, v, sf);
         }
-    }
-
-    /// [`SpringSystem::acceleration`] from padded spring forces.
-    #[inline(always)]
-    pub(crate) fn acceleration4(&self, i: usize, vi: Vec3, sf: &[Vec3]) -> Vec3 {
-        let (heads, tails) = self.inc.lists(i);
-        let mut t = [0.0; 3];
-        // Spring ids are < sf.len() (an invariant, and no spring means empty lists): clamping
-        // them to sf.len() − 1 is a no-op sparing a bounds check per entry.
-        if let Some(last) = sf.len().checked_sub(1) {
-            for &s in heads {
-                let g = sf[(s as usize).min(last)];
-                t = [t[0] + g[0], t[1] + g[1], t[2] + g[2]];
-            }
-            for &s in tails {
-                let g = sf[(s as usize).min(last)];
-                t = [t[0] - g[0], t[1] - g[1], t[2] - g[2]];
-            }
-        }
-        let (m, g, w) = (self.mass[i], self.viscosity[i], self.inv_mass[i]);
-        let f = [
-            t[0] + m * self.gravity[0] - g * vi[0],
-            t[1] + m * self.gravity[1] - g * vi[1],
-            t[2] + m * self.gravity[2] - g * vi[2],
-        ];
-        [f[0] * w, f[1] * w, f[2] * w]
     }
 }
 

@@ -440,8 +440,11 @@ impl Stepper {
         let (h, par, kernel) = (self.config.dt, self.config.parallel, self.kernel);
         let stages = [Stage::First(0.5 * h), Stage::Middle(0.5 * h), Stage::Middle(h), Stage::Last(h / 6.0)];
         // Stage 1 evaluates at y0: its padded copy.
-        for ((xs, vs), (xi, vi)) in self.xs.iter_mut().zip(&mut self.vs).zip(x.iter().zip(v.iter())) {
-            (*xs, *vs) = (pad(*xi), pad(*vi));
+        let copy = |((xs, vs), (xi, vi)): ((&mut Rec4, &mut Rec4), (&Vec3, &Vec3))| (*xs, *vs) = (pad(*xi), pad(*vi));
+        if par && x.len() > PARALLEL_CHUNK {
+            self.xs.par_iter_mut().zip(self.vs.par_iter_mut()).zip(x.par_iter().zip(v.par_iter())).for_each(copy);
+        } else {
+            self.xs.iter_mut().zip(self.vs.iter_mut()).zip(x.iter().zip(v.iter())).for_each(copy);
         }
         for stage in stages {
             sys.spring_forces4(kernel, &self.xs, &self.vs, &mut self.sf, par);
@@ -589,7 +592,7 @@ fn rk4_stage_body(sys: &SpringSystem, sf: &[Vec3], stage: Stage, first: usize, s
         Stage::First(c) => {
             for k in 0..n {
                 let (xi, vi) = (x[k], v[k]);
-                let a = sys.acceleration4(first + k, vi, sf);
+                let a = sys.acceleration(first + k, vi, sf);
                 ax[k] = vi;
                 av[k] = a;
                 xs[k] = pad(madd(xi, c, vi));
@@ -599,7 +602,7 @@ fn rk4_stage_body(sys: &SpringSystem, sf: &[Vec3], stage: Stage, first: usize, s
         Stage::Middle(c) => {
             for k in 0..n {
                 let vi = unpad(vs[k]);
-                let a = sys.acceleration4(first + k, vi, sf);
+                let a = sys.acceleration(first + k, vi, sf);
                 ax[k] = madd(ax[k], 2.0, vi);
                 av[k] = madd(av[k], 2.0, a);
                 xs[k] = pad(madd(x[k], c, vi));
@@ -609,7 +612,7 @@ fn rk4_stage_body(sys: &SpringSystem, sf: &[Vec3], stage: Stage, first: usize, s
         Stage::Last(c) => {
             for k in 0..n {
                 let vi = unpad(vs[k]);
-                let a = sys.acceleration4(first + k, vi, sf);
+                let a = sys.acceleration(first + k, vi, sf);
                 x[k] = madd(x[k], c, add(ax[k], vi));
                 v[k] = madd(v[k], c, add(av[k], a));
                 probe.add(sys.mass[first + k], x[k], v[k]);

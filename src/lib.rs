@@ -25,8 +25,8 @@
 //! ```
 //!
 //! See `docs/ARCHITECTURE.md` for the map from the seed paper's definitions to modules.
-// No unsafe code, but for the one audited exception: `mechanics::simd::Kernel::run` (calls into
-// `#[target_feature]` functions after run-time detection).
+// No unsafe code, but for the one audited exception: the `multiversion!` macro of `mechanics::simd`
+// (calls into `#[target_feature]` copies of the hot loops after run-time detection).
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 

@@ -12,7 +12,11 @@
 //! `fma` feature is not even enabled. The order of every sum is fixed by the source (vectorisation
 //! is across springs or slots, never inside one sum). So every kernel returns the same bits, and
 //! the results stay independent of the machine and of the thread count
-//! (`tests/mechanics_physics.rs` checks it on the built-in liver and random systems).
+//! (`tests/mechanics_kernels.rs` checks it on the built-in liver and random systems).
+//!
+//! This module holds the crate's only `unsafe` (the crate is `deny(unsafe_code)`): the calls into
+//! the `#[target_feature]` copies, sound because a [`Kernel`] naming a wide set is only made after
+//! run-time detection of that set.
 
 use std::sync::OnceLock;
 
@@ -58,7 +62,8 @@ impl Kernel {
 
     /// The widest kernel the CPU supports, detected once per process (later calls read a cache).
     /// The environment variable `TOPOMECH_KERNEL` (`portable`, `avx2`, `avx512`), read at that
-    /// first call, caps it for benchmarks; a kernel the CPU lacks is never chosen. O(1).
+    /// first call, caps it for benchmarks (any other value is ignored); a kernel the CPU lacks is
+    /// never chosen. O(1).
     ///
     /// # Examples
     ///

@@ -25,7 +25,9 @@
 //! ```
 //!
 //! See `docs/ARCHITECTURE.md` for the map from the seed paper's definitions to modules.
-#![forbid(unsafe_code)]
+// No unsafe code, but for the one audited exception: the `multiversion!` macro of `mechanics::simd`
+// (calls into `#[target_feature]` copies of the hot loops after run-time detection).
+#![deny(unsafe_code)]
 #![warn(missing_docs)]
 
 pub mod ambiguity;

@@ -46,7 +46,7 @@ pub struct StepBenchArgs {
     /// Steps per batch.
     #[arg(long, default_value_t = 50)]
     pub batch: usize,
-    /// Print one JSON object: map_step_us, flat_step_us, ratio, springs, vertices.
+    /// Print one JSON object: map_step_us, flat_step_us, ratio, springs, vertices, kernel.
     #[arg(long)]
     pub json: bool,
 }
@@ -64,6 +64,8 @@ pub struct BenchJson {
     pub springs: usize,
     /// Vertices.
     pub vertices: usize,
+    /// Instruction set of the hot loops (`portable`, `avx2`, `avx512`; see `mechanics::Kernel`).
+    pub kernel: &'static str,
 }
 
 fn other(e: impl std::error::Error + Send + Sync + 'static) -> CliError {
@@ -113,6 +115,7 @@ pub fn run(args: BenchArgs) -> Result<(), CliError> {
         ratio: map_us / flat_us,
         springs: sim.projection.system.springs(),
         vertices: body.map().count_cells().0[0],
+        kernel: sim.stepper.kernel().name(),
     };
     let mut out = std::io::stdout().lock();
     if args.json {
@@ -127,6 +130,7 @@ pub fn run(args: BenchArgs) -> Result<(), CliError> {
             args.rounds
         )?;
         writeln!(out, "  {:<22}{} springs, {} vertices", "system", report.springs, report.vertices)?;
+        writeln!(out, "  {:<22}{}", "kernel", report.kernel)?;
         writeln!(out, "  {:<22}{:.2} µs", "map-driven step", map_us)?;
         writeln!(out, "  {:<22}{:.2} µs", "flat baseline step", flat_us)?;
         writeln!(out, "  {:<22}{:.3}", "ratio", report.ratio)?;

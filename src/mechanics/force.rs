@@ -32,6 +32,7 @@
 use rayon::prelude::*;
 
 use super::geom::{dot, norm, sub, Vec3};
+use super::simd::{multiversion, Kernel};
 
 /// Spring and vertex count above which the parallel passes are worth their overhead.
 pub const PARALLEL_CHUNK: usize = 4096;
@@ -334,41 +335,50 @@ impl SpringSystem {
     /// assert_eq!(sys.vertex_force(1, &v, &sf), [1.0 + 2.0, 0.0, 0.0]); // −F₀ + F₁ on the middle slot
     /// ```
     pub fn spring_forces(&self, x: &[Vec3], v: &[Vec3], sf: &mut [Vec3], parallel: bool) {
-        if parallel && sf.len() > PARALLEL_CHUNK {
+        self.spring_forces_with(Kernel::detect(), x, v, sf, parallel);
+    }
+
+    /// [`SpringSystem::spring_forces`] run with `kernel`: the same bits for every kernel
+    /// ([`Kernel`]). O(springs).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::{Kernel, SpringSystem};
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// (0..2).for_each(|_| drop(sys.push_slot(1.0, false, 0.0)));
+    /// sys.push_spring([0, 1], 1.0, 2.0, 0.5);
+    /// let (x, v) = ([[0.0; 3], [0.3, 0.4, 1.2]], [[0.1, 0.0, 0.0], [0.0, -0.2, 0.0]]);
+    /// let mut reference = vec![[0.0; 3]];
+    /// sys.spring_forces_with(Kernel::portable(), &x, &v, &mut reference, false);
+    /// for kernel in Kernel::available() {
+    ///     let mut sf = vec![[0.0; 3]];
+    ///     sys.spring_forces_with(kernel, &x, &v, &mut sf, false);
+    ///     assert_eq!(sf, reference); // bit for bit
+    /// }
+    /// ```
+    pub fn spring_forces_with(&self, kernel: Kernel, x: &[Vec3], v: &[Vec3], sf: &mut [Vec3], parallel: bool) {
+        let n = self.springs();
+        assert!(sf.len() == n, "spring force buffer has {} entries for {n} springs", sf.len());
+        if parallel && n > PARALLEL_CHUNK {
             sf.par_chunks_mut(PARALLEL_CHUNK).enumerate().for_each(|(c, chunk)| {
-                self.spring_range(x, v, c * PARALLEL_CHUNK, chunk);
+                let r = c * PARALLEL_CHUNK..c * PARALLEL_CHUNK + chunk.len();
+                spring_pass(kernel, self.spring_view(r), x, v, chunk);
             });
         } else {
-            self.spring_range(x, v, 0, sf);
+            spring_pass(kernel, self.spring_view(0..n), x, v, sf);
         }
     }
 
-    /// Springs `start..start + out.len()` in blocks of [`BLOCK`]: a scalar gather of the end
-    /// states, a branch-free arithmetic loop the compiler vectorises (sqrt and division are the
-    /// cost of a spring), then the writes. Same arithmetic as [`spring_force`], bit for bit.
+    /// The spring arrays over range `r`.
     #[inline]
-    fn spring_range(&self, x: &[Vec3], v: &[Vec3], start: usize, out: &mut [Vec3]) {
-        for (b, chunk) in out.chunks_mut(BLOCK).enumerate() {
-            let first = start + b * BLOCK;
-            let n = chunk.len();
-            let mut d = [[0.0f64; BLOCK]; 3];
-            let mut dv = [[0.0f64; BLOCK]; 3];
-            for (j, &[a, bb]) in self.ends[first..first + n].iter().enumerate() {
-                let (xa, xb, va, vb) = (x[a as usize], x[bb as usize], v[a as usize], v[bb as usize]);
-                for c in 0..3 {
-                    d[c][j] = xb[c] - xa[c];
-                    dv[c][j] = vb[c] - va[c];
-                }
-            }
-            let mut s = [0.0f64; BLOCK];
-            let (rest, k, damp) =
-                (&self.rest[first..first + n], &self.stiffness[first..first + n], &self.damping[first..first + n]);
-            for j in 0..n {
-                s[j] = spring_scale(d[0][j], d[1][j], d[2][j], dv[0][j], dv[1][j], dv[2][j], rest[j], k[j], damp[j]);
-            }
-            for (j, f) in chunk.iter_mut().enumerate() {
-                *f = [s[j] * d[0][j], s[j] * d[1][j], s[j] * d[2][j]];
-            }
+    fn spring_view(&self, r: std::ops::Range<usize>) -> Springs<'_> {
+        Springs {
+            ends: &self.ends[r.clone()],
+            rest: &self.rest[r.clone()],
+            stiffness: &self.stiffness[r.clone()],
+            damping: &self.damping[r],
         }
     }
 
@@ -384,6 +394,26 @@ impl SpringSystem {
         for &s in tails {
             let g = sf[s as usize];
             f = [f[0] - g[0], f[1] - g[1], f[2] - g[2]];
+        }
+        f
+    }
+
+    /// [`SpringSystem::gather`] for an `sf` of exactly one entry per spring (checked by the
+    /// callers): the spring ids are then < sf.len() (and no spring means empty lists), so
+    /// clamping them to sf.len() − 1 is a no-op that spares a bounds check per entry.
+    #[inline(always)]
+    fn gather_full(&self, i: usize, sf: &[Vec3]) -> Vec3 {
+        let (heads, tails) = self.inc.lists(i);
+        let mut f = [0.0; 3];
+        if let Some(last) = sf.len().checked_sub(1) {
+            for &s in heads {
+                let g = sf[(s as usize).min(last)];
+                f = [f[0] + g[0], f[1] + g[1], f[2] + g[2]];
+            }
+            for &s in tails {
+                let g = sf[(s as usize).min(last)];
+                f = [f[0] - g[0], f[1] - g[1], f[2] - g[2]];
+            }
         }
         f
     }
@@ -452,13 +482,64 @@ impl SpringSystem {
     /// assert_eq!(acc, [[0.0, 0.0, -9.81], [0.0; 3]]);
     /// ```
     pub fn accelerations(&self, x: &[Vec3], v: &[Vec3], sf: &mut [Vec3], acc: &mut [Vec3], parallel: bool) {
-        self.spring_forces(x, v, sf, parallel);
+        self.accelerations_with(Kernel::detect(), x, v, sf, acc, parallel);
+    }
+
+    /// [`SpringSystem::accelerations`] run with `kernel`: the same bits for every kernel
+    /// ([`Kernel`]). O(slots + springs).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::{Kernel, SpringSystem};
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// sys.gravity = [0.0, 0.0, -9.81];
+    /// (0..3).for_each(|i| drop(sys.push_slot(1.0 + i as f64, i == 0, 0.1)));
+    /// sys.push_spring([0, 1], 1.0, 30.0, 0.2);
+    /// sys.push_spring([1, 2], 1.0, 20.0, 0.2);
+    /// let x = [[0.0; 3], [0.0, 0.0, -1.1], [0.1, 0.0, -2.3]];
+    /// let v = [[0.0; 3], [0.0, 0.3, 0.0], [0.2, 0.0, -0.1]];
+    /// let (mut sf, mut reference) = (vec![[0.0; 3]; 2], vec![[0.0; 3]; 3]);
+    /// sys.accelerations_with(Kernel::portable(), &x, &v, &mut sf, &mut reference, false);
+    /// for kernel in Kernel::available() {
+    ///     let mut acc = vec![[0.0; 3]; 3];
+    ///     sys.accelerations_with(kernel, &x, &v, &mut sf, &mut acc, false);
+    ///     assert_eq!(acc, reference); // bit for bit
+    /// }
+    /// ```
+    pub fn accelerations_with(
+        &self,
+        kernel: Kernel,
+        x: &[Vec3],
+        v: &[Vec3],
+        sf: &mut [Vec3],
+        acc: &mut [Vec3],
+        parallel: bool,
+    ) {
+        self.spring_forces_with(kernel, x, v, sf, parallel);
         let sf: &[Vec3] = sf;
-        self.per_slot(acc, parallel, |i| {
-            let f = self.vertex_force(i, v, sf);
-            let w = self.inv_mass[i];
-            [f[0] * w, f[1] * w, f[2] * w]
-        });
+        if parallel && acc.len() > PARALLEL_CHUNK {
+            acc.par_chunks_mut(PARALLEL_CHUNK).enumerate().for_each(|(c, chunk)| {
+                acceleration_pass(kernel, self, c * PARALLEL_CHUNK, v, sf, chunk);
+            });
+        } else {
+            acceleration_pass(kernel, self, 0, v, sf, acc);
+        }
+    }
+
+    /// a_i = f_i / m_i (zero on a fixed slot) from the spring forces `sf` (one per spring), with
+    /// `vi` the velocity of slot i; the same arithmetic as [`SpringSystem::vertex_force`] then the scaling.
+    #[inline(always)]
+    pub(crate) fn acceleration(&self, i: usize, vi: Vec3, sf: &[Vec3]) -> Vec3 {
+        let s = self.gather_full(i, sf);
+        let (m, g, w) = (self.mass[i], self.viscosity[i], self.inv_mass[i]);
+        let f = [
+            s[0] + m * self.gravity[0] - g * vi[0],
+            s[1] + m * self.gravity[1] - g * vi[1],
+            s[2] + m * self.gravity[2] - g * vi[2],
+        ];
+        [f[0] * w, f[1] * w, f[2] * w]
     }
 
     /// `out[i] = value(i)` for every slot, split across threads when asked and large.
@@ -595,6 +676,129 @@ impl SpringSystem {
 /// Springs per block of the vectorised spring pass.
 const BLOCK: usize = 64;
 
+/// The per-spring arrays of a range of springs.
+#[derive(Clone, Copy)]
+pub(crate) struct Springs<'a> {
+    pub(crate) ends: &'a [[u32; 2]],
+    pub(crate) rest: &'a [f64],
+    pub(crate) stiffness: &'a [f64],
+    pub(crate) damping: &'a [f64],
+}
+
+multiversion! {
+    /// F_s of the springs of `springs` into `out` (same length).
+    pub(crate) fn spring_pass(springs: Springs<'_>, x: &[Vec3], v: &[Vec3], out: &mut [Vec3]) = spring_pass_body;
+}
+
+/// Springs in blocks of [`BLOCK`]: a scalar gather of the end states into per-coordinate
+/// arrays, a branch-free arithmetic loop the compiler vectorises (sqrt and division are the cost
+/// of a spring), then the writes. Same arithmetic as [`spring_force`], bit for bit. The block
+/// arrays are written before they are read, so they are zeroed once per call, not per block.
+#[inline(always)]
+fn spring_pass_body(springs: Springs<'_>, x: &[Vec3], v: &[Vec3], out: &mut [Vec3]) {
+    let mut d = [[0.0f64; BLOCK]; 3];
+    let mut dv = [[0.0f64; BLOCK]; 3];
+    let mut s = [0.0f64; BLOCK];
+    let n_all = out.len();
+    let mut first = 0;
+    while first < n_all {
+        let n = BLOCK.min(n_all - first);
+        let ends = &springs.ends[first..first + n];
+        for (j, &[a, b]) in ends.iter().enumerate() {
+            let (xa, xb, va, vb) = (x[a as usize], x[b as usize], v[a as usize], v[b as usize]);
+            for c in 0..3 {
+                d[c][j] = xb[c] - xa[c];
+                dv[c][j] = vb[c] - va[c];
+            }
+        }
+        let (rest, k, damp) =
+            (&springs.rest[first..first + n], &springs.stiffness[first..first + n], &springs.damping[first..first + n]);
+        let (dx, dy, dz) = (&d[0][..n], &d[1][..n], &d[2][..n]);
+        let (dvx, dvy, dvz) = (&dv[0][..n], &dv[1][..n], &dv[2][..n]);
+        let s = &mut s[..n];
+        for j in 0..n {
+            s[j] = spring_scale(dx[j], dy[j], dz[j], dvx[j], dvy[j], dvz[j], rest[j], k[j], damp[j]);
+        }
+        for (j, f) in out[first..first + n].iter_mut().enumerate() {
+            *f = [s[j] * dx[j], s[j] * dy[j], s[j] * dz[j]];
+        }
+        first += n;
+    }
+}
+
+/// A padded state record: x, y, z and a zero.
+pub(crate) type Rec4 = [f64; 4];
+
+multiversion! {
+    /// [`spring_pass`] on padded records.
+    pub(crate) fn spring_pass4(springs: Springs<'_>, x: &[Rec4], v: &[Rec4], out: &mut [Vec3]) = spring_pass4_body;
+}
+
+#[inline(always)]
+fn spring_pass4_body(springs: Springs<'_>, x: &[Rec4], v: &[Rec4], out: &mut [Vec3]) {
+    let mut d = [[0.0f64; 4]; BLOCK];
+    let mut dv = [[0.0f64; 4]; BLOCK];
+    let mut s = [0.0f64; BLOCK];
+    let n_all = out.len();
+    let mut first = 0;
+    while first < n_all {
+        let n = BLOCK.min(n_all - first);
+        let ends = &springs.ends[first..first + n];
+        let (dd, ddv) = (&mut d[..n], &mut dv[..n]);
+        for j in 0..n {
+            let [a, b] = ends[j];
+            let (xa, xb, va, vb) = (x[a as usize], x[b as usize], v[a as usize], v[b as usize]);
+            dd[j] = [xb[0] - xa[0], xb[1] - xa[1], xb[2] - xa[2], xb[3] - xa[3]];
+            ddv[j] = [vb[0] - va[0], vb[1] - va[1], vb[2] - va[2], vb[3] - va[3]];
+        }
+        let (rest, k, damp) =
+            (&springs.rest[first..first + n], &springs.stiffness[first..first + n], &springs.damping[first..first + n]);
+        let s = &mut s[..n];
+        for j in 0..n {
+            let (e, w) = (dd[j], ddv[j]);
+            // The pads are +0, so l2 + (pad² + pad²) = l2 exactly; reading them keeps the
+            // interleaved loads gap-free, which spares the vectoriser a scalar epilogue.
+            let pads = e[3] * e[3] + w[3] * w[3];
+            s[j] = spring_scale_padded(e[0], e[1], e[2], w[0], w[1], w[2], pads, rest[j], k[j], damp[j]);
+        }
+        for (j, f) in out[first..first + n].iter_mut().enumerate() {
+            let e = dd[j];
+            *f = [s[j] * e[0], s[j] * e[1], s[j] * e[2]];
+        }
+        first += n;
+    }
+}
+
+impl SpringSystem {
+    /// Pass 1 on padded records (the RK4 stepper's layout).
+    pub(crate) fn spring_forces4(&self, kernel: Kernel, x: &[Rec4], v: &[Rec4], sf: &mut [Vec3], parallel: bool) {
+        let n = self.springs();
+        assert!(sf.len() == n, "spring force buffer has {} entries for {n} springs", sf.len());
+        if parallel && n > PARALLEL_CHUNK {
+            sf.par_chunks_mut(PARALLEL_CHUNK).enumerate().for_each(|(c, chunk)| {
+                let r = c * PARALLEL_CHUNK..c * PARALLEL_CHUNK + chunk.len();
+                spring_pass4(kernel, self.spring_view(r), x, v, chunk);
+            });
+        } else {
+            spring_pass4(kernel, self.spring_view(0..n), x, v, sf);
+        }
+    }
+}
+
+multiversion! {
+    /// Accelerations of slots `first..first + out.len()` into `out`.
+    fn acceleration_pass(sys: &SpringSystem, first: usize, v: &[Vec3], sf: &[Vec3], out: &mut [Vec3])
+        = acceleration_pass_body;
+}
+
+#[inline(always)]
+fn acceleration_pass_body(sys: &SpringSystem, first: usize, v: &[Vec3], sf: &[Vec3], out: &mut [Vec3]) {
+    for (k, o) in out.iter_mut().enumerate() {
+        let i = first + k;
+        *o = sys.acceleration(i, v[i], sf);
+    }
+}
+
 /// F_s on end a of a spring (see the module docs). Zero for a zero-length spring. O(1).
 ///
 /// # Examples
@@ -625,6 +829,32 @@ fn spring_scale(dx: f64, dy: f64, dz: f64, dvx: f64, dvy: f64, dvz: f64, rest: f
     let l = l2.sqrt();
     let num = k * (l - rest) * l + c * (dvx * dx + dvy * dy + dvz * dz);
     // Division by max(l2, tiny) keeps the loop branch-free; the select zeroes l = 0.
+    let q = num / l2.max(f64::MIN_POSITIVE);
+    if l2 > 0.0 {
+        q
+    } else {
+        0.0
+    }
+}
+
+/// [`spring_scale`] with `pads` (+0) added to l²: the same bits.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn spring_scale_padded(
+    dx: f64,
+    dy: f64,
+    dz: f64,
+    dvx: f64,
+    dvy: f64,
+    dvz: f64,
+    pads: f64,
+    rest: f64,
+    k: f64,
+    c: f64,
+) -> f64 {
+    let l2 = (dx * dx + dy * dy + dz * dz) + pads;
+    let l = l2.sqrt();
+    let num = k * (l - rest) * l + c * (dvx * dx + dvy * dy + dvz * dz);
     let q = num / l2.max(f64::MIN_POSITIVE);
     if l2 > 0.0 {
         q

@@ -21,8 +21,9 @@ use std::str::FromStr;
 
 use rayon::prelude::*;
 
-use super::force::{SpringSystem, PARALLEL_CHUNK};
+use super::force::{Rec4, SpringSystem, PARALLEL_CHUNK};
 use super::geom::{dot, norm, sub, Vec3};
+use super::simd::{multiversion, Kernel};
 
 /// The time integration scheme.
 ///
@@ -228,11 +229,15 @@ pub struct Stepper {
     step: u64,
     energy_scale: f64,
     sf: Vec<Vec3>,
+    /// Stage state (xs, vs) of RK4, padded to 4 lanes (one vector load per spring end).
+    xs: Vec<Rec4>,
+    vs: Vec<Rec4>,
     acc: Vec<Vec3>,
-    xs: Vec<Vec3>,
-    vs: Vec<Vec3>,
     ax: Vec<Vec3>,
     av: Vec<Vec3>,
+    /// (kinetic energy, non-finite probe) per chunk of slots, from the last RK4 stage.
+    partials: Vec<Probe>,
+    kernel: Kernel,
     cg: CgBuffers,
     /// Iterations of the last implicit solve.
     pub last_cg_iterations: usize,
@@ -281,11 +286,13 @@ impl Stepper {
             step: 0,
             energy_scale: energy_scale(sys, x, v),
             sf: z(s),
+            xs: vec![[0.0; 4]; n],
+            vs: vec![[0.0; 4]; n],
             acc: z(n),
-            xs: z(n),
-            vs: z(n),
             ax: z(n),
             av: z(n),
+            partials: Vec::new(),
+            kernel: Kernel::detect(),
             cg: CgBuffers::default(),
             last_cg_iterations: 0,
         })
@@ -329,6 +336,46 @@ impl Stepper {
         self.step
     }
 
+    /// The instruction set of the hot loops ([`Kernel::detect`] unless set). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::{Integrator, Kernel, SpringSystem, StepConfig, Stepper};
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// sys.push_slot(1.0, false, 0.0);
+    /// let stepper = Stepper::new(StepConfig::new(Integrator::Rk4, 0.1), &sys, &[[0.0; 3]], &[[0.0; 3]]).unwrap();
+    /// assert_eq!(stepper.kernel(), Kernel::detect());
+    /// ```
+    pub fn kernel(&self) -> Kernel {
+        self.kernel
+    }
+
+    /// Runs the hot loops with `kernel` from now on; every kernel gives the same bits. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::{Integrator, Kernel, SpringSystem, StepConfig, Stepper};
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// sys.gravity = [0.0, 0.0, -9.81];
+    /// sys.push_slot(1.0, false, 0.3);
+    /// let run = |kernel| {
+    ///     let (mut x, mut v) = (vec![[0.0; 3]], vec![[1.0, 0.0, 0.0]]);
+    ///     let mut stepper = Stepper::new(StepConfig::new(Integrator::Rk4, 0.01), &sys, &x, &v).unwrap();
+    ///     stepper.set_kernel(kernel);
+    ///     (0..10).for_each(|_| stepper.step(&sys, &mut x, &mut v).unwrap());
+    ///     (x, v)
+    /// };
+    /// let portable = run(Kernel::portable());
+    /// assert!(Kernel::available().into_iter().all(|k| run(k) == portable));
+    /// ```
+    pub fn set_kernel(&mut self, kernel: Kernel) {
+        self.kernel = kernel;
+    }
+
     /// Advances (x, v) by one step of the configured scheme, then checks for blow-up.
     /// O(slots + springs) (times the CG iterations for the implicit scheme).
     ///
@@ -362,6 +409,12 @@ impl Stepper {
             Integrator::Rk4 => self.rk4(sys, x, v),
             Integrator::Implicit => self.implicit(sys, x, v)?,
         }
+        if self.config.integrator != Integrator::Rk4 {
+            let par = self.config.parallel;
+            chunked(par, x.len(), &mut self.partials, |first, n| {
+                probe_state(&sys.mass[first..first + n], &x[first..first + n], &v[first..first + n])
+            });
+        }
         self.check_state(sys, x, v)?;
         self.step += 1;
         Ok(())
@@ -369,70 +422,204 @@ impl Stepper {
 
     fn euler(&mut self, sys: &SpringSystem, x: &mut [Vec3], v: &mut [Vec3]) {
         let (h, par) = (self.config.dt, self.config.parallel);
-        sys.accelerations(x, v, &mut self.sf, &mut self.acc, par);
+        sys.accelerations_with(self.kernel, x, v, &mut self.sf, &mut self.acc, par);
         axpy(x, h, v);
         axpy(v, h, &self.acc);
     }
 
     fn symplectic(&mut self, sys: &SpringSystem, x: &mut [Vec3], v: &mut [Vec3]) {
         let (h, par) = (self.config.dt, self.config.parallel);
-        sys.accelerations(x, v, &mut self.sf, &mut self.acc, par);
+        sys.accelerations_with(self.kernel, x, v, &mut self.sf, &mut self.acc, par);
         axpy(v, h, &self.acc);
         axpy(x, h, v);
     }
 
+    /// Classic RK4, each stage's per-slot update fused with the gather of its accelerations
+    /// (one pass over the slots per stage); the last stage also collects the blow-up probes.
     fn rk4(&mut self, sys: &SpringSystem, x: &mut [Vec3], v: &mut [Vec3]) {
-        let (h, par) = (self.config.dt, self.config.parallel);
-        // Stage 1 at y0: (ax, av) = k1, (xs, vs) = y0 + h/2 k1.
-        sys.accelerations(x, v, &mut self.sf, &mut self.acc, par);
-        for i in 0..x.len() {
-            let (vi, ai) = (v[i], self.acc[i]);
-            self.ax[i] = vi;
-            self.av[i] = ai;
-            self.xs[i] = madd(x[i], 0.5 * h, vi);
-            self.vs[i] = madd(vi, 0.5 * h, ai);
+        let (h, par, kernel) = (self.config.dt, self.config.parallel, self.kernel);
+        let stages = [Stage::First(0.5 * h), Stage::Middle(0.5 * h), Stage::Middle(h), Stage::Last(h / 6.0)];
+        // Stage 1 evaluates at y0: its padded copy.
+        let copy = |((xs, vs), (xi, vi)): ((&mut Rec4, &mut Rec4), (&Vec3, &Vec3))| (*xs, *vs) = (pad(*xi), pad(*vi));
+        if par && x.len() > PARALLEL_CHUNK {
+            self.xs.par_iter_mut().zip(self.vs.par_iter_mut()).zip(x.par_iter().zip(v.par_iter())).for_each(copy);
+        } else {
+            self.xs.iter_mut().zip(self.vs.iter_mut()).zip(x.iter().zip(v.iter())).for_each(copy);
         }
-        // Stages 2 and 3: k = (vs, a(xs, vs)), accumulate 2k, next stage from y0.
-        for c in [0.5 * h, h] {
-            sys.accelerations(&self.xs, &self.vs, &mut self.sf, &mut self.acc, par);
-            for i in 0..x.len() {
-                let (vi, ai) = (self.vs[i], self.acc[i]);
-                self.ax[i] = madd(self.ax[i], 2.0, vi);
-                self.av[i] = madd(self.av[i], 2.0, ai);
-                self.xs[i] = madd(x[i], c, vi);
-                self.vs[i] = madd(v[i], c, ai);
-            }
-        }
-        // Stage 4 and the combination y1 = y0 + h/6 (k1 + 2k2 + 2k3 + k4).
-        sys.accelerations(&self.xs, &self.vs, &mut self.sf, &mut self.acc, par);
-        let w = h / 6.0;
-        for i in 0..x.len() {
-            x[i] = madd(x[i], w, add(self.ax[i], self.vs[i]));
-            v[i] = madd(v[i], w, add(self.av[i], self.acc[i]));
+        for stage in stages {
+            sys.spring_forces4(kernel, &self.xs, &self.vs, &mut self.sf, par);
+            let sf: &[Vec3] = &self.sf;
+            let state = Rk4State {
+                x: &mut *x,
+                v: &mut *v,
+                xs: &mut self.xs,
+                vs: &mut self.vs,
+                ax: &mut self.ax,
+                av: &mut self.av,
+            };
+            state.run(par, &mut self.partials, |first, chunk| rk4_stage(kernel, sys, sf, stage, first, chunk));
         }
     }
 
+    /// Reports a non-finite state or a runaway kinetic energy, from the probes of
+    /// `self.partials` (filled by the step); scans the slots again only to name the culprit.
     fn check_state(&self, sys: &SpringSystem, x: &[Vec3], v: &[Vec3]) -> Result<(), StepError> {
         let step = self.step;
         let bad = |slot, reason: String| Err(StepError::BlowUp { step, slot, reason });
-        let mut kinetic = 0.0;
-        let (mut worst, mut worst_slot) = (-1.0, 0);
-        for i in 0..x.len() {
-            if !(x[i].iter().chain(&v[i]).all(|c| c.is_finite())) {
+        let (kinetic, probe) = self.partials.iter().fold((0.0, 0.0), |(k, p), q| (k + q.kinetic, p + q.probe));
+        if !probe.is_finite() {
+            if let Some(i) = (0..x.len()).find(|&i| !(x[i].iter().chain(&v[i]).all(|c| c.is_finite()))) {
                 return bad(i, format!("non-finite state x = {:?}, v = {:?}", x[i], v[i]));
-            }
-            let e = 0.5 * sys.mass[i] * dot(v[i], v[i]);
-            kinetic += e;
-            if e > worst {
-                (worst, worst_slot) = (e, i);
             }
         }
         let limit = self.config.runaway_factor * self.energy_scale;
         if self.energy_scale > 0.0 && kinetic > limit {
+            let (mut worst, mut worst_slot) = (-1.0, 0);
+            for (i, (&m, vi)) in sys.mass.iter().zip(v).enumerate() {
+                let e = 0.5 * m * dot(*vi, *vi);
+                if e > worst {
+                    (worst, worst_slot) = (e, i);
+                }
+            }
             return bad(worst_slot, format!("kinetic energy {kinetic:e} exceeds {limit:e} (runaway)"));
         }
         Ok(())
     }
+}
+
+/// Blow-up probes of a chunk of slots: its kinetic energy Σ ½ m |v|², and Σ 0·c over every
+/// coordinate c of x and v, which is NaN exactly when some c is NaN or infinite.
+#[derive(Clone, Copy, Debug, Default)]
+struct Probe {
+    kinetic: f64,
+    probe: f64,
+}
+
+impl Probe {
+    #[inline(always)]
+    fn add(&mut self, m: f64, x: Vec3, v: Vec3) {
+        self.kinetic += 0.5 * m * dot(v, v);
+        self.probe += (x[0] * 0.0 + x[1] * 0.0 + x[2] * 0.0) + (v[0] * 0.0 + v[1] * 0.0 + v[2] * 0.0);
+    }
+}
+
+/// Probes of slots with masses `m`, positions `x`, velocities `v`.
+fn probe_state(m: &[f64], x: &[Vec3], v: &[Vec3]) -> Probe {
+    let mut p = Probe::default();
+    for ((&m, &x), &v) in m.iter().zip(x).zip(v) {
+        p.add(m, x, v);
+    }
+    p
+}
+
+/// `partials[c] = probe(c·C, len)` for the chunks of C = [`PARALLEL_CHUNK`] slots of `0..n`,
+/// across threads when asked: the same chunks, hence the same sums, for any thread count.
+fn chunked(par: bool, n: usize, partials: &mut Vec<Probe>, probe: impl Fn(usize, usize) -> Probe + Sync) {
+    let chunks = n.div_ceil(PARALLEL_CHUNK);
+    let range = |c: usize| (c * PARALLEL_CHUNK, PARALLEL_CHUNK.min(n - c * PARALLEL_CHUNK));
+    if par && chunks > 1 {
+        (0..chunks).into_par_iter().map(|c| probe(range(c).0, range(c).1)).collect_into_vec(partials);
+    } else {
+        partials.clear();
+        partials.extend((0..chunks).map(|c| probe(range(c).0, range(c).1)));
+    }
+}
+
+/// Which RK4 stage a slot pass finishes (its step factor).
+#[derive(Clone, Copy, Debug)]
+enum Stage {
+    /// a = a(y0); (ax, av) = k1 = (v, a); (xs, vs) = y0 + c·k1.
+    First(f64),
+    /// a = a(xs, vs); (ax, av) += 2 (vs, a); (xs, vs) = y0 + c·(vs, a).
+    Middle(f64),
+    /// a = a(xs, vs); y0 += c·((ax, av) + (vs, a)), and the probes.
+    Last(f64),
+}
+
+/// The RK4 state over a range of slots.
+struct Rk4State<'a> {
+    x: &'a mut [Vec3],
+    v: &'a mut [Vec3],
+    xs: &'a mut [Rec4],
+    vs: &'a mut [Rec4],
+    ax: &'a mut [Vec3],
+    av: &'a mut [Vec3],
+}
+
+impl Rk4State<'_> {
+    /// `pass(first, chunk)` over the chunks of [`PARALLEL_CHUNK`] slots, across threads when asked;
+    /// the probes go to `partials` in chunk order.
+    fn run(self, par: bool, partials: &mut Vec<Probe>, pass: impl Fn(usize, Rk4State<'_>) -> Probe + Sync + Send) {
+        let c = PARALLEL_CHUNK;
+        let Rk4State { x, v, xs, vs, ax, av } = self;
+        if par && x.len() > c {
+            let chunks = (
+                x.par_chunks_mut(c),
+                v.par_chunks_mut(c),
+                xs.par_chunks_mut(c),
+                vs.par_chunks_mut(c),
+                ax.par_chunks_mut(c),
+                av.par_chunks_mut(c),
+            );
+            chunks
+                .into_par_iter()
+                .enumerate()
+                .map(|(k, (x, v, xs, vs, ax, av))| pass(k * c, Rk4State { x, v, xs, vs, ax, av }))
+                .collect_into_vec(partials);
+        } else {
+            partials.clear();
+            let chunks =
+                x.chunks_mut(c).zip(v.chunks_mut(c)).zip(xs.chunks_mut(c)).zip(vs.chunks_mut(c)).zip(ax.chunks_mut(c));
+            for (k, ((((x, v), xs), vs), ax)) in chunks.enumerate() {
+                let av = &mut av[k * c..k * c + x.len()];
+                partials.push(pass(k * c, Rk4State { x, v, xs, vs, ax, av }));
+            }
+        }
+    }
+}
+
+multiversion! {
+    /// One RK4 stage over the slots `first..` of `s` (see [`Stage`]); spring forces in `sf`.
+    fn rk4_stage(sys: &SpringSystem, sf: &[Vec3], stage: Stage, first: usize, s: Rk4State<'_>) -> Probe = rk4_stage_body;
+}
+
+#[inline(always)]
+fn rk4_stage_body(sys: &SpringSystem, sf: &[Vec3], stage: Stage, first: usize, s: Rk4State<'_>) -> Probe {
+    let n = s.x.len();
+    let (x, v, xs, vs, ax, av) = (s.x, &mut s.v[..n], &mut s.xs[..n], &mut s.vs[..n], &mut s.ax[..n], &mut s.av[..n]);
+    let mut probe = Probe::default();
+    match stage {
+        Stage::First(c) => {
+            for k in 0..n {
+                let (xi, vi) = (x[k], v[k]);
+                let a = sys.acceleration(first + k, vi, sf);
+                ax[k] = vi;
+                av[k] = a;
+                xs[k] = pad(madd(xi, c, vi));
+                vs[k] = pad(madd(vi, c, a));
+            }
+        }
+        Stage::Middle(c) => {
+            for k in 0..n {
+                let vi = unpad(vs[k]);
+                let a = sys.acceleration(first + k, vi, sf);
+                ax[k] = madd(ax[k], 2.0, vi);
+                av[k] = madd(av[k], 2.0, a);
+                xs[k] = pad(madd(x[k], c, vi));
+                vs[k] = pad(madd(v[k], c, a));
+            }
+        }
+        Stage::Last(c) => {
+            for k in 0..n {
+                let vi = unpad(vs[k]);
+                let a = sys.acceleration(first + k, vi, sf);
+                x[k] = madd(x[k], c, add(ax[k], vi));
+                v[k] = madd(v[k], c, add(av[k], a));
+                probe.add(sys.mass[first + k], x[k], v[k]);
+            }
+        }
+    }
+    probe
 }
 
 fn check_len(sys: &SpringSystem, x: &[Vec3]) -> Result<(), StepError> {
@@ -460,6 +647,16 @@ fn energy_scale(sys: &SpringSystem, x: &[Vec3], v: &[Vec3]) -> f64 {
 #[inline(always)]
 fn madd(a: Vec3, s: f64, b: Vec3) -> Vec3 {
     [a[0] + s * b[0], a[1] + s * b[1], a[2] + s * b[2]]
+}
+
+#[inline(always)]
+fn pad(a: Vec3) -> Rec4 {
+    [a[0], a[1], a[2], 0.0]
+}
+
+#[inline(always)]
+fn unpad(a: Rec4) -> Vec3 {
+    [a[0], a[1], a[2]]
 }
 
 #[inline(always)]

@@ -9,6 +9,8 @@
 //!   detection;
 //! - [`projection`]: the indexed projection of a body (seed §5.2) and the orbit-walk reference;
 //! - [`flat`]: the same model built from the tet list without a map (oracle and baseline).
+//! - [`simd`]: [`Kernel`], the run-time choice of instruction set (SSE2, AVX2, AVX-512) for the
+//!   hot loops, all giving the same bits.
 //!
 //! [`Simulation`] ties a body, its projection and a stepper together. `docs/MECHANICS.md` states
 //! every law with its formula and where the code checks it.
@@ -20,6 +22,7 @@ pub(crate) mod geom;
 pub mod integrate;
 pub mod model;
 pub mod projection;
+pub mod simd;
 
 pub use conservation::{check_conservation, conservation_violations, ConservationError};
 pub use flat::FlatModel;
@@ -28,6 +31,7 @@ pub use geom::Vec3;
 pub use integrate::{Integrator, StepConfig, StepError, Stepper};
 pub use model::{Body, BodyError, Material, Mechanics, ModelError};
 pub use projection::{forces_by_coverage, Projection, ProjectionMismatch, TouchedCells};
+pub use simd::Kernel;
 
 use crate::CellId;
 

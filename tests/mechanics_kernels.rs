@@ -1,0 +1,229 @@
+//! The run-time dispatched kernels (`mechanics::Kernel`) and the fused RK4 step: every kernel
+//! gives the same bits as the portable build, and the fused RK4 gives the same bits as the
+//! textbook composition of `accelerations` calls, on the built-in liver and on random systems,
+//! serial and on several threads; blow-ups are still reported with their slot.
+
+use topomech::load::load_builtin;
+use topomech::mechanics::force::PARALLEL_CHUNK;
+use topomech::mechanics::{
+    FlatModel, Integrator, Kernel, Material, SpringSystem, StepConfig, StepError, Stepper, Vec3,
+};
+
+/// A small deterministic generator (64-bit LCG, top bits): uniform in [0, 1).
+struct Lcg(u64);
+
+impl Lcg {
+    fn next(&mut self) -> f64 {
+        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn below(&mut self, n: usize) -> usize {
+        ((self.next() * n as f64) as usize).min(n - 1)
+    }
+    fn vec(&mut self, scale: f64) -> Vec3 {
+        [(self.next() - 0.5) * scale, (self.next() - 0.5) * scale, (self.next() - 0.5) * scale]
+    }
+}
+
+/// A system with a state (positions, velocities).
+type Case = (SpringSystem, Vec<Vec3>, Vec<Vec3>);
+
+/// The built-in liver as a flat model (pinned on its low-x tenth), with a perturbed state.
+fn liver() -> Case {
+    let loaded = load_builtin().expect("built-in mesh loads");
+    let (points, tets) = (&loaded.mesh.points, &loaded.mesh.tets);
+    let lo = points.iter().map(|p| p[0]).fold(f64::INFINITY, f64::min);
+    let hi = points.iter().map(|p| p[0]).fold(f64::NEG_INFINITY, f64::max);
+    let pinned: Vec<bool> = points.iter().map(|p| p[0] < lo + 0.1 * (hi - lo)).collect();
+    let flat = FlatModel::from_tets(points, tets, Material::default(), [0.0, 0.0, -9.81], &pinned).unwrap();
+    let mut rng = Lcg(7);
+    let x = flat.position.iter().map(|p| add(*p, rng.vec(0.05 * (hi - lo)))).collect();
+    let v = (0..points.len()).map(|_| rng.vec(0.3)).collect();
+    (flat.system, x, v)
+}
+
+/// `slots` random slots (a tenth fixed), `springs` random springs between distinct slots, a few
+/// of zero length (both ends at the same point) and a few with zero stiffness or damping.
+fn random_system(seed: u64, slots: usize, springs: usize) -> Case {
+    let mut rng = Lcg(seed);
+    let mut sys = SpringSystem::default();
+    sys.gravity = [0.1, -0.2, -9.81];
+    let mut x: Vec<Vec3> = (0..slots).map(|_| rng.vec(10.0)).collect();
+    let v: Vec<Vec3> = (0..slots).map(|_| rng.vec(2.0)).collect();
+    for _ in 0..slots {
+        sys.push_slot(0.1 + rng.next(), rng.next() < 0.1, 0.5 * rng.next());
+    }
+    for s in 0..springs {
+        let a = rng.below(slots);
+        let b = (a + 1 + rng.below(slots - 1)) % slots;
+        if s % 97 == 0 {
+            x[b] = x[a]; // zero length: the force must be 0, not NaN
+        }
+        let k = if s % 13 == 0 { 0.0 } else { 100.0 * rng.next() };
+        let c = if s % 7 == 0 { 0.0 } else { rng.next() };
+        sys.push_spring([a as u32, b as u32], 2.0 * rng.next(), k, c);
+    }
+    (sys, x, v)
+}
+
+fn add(a: Vec3, b: Vec3) -> Vec3 {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+fn madd(a: Vec3, s: f64, b: Vec3) -> Vec3 {
+    [a[0] + s * b[0], a[1] + s * b[1], a[2] + s * b[2]]
+}
+
+fn bits(a: &[Vec3]) -> Vec<[u64; 3]> {
+    a.iter().map(|p| p.map(f64::to_bits)).collect()
+}
+
+fn systems() -> Vec<(&'static str, Case)> {
+    vec![("liver", liver()), ("random", random_system(3, 300, 2000)), ("random large", random_system(5, 5000, 9000))]
+}
+
+#[test]
+fn every_kernel_gives_the_portable_forces_bit_for_bit() {
+    assert!(Kernel::available().contains(&Kernel::detect()));
+    for (name, (sys, x, v)) in systems() {
+        let eval = |kernel, parallel| {
+            let (mut sf, mut acc) = (vec![[0.0; 3]; sys.springs()], vec![[0.0; 3]; sys.slots()]);
+            sys.accelerations_with(kernel, &x, &v, &mut sf, &mut acc, parallel);
+            (bits(&sf), bits(&acc))
+        };
+        let reference = eval(Kernel::portable(), false);
+        assert!(reference.1.iter().flatten().any(|&b| f64::from_bits(b) != 0.0), "{name}: all zero");
+        assert!(reference.0.iter().flatten().all(|&b| f64::from_bits(b).is_finite()), "{name}: non-finite");
+        // The portable pass agrees with the one-spring law.
+        for (s, &[a, b]) in sys.ends.iter().enumerate().step_by(17) {
+            let (a, b) = (a as usize, b as usize);
+            let f = topomech::mechanics::force::spring_force(
+                x[a],
+                x[b],
+                v[a],
+                v[b],
+                sys.rest[s],
+                sys.stiffness[s],
+                sys.damping[s],
+            );
+            assert_eq!(f.map(f64::to_bits), reference.0[s], "{name}: spring {s}");
+        }
+        for kernel in Kernel::available() {
+            for parallel in [false, true] {
+                assert!(eval(kernel, parallel) == reference, "{name}: kernel {} parallel {parallel}", kernel.name());
+            }
+        }
+    }
+}
+
+/// RK4 as four `accelerations` calls and the per-slot combinations, in the documented order.
+fn textbook_rk4(sys: &SpringSystem, h: f64, x: &mut [Vec3], v: &mut [Vec3]) {
+    let n = x.len();
+    let mut sf = vec![[0.0; 3]; sys.springs()];
+    let mut a = vec![[0.0; 3]; n];
+    sys.accelerations_with(Kernel::portable(), x, v, &mut sf, &mut a, false);
+    let (mut ax, mut av) = (v.to_vec(), a.clone());
+    let mut xs: Vec<Vec3> = (0..n).map(|i| madd(x[i], 0.5 * h, v[i])).collect();
+    let mut vs: Vec<Vec3> = (0..n).map(|i| madd(v[i], 0.5 * h, a[i])).collect();
+    for c in [0.5 * h, h] {
+        sys.accelerations_with(Kernel::portable(), &xs, &vs, &mut sf, &mut a, false);
+        for i in 0..n {
+            ax[i] = madd(ax[i], 2.0, vs[i]);
+            av[i] = madd(av[i], 2.0, a[i]);
+            xs[i] = madd(x[i], c, vs[i]);
+            vs[i] = madd(v[i], c, a[i]);
+        }
+    }
+    sys.accelerations_with(Kernel::portable(), &xs, &vs, &mut sf, &mut a, false);
+    for i in 0..n {
+        x[i] = madd(x[i], h / 6.0, add(ax[i], vs[i]));
+        v[i] = madd(v[i], h / 6.0, add(av[i], a[i]));
+    }
+}
+
+#[test]
+fn fused_rk4_equals_the_textbook_composition_for_every_kernel_and_thread_count() {
+    for (name, (sys, x0, v0)) in systems() {
+        let h = 0.2 / sys.omega_max();
+        let (mut x, mut v) = (x0.clone(), v0.clone());
+        for _ in 0..3 {
+            textbook_rk4(&sys, h, &mut x, &mut v);
+        }
+        assert!(bits(&x) != bits(&x0), "{name}: the state must move");
+        let expected = (bits(&x), bits(&v));
+        for kernel in Kernel::available() {
+            for (threads, parallel) in [(1, false), (1, true), (2, true), (3, true)] {
+                let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+                let got = pool.install(|| {
+                    let (mut x, mut v) = (x0.clone(), v0.clone());
+                    let config = StepConfig { parallel, ..StepConfig::new(Integrator::Rk4, h) };
+                    let mut stepper = Stepper::new(config, &sys, &x, &v).unwrap();
+                    stepper.set_kernel(kernel);
+                    for _ in 0..3 {
+                        stepper.step(&sys, &mut x, &mut v).unwrap();
+                    }
+                    (bits(&x), bits(&v))
+                });
+                assert!(got == expected, "{name}: kernel {} on {threads} threads ({parallel})", kernel.name());
+            }
+        }
+    }
+    // The large random system spans several slot and spring chunks, so the parallel split runs.
+    assert!(random_system(5, 5000, 9000).0.slots() > PARALLEL_CHUNK);
+}
+
+#[test]
+fn every_integrator_steps_the_same_bits_with_every_kernel() {
+    let (sys, x0, v0) = random_system(11, 200, 900);
+    let h = 0.1 / sys.omega_max();
+    for integrator in [Integrator::Euler, Integrator::Symplectic, Integrator::Rk4, Integrator::Implicit] {
+        let run = |kernel| {
+            let (mut x, mut v) = (x0.clone(), v0.clone());
+            let mut stepper = Stepper::new(StepConfig::new(integrator, h), &sys, &x, &v).unwrap();
+            stepper.set_kernel(kernel);
+            assert_eq!(stepper.kernel(), kernel);
+            for _ in 0..4 {
+                stepper.step(&sys, &mut x, &mut v).unwrap();
+            }
+            (bits(&x), bits(&v))
+        };
+        let reference = run(Kernel::portable());
+        assert!(reference.0 != bits(&x0));
+        for kernel in Kernel::available() {
+            assert!(run(kernel) == reference, "{integrator:?} with kernel {}", kernel.name());
+        }
+    }
+}
+
+#[test]
+fn rk4_reports_a_runaway_at_the_most_energetic_slot_and_a_nan_at_its_slot() {
+    let (sys, x0, v0) = random_system(13, 50, 150);
+    let h = 0.1 / sys.omega_max();
+    let free = (0..sys.slots()).filter(|&i| sys.inv_mass[i] > 0.0).nth(7).unwrap();
+    for kernel in Kernel::available() {
+        let (mut x, mut v) = (x0.clone(), v0.clone());
+        let mut stepper = Stepper::new(StepConfig::new(Integrator::Rk4, h), &sys, &x, &v).unwrap();
+        stepper.set_kernel(kernel);
+        stepper.step(&sys, &mut x, &mut v).unwrap();
+        let mut kicked = v.clone();
+        kicked[free] = [1e9, 0.0, 0.0];
+        let (mut xk, mut vk) = (x.clone(), kicked);
+        match stepper.clone().step(&sys, &mut xk, &mut vk) {
+            Err(StepError::BlowUp { step: 1, slot, reason }) => {
+                assert_eq!(slot, free, "{}", kernel.name());
+                assert!(reason.contains("runaway"), "{reason}");
+            }
+            other => panic!("runaway not reported with {}: {other:?}", kernel.name()),
+        }
+        let last = sys.slots() - 1;
+        x[last][1] = f64::INFINITY;
+        match stepper.step(&sys, &mut x, &mut v) {
+            Err(StepError::BlowUp { step: 1, slot, reason }) => {
+                assert!(reason.contains("non-finite"), "{reason}");
+                assert!(x[slot].iter().chain(&v[slot]).any(|c| !c.is_finite()));
+                assert!((0..slot).all(|i| x[i].iter().chain(&v[i]).all(|c| c.is_finite())), "first bad slot");
+            }
+            other => panic!("infinity not reported with {}: {other:?}", kernel.name()),
+        }
+    }
+}

@@ -9,8 +9,9 @@
 //! α1(d0) to collect the other half of the fan.
 
 use crate::mechanics::geom::{cross, dot, sub};
+use crate::mechanics::model::triangle_vertices;
 use crate::mechanics::{Body, Simulation, TouchedCells, Vec3};
-use crate::{AlphaMask, CellId, DartId, GMap};
+use crate::{CellId, DartId, GMap};
 
 use super::{dissociate_face, CutError, Dissociation};
 
@@ -219,11 +220,8 @@ fn walk(map: &GMap<3>, start: DartId, mut visit: impl FnMut(DartId)) -> bool {
 /// Unit normal of the face of `d` from current positions (zero if degenerate). O(face).
 fn face_normal(body: &Body, d: DartId) -> Vec3 {
     let (map, mech) = (body.map(), body.attrs());
-    let mut ids: Vec<CellId> = map.orbit(d, AlphaMask::of(&[0, 1])).into_iter().map(|x| map.vertex_id(x)).collect();
-    ids.sort_unstable();
-    ids.dedup();
-    let [a, b, c] = ids.as_slice() else { return [0.0; 3] };
-    let p = |v: &CellId| mech.position[*v];
+    let Some([a, b, c]) = triangle_vertices(map, d) else { return [0.0; 3] };
+    let p = |v: CellId| mech.position[v];
     let n = cross(sub(p(b), p(a)), sub(p(c), p(a)));
     let len = dot(n, n).sqrt();
     if len == 0.0 {
@@ -263,11 +261,20 @@ pub fn tear_vertex(body: &mut Body, v: CellId, direction: Vec3, hint: Option<Dar
     let on_v = |d: DartId| map.contains(d) && map.vertex_id(d) == v;
     let start = hint.filter(|&d| on_v(d)).or_else(|| map.darts().find(|&d| on_v(d)));
     let start = start.ok_or(CutError::NoSuchVertex(v))?;
-    let inner: Vec<DartId> = map.cell_darts(0, start).into_iter().filter(|&d| !map.is_free(3, d)).collect();
-    let best = inner.iter().copied().max_by(|&a, &b| {
-        let score = |d| dot(face_normal(body, d), direction).abs();
-        score(a).total_cmp(&score(b)).then(b.cmp(&a))
-    });
+    // A face's score depends only on its vertices: computed once per face id.
+    let mut faces: Vec<(CellId, f64)> = Vec::new();
+    let mut score = |d: DartId| {
+        let f = map.cell_id(2, d);
+        if let Some(&(_, s)) = faces.iter().rev().find(|c| c.0 == f) {
+            return s;
+        }
+        let s = dot(face_normal(body, d), direction).abs();
+        faces.push((f, s));
+        s
+    };
+    let scored: Vec<(DartId, f64)> =
+        map.cell_darts(0, start).into_iter().filter(|&d| !map.is_free(3, d)).map(|d| (d, score(d))).collect();
+    let best = scored.iter().max_by(|a, b| a.1.total_cmp(&b.1).then(b.0.cmp(&a.0))).map(|&(d, _)| d);
     let mut tear =
         Tear { vertex: v, fan: Vec::new(), dissociations: Vec::new(), split: false, touched: TouchedCells::default() };
     let Some(d0) = best else { return Ok(tear) };

@@ -794,7 +794,7 @@ mod tests {
         let (grid, _) = GMap::<2>::from_triangles(points.len(), &triangles).unwrap();
         for i in 0..=2 {
             let (mut fast, mut slow) = (grid.clone(), grid.clone());
-            for d in grid.darts().rev() {
+            for d in grid.darts().collect::<Vec<_>>().into_iter().rev() {
                 if !fast.is_free(i, d) {
                     assert_eq!(fast.unsew_with(i, d, true).unwrap(), slow.unsew_with(i, d, false).unwrap());
                 }

@@ -149,6 +149,7 @@ impl<const N: usize> GMap<N> {
 
     /// Continues the breadth-first walk of [`GMap::orbit`] from `head` with stamps: same order.
     fn orbit_stamped(&self, out: &mut Vec<DartId>, mut head: usize, gens: &[usize]) {
+        out.reserve(4 * out.len());
         with_stamps(|stamps| {
             let tag = stamps.fresh(self.capacity(), 1);
             for &x in out.iter() {
@@ -434,6 +435,32 @@ impl<const N: usize> GMap<N> {
 }
 
 impl GMap<3> {
+    /// The distinct volume ids around the vertex of d, sorted: the vertex orbit ⟨α1, α2, α3⟩(d)
+    /// walked as its corners ⟨α1, α2⟩ (each inside one volume, walked by [`GMap::for_each_dihedral`])
+    /// joined by α3, one id per corner, no list of darts. O(vertex orbit).
+    pub(crate) fn vertex_volumes(&self, d: DartId) -> Vec<CellId> {
+        let mut volumes = Vec::with_capacity(32);
+        let mut corners = Vec::with_capacity(32);
+        with_stamps(|stamps| {
+            let tag = stamps.fresh(self.capacity(), 1);
+            self.for_each_dihedral(d, 1, 2, |x| stamps.mark(x.0, tag));
+            corners.push(d);
+            while let Some(c) = corners.pop() {
+                volumes.push(self.cell_id(3, c));
+                self.for_each_dihedral(c, 1, 2, |x| {
+                    let y = self.alpha::<3>(x);
+                    if y != x && !stamps.has(y.0, tag) {
+                        self.for_each_dihedral(y, 1, 2, |z| stamps.mark(z.0, tag));
+                        corners.push(y);
+                    }
+                });
+            }
+        });
+        volumes.sort_unstable();
+        volumes.dedup();
+        volumes
+    }
+
     /// The darts w(d) for the 24 words w of [`TetWords`] if they are closed under α0, α1, α2 —
     /// then they are exactly the volume orbit ⟨α0, α1, α2⟩(d) (possibly with repeats, for a
     /// folded volume); `None` otherwise (a volume that is not a closed tetrahedron, such as one
@@ -649,6 +676,18 @@ mod tests {
                 want.sort_unstable();
                 assert_eq!(seen, want, "<a{j}, a{k}>({d})");
             }
+        }
+    }
+
+    /// The corner walk finds the volumes of the whole vertex orbit.
+    #[test]
+    fn vertex_volumes_are_those_of_the_vertex_orbit() {
+        let map = cut_cube();
+        for d in map.darts().step_by(4) {
+            let mut want: Vec<CellId> = map.cell_darts(0, d).iter().map(|&x| map.cell_id(3, x)).collect();
+            want.sort_unstable();
+            want.dedup();
+            assert_eq!(map.vertex_volumes(d), want);
         }
     }
 

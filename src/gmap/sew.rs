@@ -527,11 +527,24 @@ impl<const N: usize> GMap<N> {
                 continue;
             }
             let anchor = endpoint(pairs, a);
-            let Some((side, is_z_side)) = self.split_side(anchor, z, mask) else { continue };
-            let new = self.alloc_cell_id(dim);
-            for &w in &side {
-                self.set_cell_raw(dim, w, new);
-            }
+            let new = match links.split_of_whole_classes(&classes, dim, a, k) {
+                Some((side, is_z_side)) => {
+                    let new = self.alloc_cell_id(dim);
+                    for w in (0..2 * pairs.len()).filter(|&w| classes.joined(w, side)) {
+                        self.set_cell_raw(dim, endpoint(pairs, w), new);
+                    }
+                    (new, is_z_side)
+                }
+                None => {
+                    let Some((side, is_z_side)) = self.split_side(anchor, z, mask) else { continue };
+                    let new = self.alloc_cell_id(dim);
+                    for &w in &side {
+                        self.set_cell_raw(dim, w, new);
+                    }
+                    (new, is_z_side)
+                }
+            };
+            let (new, is_z_side) = new;
             complete.push(new);
             let (dart_kept, dart_new) = if is_z_side { (anchor, z) } else { (z, anchor) };
             anchors[slot].1 = if is_z_side { a } else { k };
@@ -574,6 +587,10 @@ struct QuickLinks {
     /// either way the proof holds in the cells of every dimension other than k (and i).
     links: [(u8, u8, u8); QuickLinks::MAX_LINKS],
     len: usize,
+    /// Per endpoint, the bit set of the generators k with a direct link αk(p) = q or αk(p) = p.
+    direct: [u8; 2 * QuickLinks::MAX_PAIRS],
+    /// The bit set of the map's generators α0 … αn.
+    gens: u8,
     /// Number of endpoints covered (0: no proof was built).
     ends: usize,
 }
@@ -612,7 +629,7 @@ impl QuickLinks {
 
     /// No proof at all.
     fn none() -> Self {
-        QuickLinks { links: [(0, 0, 0); Self::MAX_LINKS], len: 0, ends: 0 }
+        QuickLinks { links: [(0, 0, 0); Self::MAX_LINKS], len: 0, direct: [0; 2 * Self::MAX_PAIRS], gens: 0, ends: 0 }
     }
 
     fn find<const N: usize>(map: &GMap<N>, i: usize, pairs: &[(DartId, DartId)]) -> Self {
@@ -621,13 +638,20 @@ impl QuickLinks {
             return out;
         }
         out.ends = 2 * pairs.len();
+        out.gens = ((1u16 << (N + 1)) - 1) as u8;
         let ends = out.ends;
         let index = |d: DartId| (0..ends).find(|&k| endpoint(pairs, k) == d);
         let commuting = |k: usize, j: usize| k.abs_diff(i) >= 2 && k.abs_diff(j) >= 2;
         for p in 0..ends {
             let x = endpoint(pairs, p);
+            out.direct[p] |= 1 << i; // every endpoint is i-free now
             for k in (0..=N).filter(|&k| k.abs_diff(i) >= 2) {
-                if let Some(q) = index(map.alpha_dyn(k, x)).filter(|&q| q > p) {
+                let y = map.alpha_dyn(k, x);
+                if y == x {
+                    out.direct[p] |= 1 << k;
+                } else if let Some(q) = index(y).filter(|&q| q > p) {
+                    out.direct[p] |= 1 << k;
+                    out.direct[q] |= 1 << k;
                     out.push(p, q, k);
                 }
             }
@@ -661,6 +685,33 @@ impl QuickLinks {
             }
         }
         out
+    }
+
+    /// When the classes of endpoints a and z (not joined) are each a whole dim-cell — every
+    /// member's αk image, for every αk of the cell's orbit, is itself or a member reached by a
+    /// direct link — the split [`GMap::split_side`] would find, without walking: the class of a
+    /// if it is not larger (the lockstep walk exhausts a's side first then, a's side moving
+    /// first in each round), else z's. Returns a member of that class and whether it is z's.
+    fn split_of_whole_classes(&self, classes: &Classes, dim: usize, a: usize, z: usize) -> Option<(usize, bool)> {
+        if self.ends == 0 {
+            return None;
+        }
+        let cell = self.gens & !(1 << dim);
+        let mut size = [0usize; 2];
+        for p in 0..self.ends {
+            let side = if classes.joined(p, a) {
+                0
+            } else if classes.joined(p, z) {
+                1
+            } else {
+                continue;
+            };
+            if self.direct[p] & cell != cell {
+                return None;
+            }
+            size[side] += 1;
+        }
+        Some(if size[0] <= size[1] { (a, false) } else { (z, true) })
     }
 
     /// The classes of endpoints proven joined in the cells of dimension `dim`.

@@ -563,16 +563,7 @@ impl Mechanics {
     /// }
     /// ```
     pub fn vertex_mass_from_map(&self, map: &GMap<3>, d: DartId) -> f64 {
-        // Darts of one tet follow each other in the walk: skipping repeats first keeps the sort short.
-        let mut tets: Vec<CellId> = Vec::with_capacity(64);
-        for x in map.cell_darts(0, d) {
-            let t = map.cell_id(3, x);
-            if tets.last() != Some(&t) {
-                tets.push(t);
-            }
-        }
-        tets.sort_unstable();
-        tets.dedup();
+        let tets = map.vertex_volumes(d);
         tets.iter().map(|&t| self.tet_mass[t] / 4.0).sum()
     }
 
@@ -772,13 +763,17 @@ impl CellRules<3> for Mechanics {
         }
         // Once per face: every dart of a face gives the same flag and normal (a face is α3-free
         // on all of its ⟨α0, α1⟩ orbit or on none of it).
-        let mut done: Vec<CellId> = Vec::new();
+        let (mut recent, mut done) = ([CellId(u32::MAX); 4], Vec::new());
         for d in changes.pairs.iter().flat_map(|&(a, b)| [a, b]) {
             let f = map.cell_id(2, d);
-            if done.contains(&f) {
+            if recent.contains(&f) || done.contains(&f) {
                 continue;
             }
-            done.push(f);
+            // The first faces met are kept on the stack (an α3 unsew meets two).
+            match recent.iter_mut().find(|r| r.0 == u32::MAX) {
+                Some(r) => *r = f,
+                None => done.push(f),
+            }
             self.face_boundary[f] = map.is_free(3, d);
             self.face_normal[f] = if self.face_boundary[f] { self.outward_normal(map, d) } else { [0.0; 3] };
         }

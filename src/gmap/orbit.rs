@@ -2,7 +2,10 @@
 //!
 //! The i-cell of d is the orbit ⟨⟩N−{i}(d) = ⟨α0, …, αi−1, αi+1, …, αn⟩(d) (seed 000, §2.1).
 //! Walks are breadth-first, visit generators in increasing index order (so the order is
-//! deterministic), and are bounded by the number of live darts.
+//! deterministic), and are bounded by the number of live darts. Their visited set is the list of
+//! darts found while it is short (`LINEAR_LIMIT`), then a per-thread array of epoch stamps
+//! (`Stamps`: one u32 per dart slot, a fresh tag per walk, never cleared): no hashing. Orbits of
+//! two generators need no visited set at all (`GMap::for_each_dihedral`).
 
 use super::{AlphaMask, CellId, DartId, GMap};
 
@@ -471,7 +474,8 @@ impl GMap<3> {
         for (k, &(parent, g)) in words.tree.iter().enumerate().skip(1) {
             darts[k] = self.alpha_dyn(g as usize, darts[parent as usize]);
         }
-        let closed = words.extra.iter().all(|&(a, g, b)| self.alpha_dyn(g as usize, darts[a as usize]) == darts[b as usize]);
+        let closed =
+            words.extra.iter().all(|&(a, g, b)| self.alpha_dyn(g as usize, darts[a as usize]) == darts[b as usize]);
         closed.then_some(darts)
     }
 }

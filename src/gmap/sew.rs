@@ -11,7 +11,11 @@
 //! did as [`CellChanges`], which the embedding layer turns into attribute merges and splits.
 //!
 //! Cost: O(|O1| · n) for the links plus the size of the relabelled cells; an unsew also walks,
-//! for each cell it might split, both sides in lockstep until they meet or the smaller one ends.
+//! for each cell it might split, both sides in lockstep until they meet or the smaller one ends —
+//! unless a cheap proof settles it first (`QuickLinks`: direct αk links between the unsewn darts,
+//! and the rings ⟨αi±1, αi⟩ walked from both darts of each pair). For the α3-unsew of an inner
+//! triangle that proof covers all three vertices and edges (three rings of tets around its edges)
+//! and the face itself, so nothing is walked beyond the rings.
 
 use rustc_hash::FxHashMap;
 
@@ -803,7 +807,8 @@ mod tests {
 
     fn same_state<const N: usize>(a: &GMap<N>, b: &GMap<N>) -> bool {
         a.capacity() == b.capacity()
-            && a.darts().all(|d| (0..=N).all(|k| a.alpha_dyn(k, d) == b.alpha_dyn(k, d) && a.cell_id(k, d) == b.cell_id(k, d)))
+            && a.darts()
+                .all(|d| (0..=N).all(|k| a.alpha_dyn(k, d) == b.alpha_dyn(k, d) && a.cell_id(k, d) == b.cell_id(k, d)))
     }
 
     /// Unsews every sewn dart of a Kuhn cube by αi (i = 0..=3, each on a fresh cube, in a

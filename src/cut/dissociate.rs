@@ -74,7 +74,9 @@ pub struct Dissociation {
 /// recomputed from the tets now around them (m = m1 + m2, k = k1 + k2).
 ///
 /// Cost: O(face + split cells' orbits) — the kernel's unsew walks both sides of each cell it might
-/// split in lockstep, and the rules recompute each split cell from its orbit.
+/// split in lockstep, and the rules recompute each split cell from its orbit. For an inner face
+/// whose vertices and edges do not split, that is the three rings of tets around its edges (the
+/// kernel's proof that nothing split) and two O(1) face normals.
 ///
 /// # Errors
 /// [`CutError::NoSuchDart`], [`CutError::BoundaryFace`] (body unchanged); [`CutError::Body`] if the

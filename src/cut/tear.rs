@@ -9,8 +9,9 @@
 //! α1(d0) to collect the other half of the fan.
 
 use crate::mechanics::geom::{cross, dot, sub};
+use crate::mechanics::model::triangle_vertices;
 use crate::mechanics::{Body, Simulation, TouchedCells, Vec3};
-use crate::{AlphaMask, CellId, DartId, GMap};
+use crate::{CellId, DartId, GMap};
 
 use super::{dissociate_face, CutError, Dissociation};
 
@@ -219,11 +220,8 @@ fn walk(map: &GMap<3>, start: DartId, mut visit: impl FnMut(DartId)) -> bool {
 /// Unit normal of the face of `d` from current positions (zero if degenerate). O(face).
 fn face_normal(body: &Body, d: DartId) -> Vec3 {
     let (map, mech) = (body.map(), body.attrs());
-    let mut ids: Vec<CellId> = map.orbit(d, AlphaMask::of(&[0, 1])).into_iter().map(|x| map.vertex_id(x)).collect();
-    ids.sort_unstable();
-    ids.dedup();
-    let [a, b, c] = ids.as_slice() else { return [0.0; 3] };
-    let p = |v: &CellId| mech.position[*v];
+    let Some([a, b, c]) = triangle_vertices(map, d) else { return [0.0; 3] };
+    let p = |v: CellId| mech.position[v];
     let n = cross(sub(p(b), p(a)), sub(p(c), p(a)));
     let len = dot(n, n).sqrt();
     if len == 0.0 {
@@ -263,11 +261,20 @@ pub fn tear_vertex(body: &mut Body, v: CellId, direction: Vec3, hint: Option<Dar
     let on_v = |d: DartId| map.contains(d) && map.vertex_id(d) == v;
     let start = hint.filter(|&d| on_v(d)).or_else(|| map.darts().find(|&d| on_v(d)));
     let start = start.ok_or(CutError::NoSuchVertex(v))?;
-    let inner: Vec<DartId> = map.cell_darts(0, start).into_iter().filter(|&d| !map.is_free(3, d)).collect();
-    let best = inner.iter().copied().max_by(|&a, &b| {
-        let score = |d| dot(face_normal(body, d), direction).abs();
-        score(a).total_cmp(&score(b)).then(b.cmp(&a))
-    });
+    // A face's score depends only on its vertices, shared by d, α1(d), α3(d), α1α3(d): only the
+    // smallest of the four is scored. The choice is unchanged (highest score, then smallest
+    // dart): every dart left out has a smaller one with the same score that is kept.
+    let kept = |d: DartId| {
+        let (a1, a3) = (map.alpha::<1>(d), map.alpha::<3>(d));
+        !map.is_free(3, d) && d <= a1 && d <= a3 && d <= map.alpha::<1>(a3)
+    };
+    let scored: Vec<(DartId, f64)> = map
+        .cell_darts(0, start)
+        .into_iter()
+        .filter(|&d| kept(d))
+        .map(|d| (d, dot(face_normal(body, d), direction).abs()))
+        .collect();
+    let best = scored.iter().max_by(|a, b| a.1.total_cmp(&b.1).then(b.0.cmp(&a.0))).map(|&(d, _)| d);
     let mut tear =
         Tear { vertex: v, fan: Vec::new(), dissociations: Vec::new(), split: false, touched: TouchedCells::default() };
     let Some(d0) = best else { return Ok(tear) };
@@ -338,4 +345,43 @@ pub fn tear_step(
 
 fn mul(m: &[[f64; 3]; 3], v: Vec3) -> Vec3 {
     [dot(m[0], v), dot(m[1], v), dot(m[2], v)]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cut::ops::jittered_cube;
+    use crate::mechanics::Material;
+
+    /// The start face is the one the full scan (every inner dart of the vertex scored, highest
+    /// score then smallest dart) picks, also with exact ties (the unjittered cube) and after cuts.
+    #[test]
+    fn start_face_is_the_full_scan_choice() {
+        let dirs = [[1.0, 0.0, 0.0], [0.3, -0.7, 0.2], [0.0, 0.0, 1.0], [1.0, 1.0, 1.0]];
+        for (seed, jitter) in [(3, true), (0, false)] {
+            let (points, tets) = if jitter { jittered_cube(3, seed) } else { crate::generate::kuhn_cube(3) };
+            let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+            let some: Vec<DartId> = body.map().darts().filter(|d| d.0 % 97 == 0).collect();
+            for d in some {
+                if !body.map().is_free(3, d) {
+                    dissociate_face(&mut body, d).unwrap();
+                }
+            }
+            let map = body.map();
+            let mut checked = 0;
+            for start in map.one_dart_per_cell(0) {
+                for dir in dirs {
+                    let full = map.cell_darts(0, start).into_iter().filter(|&d| !map.is_free(3, d)).max_by(|&a, &b| {
+                        let score = |d| dot(face_normal(&body, d), dir).abs();
+                        score(a).total_cmp(&score(b)).then(b.cmp(&a))
+                    });
+                    let mut copy = body.clone();
+                    let tear = tear_vertex(&mut copy, map.vertex_id(start), dir, Some(start)).unwrap();
+                    assert_eq!(tear.fan.first().copied(), full, "vertex {} direction {dir:?}", map.vertex_id(start));
+                    checked += usize::from(full.is_some());
+                }
+            }
+            assert!(checked > 100);
+        }
+    }
 }

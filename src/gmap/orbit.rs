@@ -2,97 +2,72 @@
 //!
 //! The i-cell of d is the orbit ⟨⟩N−{i}(d) = ⟨α0, …, αi−1, αi+1, …, αn⟩(d) (seed 000, §2.1).
 //! Walks are breadth-first, visit generators in increasing index order (so the order is
-//! deterministic), and are bounded by the number of live darts.
+//! deterministic), and are bounded by the number of live darts. Their visited set is the list of
+//! darts found while it is short (`LINEAR_LIMIT`), then a per-thread array of epoch stamps
+//! (`Stamps`: one u32 per dart slot, a fresh tag per walk, never cleared): no hashing. Orbits of
+//! two generators need no visited set at all (`GMap::for_each_dihedral`).
 
 use super::{AlphaMask, CellId, DartId, GMap};
 
-/// A visited set tuned for single orbits: linear scan while small, then an open-addressing hash
-/// table of dart ids (Fibonacci hashing, linear probing, grown at half load).
-pub(crate) struct SmallDartSet {
-    small: Vec<u32>,
-    table: Vec<u32>,
-    len: usize,
+/// Epoch-stamped visited marks, one u32 per dart slot, shared by the walks of one thread.
+///
+/// A walk takes fresh tags ([`Stamps::fresh`]) and marks a dart by writing its tag; a dart is
+/// visited iff its mark equals the tag. Nothing is cleared between walks (a new tag makes every
+/// old mark stale), so a test or a mark is one load or store with no hashing. The array grows to
+/// the largest map capacity the thread walks (4 bytes per dart slot), and is wiped only when
+/// the 32-bit tags wrap.
+#[derive(Default)]
+pub(crate) struct Stamps {
+    marks: Vec<u32>,
+    last: u32,
 }
 
-impl SmallDartSet {
-    const LINEAR_LIMIT: usize = 24;
-    const EMPTY: u32 = u32::MAX;
-
-    pub(crate) fn new() -> Self {
-        SmallDartSet { small: Vec::new(), table: Vec::new(), len: 0 }
+impl Stamps {
+    /// `tags` consecutive tags never written since the last wipe, the first returned; `len`
+    /// slots are addressable afterwards. O(1) amortised (O(len) on growth or wrap).
+    pub(crate) fn fresh(&mut self, len: usize, tags: u32) -> u32 {
+        if self.marks.len() < len {
+            self.marks.resize(len, 0);
+        }
+        if self.last > u32::MAX - tags {
+            self.marks.fill(0);
+            self.last = 0;
+        }
+        let first = self.last + 1;
+        self.last += tags;
+        first
     }
 
+    /// Marks slot d with `tag`.
     #[inline(always)]
-    fn slot(table_len: usize, d: u32) -> usize {
-        let shift = 64 - table_len.trailing_zeros();
-        (u64::from(d).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> shift) as usize
+    pub(crate) fn mark(&mut self, d: u32, tag: u32) {
+        self.marks[d as usize] = tag;
     }
 
-    /// Inserts into the table (which has room); returns whether d was absent.
-    #[inline]
-    fn table_insert(table: &mut [u32], d: u32) -> bool {
-        let mask = table.len() - 1;
-        let mut k = Self::slot(table.len(), d);
-        loop {
-            match table[k] {
-                Self::EMPTY => {
-                    table[k] = d;
-                    return true;
-                }
-                x if x == d => return false,
-                _ => k = (k + 1) & mask,
-            }
-        }
-    }
-
-    fn grow(&mut self) {
-        let old = std::mem::replace(&mut self.table, vec![Self::EMPTY; (self.len * 4).next_power_of_two().max(128)]);
-        for &d in old.iter().chain(self.small.iter()).filter(|&&d| d != Self::EMPTY) {
-            Self::table_insert(&mut self.table, d);
-        }
-        self.small.clear();
-    }
-
-    /// Inserts d; returns whether it was absent.
-    #[inline]
-    pub(crate) fn insert(&mut self, d: DartId) -> bool {
-        if self.table.is_empty() {
-            if self.small.contains(&d.0) {
-                return false;
-            }
-            self.small.push(d.0);
-            self.len += 1;
-            if self.small.len() > Self::LINEAR_LIMIT {
-                self.grow();
-            }
-            return true;
-        }
-        if !Self::table_insert(&mut self.table, d.0) {
-            return false;
-        }
-        self.len += 1;
-        if self.len * 2 > self.table.len() {
-            self.grow();
-        }
-        true
-    }
-
-    #[inline]
-    pub(crate) fn contains(&self, d: DartId) -> bool {
-        if self.table.is_empty() {
-            return self.small.contains(&d.0);
-        }
-        let mask = self.table.len() - 1;
-        let mut k = Self::slot(self.table.len(), d.0);
-        loop {
-            match self.table[k] {
-                Self::EMPTY => return false,
-                x if x == d.0 => return true,
-                _ => k = (k + 1) & mask,
-            }
-        }
+    /// Whether slot d carries `tag`.
+    #[inline(always)]
+    pub(crate) fn has(&self, d: u32, tag: u32) -> bool {
+        self.marks[d as usize] == tag
     }
 }
+
+thread_local! {
+    static STAMPS: std::cell::RefCell<Stamps> = std::cell::RefCell::new(Stamps::default());
+}
+
+/// Runs `f` with this thread's [`Stamps`] (a private, fresh set if they are in use already, so a
+/// nested walk is correct, only slower). `f` must not keep tags across calls.
+pub(crate) fn with_stamps<R>(f: impl FnOnce(&mut Stamps) -> R) -> R {
+    STAMPS.with(|cell| match cell.try_borrow_mut() {
+        Ok(mut stamps) => f(&mut stamps),
+        Err(_) => f(&mut Stamps::default()),
+    })
+}
+
+/// Orbits up to this many darts are walked with a linear scan of the darts found so far (no
+/// stamps: cheaper for the small orbits of faces, edges and tets, and no cache miss in the
+/// stamp array); larger ones switch to [`Stamps`].
+const LINEAR_LIMIT: usize = 32;
 
 /// A fixed-size bit set over dart slots (or ids): the visited set of whole-map traversals. No
 /// growth and no count, so the hot test-and-set is one load, one store and one bounds check.
@@ -153,23 +128,49 @@ impl<const N: usize> GMap<N> {
     /// assert_eq!(map.orbit(d, AlphaMask::EMPTY), vec![d]);
     /// ```
     pub fn orbit(&self, d: DartId, mask: AlphaMask) -> Vec<DartId> {
-        let mut seen = SmallDartSet::new();
-        let mut out = vec![d];
-        seen.insert(d);
         let (gens, len) = generators(N, mask);
+        let gens = &gens[..len];
+        let mut out = vec![d];
         let mut head = 0;
         while head < out.len() {
+            if out.len() > LINEAR_LIMIT {
+                self.orbit_stamped(&mut out, head, gens);
+                break;
+            }
             let x = out[head];
             head += 1;
             let row = self.alpha_row(x.0);
-            for &i in &gens[..len] {
+            for &i in gens {
                 let y = DartId(row[i]);
-                if y != x && seen.insert(y) {
+                if y != x && !out.contains(&y) {
                     out.push(y);
                 }
             }
         }
         out
+    }
+
+    /// Continues the breadth-first walk of [`GMap::orbit`] from `head` with stamps: same order.
+    fn orbit_stamped(&self, out: &mut Vec<DartId>, mut head: usize, gens: &[usize]) {
+        out.reserve(4 * out.len());
+        with_stamps(|stamps| {
+            let tag = stamps.fresh(self.capacity(), 1);
+            for &x in out.iter() {
+                stamps.mark(x.0, tag);
+            }
+            while head < out.len() {
+                let x = out[head];
+                head += 1;
+                let row = self.alpha_row(x.0);
+                for &i in gens {
+                    let y = row[i];
+                    if !stamps.has(y, tag) {
+                        stamps.mark(y, tag);
+                        out.push(DartId(y));
+                    }
+                }
+            }
+        })
     }
 
     /// The darts of the i-cell of d, ⟨⟩N−{i}(d). O(cell · n).
@@ -215,30 +216,28 @@ impl<const N: usize> GMap<N> {
         if a == b {
             return None;
         }
-        let mut seen = [SmallDartSet::new(), SmallDartSet::new()];
-        let mut queue = [vec![a], vec![b]];
-        let mut head = [0usize, 0usize];
-        seen[0].insert(a);
-        seen[1].insert(b);
         let (gens, len) = generators(N, mask);
+        let gens = &gens[..len];
+        let mut walk = Lockstep { queue: [Vec::with_capacity(16), Vec::with_capacity(16)], head: [0, 0] };
+        walk.queue[0].push(a);
+        walk.queue[1].push(b);
         loop {
+            if walk.queue[0].len() + walk.queue[1].len() > LINEAR_LIMIT {
+                return with_stamps(|stamps| walk.finish_stamped(self, gens, stamps));
+            }
             for side in 0..2 {
-                if head[side] == queue[side].len() {
-                    return Some((std::mem::take(&mut queue[side]), side == 1));
-                }
-                let x = queue[side][head[side]];
-                head[side] += 1;
+                let Some(x) = walk.next(side) else { return Some(walk.take(side)) };
                 let row = self.alpha_row(x.0);
-                for &i in &gens[..len] {
+                for &i in gens {
                     let y = DartId(row[i]);
                     if y == x {
                         continue;
                     }
-                    if seen[1 - side].contains(y) {
+                    if walk.queue[1 - side].contains(&y) {
                         return None;
                     }
-                    if seen[side].insert(y) {
-                        queue[side].push(y);
+                    if !walk.queue[side].contains(&y) {
+                        walk.queue[side].push(y);
                     }
                 }
             }
@@ -409,6 +408,173 @@ impl<const N: usize> GMap<N> {
     }
 }
 
+impl<const N: usize> GMap<N> {
+    /// Calls `f` once on every dart of the two-generator orbit ⟨αj, αk⟩(d), d first, with no
+    /// visited set: such an orbit is a cycle or a path of alternating αj, αk links, walked from d
+    /// one way (αj first) until it closes or ends, then the other way. O(orbit).
+    pub(crate) fn for_each_dihedral(&self, d: DartId, j: usize, k: usize, mut f: impl FnMut(DartId)) {
+        f(d);
+        for gens in [[j, k], [k, j]] {
+            let mut x = d;
+            for step in 0..=self.capacity() {
+                let y = self.alpha_dyn(gens[step % 2], x);
+                if y == x {
+                    break; // an end of the path: walk the other way from d
+                }
+                if y == d {
+                    return; // the cycle closed: every dart was visited
+                }
+                f(y);
+                x = y;
+            }
+        }
+    }
+}
+
+impl GMap<3> {
+    /// The distinct volume ids around the vertex of d, sorted: the vertex orbit ⟨α1, α2, α3⟩(d)
+    /// walked as its corners ⟨α1, α2⟩ (each inside one volume, walked by [`GMap::for_each_dihedral`])
+    /// joined by α3, one id per corner, no list of darts. O(vertex orbit).
+    pub(crate) fn vertex_volumes(&self, d: DartId) -> Vec<CellId> {
+        let mut volumes = Vec::with_capacity(32);
+        let mut corners = Vec::with_capacity(32);
+        with_stamps(|stamps| {
+            let tag = stamps.fresh(self.capacity(), 1);
+            self.for_each_dihedral(d, 1, 2, |x| stamps.mark(x.0, tag));
+            corners.push(d);
+            while let Some(c) = corners.pop() {
+                volumes.push(self.cell_id(3, c));
+                self.for_each_dihedral(c, 1, 2, |x| {
+                    let y = self.alpha::<3>(x);
+                    if y != x && !stamps.has(y.0, tag) {
+                        self.for_each_dihedral(y, 1, 2, |z| stamps.mark(z.0, tag));
+                        corners.push(y);
+                    }
+                });
+            }
+        });
+        volumes.sort_unstable();
+        volumes.dedup();
+        volumes
+    }
+
+    /// The darts w(d) for the 24 words w of [`TetWords`] if they are closed under α0, α1, α2 —
+    /// then they are exactly the volume orbit ⟨α0, α1, α2⟩(d) (possibly with repeats, for a
+    /// folded volume); `None` otherwise (a volume that is not a closed tetrahedron, such as one
+    /// being taken apart). 23 + 2 · 13 lookups, no visited set. O(1).
+    pub(crate) fn closed_tet_darts(&self, d: DartId) -> Option<[DartId; 24]> {
+        let words = TetWords::get();
+        let mut darts = [d; 24];
+        for (k, &(parent, g)) in words.tree.iter().enumerate().skip(1) {
+            darts[k] = self.alpha_dyn(g as usize, darts[parent as usize]);
+        }
+        let closed =
+            words.extra.iter().all(|&(a, g, b)| self.alpha_dyn(g as usize, darts[a as usize]) == darts[b as usize]);
+        closed.then_some(darts)
+    }
+}
+
+/// The 24 flags of a tetrahedron as words in α0, α1, α2 from one of them: a breadth-first
+/// spanning tree of the flag graph of a lone tet built by [`GMap::from_tets`] (`tree[k]` =
+/// (parent, generator), `tree[0]` the root) and its 13 other links (`extra`: (a, g, b) with
+/// αg(flag a) = flag b). A set of darts w(d) closed under these links is closed under α0, α1,
+/// α2: every (flag, generator) is a tree link or an extra link, both ways.
+struct TetWords {
+    tree: [(u8, u8); 24],
+    extra: Vec<(u8, u8, u8)>,
+}
+
+impl TetWords {
+    fn get() -> &'static TetWords {
+        static WORDS: std::sync::OnceLock<TetWords> = std::sync::OnceLock::new();
+        WORDS.get_or_init(TetWords::build)
+    }
+
+    fn build() -> TetWords {
+        let (tet, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).expect("a lone tet builds");
+        let mut index = vec![u8::MAX; tet.capacity()];
+        let mut order = vec![DartId(0)];
+        let mut tree = [(0u8, 0u8); 24];
+        index[0] = 0;
+        let mut extra = Vec::new();
+        let mut head = 0;
+        while head < order.len() {
+            let x = order[head];
+            for g in 0..3 {
+                let y = tet.alpha_dyn(g, x);
+                if index[y.index()] == u8::MAX {
+                    index[y.index()] = order.len() as u8;
+                    tree[order.len()] = (head as u8, g as u8);
+                    order.push(y);
+                } else if index[y.index()] as usize > head && tree[index[y.index()] as usize] != (head as u8, g as u8) {
+                    extra.push((head as u8, g as u8, index[y.index()]));
+                }
+            }
+            head += 1;
+        }
+        assert_eq!((order.len(), extra.len()), (24, 13), "a tetrahedron has 24 flags and 36 links");
+        TetWords { tree, extra }
+    }
+}
+
+/// The state of [`GMap::split_side`]: two breadth-first walks, each queue holding every dart its
+/// side has found (so the queues are also the visited sets while they are small).
+struct Lockstep {
+    queue: [Vec<DartId>; 2],
+    head: [usize; 2],
+}
+
+impl Lockstep {
+    /// The next dart of `side` to expand, or `None` if that side is exhausted.
+    #[inline]
+    fn next(&mut self, side: usize) -> Option<DartId> {
+        let x = self.queue[side].get(self.head[side]).copied()?;
+        self.head[side] += 1;
+        Some(x)
+    }
+
+    /// The exhausted side's darts and whether it is b's (side 1).
+    fn take(&mut self, side: usize) -> (Vec<DartId>, bool) {
+        (std::mem::take(&mut self.queue[side]), side == 1)
+    }
+
+    /// Continues the lockstep walk with stamps (tag t for side 0, t + 1 for side 1): the same
+    /// visiting order and the same answer as the linear phase would give.
+    fn finish_stamped<const N: usize>(
+        &mut self,
+        map: &GMap<N>,
+        gens: &[usize],
+        stamps: &mut Stamps,
+    ) -> Option<(Vec<DartId>, bool)> {
+        let tag = stamps.fresh(map.capacity(), 2);
+        for side in 0..2 {
+            for &x in &self.queue[side] {
+                stamps.mark(x.0, tag + side as u32);
+            }
+        }
+        loop {
+            for side in 0..2 {
+                let Some(x) = self.next(side) else { return Some(self.take(side)) };
+                let (own, other) = (tag + side as u32, tag + 1 - side as u32);
+                let row = map.alpha_row(x.0);
+                for &i in gens {
+                    let y = row[i];
+                    if y == x.0 {
+                        continue;
+                    }
+                    if stamps.has(y, other) {
+                        return None;
+                    }
+                    if !stamps.has(y, own) {
+                        stamps.mark(y, own);
+                        self.queue[side].push(DartId(y));
+                    }
+                }
+            }
+        }
+    }
+}
+
 /// The root of x in a union-find forest (`forest[r] == r` at roots), halving the path on the way.
 #[inline(always)]
 pub(crate) fn find_root(forest: &mut [u32], mut x: u32) -> u32 {
@@ -448,4 +614,109 @@ pub(crate) fn join_with_smaller(forest: &mut [u32], d: u32, row: &[u32], gens: &
         }
     }
     joins
+}
+
+#[cfg(test)]
+mod tests {
+    use std::collections::HashSet;
+
+    use super::*;
+    use crate::generate::kuhn_cube;
+
+    /// Breadth-first orbit with a hash set: the reference for [`GMap::orbit`]'s order.
+    fn orbit_reference<const N: usize>(map: &GMap<N>, d: DartId, mask: AlphaMask) -> Vec<DartId> {
+        let (mut out, mut seen, mut head) = (vec![d], HashSet::from([d]), 0);
+        while head < out.len() {
+            let x = out[head];
+            head += 1;
+            for i in mask.indices().filter(|&i| i <= N) {
+                let y = map.alpha_dyn(i, x);
+                if seen.insert(y) {
+                    out.push(y);
+                }
+            }
+        }
+        out
+    }
+
+    fn cut_cube() -> GMap<3> {
+        let (points, tets) = kuhn_cube(3);
+        let (mut map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+        let inner: Vec<DartId> = map.one_dart_per_cell(2).into_iter().filter(|&d| !map.is_free(3, d)).collect();
+        for d in inner.into_iter().step_by(3) {
+            map.unsew::<3>(d).unwrap();
+        }
+        map
+    }
+
+    /// Orbits small (linear phase) and large (stamped phase, interior vertices have 144 darts)
+    /// come out in the reference order; split_side agrees with the reference orbits.
+    #[test]
+    fn orbits_match_the_hash_set_walk() {
+        let map = cut_cube();
+        let mut large = 0;
+        for dim in 0..=3 {
+            let mask = AlphaMask::cell(3, dim);
+            for d in map.darts().step_by(5) {
+                let orbit = map.orbit(d, mask);
+                assert_eq!(orbit, orbit_reference(&map, d, mask));
+                large += usize::from(orbit.len() > LINEAR_LIMIT);
+                let e = DartId((d.0 * 7919) % map.capacity() as u32);
+                let joined = orbit.contains(&e);
+                assert_eq!(map.same_orbit(d, e, mask), joined);
+                if let Some((side, is_e)) = map.split_side(d, e, mask) {
+                    let whole = orbit_reference(&map, if is_e { e } else { d }, mask);
+                    assert_eq!(side.iter().collect::<HashSet<_>>(), whole.iter().collect::<HashSet<_>>());
+                }
+            }
+        }
+        assert!(large > 0, "no orbit exercised the stamped phase");
+    }
+
+    /// The two-generator walk visits each dart of ⟨αj, αk⟩ once, on cycles (inner edges) and
+    /// on paths (boundary edges).
+    #[test]
+    fn dihedral_walks_visit_each_dart_once() {
+        let map = cut_cube();
+        for (j, k) in [(0, 1), (1, 2), (2, 3), (0, 2), (0, 3), (1, 3)] {
+            for d in map.darts().step_by(3) {
+                let mut seen = Vec::new();
+                map.for_each_dihedral(d, j, k, |x| seen.push(x));
+                let mut want = map.orbit(d, AlphaMask::of(&[j, k]));
+                assert_eq!(seen[0], d);
+                seen.sort_unstable();
+                want.sort_unstable();
+                assert_eq!(seen, want, "<a{j}, a{k}>({d})");
+            }
+        }
+    }
+
+    /// The corner walk finds the volumes of the whole vertex orbit.
+    #[test]
+    fn vertex_volumes_are_those_of_the_vertex_orbit() {
+        let map = cut_cube();
+        for d in map.darts().step_by(4) {
+            let mut want: Vec<CellId> = map.cell_darts(0, d).iter().map(|&x| map.cell_id(3, x)).collect();
+            want.sort_unstable();
+            want.dedup();
+            assert_eq!(map.vertex_volumes(d), want);
+        }
+    }
+
+    /// Closed tets give their 24 darts; a tet opened inside (α2 unsewn) gives `None`.
+    #[test]
+    fn closed_tet_darts_are_the_volume_orbit() {
+        let mut map = cut_cube();
+        for d in map.darts().step_by(7) {
+            let mut got = map.closed_tet_darts(d).unwrap().to_vec();
+            let mut want = map.cell_darts(3, d);
+            got.sort_unstable();
+            want.sort_unstable();
+            assert_eq!(got, want);
+        }
+        let d = DartId(0);
+        map.unsew::<2>(d).unwrap();
+        assert_eq!(map.closed_tet_darts(d), None);
+        assert!(map.closed_tet_darts(DartId(24)).is_some()); // the next tet is intact
+    }
 }

@@ -11,7 +11,11 @@
 //! did as [`CellChanges`], which the embedding layer turns into attribute merges and splits.
 //!
 //! Cost: O(|O1| · n) for the links plus the size of the relabelled cells; an unsew also walks,
-//! for each cell it might split, both sides in lockstep until they meet or the smaller one ends.
+//! for each cell it might split, both sides in lockstep until they meet or the smaller one ends —
+//! unless a cheap proof settles it first (`QuickLinks`: direct αk links between the unsewn darts,
+//! and the rings ⟨αi±1, αi⟩ walked from both darts of each pair). For the α3-unsew of an inner
+//! triangle that proof covers all three vertices and edges (three rings of tets around its edges)
+//! and the face itself, so nothing is walked beyond the rings.
 
 use rustc_hash::FxHashMap;
 
@@ -453,6 +457,12 @@ impl<const N: usize> GMap<N> {
     /// assert_eq!(map.unsew_dyn(0, a), Err(SewError::AlreadyFree { dart: a, i: 0 }));
     /// ```
     pub fn unsew_dyn(&mut self, i: usize, d: DartId) -> Result<CellChanges, SewError> {
+        self.unsew_with(i, d, true)
+    }
+
+    /// [`GMap::unsew_dyn`], with the cheap proofs of [`QuickLinks`] (`quick`) or without them
+    /// (every candidate split is walked): the same outcome either way.
+    fn unsew_with(&mut self, i: usize, d: DartId, quick: bool) -> Result<CellChanges, SewError> {
         Self::check_index(i)?;
         self.check_dart(d)?;
         if self.is_free(i, d) {
@@ -474,11 +484,15 @@ impl<const N: usize> GMap<N> {
             self.unlink_raw(i, x);
         }
         let mut report = CellChanges { changes: Vec::new(), pairs };
-        let ends = touched(&report.pairs);
+        let links = if quick { QuickLinks::find(self, i, &report.pairs) } else { QuickLinks::none() };
+        let mut scratch = (Vec::new(), Vec::new());
         for dim in (0..=N).filter(|&dim| dim != i) {
-            self.split_cells(dim, &ends, &mut report.changes);
+            self.split_cells(dim, &report.pairs, &links, &mut scratch, &mut report.changes);
         }
+        #[cfg(debug_assertions)]
         self.after_mutation(&touched(&report.pairs));
+        #[cfg(not(debug_assertions))]
+        self.after_mutation(&[]);
         Ok(report)
     }
 
@@ -486,35 +500,363 @@ impl<const N: usize> GMap<N> {
     /// holds an endpoint of an unlinked pair, so it suffices to check each endpoint against an
     /// *anchor* endpoint of its current id: if they are no longer in one orbit, the piece found
     /// smaller by the lockstep walk (a complete orbit) gets a fresh id. A piece that got a fresh
-    /// id is complete, so its other endpoints are skipped.
-    fn split_cells(&mut self, dim: usize, ends: &[DartId], changes: &mut Vec<CellChange>) {
+    /// id is complete, so its other endpoints are skipped. Endpoints that `links` proves still
+    /// joined skip the walk (it would find them joined too: the outcome is the same).
+    /// `scratch` holds the (id, anchor endpoint index) list and the ids that got a fresh id (the
+    /// complete pieces), reused across dimensions.
+    fn split_cells(
+        &mut self,
+        dim: usize,
+        pairs: &[(DartId, DartId)],
+        links: &QuickLinks,
+        (anchors, complete): &mut (Vec<(u32, usize)>, Vec<u32>),
+        changes: &mut Vec<CellChange>,
+    ) {
         let mask = AlphaMask::cell(N, dim);
-        let mut anchors: Vec<(u32, DartId)> = Vec::new();
-        let mut complete: Vec<u32> = Vec::new();
-        for &z in ends {
+        let classes = links.classes(dim);
+        anchors.clear();
+        complete.clear();
+        for k in 0..2 * pairs.len() {
+            let z = endpoint(pairs, k);
             let id = self.cell_id(dim, z).0;
             if complete.contains(&id) {
                 continue;
             }
             let Some(slot) = anchors.iter().position(|a| a.0 == id) else {
-                anchors.push((id, z));
+                anchors.push((id, k));
                 continue;
             };
-            let anchor = anchors[slot].1;
-            let Some((side, is_z_side)) = self.split_side(anchor, z, mask) else { continue };
-            let new = self.alloc_cell_id(dim);
-            for &w in &side {
-                self.set_cell_raw(dim, w, new);
+            let a = anchors[slot].1;
+            if classes.joined(a, k) {
+                continue;
             }
+            let anchor = endpoint(pairs, a);
+            let new = match links.split_of_whole_classes(&classes, dim, a, k) {
+                Some((side, is_z_side)) => {
+                    let new = self.alloc_cell_id(dim);
+                    for w in (0..2 * pairs.len()).filter(|&w| classes.joined(w, side)) {
+                        self.set_cell_raw(dim, endpoint(pairs, w), new);
+                    }
+                    (new, is_z_side)
+                }
+                None => {
+                    let Some((side, is_z_side)) = self.split_side(anchor, z, mask) else { continue };
+                    let new = self.alloc_cell_id(dim);
+                    for &w in &side {
+                        self.set_cell_raw(dim, w, new);
+                    }
+                    (new, is_z_side)
+                }
+            };
+            let (new, is_z_side) = new;
             complete.push(new);
             let (dart_kept, dart_new) = if is_z_side { (anchor, z) } else { (z, anchor) };
-            anchors[slot].1 = dart_kept;
+            anchors[slot].1 = if is_z_side { a } else { k };
             changes.push(CellChange::Split { dim, kept: CellId(id), new: CellId(new), dart_kept, dart_new });
         }
+    }
+}
+
+/// Endpoint k of the unlinked pairs: pair k / 2, first or second dart.
+#[inline]
+fn endpoint(pairs: &[(DartId, DartId)], k: usize) -> DartId {
+    let (x, y) = pairs[k / 2];
+    if k % 2 == 0 {
+        x
+    } else {
+        y
+    }
+}
+
+/// Connections between the endpoints of an unsew that are cheap to prove, so that the exact
+/// lockstep walk runs only where a cell may really have split.
+///
+/// Two kinds of proof, both valid after the unlinking:
+/// - a direct link: endpoint q = αk(p), with αk commuting with αi (so it maps the unsewn orbit
+///   into itself), joins p and q in every cell whose orbit uses αk;
+/// - a ring: for j = i ± 1, the orbit ⟨αj, αi⟩ of an endpoint is a path starting there (it is
+///   i-free now); when the paths of the two darts x, y of an unlinked pair are one path (found
+///   by [`RingWalks`], no visited set, at most [`QuickLinks::RING_STEPS`] rounds), x and y are
+///   joined in every cell whose orbit uses both αj and αi — the dimensions other than i and j.
+///   In a 3-map unsewn by α3 the ring is the chain of tets around an edge of the face: when it
+///   still links both sides of the face, neither that edge nor its two vertices split, the
+///   common case of an inner face. A generator αk commuting with αi and αj maps the path of
+///   (x, y) onto that of (αk(x), αk(y)), so that one is not walked (α0 in the example: the
+///   other end of the edge).
+///
+/// Built only for up to [`QuickLinks::MAX_PAIRS`] pairs (else no proof: every check walks);
+/// proofs beyond [`QuickLinks::MAX_LINKS`] are dropped (a dropped proof only costs a walk).
+struct QuickLinks {
+    /// (p, q, k): endpoints p and q joined through αk (direct) or through the ring ⟨αk, αi⟩;
+    /// either way the proof holds in the cells of every dimension other than k (and i).
+    links: [(u8, u8, u8); QuickLinks::MAX_LINKS],
+    len: usize,
+    /// Per endpoint, the bit set of the generators k with a direct link αk(p) = q or αk(p) = p.
+    direct: [u8; 2 * QuickLinks::MAX_PAIRS],
+    /// The bit set of the map's generators α0 … αn.
+    gens: u8,
+    /// Number of endpoints covered (0: no proof was built).
+    ends: usize,
+}
+
+/// A partition of the endpoints into classes known to be joined in one cell dimension.
+struct Classes {
+    parent: [u8; 2 * QuickLinks::MAX_PAIRS],
+    len: usize,
+}
+
+impl Classes {
+    fn root(&self, mut p: usize) -> usize {
+        while self.parent[p] as usize != p {
+            p = self.parent[p] as usize;
+        }
+        p
+    }
+
+    /// Whether endpoints p and q are proven joined (false when no proof was built).
+    fn joined(&self, p: usize, q: usize) -> bool {
+        p < self.len && q < self.len && self.root(p) == self.root(q)
+    }
+}
+
+impl QuickLinks {
+    const MAX_PAIRS: usize = 16;
+    const MAX_LINKS: usize = 64;
+    const RING_STEPS: usize = 64;
+
+    fn push(&mut self, p: usize, q: usize, k: usize) {
+        if p != q && self.len < Self::MAX_LINKS {
+            self.links[self.len] = (p as u8, q as u8, k as u8);
+            self.len += 1;
+        }
+    }
+
+    /// No proof at all.
+    fn none() -> Self {
+        QuickLinks { links: [(0, 0, 0); Self::MAX_LINKS], len: 0, direct: [0; 2 * Self::MAX_PAIRS], gens: 0, ends: 0 }
+    }
+
+    fn find<const N: usize>(map: &GMap<N>, i: usize, pairs: &[(DartId, DartId)]) -> Self {
+        let mut out = Self::none();
+        if pairs.len() > Self::MAX_PAIRS {
+            return out;
+        }
+        out.ends = 2 * pairs.len();
+        out.gens = ((1u16 << (N + 1)) - 1) as u8;
+        let ends = out.ends;
+        let index = |d: DartId| (0..ends).find(|&k| endpoint(pairs, k) == d);
+        let commuting = |k: usize, j: usize| k.abs_diff(i) >= 2 && k.abs_diff(j) >= 2;
+        for p in 0..ends {
+            let x = endpoint(pairs, p);
+            out.direct[p] |= 1 << i; // every endpoint is i-free now
+            for k in (0..=N).filter(|&k| k.abs_diff(i) >= 2) {
+                let y = map.alpha_dyn(k, x);
+                if y == x {
+                    out.direct[p] |= 1 << k;
+                } else if let Some(q) = index(y).filter(|&q| q > p) {
+                    out.direct[p] |= 1 << k;
+                    out.direct[q] |= 1 << k;
+                    out.push(p, q, k);
+                }
+            }
+        }
+        for j in [i.checked_sub(1), Some(i + 1).filter(|&j| j <= N)].into_iter().flatten() {
+            let mirrors = || (0..=N).filter(move |&k| commuting(k, j));
+            // One walk per pair, none for a pair that is the αk image of a walked one.
+            let mut covered = [false; 2 * Self::MAX_PAIRS];
+            let mut walks = RingWalks::new(i, j);
+            for m in 0..pairs.len() {
+                if covered[2 * m] {
+                    continue;
+                }
+                walks.start(pairs[m], m);
+                for p in [2 * m, 2 * m + 1] {
+                    covered[p] = true;
+                    for q in mirrors().filter_map(|k| index(map.alpha_dyn(k, endpoint(pairs, p)))) {
+                        covered[q] = true;
+                    }
+                }
+            }
+            walks.run(map, Self::RING_STEPS);
+            for m in walks.joined() {
+                out.push(2 * m, 2 * m + 1, j);
+                let (x, y) = pairs[m];
+                for k in mirrors() {
+                    if let (Some(p), Some(q)) = (index(map.alpha_dyn(k, x)), index(map.alpha_dyn(k, y))) {
+                        out.push(p, q, j);
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// When the classes of endpoints a and z (not joined) are each a whole dim-cell — every
+    /// member's αk image, for every αk of the cell's orbit, is itself or a member reached by a
+    /// direct link — the split [`GMap::split_side`] would find, without walking: the class of a
+    /// if it is not larger (the lockstep walk exhausts a's side first then, a's side moving
+    /// first in each round), else z's. Returns a member of that class and whether it is z's.
+    fn split_of_whole_classes(&self, classes: &Classes, dim: usize, a: usize, z: usize) -> Option<(usize, bool)> {
+        if self.ends == 0 {
+            return None;
+        }
+        let cell = self.gens & !(1 << dim);
+        let mut size = [0usize; 2];
+        for p in 0..self.ends {
+            let side = if classes.joined(p, a) {
+                0
+            } else if classes.joined(p, z) {
+                1
+            } else {
+                continue;
+            };
+            if self.direct[p] & cell != cell {
+                return None;
+            }
+            size[side] += 1;
+        }
+        Some(if size[0] <= size[1] { (a, false) } else { (z, true) })
+    }
+
+    /// The classes of endpoints proven joined in the cells of dimension `dim`.
+    fn classes(&self, dim: usize) -> Classes {
+        let mut c = Classes { parent: std::array::from_fn(|p| p as u8), len: self.ends };
+        // αk is in the dim-cell orbit iff k ≠ dim; a ring also needs αi, and dim ≠ i here.
+        for &(p, q, _) in self.links[..self.len].iter().filter(|l| l.2 as usize != dim) {
+            let (rp, rq) = (c.root(p as usize), c.root(q as usize));
+            if rp != rq {
+                c.parent[rp.max(rq)] = rp.min(rq) as u8;
+            }
+        }
+        c
+    }
+}
+
+/// Walks of the paths ⟨αj, αi⟩ between the two darts of unlinked pairs, all interleaved (the
+/// loads of different walks are independent, so their cache misses overlap). Each walk goes from
+/// both ends at once (both darts are i-free, so each is an end of its path, which alternates αj,
+/// αi from there): the two fronts meet iff the pair is still joined through the ring, after
+/// about half the ring each; a front that reaches the other end of its path first proves
+/// nothing.
+struct RingWalks {
+    gens: [usize; 2],
+    /// (front from x, front from y, parity of the steps taken by each, pair index, state).
+    walks: [([DartId; 2], [u8; 2], u8, Walk); QuickLinks::MAX_PAIRS],
+    len: usize,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Walk {
+    Running,
+    Met,
+    Open,
+}
+
+impl RingWalks {
+    fn new(i: usize, j: usize) -> Self {
+        RingWalks { gens: [j, i], walks: [([DartId(0); 2], [0; 2], 0, Walk::Open); QuickLinks::MAX_PAIRS], len: 0 }
+    }
+
+    fn start(&mut self, (x, y): (DartId, DartId), pair: usize) {
+        self.walks[self.len] = ([x, y], [0, 0], pair as u8, Walk::Running);
+        self.len += 1;
+    }
+
+    /// Advances every running walk, one step of each front per round, for at most `rounds`.
+    fn run<const N: usize>(&mut self, map: &GMap<N>, rounds: usize) {
+        for _ in 0..rounds {
+            let mut running = false;
+            for (fronts, steps, _, state) in self.walks[..self.len].iter_mut().filter(|w| w.3 == Walk::Running) {
+                for f in 0..2 {
+                    let here = fronts[f];
+                    let next = map.alpha_dyn(self.gens[steps[f] as usize], here);
+                    if next == here {
+                        *state = Walk::Open;
+                        break;
+                    }
+                    fronts[f] = next;
+                    steps[f] ^= 1;
+                    if fronts[0] == fronts[1] {
+                        *state = Walk::Met;
+                        break;
+                    }
+                }
+                running |= *state == Walk::Running;
+            }
+            if !running {
+                return;
+            }
+        }
+    }
+
+    /// The pairs whose fronts met.
+    fn joined(&self) -> impl Iterator<Item = usize> + '_ {
+        self.walks[..self.len].iter().filter(|w| w.3 == Walk::Met).map(|w| w.2 as usize)
     }
 }
 
 /// The darts of the pairs, for the local checks.
 fn touched(pairs: &[(DartId, DartId)]) -> Vec<DartId> {
     pairs.iter().flat_map(|&(x, y)| [x, y]).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::generate::{kuhn_cube, SplitMix64};
+
+    fn same_state<const N: usize>(a: &GMap<N>, b: &GMap<N>) -> bool {
+        a.capacity() == b.capacity()
+            && a.darts()
+                .all(|d| (0..=N).all(|k| a.alpha_dyn(k, d) == b.alpha_dyn(k, d) && a.cell_id(k, d) == b.cell_id(k, d)))
+    }
+
+    /// Unsews every sewn dart of a Kuhn cube by αi (i = 0..=3, each on a fresh cube, in a
+    /// scrambled order), with and without the quick proofs: the reports and the maps must be
+    /// identical at every step, and real splits must have happened in every dimension.
+    #[test]
+    fn quick_proofs_change_no_outcome() {
+        let (points, tets) = kuhn_cube(2);
+        let (cube, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+        let mut splits = [0usize; 4];
+        for i in 0..=3 {
+            let (mut fast, mut slow) = (cube.clone(), cube.clone());
+            let mut darts: Vec<DartId> = cube.darts().collect();
+            let mut rng = SplitMix64(11 + i as u64);
+            for k in (1..darts.len()).rev() {
+                darts.swap(k, rng.below(k + 1));
+            }
+            for d in darts {
+                if fast.is_free(i, d) {
+                    continue;
+                }
+                let (a, b) = (fast.unsew_with(i, d, true).unwrap(), slow.unsew_with(i, d, false).unwrap());
+                assert_eq!(a, b, "alpha{i} unsew of {d}");
+                for (dim, n) in splits.iter_mut().enumerate() {
+                    *n += a.splits(dim).count();
+                }
+            }
+            assert!(same_state(&fast, &slow), "alpha{i}: the maps differ");
+            assert_eq!(fast.validate(), Ok(()));
+            assert_eq!(fast.count_cells(), fast.count_cells_by_traversal());
+        }
+        assert!(splits.iter().all(|&n| n > 0), "splits per dimension {splits:?}");
+    }
+
+    /// The same on a 2-map (rings ⟨α1, α2⟩ and ⟨α0, α1⟩, ⟨α2, α1⟩), cut edge by edge.
+    #[test]
+    fn quick_proofs_change_no_outcome_in_2d() {
+        let (points, triangles) = crate::generate::grid_triangles(4);
+        let (grid, _) = GMap::<2>::from_triangles(points.len(), &triangles).unwrap();
+        for i in 0..=2 {
+            let (mut fast, mut slow) = (grid.clone(), grid.clone());
+            for d in grid.darts().collect::<Vec<_>>().into_iter().rev() {
+                if !fast.is_free(i, d) {
+                    assert_eq!(fast.unsew_with(i, d, true).unwrap(), slow.unsew_with(i, d, false).unwrap());
+                }
+            }
+            assert!(same_state(&fast, &slow));
+            assert_eq!(fast.count_cells(), fast.count_cells_by_traversal());
+        }
+    }
 }

@@ -161,3 +161,29 @@ proptest! {
         map.free_mark(mark);
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+    /// `try_alpha(i, d)` succeeds exactly when i ≤ n and d is live, and then equals `alpha_dyn`;
+    /// otherwise it names the dart. Checked for every slot (dead ones included) and one past.
+    #[test]
+    fn try_alpha_succeeds_exactly_on_live_darts_and_valid_indices(ops in op_sequence()) {
+        let map = build::<3>(&ops);
+        for slot in 0..map.capacity() as u32 + 2 {
+            let d = DartId(slot);
+            for i in 0..=4 {
+                match map.try_alpha(i, d) {
+                    Ok(x) => {
+                        prop_assert!(i <= 3 && map.contains(d), "try_alpha({i}, {d:?}) accepted");
+                        prop_assert_eq!(x, map.alpha_dyn(i, d));
+                    }
+                    Err(e) => {
+                        prop_assert!(i > 3 || !map.contains(d), "try_alpha({i}, {d:?}) refused: {e}");
+                        prop_assert_eq!(e, topomech::gmap::DartError::NoSuchDart(d));
+                    }
+                }
+            }
+        }
+    }
+}

@@ -136,3 +136,16 @@ fn ids_follow_the_documented_numbering_on_pinched_inputs() {
         }
     }
 }
+
+/// The memory law of issue 2: a map built from tets holds, per live dart, at least its 4 links
+/// and 4 cell ids of 4 bytes (32 bytes) and, for a fresh build, at most 32 bytes plus the 1-bit
+/// liveness words and the rounding of the allocator (CGAL: 72).
+#[test]
+fn a_built_map_uses_32_bytes_per_dart() {
+    for k in [1, 3, 6] {
+        let (points, tets) = topomech::generate::kuhn_cube(k);
+        let (map, _) = topomech::GMap::<3>::from_tets(points.len(), &tets).unwrap();
+        let bytes = map.bytes_per_dart();
+        assert!((32.0..=33.0).contains(&bytes), "k = {k}: {bytes} bytes per dart");
+    }
+}

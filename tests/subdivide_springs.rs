@@ -382,3 +382,43 @@ fn the_refine_command_reports_the_spring_coupling_with_springs() {
         .collect();
     assert_eq!(before as usize, edges.len());
 }
+
+/// A cut that opens the ring of faces around an inner edge at two places splits the edge into
+/// two edges between the same two vertices (its ends stay joined through their other tets):
+/// springs keyed by vertex pairs would be ambiguous, so the coupling refuses the map up front,
+/// naming the two vertices, instead of failing half-way through a later operation.
+#[test]
+fn a_cut_edge_whose_ends_did_not_split_is_refused_up_front() {
+    use topomech::mechanics::Body;
+    let (points, tets) = kuhn_cube(3);
+    let (mut body, _) = Body::from_tets(&points, &tets, material()).unwrap();
+    let inner = |v: topomech::CellId| body.attrs().rest_position[v].iter().all(|&c| c > 0.5 && c < 2.5);
+    let map = body.map();
+    let edge = map
+        .one_dart_per_cell(1)
+        .into_iter()
+        .find(|&d| inner(map.vertex_id(d)) && inner(map.vertex_id(map.alpha::<0>(d))))
+        .expect("an edge between two inner vertices");
+    let (a, b) = (map.vertex_id(edge).0, map.vertex_id(map.alpha::<0>(edge)).0);
+    // The faces around the edge, in ring order: α2 then α3 from the edge's dart.
+    let mut ring = vec![edge];
+    let mut x = map.alpha::<3>(map.alpha::<2>(edge));
+    while x != edge && ring.len() < 64 {
+        ring.push(x);
+        x = map.alpha::<3>(map.alpha::<2>(x));
+    }
+    assert!(ring.len() >= 4, "an inner edge has a closed ring of at least 4 tets: {}", ring.len());
+    for f in [ring[0], ring[ring.len() / 2]] {
+        let face = body.map().alpha::<2>(f);
+        topomech::cut::dissociate_face(&mut body, face).unwrap();
+    }
+    let map = body.map();
+    assert_eq!((map.vertex_id(edge).0, map.vertex_id(map.alpha::<0>(edge)).0), (a, b), "the ends did not split");
+    let rest = body.attrs().rest_position.as_slice().to_vec();
+    let m = LeveledMap::new(map.clone(), rest);
+    let err = LeveledMechanics::new(&m, material()).unwrap_err();
+    assert_eq!(err, CouplingError::AmbiguousEdge(a.min(b), a.max(b)), "{err}");
+    // The uncut cube is accepted.
+    let fresh = LeveledMap::new(GMap::<3>::from_tets(points.len(), &tets).unwrap().0, points.clone());
+    assert!(LeveledMechanics::new(&fresh, material()).is_ok());
+}

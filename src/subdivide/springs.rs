@@ -115,6 +115,24 @@ pub enum CouplingError {
     /// The map split an edge that has no spring (a bug, or a tampered coupling).
     #[error("edge ({0}, {1}) was split but has no spring")]
     NoSpring(u32, u32),
+    /// Two distinct edges join the same two vertices (an edge dissociated by a cut whose end
+    /// vertices stayed joined): springs are keyed by vertex pairs, so this map cannot be coupled.
+    #[error("two edges join vertices {0} and {1} (a dissociated edge whose ends did not split): springs keyed by vertex pairs would be ambiguous")]
+    AmbiguousEdge(u32, u32),
+}
+
+/// Errors if two distinct edges of the map join the same two vertices. O(darts).
+fn check_unambiguous(m: &LeveledMap<3>) -> Result<(), CouplingError> {
+    let map = m.map();
+    let mut seen = std::collections::HashSet::new();
+    for d in map.one_dart_per_cell(1) {
+        let (a, b) = (map.vertex_id(d).0, map.vertex_id(map.alpha_dyn(0, d)).0);
+        if !seen.insert(key(a, b)) {
+            let (a, b) = key(a, b);
+            return Err(CouplingError::AmbiguousEdge(a, b));
+        }
+    }
+    Ok(())
 }
 
 /// Springs, masses and vertex state of a [`LeveledMap<3>`] following its subdivision (module docs).
@@ -193,6 +211,7 @@ impl LeveledMechanics {
         if m.points().len() < nv {
             return Err(CouplingError::NoGeometry(m.points().len() as u32));
         }
+        check_unambiguous(m)?;
         let masses = TetMasses::from_density(m, material.density)?;
         let tets0: Vec<[u32; 4]> = m.finest_tets()?.into_iter().map(|(t, _, _)| t).collect();
         let mut mech = LeveledMechanics {

@@ -268,24 +268,25 @@ pub fn tear_vertex(body: &mut Body, v: CellId, direction: Vec3, hint: Option<Dar
         let (a1, a3) = (map.alpha::<1>(d), map.alpha::<3>(d));
         !map.is_free(3, d) && d <= a1 && d <= a3 && d <= map.alpha::<1>(a3)
     };
-    let scored: Vec<(DartId, f64)> = map
+    let best = map
         .cell_darts(0, start)
         .into_iter()
         .filter(|&d| kept(d))
         .map(|d| (d, dot(face_normal(body, d), direction).abs()))
-        .collect();
-    let best = scored.iter().max_by(|a, b| a.1.total_cmp(&b.1).then(b.0.cmp(&a.0))).map(|&(d, _)| d);
+        .max_by(|a, b| a.1.total_cmp(&b.1).then(b.0.cmp(&a.0)))
+        .map(|(d, _)| d);
     let mut tear =
         Tear { vertex: v, fan: Vec::new(), dissociations: Vec::new(), split: false, touched: TouchedCells::default() };
     let Some(d0) = best else { return Ok(tear) };
     tear.fan = fan_darts(body.map(), d0);
+    tear.dissociations.reserve(tear.fan.len());
     for &d in &tear.fan {
         if body.map().is_free(3, d) {
             continue;
         }
         let dis = dissociate_face(body, d)?;
         tear.split |= dis.vertices.iter().any(|s| s.kept == v);
-        tear.touched.extend(dis.touched.clone());
+        append(&mut tear.touched, &dis.touched);
         tear.dissociations.push(dis);
     }
     Ok(tear)
@@ -334,13 +335,19 @@ pub fn tear_step(
             continue;
         }
         let tear = tear_vertex(body, id, stress[v].direction, Some(hint))?;
-        touched.extend(tear.touched.clone());
+        append(&mut touched, &tear.touched);
         out.tears.push(tear);
     }
     if !touched.is_empty() {
         sim.update(body, &touched)?;
     }
     Ok(out)
+}
+
+/// Appends `more`'s records to `into`, in order, without cloning `more`. O(records).
+fn append(into: &mut TouchedCells, more: &TouchedCells) {
+    into.vertices.extend_from_slice(&more.vertices);
+    into.edges.extend_from_slice(&more.edges);
 }
 
 fn mul(m: &[[f64; 3]; 3], v: Vec3) -> Vec3 {

@@ -569,11 +569,11 @@ impl TouchedCells {
 /// Per id, the latest record whose dart still carries the id in dimension `dim`, or `None`.
 fn resolve(map: &GMap<3>, dim: usize, records: &[(CellId, Option<DartId>)]) -> Vec<(CellId, Option<DartId>)> {
     let mut out: FxHashMap<CellId, Option<DartId>> = FxHashMap::default();
+    out.reserve(records.len());
     for &(id, d) in records.iter().rev() {
-        let valid = d.filter(|&d| map.contains(d) && map.cell_id(dim, d) == id);
         let slot = out.entry(id).or_insert(None);
         if slot.is_none() {
-            *slot = valid;
+            *slot = d.filter(|&d| map.contains(d) && map.cell_id(dim, d) == id);
         }
     }
     let mut v: Vec<_> = out.into_iter().collect();

@@ -149,3 +149,15 @@ fn a_built_map_uses_32_bytes_per_dart() {
         assert!((32.0..=33.0).contains(&bytes), "k = {k}: {bytes} bytes per dart");
     }
 }
+
+/// Two tets sharing only an edge split that edge (two edge orbits between the same points); with
+/// two such pairs the report names both edges, each with its orbit count, sorted by point pair.
+#[test]
+fn edges_shared_only_by_edge_touching_tets_are_reported_each() {
+    // Tets 0 and 1 share edge (0, 1) only; tets 2 and 3 share edge (7, 8) only, three times over.
+    let tets = [[0, 1, 2, 3], [0, 1, 4, 5], [7, 8, 9, 10], [7, 8, 11, 12], [7, 8, 13, 14]];
+    let (map, report) = GMap::<3>::from_tets(15, &tets).unwrap();
+    map.validate().unwrap();
+    assert_eq!(report.split_edges, vec![([0, 1], 2), ([7, 8], 3)]);
+    assert_eq!(map.count_cells().0[1], 6 * 5, "no edge is shared through a face: 6 edges per tet");
+}

@@ -187,3 +187,22 @@ proptest! {
         }
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+    /// `sewn_pairs(i)` lists every i-sewn link once as (d, αi(d)) with d < αi(d): as many pairs
+    /// as half the i-sewn darts, and every listed pair is a link.
+    #[test]
+    fn sewn_pairs_list_each_link_once_in_order(ops in op_sequence()) {
+        let map = build::<3>(&ops);
+        for i in 0..=3 {
+            let pairs: Vec<(DartId, DartId)> = map.sewn_pairs(i).collect();
+            let sewn = map.darts().filter(|&d| !map.is_free(i, d)).count();
+            prop_assert_eq!(pairs.len() * 2, sewn, "α{}", i);
+            for (d, e) in pairs {
+                prop_assert!(d < e && map.alpha_dyn(i, d) == e, "α{}: ({:?}, {:?})", i, d, e);
+            }
+        }
+    }
+}

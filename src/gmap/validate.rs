@@ -478,3 +478,25 @@ impl<const N: usize> GMap<N> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A local minimum is a dart none of whose neighbours is smaller: a free link (αj(d) = d)
+    /// is not a smaller neighbour, a link to a smaller dart is, and only the dimensions whose
+    /// generators include that link lose the minimum.
+    #[test]
+    fn free_links_do_not_hide_a_local_minimum() {
+        let mut used: Vec<VisitBits> = (0..3).map(|_| VisitBits::new(8)).collect();
+        let mut census = IdCensus { minima: vec![0; 3], distinct: vec![0; 3], used: &mut used };
+        // Dart 5 of a 2-map: α0 free, α1 → 7, α2 free: a minimum in every dimension.
+        census.record(&[5, 7, 5], &[1, 2, 3], 5);
+        assert_eq!(census.minima, vec![1, 1, 1]);
+        assert_eq!(census.distinct, vec![1, 1, 1]);
+        // Dart 6: α1 → 2 (smaller): a minimum only for the 1-cell (generators α0, α2).
+        census.record(&[6, 2, 6], &[4, 5, 3], 6);
+        assert_eq!(census.minima, vec![1, 2, 1]);
+        assert_eq!(census.distinct, vec![1, 2, 1], "id 5 is new for dimension 1");
+    }
+}

@@ -173,6 +173,12 @@ pub fn incise_plane(body: &mut Body, plane: &Plane) -> Result<Incision, CutError
             other != d && side[map.cell_id(3, d).index()] != side[map.cell_id(3, other).index()]
         })
         .collect();
+    dissociate_all(body, faces)
+}
+
+/// Dissociates `faces` (one dart each, all inner) in order and gathers what they did: the common
+/// tail of the incisions. O(Σ dissociation costs).
+pub(crate) fn dissociate_all(body: &mut Body, faces: Vec<DartId>) -> Result<Incision, CutError> {
     let mut out = Incision { dissociations: Vec::with_capacity(faces.len()), touched: TouchedCells::default() };
     for d in faces {
         let dis = dissociate_face(body, d)?;

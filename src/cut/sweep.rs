@@ -20,10 +20,11 @@
 //! does not cross it. Cost: O(darts) for the centroids plus O(inner faces × n) tests, each
 //! skipped when the segment's box misses the surface's box.
 
-use crate::mechanics::{geom, Body, TouchedCells, Vec3};
+use crate::mechanics::{geom, Body, Vec3};
 use crate::DartId;
 
-use super::{dissociate_face, incise::tet_centroids, CutError, Incision};
+use super::incise::{dissociate_all, tet_centroids};
+use super::{CutError, Incision};
 
 /// A polyline swept along a vector: the cut surface of [`incise_sweep`] (module docs).
 ///
@@ -195,9 +196,9 @@ pub fn sweep_faces(body: &Body, surface: &PolylineSweep) -> Result<Vec<DartId>, 
 /// Dissociates every inner face whose two tets' centroid segment crosses the swept polyline
 /// (module docs): a bounded incision, a slit or a bent cut. The faces are found first, then
 /// dissociated one by one, so the result does not depend on the order; every dissociation
-/// conserves mass and stiffness ([`dissociate_face`]).
+/// conserves mass and stiffness ([`dissociate_face`](super::dissociate_face)).
 ///
-/// Cost: O(darts + inner faces × n) to select, plus one [`dissociate_face`] per cut face.
+/// Cost: O(darts + inner faces × n) to select, plus one [`dissociate_face`](super::dissociate_face) per cut face.
 ///
 /// # Errors
 /// [`CutError::BadSweep`] (body unchanged); [`CutError::Body`] is a bug.
@@ -220,11 +221,5 @@ pub fn sweep_faces(body: &Body, surface: &PolylineSweep) -> Result<Vec<DartId>, 
 /// ```
 pub fn incise_sweep(body: &mut Body, surface: &PolylineSweep) -> Result<Incision, CutError> {
     let faces = sweep_faces(body, surface)?;
-    let mut out = Incision { dissociations: Vec::with_capacity(faces.len()), touched: TouchedCells::default() };
-    for d in faces {
-        let dis = dissociate_face(body, d)?;
-        out.touched.extend(dis.touched.clone());
-        out.dissociations.push(dis);
-    }
-    Ok(out)
+    dissociate_all(body, faces)
 }

@@ -359,15 +359,22 @@ impl SpringSystem {
     /// }
     /// ```
     pub fn spring_forces_with(&self, kernel: Kernel, x: &[Vec3], v: &[Vec3], sf: &mut [Vec3], parallel: bool) {
+        self.by_spring_chunks(sf, parallel, |springs, out| spring_pass(kernel, springs, x, v, out));
+    }
+
+    /// Runs `pass` over the springs and their slots of `sf`: in chunks of [`PARALLEL_CHUNK`]
+    /// across threads when asked and large, else once. Panics if `sf` is not one slot per spring.
+    #[inline]
+    fn by_spring_chunks(&self, sf: &mut [Vec3], parallel: bool, pass: impl Fn(Springs<'_>, &mut [Vec3]) + Sync) {
         let n = self.springs();
         assert!(sf.len() == n, "spring force buffer has {} entries for {n} springs", sf.len());
         if parallel && n > PARALLEL_CHUNK {
             sf.par_chunks_mut(PARALLEL_CHUNK).enumerate().for_each(|(c, chunk)| {
                 let r = c * PARALLEL_CHUNK..c * PARALLEL_CHUNK + chunk.len();
-                spring_pass(kernel, self.spring_view(r), x, v, chunk);
+                pass(self.spring_view(r), chunk);
             });
         } else {
-            spring_pass(kernel, self.spring_view(0..n), x, v, sf);
+            pass(self.spring_view(0..n), sf);
         }
     }
 
@@ -772,16 +779,7 @@ fn spring_pass4_body(springs: Springs<'_>, x: &[Rec4], v: &[Rec4], out: &mut [Ve
 impl SpringSystem {
     /// Pass 1 on padded records (the RK4 stepper's layout).
     pub(crate) fn spring_forces4(&self, kernel: Kernel, x: &[Rec4], v: &[Rec4], sf: &mut [Vec3], parallel: bool) {
-        let n = self.springs();
-        assert!(sf.len() == n, "spring force buffer has {} entries for {n} springs", sf.len());
-        if parallel && n > PARALLEL_CHUNK {
-            sf.par_chunks_mut(PARALLEL_CHUNK).enumerate().for_each(|(c, chunk)| {
-                let r = c * PARALLEL_CHUNK..c * PARALLEL_CHUNK + chunk.len();
-                spring_pass4(kernel, self.spring_view(r), x, v, chunk);
-            });
-        } else {
-            spring_pass4(kernel, self.spring_view(0..n), x, v, sf);
-        }
+        self.by_spring_chunks(sf, parallel, |springs, out| spring_pass4(kernel, springs, x, v, out));
     }
 }
 

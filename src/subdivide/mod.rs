@@ -43,13 +43,47 @@ pub use conform::{triangulate_polygon, ConformingMesh};
 pub use cut_error::{cut_error, measure_cut, CutSurfaceError};
 pub use parts::{record_errors, DartLevels, HistoryEntry, LevelParts, LevelPartsError};
 pub use region::{tet_distance, Refinement, TetMasses};
-pub use springs::{CouplingError, LeveledMechanics, Spring};
+pub use springs::{CouplingError, EdgeKey, LeveledMechanics, Spring};
 pub use springs_check::SpringLawError;
 
 use crate::gmap::{AlphaMask, DartId, GMap, InvariantViolation};
 
 /// The largest level an operation may use.
 pub const MAX_LEVEL: u8 = 250;
+
+/// The edge cells of one vertex insertion ([`LeveledMap::edge_split_log`]): the edge with cell id
+/// `edge` joining `ends[0]` and `ends[1]` was split at the new vertex `vertex`; afterwards the half
+/// (ends[0], vertex) has edge id `halves[0]` and the half (vertex, ends[1]) has `halves[1]`. One of
+/// the halves keeps `edge` (the relabelling keeps an old id when it can), the other gets a fresh id.
+/// Edge ids, unlike vertex pairs, tell apart two edges joining the same two vertices (a cut edge
+/// whose ends stayed joined).
+///
+/// # Examples
+///
+/// ```
+/// # use topomech::subdivide::{EdgeSplit, LeveledMap};
+/// # use topomech::GMap;
+/// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+/// let mut m = LeveledMap::new(map, vec![[0.0; 3], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]]);
+/// let d = m.map().darts().next().unwrap();
+/// let edge = m.map().cell_id(1, d).0;
+/// let mid = m.split_edge(d, 1).unwrap();
+/// let s: EdgeSplit = m.edge_split_log()[0];
+/// assert_eq!((s.vertex, s.edge), (m.map().vertex_id(mid).0, edge));
+/// assert_eq!(s.halves[0], m.map().cell_id(1, d).0);
+/// assert!(s.halves.contains(&edge) && s.halves[0] != s.halves[1]);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct EdgeSplit {
+    /// The inserted vertex id.
+    pub vertex: u32,
+    /// The end vertex ids of the split edge (as in [`LeveledMap::split_log`]).
+    pub ends: [u32; 2],
+    /// The edge cell id of the split edge before the operation.
+    pub edge: u32,
+    /// The edge cell ids of the halves at `ends[0]` and at `ends[1]` after the operation.
+    pub halves: [u32; 2],
+}
 
 /// A link value that an operation of level `level` overwrote: before `level`, αj(d) was `old`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -278,6 +312,8 @@ pub struct LeveledMap<const N: usize> {
     points: Vec<[f64; 3]>,
     /// Every inserted vertex as [new vertex id, end vertex ids] (see [`LeveledMap::split_log`]).
     splits: Vec<[u32; 3]>,
+    /// The edge cells of every inserted vertex, parallel to `splits` (see [`LeveledMap::edge_split_log`]).
+    edge_splits: Vec<EdgeSplit>,
     op: ops::OpLog,
 }
 
@@ -309,6 +345,7 @@ impl<const N: usize> LeveledMap<N> {
             max_level: 0,
             points,
             splits: Vec::new(),
+            edge_splits: Vec::new(),
             op: ops::OpLog::default(),
         }
     }
@@ -424,6 +461,27 @@ impl<const N: usize> LeveledMap<N> {
     /// ```
     pub fn split_log(&self) -> &[[u32; 3]] {
         &self.splits
+    }
+
+    /// The edge cells of every entry of [`Self::split_log`] (same order, same length): which edge
+    /// cell was split and which edge cells its halves are ([`EdgeSplit`]). Not saved by
+    /// [`LeveledMap::to_parts`]. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::subdivide::LeveledMap;
+    /// # use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let mut m = LeveledMap::new(map, vec![]);
+    /// let d = m.map().darts().next().unwrap();
+    /// m.subdivide_tet(d, 1).unwrap();
+    /// let log = m.edge_split_log();
+    /// assert_eq!(log.len(), m.split_log().len());
+    /// assert!(log.iter().zip(m.split_log()).all(|(e, s)| [e.vertex, e.ends[0], e.ends[1]] == *s));
+    /// ```
+    pub fn edge_split_log(&self) -> &[EdgeSplit] {
+        &self.edge_splits
     }
 
     /// Position of the vertex of dart `d` (the origin if no geometry was given). O(1).

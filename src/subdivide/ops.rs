@@ -118,15 +118,19 @@ impl<const N: usize> LeveledMap<N> {
     /// Closes the operation: exact cell ids for every touched cell, positions of new vertices, the
     /// new maximum level. The finest map is valid afterwards (checked in debug builds).
     pub(super) fn finish(&mut self) {
+        let midpoints = std::mem::take(&mut self.op.midpoints);
+        // Before the relabelling, a pre-existing dart still carries the id its edge had.
+        let old_edges: Vec<u32> = midpoints.iter().map(|&(_, a, _)| self.map.cell_id(1, a).0).collect();
         for dim in 0..=N {
             self.relabel_dim(dim);
         }
-        let midpoints = std::mem::take(&mut self.op.midpoints);
-        for (m, a, b) in midpoints {
+        for ((m, a, b), edge) in midpoints.into_iter().zip(old_edges) {
             let (pa, pb) = (self.position(a), self.position(b));
             let v = self.map.vertex_id(m).index();
             let ends = [self.map.vertex_id(a).0, self.map.vertex_id(b).0];
             self.splits.push([v as u32, ends[0], ends[1]]);
+            let halves = [self.map.cell_id(1, a).0, self.map.cell_id(1, b).0];
+            self.edge_splits.push(super::EdgeSplit { vertex: v as u32, ends, edge, halves });
             if !self.points.is_empty() {
                 if self.points.len() <= v {
                     self.points.resize(v + 1, [0.0; 3]);

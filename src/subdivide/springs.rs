@@ -1,10 +1,14 @@
 //! The mass/spring state of a [`LeveledMap<3>`] carried through every subdivision operation
 //! (issue 5, "mechanics coupling"; beyond seed 004, which stops at the topology).
 //!
-//! [`LeveledMechanics`] keys everything by cell ids of the finest map: one [`Spring`] per edge,
-//! keyed by the sorted pair of its vertex ids (vertex ids never change under subdivision), one mass
-//! per volume id ([`TetMasses`]), position and velocity per vertex id. Its operations call the
-//! map's and then apply the rules below; [`LeveledMechanics::check`] states them as laws.
+//! [`LeveledMechanics`] keys everything by cell ids of the finest map: one [`Spring`] per edge
+//! cell, keyed by an [`EdgeKey`] (the edge's cell id and the sorted pair of its vertex ids; vertex
+//! ids never change under subdivision, an edge keeps its id until it is split), one mass per volume
+//! id ([`TetMasses`]), position and velocity per vertex id. Two distinct edges joining the same two
+//! vertices (a cut edge whose ends stayed joined, e.g. after a tear) are two edge cells, so two
+//! springs. Its operations call the map's, follow its [`LeveledMap::edge_split_log`] (which edge
+//! cell each inserted vertex split, which cells the halves are) and then apply the rules below;
+//! [`LeveledMechanics::check`] states them as laws.
 //!
 //! # Rules
 //! - **Edge split** (any operation that inserts a midpoint m on an edge (a, b) with spring
@@ -33,11 +37,91 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
-use super::{LeveledMap, Refinement, SubdivideError, TetMasses};
-use crate::gmap::{AlphaMask, DartId};
+use super::{EdgeSplit, LeveledMap, Refinement, SubdivideError, TetMasses};
+use crate::gmap::{AlphaMask, DartId, GMap};
 use crate::mechanics::geom::{norm, sub, Vec3};
 use crate::mechanics::model::stiffness_contribution;
 use crate::mechanics::{Material, SpringSystem};
+
+/// The six corner pairs of a tet, in the order of [`EdgeKey`] arrays of a tet.
+pub(super) const PAIRS: [(usize, usize); 6] = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
+
+/// One edge cell of the finest map: its end vertex ids a ≤ b and its edge cell id. Ordered by
+/// (a, b, id): springs come in vertex-pair order, and the edges joining the same two vertices are
+/// neighbours. An edge keeps its key until it is split (vertex ids never change; an unsplit edge
+/// keeps its cell id); after a split one half reuses the id with a new end, so a key never names
+/// two edges.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::subdivide::EdgeKey;
+/// use topomech::GMap;
+/// let k = EdgeKey::new(7, 5, 2);
+/// assert_eq!((k.a, k.b, k.id, k.ends()), (2, 5, 7, (2, 5)));
+/// assert!(EdgeKey::new(9, 0, 1) < k && k < EdgeKey::new(8, 2, 5)); // pair first, then id
+/// assert_eq!(k.to_string(), "edge 7 (2, 5)");
+/// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+/// let d = map.darts().next().unwrap();
+/// assert_eq!(EdgeKey::of(&map, d).id, map.cell_id(1, d).0);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct EdgeKey {
+    /// The smaller end vertex id.
+    pub a: u32,
+    /// The larger end vertex id.
+    pub b: u32,
+    /// The edge cell id in the finest map.
+    pub id: u32,
+}
+
+impl EdgeKey {
+    /// The key of edge cell `id` joining vertices u and v (either order). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::subdivide::EdgeKey;
+    /// assert_eq!(EdgeKey::new(3, 4, 1), EdgeKey::new(3, 1, 4));
+    /// ```
+    pub fn new(id: u32, u: u32, v: u32) -> Self {
+        EdgeKey { a: u.min(v), b: u.max(v), id }
+    }
+
+    /// The key of the edge of dart `d` in `map`: its cell id and the vertex ids of d and α0(d).
+    /// O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::subdivide::EdgeKey;
+    /// use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let d = map.darts().next().unwrap();
+    /// assert_eq!(EdgeKey::of(&map, d), EdgeKey::of(&map, map.alpha_dyn(0, d)));
+    /// ```
+    pub fn of(map: &GMap<3>, d: DartId) -> Self {
+        EdgeKey::new(map.cell_id(1, d).0, map.vertex_id(d).0, map.vertex_id(map.alpha_dyn(0, d)).0)
+    }
+
+    /// The end vertex ids (a, b), a ≤ b. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::subdivide::EdgeKey;
+    /// assert_eq!(EdgeKey::new(0, 9, 4).ends(), (4, 9));
+    /// ```
+    pub fn ends(self) -> (u32, u32) {
+        (self.a, self.b)
+    }
+}
+
+impl std::fmt::Display for EdgeKey {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "edge {} ({}, {})", self.id, self.a, self.b)
+    }
+}
 
 /// One spring: rest length L, stiffness k, damping c.
 ///
@@ -104,6 +188,14 @@ pub enum CouplingError {
     /// A vertex has no rest position (the map was built without geometry).
     #[error("vertex {0} has no rest position: the leveled map needs its points")]
     NoGeometry(u32),
+    /// A live volume has no mass, or a negative or non-finite one ([`LeveledMechanics::with_masses`]).
+    #[error("volume {volume} has no valid mass (given: {given:?})")]
+    BadMass {
+        /// The volume cell id.
+        volume: u32,
+        /// The mass given for it, if any.
+        given: Option<f64>,
+    },
     /// The map inserted vertices the coupling did not see (an operation called on the map alone).
     #[error("the coupling applied {applied} vertex insertions but the map logged {logged}")]
     OutOfSync {
@@ -112,27 +204,26 @@ pub enum CouplingError {
         /// Insertions in [`LeveledMap::split_log`].
         logged: usize,
     },
-    /// The map split an edge that has no spring (a bug, or a tampered coupling).
-    #[error("edge ({0}, {1}) was split but has no spring")]
-    NoSpring(u32, u32),
-    /// Two distinct edges join the same two vertices (an edge dissociated by a cut whose end
-    /// vertices stayed joined): springs are keyed by vertex pairs, so this map cannot be coupled.
-    #[error("two edges join vertices {0} and {1} (a dissociated edge whose ends did not split): springs keyed by vertex pairs would be ambiguous")]
-    AmbiguousEdge(u32, u32),
+    /// The map split an edge cell that has no spring (a bug, or a tampered coupling).
+    #[error("{0} was split but has no spring")]
+    NoSpring(EdgeKey),
 }
 
-/// Errors if two distinct edges of the map join the same two vertices. O(darts).
-fn check_unambiguous(m: &LeveledMap<3>) -> Result<(), CouplingError> {
-    let map = m.map();
-    let mut seen = std::collections::HashSet::new();
-    for d in map.one_dart_per_cell(1) {
-        let (a, b) = (map.vertex_id(d).0, map.vertex_id(map.alpha_dyn(0, d)).0);
-        if !seen.insert(key(a, b)) {
-            let (a, b) = key(a, b);
-            return Err(CouplingError::AmbiguousEdge(a, b));
-        }
-    }
-    Ok(())
+/// A level-0 tet: its corner vertex ids (increasing) and the keys of its six edges in [`PAIRS`]
+/// order (`None` for a corner pair that is no edge of its volume).
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct Tet0 {
+    pub(super) corners: [u32; 4],
+    pub(super) edges: [Option<EdgeKey>; 6],
+}
+
+/// The corners of the tet of `d` (increasing) and the keys of the edges of its volume joining each
+/// corner pair of [`PAIRS`] (`None` where that pair is split or no edge). O(volume).
+pub(super) fn tet_edges(m: &LeveledMap<3>, d: DartId) -> Result<Tet0, SubdivideError> {
+    let corners = m.tet_vertices(d)?;
+    let edges: Vec<EdgeKey> = m.map().orbit(d, AlphaMask::of(&[0, 1, 2])).iter().map(|&x| EdgeKey::of(m.map(), x)).collect();
+    let find = |u: u32, v: u32| edges.iter().copied().find(|e| e.ends() == (u.min(v), u.max(v)));
+    Ok(Tet0 { corners, edges: PAIRS.map(|(i, j)| find(corners[i], corners[j])) })
 }
 
 /// Springs, masses and vertex state of a [`LeveledMap<3>`] following its subdivision (module docs).
@@ -151,7 +242,7 @@ fn check_unambiguous(m: &LeveledMap<3>) -> Result<(), CouplingError> {
 /// assert_eq!(mech.springs().count(), 19);
 /// mech.refine_around(&mut m, [0.2, 0.2, 0.2], 0.1, 1).unwrap();
 /// mech.check(&m).unwrap();
-/// assert_eq!(mech.springs().count(), m.map().count_cells().0[1]); // one spring per edge
+/// assert_eq!(mech.springs().count(), m.map().count_cells().0[1]); // one spring per edge cell
 /// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct LeveledMechanics {
@@ -163,29 +254,27 @@ pub struct LeveledMechanics {
     pub position: Vec<Vec3>,
     /// Velocity per vertex id.
     pub velocity: Vec<Vec3>,
-    pub(super) springs: BTreeMap<(u32, u32), Spring>,
+    /// One spring per edge cell of the finest map.
+    pub(super) springs: BTreeMap<EdgeKey, Spring>,
     /// Springs that were split and were not halves themselves: their value before the split.
-    pub(super) roots: BTreeMap<(u32, u32), Spring>,
-    /// Every edge ever split → its midpoint.
-    pub(super) split_at: BTreeMap<(u32, u32), u32>,
+    pub(super) roots: BTreeMap<EdgeKey, Spring>,
+    /// Every edge ever split → its midpoint and its halves (the one at its end `a`, at `b`).
+    pub(super) split_at: BTreeMap<EdgeKey, (u32, [EdgeKey; 2])>,
     /// Halves produced by splits.
-    pub(super) halves: BTreeSet<(u32, u32)>,
+    pub(super) halves: BTreeSet<EdgeKey>,
     /// The level-0 tets (their springs come from law 2 over them).
-    pub(super) tets0: Vec<[u32; 4]>,
+    pub(super) tets0: Vec<Tet0>,
     /// Entries of the map's split log already followed.
     pub(super) applied: usize,
     /// Σ m_t when the coupling was built.
     pub(super) total_mass: f64,
 }
 
-/// The key of the edge between vertices a and b: the sorted pair.
-pub(super) fn key(a: u32, b: u32) -> (u32, u32) {
-    (a.min(b), a.max(b))
-}
-
 impl LeveledMechanics {
-    /// The coupling of a level-0 map: masses ρ·V_t, springs from law 2 (k_e = Σ_{t ∋ e} E V_t / L_e²,
-    /// c_e = β k_e, L_e the rest distance), at rest with zero velocity. O(darts + E log E).
+    /// The coupling of a level-0 map: masses ρ·V_t, springs from law 2 (k_e = Σ_{t ∋ e} E V_t / L_e²
+    /// over the tets whose volume holds the edge cell e, c_e = β k_e, L_e the rest distance), at rest
+    /// with zero velocity. Two edge cells joining the same vertices get a spring each, from their own
+    /// tets. O(darts + E log E).
     ///
     /// Errors: [`CouplingError::NotLevelZero`], [`CouplingError::NoGeometry`], and the errors of
     /// [`LeveledMap::tet_vertices`] for a volume that is not a tet.
@@ -204,16 +293,48 @@ impl LeveledMechanics {
     /// assert!((s.stiffness - 1.0).abs() < 1e-12); // E V / L² = 6 · (1/6) / 1
     /// ```
     pub fn new(m: &LeveledMap<3>, material: Material) -> Result<Self, CouplingError> {
-        if m.max_level() != 0 {
-            return Err(CouplingError::NotLevelZero(m.max_level()));
-        }
-        let nv = m.map().cell_id_bound(0);
-        if m.points().len() < nv {
-            return Err(CouplingError::NoGeometry(m.points().len() as u32));
-        }
-        check_unambiguous(m)?;
+        check_start(m)?;
         let masses = TetMasses::from_density(m, material.density)?;
-        let tets0: Vec<[u32; 4]> = m.finest_tets()?.into_iter().map(|(t, _, _)| t).collect();
+        Self::build(m, material, masses)
+    }
+
+    /// As [`Self::new`] with the given tet masses (indexed by volume id) instead of ρ·V_t: e.g. the
+    /// masses of a [`crate::mechanics::Body`] whose map and positions the leveled map copies.
+    /// O(darts + E log E).
+    ///
+    /// Errors: those of [`Self::new`], and [`CouplingError::BadMass`] for a live volume with no mass
+    /// or a negative or non-finite one.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::Material;
+    /// use topomech::subdivide::{CouplingError, LeveledMap, LeveledMechanics, TetMasses};
+    /// use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let m = LeveledMap::new(map, pts);
+    /// let mech = LeveledMechanics::with_masses(&m, Material::default(), TetMasses { mass: vec![2.0] }).unwrap();
+    /// assert!((mech.vertex_masses(&m)[3] - 0.5).abs() < 1e-15);
+    /// let e = LeveledMechanics::with_masses(&m, Material::default(), TetMasses { mass: vec![] }).unwrap_err();
+    /// assert_eq!(e, CouplingError::BadMass { volume: 0, given: None });
+    /// ```
+    pub fn with_masses(m: &LeveledMap<3>, material: Material, masses: TetMasses) -> Result<Self, CouplingError> {
+        check_start(m)?;
+        for d in m.map().one_dart_per_cell(3) {
+            let volume = m.map().cell_id(3, d);
+            let given = masses.mass.get(volume.index()).copied();
+            if !given.is_some_and(|x| x.is_finite() && x >= 0.0) {
+                return Err(CouplingError::BadMass { volume: volume.0, given });
+            }
+        }
+        Self::build(m, material, masses)
+    }
+
+    /// The coupling of a checked level-0 map with these masses.
+    fn build(m: &LeveledMap<3>, material: Material, masses: TetMasses) -> Result<Self, CouplingError> {
+        let nv = m.map().cell_id_bound(0);
+        let tets0 = m.map().one_dart_per_cell(3).into_iter().map(|d| tet_edges(m, d)).collect::<Result<Vec<_>, _>>()?;
         let mut mech = LeveledMechanics {
             material,
             total_mass: masses.total(m),
@@ -225,16 +346,17 @@ impl LeveledMechanics {
             split_at: BTreeMap::new(),
             halves: BTreeSet::new(),
             tets0: Vec::new(),
-            applied: m.split_log().len(),
+            applied: m.edge_split_log().len(),
         };
         for t in &tets0 {
-            mech.add_tet(m, *t);
+            mech.add_tet(m, t);
         }
         mech.tets0 = tets0;
         Ok(mech)
     }
 
-    /// The spring of the edge between vertices a and b (either order), if any. O(log E).
+    /// The spring of the edge between vertices a and b (either order) when exactly one edge cell
+    /// joins them; `None` when none or several do (see [`Self::springs_between`]). O(log E).
     ///
     /// # Examples
     ///
@@ -249,11 +371,75 @@ impl LeveledMechanics {
     /// assert!(mech.spring(0, 0).is_none());
     /// ```
     pub fn spring(&self, a: u32, b: u32) -> Option<Spring> {
-        self.springs.get(&key(a, b)).copied()
+        match self.springs_between(a, b).as_slice() {
+            [(_, s)] => Some(*s),
+            _ => None,
+        }
     }
 
-    /// Mutable access to a spring (for tests and tools; [`Self::check`] says whether the laws still
-    /// hold). O(log E).
+    /// The key of the edge between vertices a and b when exactly one edge cell joins them. O(log E).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::Material;
+    /// use topomech::subdivide::{LeveledMap, LeveledMechanics};
+    /// use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let m = LeveledMap::new(map, pts);
+    /// let mech = LeveledMechanics::new(&m, Material::default()).unwrap();
+    /// assert_eq!(mech.edge(2, 1).unwrap().ends(), (1, 2));
+    /// ```
+    pub fn edge(&self, a: u32, b: u32) -> Option<EdgeKey> {
+        match self.springs_between(a, b).as_slice() {
+            [(e, _)] => Some(*e),
+            _ => None,
+        }
+    }
+
+    /// Every spring of an edge cell joining vertices a and b (either order), by edge id: one per
+    /// edge, so two for a cut edge whose ends stayed joined. O(log E + found).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::Material;
+    /// use topomech::subdivide::{LeveledMap, LeveledMechanics};
+    /// use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mech = LeveledMechanics::new(&LeveledMap::new(map, pts), Material::default()).unwrap();
+    /// assert_eq!(mech.springs_between(3, 0).len(), 1);
+    /// assert!(mech.springs_between(0, 7).is_empty());
+    /// ```
+    pub fn springs_between(&self, a: u32, b: u32) -> Vec<(EdgeKey, Spring)> {
+        let (a, b) = (a.min(b), a.max(b));
+        let range = EdgeKey { a, b, id: 0 }..=EdgeKey { a, b, id: u32::MAX };
+        self.springs.range(range).map(|(&e, &s)| (e, s)).collect()
+    }
+
+    /// The spring of the edge cell `e` of the finest level, if it has one. O(log E).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::Material;
+    /// use topomech::subdivide::{EdgeKey, LeveledMap, LeveledMechanics};
+    /// use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let m = LeveledMap::new(map, pts);
+    /// let mech = LeveledMechanics::new(&m, Material::default()).unwrap();
+    /// let d = m.map().darts().next().unwrap();
+    /// assert!(mech.spring_at(EdgeKey::of(m.map(), d)).is_some());
+    /// ```
+    pub fn spring_at(&self, e: EdgeKey) -> Option<Spring> {
+        self.springs.get(&e).copied()
+    }
+
+    /// Mutable access to the spring of edge cell `e` (for tests and tools; [`Self::check`] says
+    /// whether the laws still hold). O(log E).
     ///
     /// # Examples
     ///
@@ -265,14 +451,16 @@ impl LeveledMechanics {
     /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
     /// let m = LeveledMap::new(map, pts);
     /// let mut mech = LeveledMechanics::new(&m, Material::default()).unwrap();
-    /// mech.spring_mut(2, 3).unwrap().stiffness *= 1.5;
+    /// let e = mech.edge(2, 3).unwrap();
+    /// mech.spring_mut(e).unwrap().stiffness *= 1.5;
     /// assert!(matches!(mech.check(&m), Err(SpringLawError::Stiffness { a: 2, b: 3, .. })));
     /// ```
-    pub fn spring_mut(&mut self, a: u32, b: u32) -> Option<&mut Spring> {
-        self.springs.get_mut(&key(a, b))
+    pub fn spring_mut(&mut self, e: EdgeKey) -> Option<&mut Spring> {
+        self.springs.get_mut(&e)
     }
 
-    /// Every spring as ((a, b), spring), a < b, in increasing order of the pair. O(1) per item.
+    /// Every spring of the finest level as (edge key, spring), one per edge cell, in key order
+    /// (vertex pair, then edge id). O(1) per item.
     ///
     /// # Examples
     ///
@@ -283,15 +471,15 @@ impl LeveledMechanics {
     /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
     /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
     /// let mech = LeveledMechanics::new(&LeveledMap::new(map, pts), Material::default()).unwrap();
-    /// let pairs: Vec<(u32, u32)> = mech.springs().map(|(e, _)| e).collect();
+    /// let pairs: Vec<(u32, u32)> = mech.springs().map(|(e, _)| e.ends()).collect();
     /// assert_eq!(pairs, vec![(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]);
     /// ```
-    pub fn springs(&self) -> impl Iterator<Item = ((u32, u32), Spring)> + '_ {
+    pub fn springs(&self) -> impl Iterator<Item = (EdgeKey, Spring)> + '_ {
         self.springs.iter().map(|(&e, &s)| (e, s))
     }
 
-    /// The finest springs along the edge (a, b) of some level, in order from a to b: the edge itself
-    /// if it was never split, else the chains of its two halves. O(chain · log E).
+    /// Every root: an edge cell split when it was not itself a half, with its spring at that
+    /// moment, in key order. O(1) per item.
     ///
     /// # Examples
     ///
@@ -303,25 +491,55 @@ impl LeveledMechanics {
     /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
     /// let mut m = LeveledMap::new(map, pts);
     /// let mut mech = LeveledMechanics::new(&m, Material::default()).unwrap();
-    /// let d = m.map().darts().find(|&d| m.map().vertex_id(d).0 == 0 && m.map().vertex_id(m.map().alpha_dyn(0, d)).0 == 1).unwrap();
-    /// mech.split_edge(&mut m, d, 1).unwrap();
-    /// assert_eq!(mech.chain(0, 1), vec![(0, 4), (4, 1)]);
-    /// let compliance: f64 = mech.chain(0, 1).iter().map(|&(a, b)| 1.0 / mech.spring(a, b).unwrap().stiffness).sum();
-    /// assert!((compliance * mech.root(0, 1).unwrap().stiffness - 1.0).abs() < 1e-12);
+    /// let d = m.map().darts().next().unwrap();
+    /// mech.subdivide_tet(&mut m, d, 1).unwrap();
+    /// assert_eq!(mech.roots().count(), 6);
     /// ```
-    pub fn chain(&self, a: u32, b: u32) -> Vec<(u32, u32)> {
-        match self.split_at.get(&key(a, b)) {
-            Some(&m) => {
-                let mut out = self.chain(a, m);
-                out.extend(self.chain(m, b));
-                out
+    pub fn roots(&self) -> impl Iterator<Item = (EdgeKey, Spring)> + '_ {
+        self.roots.iter().map(|(&e, &s)| (e, s))
+    }
+
+    /// The finest springs along the edge cell `e` of some level, in order from its end `e.a` to
+    /// `e.b`: `e` itself if it was never split, else the chains of its two halves. O(chain · log E).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::Material;
+    /// use topomech::subdivide::{LeveledMap, LeveledMechanics};
+    /// use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mut m = LeveledMap::new(map, pts);
+    /// let mut mech = LeveledMechanics::new(&m, Material::default()).unwrap();
+    /// let e = mech.edge(0, 1).unwrap();
+    /// let d = m.map().darts().find(|&d| m.map().cell_id(1, d).0 == e.id).unwrap();
+    /// mech.split_edge(&mut m, d, 1).unwrap();
+    /// let chain = mech.chain(e);
+    /// assert_eq!(chain.iter().map(|h| h.ends()).collect::<Vec<_>>(), vec![(0, 4), (1, 4)]);
+    /// let compliance: f64 = chain.iter().map(|&h| 1.0 / mech.spring_at(h).unwrap().stiffness).sum();
+    /// assert!((compliance * mech.root(e).unwrap().stiffness - 1.0).abs() < 1e-12);
+    /// ```
+    pub fn chain(&self, e: EdgeKey) -> Vec<EdgeKey> {
+        let mut out = Vec::new();
+        self.chain_from(e, e.a, &mut out);
+        out
+    }
+
+    /// Appends the chain of `e` walked from its end vertex `from`.
+    fn chain_from(&self, e: EdgeKey, from: u32, out: &mut Vec<EdgeKey>) {
+        match self.split_at.get(&e) {
+            Some(&(mid, [at_a, at_b])) => {
+                let (first, second) = if from == e.a { (at_a, at_b) } else { (at_b, at_a) };
+                self.chain_from(first, from, out);
+                self.chain_from(second, mid, out);
             }
-            None => vec![(a, b)],
+            None => out.push(e),
         }
     }
 
-    /// The spring the edge (a, b) had when it was first split, if it was a root (a spring that was not
-    /// itself a half). O(log E).
+    /// The spring the edge cell `e` had when it was first split, if it was a root (a spring that was
+    /// not itself a half). O(log E).
     ///
     /// # Examples
     ///
@@ -333,25 +551,23 @@ impl LeveledMechanics {
     /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
     /// let mut m = LeveledMap::new(map, pts);
     /// let mut mech = LeveledMechanics::new(&m, Material::default()).unwrap();
-    /// let before = mech.spring(0, 1);
+    /// let e = mech.edge(0, 1).unwrap();
+    /// let before = mech.spring_at(e);
     /// let d = m.map().darts().next().unwrap();
     /// mech.subdivide_tet(&mut m, d, 1).unwrap();
-    /// assert_eq!(mech.root(0, 1), before);
-    /// assert!(mech.spring(0, 1).is_none()); // no longer an edge of the finest level
+    /// assert_eq!(mech.root(e), before);
+    /// assert!(mech.spring_at(e).is_none() && mech.spring(0, 1).is_none()); // no longer an edge
     /// ```
-    pub fn root(&self, a: u32, b: u32) -> Option<Spring> {
-        self.roots.get(&key(a, b)).copied()
+    pub fn root(&self, e: EdgeKey) -> Option<Spring> {
+        self.roots.get(&e).copied()
     }
 
-    /// Adds law 2's contribution of the tet with corners `t` to its six edges that are not halves.
-    fn add_tet(&mut self, m: &LeveledMap<3>, t: [u32; 4]) {
-        let p = t.map(|v| m.points()[v as usize]);
+    /// Adds law 2's contribution of the tet `t` to its edges that are not halves.
+    fn add_tet(&mut self, m: &LeveledMap<3>, t: &Tet0) {
+        let p = t.corners.map(|v| m.points()[v as usize]);
         let volume = crate::mesh::signed_volume(p[0], p[1], p[2], p[3]);
-        for (i, j) in [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)] {
-            let e = key(t[i], t[j]);
-            if self.halves.contains(&e) {
-                continue;
-            }
+        for (&(i, j), e) in PAIRS.iter().zip(t.edges) {
+            let Some(e) = e.filter(|e| !self.halves.contains(e)) else { continue };
             let rest = norm(sub(p[j], p[i]));
             let k = stiffness_contribution(self.material.young, volume, rest);
             let s = self.springs.entry(e).or_insert(Spring { rest, stiffness: 0.0, damping: 0.0 });
@@ -362,12 +578,23 @@ impl LeveledMechanics {
 
     /// Errors unless every vertex insertion of the map was followed.
     fn in_sync(&self, m: &LeveledMap<3>) -> Result<(), CouplingError> {
-        let logged = m.split_log().len();
+        let logged = m.edge_split_log().len();
         if logged != self.applied {
             return Err(CouplingError::OutOfSync { applied: self.applied, logged });
         }
         Ok(())
     }
+}
+
+/// Errors unless `m` is at level 0 and has a rest position for every vertex id. O(1).
+fn check_start(m: &LeveledMap<3>) -> Result<(), CouplingError> {
+    if m.max_level() != 0 {
+        return Err(CouplingError::NotLevelZero(m.max_level()));
+    }
+    if m.points().len() < m.map().cell_id_bound(0) {
+        return Err(CouplingError::NoGeometry(m.points().len() as u32));
+    }
+    Ok(())
 }
 
 impl LeveledMechanics {
@@ -517,12 +744,13 @@ impl LeveledMechanics {
         Ok(Refinement { subdivided_per_level: per_level, total_mass_before: before, total_mass_after: after })
     }
 
-    /// Applies the rules after an operation of the map: series splits from the new entries of the
-    /// split log, zero springs on the new edges of `faces` and `children`, law 2 from `children`.
+    /// Applies the rules after an operation of the map: series splits from the new entries of its
+    /// edge split log, zero springs on the new edge cells of `faces` and `children`, law 2 from
+    /// `children`.
     fn follow(&mut self, m: &LeveledMap<3>, faces: &[DartId], children: &[DartId]) -> Result<(), CouplingError> {
-        let log = m.split_log();
-        for &[v, a, b] in &log[self.applied..] {
-            self.split_spring(m, v, a, b)?;
+        let log = m.edge_split_log();
+        for &s in &log[self.applied..] {
+            self.split_spring(m, s)?;
         }
         self.applied = log.len();
         let mut region: Vec<DartId> = Vec::new();
@@ -533,15 +761,15 @@ impl LeveledMechanics {
             region.extend(m.map().orbit(c, AlphaMask::of(&[0, 1, 2])));
         }
         for d in region {
-            let (a, b) = (m.map().vertex_id(d).0, m.map().vertex_id(m.map().alpha_dyn(0, d)).0);
-            if a != b {
-                let rest = norm(sub(m.points()[b as usize], m.points()[a as usize]));
-                self.springs.entry(key(a, b)).or_insert(Spring { rest, stiffness: 0.0, damping: 0.0 });
+            let e = EdgeKey::of(m.map(), d);
+            if e.a != e.b {
+                let rest = norm(sub(m.points()[e.b as usize], m.points()[e.a as usize]));
+                self.springs.entry(e).or_insert(Spring { rest, stiffness: 0.0, damping: 0.0 });
             }
         }
         for &c in children {
-            let t = m.tet_vertices(c)?;
-            self.add_tet(m, t);
+            let t = tet_edges(m, c)?;
+            self.add_tet(m, &t);
         }
         Ok(())
     }
@@ -556,15 +784,19 @@ impl LeveledMechanics {
         let _ = m;
     }
 
-    /// The series rule for the insertion of vertex v on the edge (a, b), and v's state.
-    fn split_spring(&mut self, m: &LeveledMap<3>, v: u32, a: u32, b: u32) -> Result<(), CouplingError> {
-        let e = key(a, b);
-        let s = self.springs.remove(&e).ok_or(CouplingError::NoSpring(e.0, e.1))?;
+    /// The series rule for one vertex insertion of the map (the edge cell it split, the cells of the
+    /// halves), and the new vertex's state.
+    fn split_spring(&mut self, m: &LeveledMap<3>, split: EdgeSplit) -> Result<(), CouplingError> {
+        let (v, [a, b]) = (split.vertex, split.ends);
+        let e = EdgeKey::new(split.edge, a, b);
+        let s = self.springs.remove(&e).ok_or(CouplingError::NoSpring(e))?;
         if !self.halves.contains(&e) {
             self.roots.insert(e, s);
         }
-        self.split_at.insert(e, v);
-        for h in [key(a, v), key(v, b)] {
+        let (at_a, at_b) = (EdgeKey::new(split.halves[0], a, v), EdgeKey::new(split.halves[1], v, b));
+        let ordered = if a == e.a { [at_a, at_b] } else { [at_b, at_a] };
+        self.split_at.insert(e, (v, ordered));
+        for h in [at_a, at_b] {
             self.springs.insert(h, s.half());
             self.halves.insert(h);
         }
@@ -611,7 +843,8 @@ impl LeveledMechanics {
     }
 
     /// The finest level as a flat [`SpringSystem`] with slots = vertex ids (so [`Self::position`] and
-    /// [`Self::velocity`] are its state arrays): springs in pair order, masses from
+    /// [`Self::velocity`] are its state arrays): one spring per edge cell in key order (two springs
+    /// with the same ends for two edges joining the same vertices), masses from
     /// [`Self::vertex_masses`], viscosity ν·m_v, `fixed[v]` pinning vertex v (missing entries:
     /// free). No tet list is rebuilt. O(darts + E).
     ///
@@ -639,7 +872,7 @@ impl LeveledMechanics {
         let n = mass.len();
         let pinned: Vec<bool> = (0..n).map(|v| fixed.get(v).copied().unwrap_or(false)).collect();
         let viscosity = mass.iter().map(|x| self.material.viscosity * x).collect();
-        let ends = self.springs.keys().map(|&(a, b)| [a, b]).collect();
+        let ends = self.springs.keys().map(|e| [e.a, e.b]).collect();
         let rest = self.springs.values().map(|s| s.rest).collect();
         let stiffness = self.springs.values().map(|s| s.stiffness).collect();
         let damping = self.springs.values().map(|s| s.damping).collect();

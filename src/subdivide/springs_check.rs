@@ -3,13 +3,18 @@
 //! tets are trusted.
 //!
 //! 1. the coupling followed every vertex insertion of the map, and has a state for every vertex;
-//! 2. every edge of the finest map has exactly one spring and every spring is an edge of the finest
-//!    map (so its ends are vertices of the finest level); no two edges join the same vertices;
+//! Springs are stated per *edge cell* ([`super::EdgeKey`]: cell id and end vertices), so two edges
+//! joining the same two vertices (a cut edge whose ends stayed joined) are two springs, each under
+//! every law below.
+//!
+//! 2. every edge cell of the finest map has exactly one spring, under its key (its cell id and the
+//!    vertex ids of its ends), and every spring is an edge cell of the finest map;
 //! 3. L_s = |P_a − P_b| on the rest positions;
-//! 4. series: along every root (a, b), the chain of finest springs has Σ 1/k_i = 1/k_root,
-//!    Σ 1/c_i = 1/c_root and Σ L_i = L_root;
+//! 4. series: along every root (an edge cell split when it was not a half), the chain of finest
+//!    springs has Σ 1/k_i = 1/k_root, Σ 1/c_i = 1/c_root and Σ L_i = L_root;
 //! 5. every spring that is not a half of a split: k = Σ_{t ∋ e} E V_t / L_e² over the level-0 tets
-//!    and the finest tets of level μt ≥ 1 that have e among their six corner edges, and c = β k;
+//!    and the finest tets of level μt ≥ 1 whose volume holds the edge cell e between two of its
+//!    corners, and c = β k;
 //! 6. Σ_t m_t equals its value when the coupling was built, and every vertex mass gathered from the
 //!    volumes around the vertex (m_v = Σ m_t / n_t) equals the scatter of
 //!    [`LeveledMechanics::vertex_masses`], so Σ_v m_v = Σ_t m_t.
@@ -18,7 +23,7 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
-use super::springs::{key, volume_vertices};
+use super::springs::{tet_edges, volume_vertices, EdgeKey, Tet0, PAIRS};
 use super::{LeveledMap, LeveledMechanics};
 use crate::gmap::AlphaMask;
 use crate::mechanics::geom::{norm, sub};
@@ -27,15 +32,15 @@ use crate::mechanics::model::stiffness_contribution;
 /// Relative tolerance of every comparison of [`LeveledMechanics::check`].
 const TOLERANCE: f64 = 1e-12;
 
-/// A law of the subdivided spring network that does not hold, naming the edge (vertex ids a < b)
-/// or the vertex.
+/// A law of the subdivided spring network that does not hold, naming the edge (vertex ids a ≤ b and
+/// edge cell id) or the vertex.
 ///
 /// # Examples
 ///
 /// ```
 /// use topomech::subdivide::SpringLawError;
-/// let e = SpringLawError::Series { a: 0, b: 1, compliance: 0.2, expected: 0.1 };
-/// assert!(e.to_string().contains("(0, 1)"));
+/// let e = SpringLawError::Series { a: 0, b: 1, edge: 4, compliance: 0.2, expected: 0.1 };
+/// assert!(e.to_string().contains("edge 4 (0, 1)"));
 /// ```
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SpringLawError {
@@ -55,73 +60,77 @@ pub enum SpringLawError {
         /// Entries of the shortest state array.
         states: usize,
     },
-    /// Two edges of the finest map join the same two vertices.
-    #[error("two edges join vertices ({a}, {b})")]
-    DuplicateEdge {
-        /// Smaller vertex id.
-        a: u32,
-        /// Larger vertex id.
-        b: u32,
-    },
-    /// An edge of the finest map has no spring.
-    #[error("edge ({a}, {b}) has no spring")]
+    /// An edge cell of the finest map has no spring.
+    #[error("edge {edge} ({a}, {b}) has no spring")]
     MissingSpring {
         /// Smaller vertex id.
         a: u32,
         /// Larger vertex id.
         b: u32,
+        /// Edge cell id.
+        edge: u32,
     },
-    /// A spring joins two vertices that no edge of the finest map joins.
-    #[error("spring ({a}, {b}) is not an edge of the finest level")]
+    /// A spring's key is no edge cell of the finest map (with those ends).
+    #[error("spring of edge {edge} ({a}, {b}) is not an edge cell of the finest level")]
     StraySpring {
         /// Smaller vertex id.
         a: u32,
         /// Larger vertex id.
         b: u32,
+        /// Edge cell id.
+        edge: u32,
     },
     /// The rest length differs from the distance of the rest positions.
-    #[error("spring ({a}, {b}) has rest length {stored}, its ends are {measured} apart at rest")]
+    #[error("spring of edge {edge} ({a}, {b}) has rest length {stored}, its ends are {measured} apart at rest")]
     RestLength {
         /// Smaller vertex id.
         a: u32,
         /// Larger vertex id.
         b: u32,
+        /// Edge cell id.
+        edge: u32,
         /// Stored L.
         stored: f64,
         /// Measured distance.
         measured: f64,
     },
     /// The chain along a split edge breaks the series rule (stiffness, damping or length).
-    #[error("the chain along ({a}, {b}) has compliance {compliance}, the split spring {expected}")]
+    #[error("the chain along edge {edge} ({a}, {b}) has compliance {compliance}, the split spring {expected}")]
     Series {
         /// Smaller vertex id.
         a: u32,
         /// Larger vertex id.
         b: u32,
+        /// Edge cell id.
+        edge: u32,
         /// Σ 1/k_i (or Σ 1/c_i, or Σ L_i) of the chain.
         compliance: f64,
         /// 1/k (or 1/c, or L) of the root.
         expected: f64,
     },
     /// A spring that is not a half has k ≠ the sum of its tets' contributions.
-    #[error("spring ({a}, {b}) has stiffness {stored}, its tets give {expected}")]
+    #[error("spring of edge {edge} ({a}, {b}) has stiffness {stored}, its tets give {expected}")]
     Stiffness {
         /// Smaller vertex id.
         a: u32,
         /// Larger vertex id.
         b: u32,
+        /// Edge cell id.
+        edge: u32,
         /// Stored k.
         stored: f64,
         /// Σ E V_t / L².
         expected: f64,
     },
     /// A spring that is not a half has c ≠ β k.
-    #[error("spring ({a}, {b}) has damping {stored}, β k = {expected}")]
+    #[error("spring of edge {edge} ({a}, {b}) has damping {stored}, β k = {expected}")]
     Damping {
         /// Smaller vertex id.
         a: u32,
         /// Larger vertex id.
         b: u32,
+        /// Edge cell id.
+        edge: u32,
         /// Stored c.
         stored: f64,
         /// β k.
@@ -181,8 +190,8 @@ impl LeveledMechanics {
     /// let d = m.map().darts().next().unwrap();
     /// mech.subdivide_tet(&mut m, d, 1).unwrap();
     /// assert!(mech.check(&m).is_ok());
-    /// let (e, _) = mech.springs().find(|&((a, b), _)| a < 4 && b >= 4).unwrap(); // a half
-    /// mech.spring_mut(e.0, e.1).unwrap().stiffness *= 2.0;
+    /// let (e, _) = mech.springs().find(|(e, _)| e.a < 4 && e.b >= 4).unwrap(); // a half
+    /// mech.spring_mut(e).unwrap().stiffness *= 2.0;
     /// assert!(matches!(mech.check(&m), Err(SpringLawError::Series { .. })));
     /// ```
     pub fn check(&self, m: &LeveledMap<3>) -> Result<(), SpringLawError> {
@@ -211,23 +220,23 @@ impl LeveledMechanics {
         let map = m.map();
         let mut edges = BTreeSet::new();
         for d in map.one_dart_per_cell(1) {
-            let (a, b) = key(map.vertex_id(d).0, map.vertex_id(map.alpha_dyn(0, d)).0);
-            if !edges.insert((a, b)) {
-                return Err(SpringLawError::DuplicateEdge { a, b });
-            }
-            let s = self.springs.get(&(a, b)).ok_or(SpringLawError::MissingSpring { a, b })?;
+            let e = EdgeKey::of(map, d);
+            edges.insert(e);
+            let (a, b, edge) = (e.a, e.b, e.id);
+            let s = self.springs.get(&e).ok_or(SpringLawError::MissingSpring { a, b, edge })?;
             let measured = norm(sub(m.points()[b as usize], m.points()[a as usize]));
             if !close(s.rest, measured) {
-                return Err(SpringLawError::RestLength { a, b, stored: s.rest, measured });
+                return Err(SpringLawError::RestLength { a, b, edge, stored: s.rest, measured });
             }
         }
         match self.springs.keys().find(|e| !edges.contains(e)) {
-            Some(&(a, b)) => Err(SpringLawError::StraySpring { a, b }),
+            Some(e) => Err(SpringLawError::StraySpring { a: e.a, b: e.b, edge: e.id }),
             None => Ok(()),
         }
     }
 
-    /// Law 4 alone (the series rule along every split spring), without the map. O(E log E).
+    /// Law 4 alone (the series rule along every split spring, per edge cell), without the map.
+    /// O(E log E).
     ///
     /// Errors: [`SpringLawError::MissingSpring`] (a link of a chain has no spring) or
     /// [`SpringLawError::Series`], naming the root edge.
@@ -245,16 +254,15 @@ impl LeveledMechanics {
     /// let d = m.map().darts().find(|&d| m.map().vertex_id(d).0 == 0 && m.map().vertex_id(m.map().alpha_dyn(0, d)).0 == 1).unwrap();
     /// mech.split_edge(&mut m, d, 1).unwrap();
     /// assert!(mech.check_series().is_ok());
-    /// mech.spring_mut(0, 4).unwrap().rest *= 1.1;
+    /// let half = mech.edge(0, 4).unwrap();
+    /// mech.spring_mut(half).unwrap().rest *= 1.1;
     /// assert!(matches!(mech.check_series(), Err(SpringLawError::Series { a: 0, b: 1, .. })));
     /// ```
     pub fn check_series(&self) -> Result<(), SpringLawError> {
-        for (&(a, b), root) in &self.roots {
-            let chain: Vec<_> = self.chain(a, b).into_iter().map(|(p, q)| self.springs.get(&key(p, q))).collect();
-            let chain: Vec<_> = match chain.into_iter().collect::<Option<Vec<_>>>() {
-                Some(c) => c,
-                None => return Err(SpringLawError::MissingSpring { a, b }),
-            };
+        for (&e, root) in &self.roots {
+            let (a, b, edge) = (e.a, e.b, e.id);
+            let chain: Option<Vec<_>> = self.chain(e).into_iter().map(|h| self.springs.get(&h)).collect();
+            let chain = chain.ok_or(SpringLawError::MissingSpring { a, b, edge })?;
             let laws = [
                 series(chain.iter().map(|s| s.stiffness), root.stiffness),
                 series(chain.iter().map(|s| s.damping), root.damping),
@@ -262,7 +270,7 @@ impl LeveledMechanics {
             ];
             for (compliance, expected) in laws {
                 if !close(compliance, expected) {
-                    return Err(SpringLawError::Series { a, b, compliance, expected });
+                    return Err(SpringLawError::Series { a, b, edge, compliance, expected });
                 }
             }
         }
@@ -271,32 +279,35 @@ impl LeveledMechanics {
 
     /// Law 5.
     fn check_tet_law(&self, m: &LeveledMap<3>) -> Result<(), SpringLawError> {
-        let mut expected: BTreeMap<(u32, u32), f64> = BTreeMap::new();
-        let mut add = |t: [u32; 4]| {
-            let p = t.map(|v| m.points()[v as usize]);
+        let mut expected: BTreeMap<EdgeKey, f64> = BTreeMap::new();
+        let mut add = |t: &Tet0| {
+            let p = t.corners.map(|v| m.points()[v as usize]);
             let volume = crate::mesh::signed_volume(p[0], p[1], p[2], p[3]);
-            for (i, j) in [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)] {
-                let k = stiffness_contribution(self.material.young, volume, norm(sub(p[j], p[i])));
-                *expected.entry(key(t[i], t[j])).or_insert(0.0) += k;
+            for (&(i, j), e) in PAIRS.iter().zip(t.edges) {
+                if let Some(e) = e {
+                    let k = stiffness_contribution(self.material.young, volume, norm(sub(p[j], p[i])));
+                    *expected.entry(e).or_insert(0.0) += k;
+                }
             }
         };
-        self.tets0.iter().for_each(|&t| add(t));
+        self.tets0.iter().for_each(&mut add);
         for d in m.map().one_dart_per_cell(3) {
             if m.mu(d).tet >= 1 {
                 // Checked by the map's own laws; a volume that is not a tet contributes nothing.
-                if let Ok(t) = m.tet_vertices(d) {
-                    add(t);
+                if let Ok(t) = tet_edges(m, d) {
+                    add(&t);
                 }
             }
         }
-        for (&(a, b), s) in self.springs.iter().filter(|(e, _)| !self.halves.contains(e)) {
-            let k = expected.get(&(a, b)).copied().unwrap_or(0.0);
+        for (&e, s) in self.springs.iter().filter(|(e, _)| !self.halves.contains(e)) {
+            let (a, b, edge) = (e.a, e.b, e.id);
+            let k = expected.get(&e).copied().unwrap_or(0.0);
             if !close(s.stiffness, k) {
-                return Err(SpringLawError::Stiffness { a, b, stored: s.stiffness, expected: k });
+                return Err(SpringLawError::Stiffness { a, b, edge, stored: s.stiffness, expected: k });
             }
             let c = self.material.damping * s.stiffness;
             if !close(s.damping, c) {
-                return Err(SpringLawError::Damping { a, b, stored: s.damping, expected: c });
+                return Err(SpringLawError::Damping { a, b, edge, stored: s.damping, expected: c });
             }
         }
         Ok(())

@@ -76,10 +76,17 @@ fn every_check_passes_and_mass_is_kept_or_accounted_for() {
     assert!((num(&s, "final_mass") + num(&s, "removed_mass") - m0).abs() <= 1e-9 * m0);
     assert_eq!(int(&s, "checks_passed"), int(stage(&s, "refinement"), "checks_passed"));
     assert_eq!(s["mesh"]["vertices"], 547, "the built-in liver");
-    assert_eq!(s["refinement_mechanics"], false, "springs do not follow the refinement yet");
+    assert_eq!(s["refinement_mechanics"], false, "the simulation does not follow the refinement yet");
     let refined = stage(&s, "refinement");
     assert!(num(refined, "mass_residual").abs() <= 1e-9, "the children share their parents' masses");
     assert!((num(refined, "total_mass") - num(&s, "final_mass")).abs() <= 1e-9 * m0);
+    // Springs follow the refinement, one per edge cell before and after; a 1→8 only adds stiffness.
+    let springs = &s["refinement_springs"];
+    assert_eq!(int(springs, "before"), int(stage(&s, "removal"), "edges"), "one spring per edge of the final body");
+    assert_eq!(int(springs, "after"), int(refined, "edges"), "one spring per edge cell of the finest level");
+    assert!(int(springs, "doubled_split") <= int(springs, "doubled_edges"));
+    assert_ne!(int(springs, "doubled_edges"), 1, "an edge is doubled with at least one other");
+    assert!(num(refined, "stiffness_sum") > num(stage(&s, "removal"), "stiffness_sum") * (1.0 - 1e-9));
 }
 
 #[test]
@@ -161,7 +168,8 @@ fn the_text_report_ends_with_a_table_of_every_stage() {
         assert!(table.lines().any(|l| l.trim_start().starts_with(name)), "{name} row: {table}");
     }
     assert!(report.contains("checks passed"), "{report}");
-    assert!(report.contains("springs and the simulation do not follow"), "{report}");
+    assert!(report.contains("springs carried, one per edge cell"), "{report}");
+    assert!(report.contains("the simulation does not follow subdivision"), "{report}");
     assert!(dir.join("pictures/scene.pvd").is_file(), "--out is used");
     assert!(!dir.join("out").exists(), "and the default is not");
 }

@@ -389,7 +389,6 @@ fn the_refine_command_reports_the_spring_coupling_with_springs() {
     assert_eq!(before as usize, edges.len());
 }
 
-
 /// The inner edges of a Kuhn cube of side 3 (both ends strictly inside), one dart each.
 fn inner_edges(body: &topomech::mechanics::Body) -> Vec<DartId> {
     let map = body.map();

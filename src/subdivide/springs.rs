@@ -221,7 +221,8 @@ pub(super) struct Tet0 {
 /// corner pair of [`PAIRS`] (`None` where that pair is split or no edge). O(volume).
 pub(super) fn tet_edges(m: &LeveledMap<3>, d: DartId) -> Result<Tet0, SubdivideError> {
     let corners = m.tet_vertices(d)?;
-    let edges: Vec<EdgeKey> = m.map().orbit(d, AlphaMask::of(&[0, 1, 2])).iter().map(|&x| EdgeKey::of(m.map(), x)).collect();
+    let edges: Vec<EdgeKey> =
+        m.map().orbit(d, AlphaMask::of(&[0, 1, 2])).iter().map(|&x| EdgeKey::of(m.map(), x)).collect();
     let find = |u: u32, v: u32| edges.iter().copied().find(|e| e.ends() == (u.min(v), u.max(v)));
     Ok(Tet0 { corners, edges: PAIRS.map(|(i, j)| find(corners[i], corners[j])) })
 }

@@ -2,11 +2,11 @@
 //! and the rest positions; only the roots (the springs as they were when first split) and the level-0
 //! tets are trusted.
 //!
-//! 1. the coupling followed every vertex insertion of the map, and has a state for every vertex;
 //! Springs are stated per *edge cell* ([`super::EdgeKey`]: cell id and end vertices), so two edges
 //! joining the same two vertices (a cut edge whose ends stayed joined) are two springs, each under
 //! every law below.
 //!
+//! 1. the coupling followed every vertex insertion of the map, and has a state for every vertex;
 //! 2. every edge cell of the finest map has exactly one spring, under its key (its cell id and the
 //!    vertex ids of its ends), and every spring is an edge cell of the finest map;
 //! 3. L_s = |P_a − P_b| on the rest positions;

@@ -4,7 +4,7 @@
 //! A liver (the built-in mesh, or any mesh file) pinned at one end of its longest axis:
 //!
 //! ```text
-//!   rest ─► 1 sag ─► 2 incision ─► 3 tear ─► 4 removal ─► 5 refinement (masses shared, no springs yet)
+//!   rest ─► 1 sag ─► 2 incision ─► 3 tear ─► 4 removal ─► 5 refinement (masses and springs carried)
 //!           N steps   cut + N/2     N/2 steps  ball + N/4   1→8 subdivision of the tets
 //!                     steps         with tears steps        beside the incision, level 1
 //! ```
@@ -32,13 +32,13 @@ use topomech::cut::CutError;
 use topomech::load::{self, Loaded};
 use topomech::mechanics::{ConservationError, ModelError, SimError};
 use topomech::render::{Colormap, RenderError, Shading};
-use topomech::subdivide::{LevelError, LeveledMap, SubdivideError};
+use topomech::subdivide::{CouplingError, LevelError, LeveledMap, SpringLawError};
 use topomech::surface::{self, SurfaceError};
 use topomech::vtk::VtkError;
 use topomech::{CellId, InvariantViolation};
 
 use self::output::Output;
-use self::report::{DemoJson, FilesJson, SceneJson, StageRow};
+use self::report::{DemoJson, FilesJson, SceneJson, SpringsJson, StageRow};
 use self::scene::{Scene, StageRun};
 use super::{print_warnings, Characteristics, CliError};
 
@@ -123,14 +123,40 @@ pub enum DemoError {
         /// Its relative residual.
         residual: f64,
     },
-    /// A tet of the incision zone could not be subdivided.
-    #[error("refinement: subdividing tet {tet} failed: {source}")]
-    Subdivide {
-        /// The volume id.
-        tet: CellId,
+    /// The body could not be coupled (`tet: None`) or a tet of the incision zone could not be
+    /// subdivided through the coupling.
+    #[error("refinement: {}{source}", tet.map_or(String::new(), |t| format!("subdividing tet {t} failed: ")))]
+    Coupling {
+        /// The volume id, for a subdivision.
+        tet: Option<CellId>,
         /// The cause.
-        source: SubdivideError,
+        source: CouplingError,
     },
+    /// A spring of the level-0 coupling differs from the body's spring on the same edge cell.
+    #[error("refinement: edge {edge} {ends:?}: {quantity} {coupled} in the coupling, {body} in the body")]
+    SpringMismatch {
+        /// The edge cell id.
+        edge: u32,
+        /// Its end vertex ids.
+        ends: (u32, u32),
+        /// Rest length, stiffness or damping.
+        quantity: &'static str,
+        /// The coupling's value.
+        coupled: f64,
+        /// The body's value.
+        body: f64,
+    },
+    /// The springs are not one per edge cell.
+    #[error("refinement: {springs} springs for {edges} edge cells")]
+    SpringCount {
+        /// Springs.
+        springs: usize,
+        /// Edge cells.
+        edges: usize,
+    },
+    /// The refined spring network breaks a law of `LeveledMechanics::check`.
+    #[error("refinement: {0}")]
+    SpringLaws(#[source] SpringLawError),
     /// The refined map breaks a level law.
     #[error("refinement: {0}")]
     Levels(#[source] LevelError),
@@ -202,6 +228,7 @@ struct Played {
     rows: Vec<StageRow>,
     output: Output,
     threshold: f64,
+    springs: SpringsJson,
 }
 
 /// The progress bar over all steps, on stderr; hidden with `--json` or when stdout or stderr is
@@ -270,18 +297,24 @@ fn play(args: &DemoArgs, loaded: &Loaded, log: &mut dyn Write) -> Result<Played,
     let mut refinement = StageRun { name: "refinement", ..StageRun::default() };
     bar.set_message("refinement");
     bar.inc_length(scene.incision_tets.len() as u64);
-    let (lm, masses, checks) = refine::refine(&scene.body, &scene.incision_tets, &mut refinement, &bar)?;
-    scene.checker.passed += checks;
+    let refined = refine::refine(&scene.body, &scene.incision_tets, &mut refinement, &bar)?;
+    scene.checker.passed += refined.checks;
     bar.finish_and_clear();
-    rows.push(report::refined_row(&lm, &masses, &scene, &refinement));
-    let (refined, levels) = refine::refined_surface(&lm);
-    output.obj("refined.obj", &refined)?;
+    rows.push(report::refined_row(&refined, &scene, &refinement));
+    let springs = SpringsJson {
+        before: refined.springs_before,
+        after: refined.mech.springs().count(),
+        doubled_edges: refined.doubled_edges,
+        doubled_split: refined.doubled_split,
+    };
+    let (surface, levels) = refine::refined_surface(&refined.lm, &refined.mech.position);
+    output.obj("refined.obj", &surface)?;
     let values = levels.into_iter().map(f64::from).collect();
     let range = (0.0, f64::from(refine::LEVEL));
     let shading = Shading::PerTriangle { values, range, colormap: Colormap::Sequential };
-    output.picture("5_refined.png", &refined, &shading)?;
-    write_refinement(log, &lm, &refinement, scene.checker.passed)?;
-    Ok(Played { scene, rows, output, threshold })
+    output.picture("5_refined.png", &surface, &shading)?;
+    write_refinement(log, &refined.lm, &springs, &refinement, scene.checker.passed)?;
+    Ok(Played { scene, rows, output, threshold, springs })
 }
 
 /// "1 step", "3 steps".
@@ -340,7 +373,13 @@ fn finish_stage(
     Ok(())
 }
 
-fn write_refinement(out: &mut dyn Write, lm: &LeveledMap<3>, run: &StageRun, checks: usize) -> std::io::Result<()> {
+fn write_refinement(
+    out: &mut dyn Write,
+    lm: &LeveledMap<3>,
+    springs: &SpringsJson,
+    run: &StageRun,
+    checks: usize,
+) -> std::io::Result<()> {
     writeln!(
         out,
         "  [5/5] {:<11}{} tets beside the incision split 1→8 at level {}; {} darts at level 0, {} at level {}; \
@@ -352,7 +391,16 @@ fn write_refinement(out: &mut dyn Write, lm: &LeveledMap<3>, run: &StageRun, che
         lm.darts_at_level(refine::LEVEL),
         refine::LEVEL
     )?;
-    writeln!(out, "        (tet masses follow the children; springs and the simulation do not follow subdivision yet)")
+    writeln!(
+        out,
+        "        springs carried, one per edge cell: {} → {} ({} doubled edges from the tear, {} of them split); \
+         series rule and law 2 checked",
+        springs.before, springs.after, springs.doubled_edges, springs.doubled_split
+    )?;
+    writeln!(
+        out,
+        "        (tet masses and springs follow the children; the simulation does not follow subdivision yet)"
+    )
 }
 
 impl Played {
@@ -380,6 +428,7 @@ impl Played {
             final_mass: checks::total_mass(&self.scene.body),
             removed_mass: self.scene.checker.removed_mass,
             refinement_mechanics: false,
+            refinement_springs: self.springs.clone(),
             files: FilesJson {
                 dir: path(&args.out),
                 pvd: path(&self.output.pvd()),

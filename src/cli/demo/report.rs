@@ -6,15 +6,16 @@ use std::io::Write;
 use topomech::cut;
 use topomech::gmap::GMap;
 use topomech::mechanics::Vec3;
-use topomech::subdivide::{LeveledMap, TetMasses};
 
 use super::checks::{total_mass, total_stiffness};
+use super::refine::Refined;
 use super::scene::{Scene, StageRun};
 use crate::cli::simulate::median;
 use crate::cli::InfoJson;
 
-/// One stage of the summary (JSON keys in this order). Stiffness fields are `None` for the
-/// refinement (springs do not follow subdivision yet); its mass is Σ tet mass of the finest level.
+/// One stage of the summary (JSON keys in this order). For the refinement, the mass is Σ tet mass
+/// of the finest level, the stiffness sum Σ k over its springs and the stiffness residual `None`
+/// (a 1→8 adds the stiffness of its inner springs: nothing to conserve).
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct StageRow {
     /// Stage name: rest, sag, incision, tear, removal, refinement.
@@ -104,18 +105,34 @@ pub fn scene_row(scene: &Scene, run: &StageRun) -> StageRow {
     }
 }
 
-/// The row of the refinement: cell counts of the finest level and Σ tet mass (the children share
-/// their parents' masses); no springs yet, so no stiffness. O(darts).
-pub fn refined_row(lm: &LeveledMap<3>, masses: &TetMasses, scene: &Scene, run: &StageRun) -> StageRow {
+/// The row of the refinement: cell counts of the finest level, Σ tet mass (the children share
+/// their parents' masses) and Σ k over the springs carried (no residual: a 1→8 adds stiffness).
+/// O(darts + E).
+pub fn refined_row(r: &Refined, scene: &Scene, run: &StageRun) -> StageRow {
     let ch = &scene.checker;
-    let total = masses.total(lm);
+    let total = r.mech.masses.total(&r.lm);
     StageRow {
         total_mass: Some(total),
         removed_mass: Some(ch.removed_mass),
         mass_residual: Some((total + ch.removed_mass - ch.initial_mass) / ch.initial_mass),
+        stiffness_sum: Some(r.mech.springs().map(|(_, s)| s.stiffness).sum()),
         checks_passed: ch.passed,
-        ..counts_row(run.name, lm.map(), run)
+        ..counts_row(run.name, r.lm.map(), run)
     }
+}
+
+/// The springs the refinement carried, for the JSON summary.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct SpringsJson {
+    /// Springs before the refinement (one per edge cell of the final body).
+    pub before: usize,
+    /// Springs after it (one per edge cell of the finest level).
+    pub after: usize,
+    /// Edge cells of the final body sharing both ends with another edge cell (cut edges whose ends
+    /// stayed joined): each has its own spring.
+    pub doubled_edges: usize,
+    /// How many of those the refinement split (each into its own chain).
+    pub doubled_split: usize,
 }
 
 /// The parameters and files of the run, for the JSON summary.
@@ -177,9 +194,11 @@ pub struct DemoJson {
     pub final_mass: f64,
     /// Mass removed.
     pub removed_mass: f64,
-    /// Whether the whole mechanics (springs, simulation) follows the refinement (not yet: only the
-    /// tet masses do).
+    /// Whether the whole mechanics (springs and the simulation) follows the refinement (not yet:
+    /// the tet masses and springs do, see `refinement_springs`, the simulation does not).
     pub refinement_mechanics: bool,
+    /// The springs carried through the refinement.
+    pub refinement_springs: SpringsJson,
     /// Output files.
     pub files: FilesJson,
     /// Wall time of the whole run in ms.

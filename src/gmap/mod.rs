@@ -572,6 +572,12 @@ impl<const N: usize> GMap<N> {
         GMap { alpha, cell, alive, n_alive: darts, ..Self::new() }
     }
 
+    /// The raw rows (αi and i-cell id of dart d at `d * (n + 1) + i`) for a bulk rewrite in place
+    /// (`subdivide`'s uniform refinement). The caller must leave every law true.
+    pub(crate) fn rows_mut_raw(&mut self) -> (&mut [u32], &mut [u32]) {
+        (&mut self.alpha, &mut self.cell)
+    }
+
     /// Sets the id allocator of dimension i to "ids 0..next are used but those in `free`".
     pub(crate) fn set_id_alloc_raw(&mut self, i: usize, next: u32, free: Vec<u32>) {
         self.ids[i] = IdAlloc { next, free };

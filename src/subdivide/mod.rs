@@ -38,6 +38,7 @@ mod springs;
 mod springs_check;
 mod tet;
 mod tri;
+mod uniform;
 
 pub use conform::{triangulate_polygon, ConformingMesh};
 pub use cut_error::{cut_error, measure_cut, CutSurfaceError};
@@ -159,6 +160,17 @@ pub enum SubdivideError {
     /// The edge has an α0-free dart: it has no second vertex to split between.
     #[error("the edge of {0} is open (α0-free)")]
     OpenEdge(DartId),
+    /// Uniform refinement ([`LeveledMap::refine_uniform`]) needs every dart at one resolution
+    /// level m (μa = μf = m, μt = m in 3D and 0 in 2D) and no inserted (flat) vertex.
+    #[error("uniform refinement needs every cell at one level {expected} and no inserted vertex: {dart} has μa = {}, μf = {}, μt = {}", .mu.edge, .mu.face, .mu.tet)]
+    NotUniform {
+        /// The first dart found off the common level (or flat).
+        dart: DartId,
+        /// Its levels.
+        mu: Mu,
+        /// The level of the first live dart, which every dart must share.
+        expected: u8,
+    },
     /// The conforming closure met a face polygon it cannot triangulate (zero area or a reflex
     /// corner) or a cone tet of zero volume, at the face or volume of this dart.
     #[error("the face or volume of {0} is degenerate: no conforming triangulation")]

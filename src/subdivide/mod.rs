@@ -31,6 +31,7 @@ mod conform;
 mod cut;
 mod cut_error;
 pub mod fuzz;
+mod history;
 mod ops;
 mod parts;
 mod region;
@@ -285,7 +286,7 @@ pub struct LeveledMap<const N: usize> {
     /// Whether the vertex of the dart inside its face is an inserted (flat) vertex of a side of
     /// the face rather than one of its corners.
     flat: Vec<bool>,
-    history: Vec<Vec<LinkChange>>,
+    history: history::LinkHistory,
     max_level: u8,
     points: Vec<[f64; 3]>,
     /// Every inserted vertex as [new vertex id, end vertex ids] (see [`LeveledMap::split_log`]).
@@ -317,7 +318,7 @@ impl<const N: usize> LeveledMap<N> {
             dart_level: vec![0; cap],
             mu: vec![Mu::default(); cap],
             flat: vec![false; cap],
-            history: vec![Vec::new(); cap],
+            history: history::LinkHistory::new(cap),
             max_level: 0,
             points,
             splits: Vec::new(),
@@ -492,8 +493,8 @@ impl<const N: usize> LeveledMap<N> {
     pub fn alpha_at(&self, i: u8, j: usize, d: DartId) -> DartId {
         // The history of d is in non-decreasing level order; the first change made after level i
         // holds the value the link had at level i.
-        self.history[d.index()]
-            .iter()
+        self.history
+            .of(d.index())
             .find(|c| c.j as usize == j && c.level > i)
             .map_or_else(|| self.map.alpha_dyn(j, d), |c| DartId(c.old))
     }

@@ -39,6 +39,9 @@ use crate::gmap::DartId;
 /// αn target of a slot on the parent's facet: child k of αn(parent dart).
 const BORDER: u8 = u8::MAX;
 
+/// Capacity of a parent's flat table of local cell ids (a tet has 10 + 25 + 24 + 8 = 67).
+const FLAT: usize = 80;
+
 /// How one local cell of a refined parent gets its global id.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Rule {
@@ -88,8 +91,15 @@ struct Template {
     face_parent: [u8; 4],
     /// The children as label sets (n + 1 labels each).
     children: Vec<[u8; 4]>,
+    /// The corner pairs (midpoint of pair i: label n + 1 + i).
+    pairs: Vec<(u8, u8)>,
     /// Per child: its local n-cell index.
     child_cell: Vec<u8>,
+    /// Per slot and dimension: the index of its cell in the flat id table of a parent (local
+    /// index + offset of the dimension), filled by [`Template::flatten`].
+    flat_cell: Vec<[u8; 4]>,
+    /// Offset of each dimension in the flat id table.
+    offset: [usize; 5],
 }
 
 /// The corner pairs of an n-simplex in order; the midpoint of pair i has label n + 1 + i.
@@ -159,9 +169,10 @@ impl Template {
             flags.extend(tuples(n, &set[..=n]).into_iter().map(|t| (c as u8, t)));
         }
         let holder = |face: &[u8], not: Option<u8>| -> u8 {
-            let found = children.iter().enumerate().position(|(c, set)| {
-                Some(c as u8) != not && face.iter().all(|l| set[..=n].contains(l))
-            });
+            let found = children
+                .iter()
+                .enumerate()
+                .position(|(c, set)| Some(c as u8) != not && face.iter().all(|l| set[..=n].contains(l)));
             found.expect("a child holds the face") as u8
         };
         let per = if n == 3 { 8 } else { 4 };
@@ -210,9 +221,10 @@ impl Template {
                 for (j, slot) in l.iter_mut().enumerate().take(n) {
                     *slot = slot_of((c, flag_alpha(n, set, t, j)));
                 }
-                let other = children.iter().enumerate().position(|(o, s)| {
-                    o as u8 != c && t[..n].iter().all(|x| s[..=n].contains(x))
-                });
+                let other = children
+                    .iter()
+                    .enumerate()
+                    .position(|(o, s)| o as u8 != c && t[..n].iter().all(|x| s[..=n].contains(x)));
                 l[n] = other.map_or(BORDER, |o| slot_of((o as u8, t)));
                 l
             })
@@ -234,6 +246,9 @@ impl Template {
                 })
                 .collect(),
             child_cell: Vec::new(),
+            pairs: pr.clone(),
+            flat_cell: Vec::new(),
+            offset: [0; 5],
             corner_parent: [0; 4],
             face_parent: [0; 4],
             children,
@@ -241,7 +256,24 @@ impl Template {
         };
         template.fill_corner_and_face_parents();
         template.fill_cells(&slot_flag, &pr);
+        template.flatten();
         template
+    }
+
+    /// The flat id table layout: dimension i's cells at `offset[i]..offset[i + 1]`.
+    fn flatten(&mut self) {
+        for i in 0..=self.n {
+            self.offset[i + 1] = self.offset[i] + self.rules[i].len();
+        }
+        for i in self.n + 1..4 {
+            self.offset[i + 1] = self.offset[i];
+        }
+        assert!(self.offset[self.n + 1] <= FLAT, "template bug: {} local cells", self.offset[self.n + 1]);
+        self.flat_cell = self
+            .cell
+            .iter()
+            .map(|c| [0, 1, 2, 3].map(|i| (self.offset[i.min(self.n)] + c[i] as usize) as u8))
+            .collect();
     }
 
     /// BFS tree over the parent flags from flag 0.
@@ -348,9 +380,7 @@ impl Template {
 /// The templates of tets (one per diagonal label 4, 5, 6) or of triangles.
 fn templates(n: usize) -> Vec<Template> {
     if n == 3 {
-        (4..7u8)
-            .map(|diag| Template::new(3, child_tets(diag).into_iter().collect()))
-            .collect()
+        (4..7u8).map(|diag| Template::new(3, child_tets(diag).into_iter().collect())).collect()
     } else {
         vec![Template::new(2, vec![[0, 3, 4, 0], [1, 3, 5, 0], [2, 4, 5, 0], [3, 4, 5, 0]])]
     }
@@ -439,11 +469,13 @@ impl<const N: usize> LeveledMap<N> {
                     }
                 }
             }
-            let vid = |c: usize| self.map.vertex_id(DartId(lab[t0.corner_parent[c] as usize])).0;
-            let vids: Vec<u32> = (0..=N).map(vid).collect();
+            let mut vids = [0u32; 4];
+            for (c, v) in vids.iter_mut().enumerate().take(N + 1) {
+                *v = self.map.vertex_id(DartId(lab[t0.corner_parent[c] as usize])).0;
+            }
             let distinct = (0..=N).all(|a| (a + 1..=N).all(|b| vids[a] != vids[b]));
             if !distinct {
-                let mut v = vids.clone();
+                let mut v = vids[..=N].to_vec();
                 v.sort_unstable();
                 v.dedup();
                 return Err(not_simplex(v.len()));
@@ -457,8 +489,7 @@ impl<const N: usize> LeveledMap<N> {
 
     /// Ranks the parent's edges and faces at first meeting.
     fn rank_cells(&self, lab: &[u32], t0: &Template, vids: &[u32], out: &mut Labelled) {
-        let pr = pairs(N);
-        for (k, &(x, y)) in pr.iter().enumerate() {
+        for (k, &(x, y)) in t0.pairs.iter().enumerate() {
             let e = self.map.cell_id(1, DartId(lab[t0.pair_parent[k] as usize])).index();
             if out.edge_rank[e] == u32::MAX {
                 out.edge_rank[e] = out.edges.len() as u32;
@@ -478,8 +509,8 @@ impl<const N: usize> LeveledMap<N> {
 
     /// The template index (diagonal label − 4) of a parent tet, by [`choose_diagonal`].
     fn diagonal_template(&self, vids: &[u32], lab: &[u32], t0: &Template) -> u8 {
-        let corner = vids.iter().map(|&v| self.vertex_pos(v)).collect::<Vec<_>>();
-        let pr = pairs(3);
+        let corner = [0, 1, 2, 3].map(|c| self.vertex_pos(vids[c]));
+        let pr = [(0u8, 1u8), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
         let mut pos = [[0.0; 3]; 6];
         let mut mid_vid = [0u32; 6];
         for (k, &(x, y)) in pr.iter().enumerate() {
@@ -501,67 +532,86 @@ impl<const N: usize> LeveledMap<N> {
         let t0 = &tpl[0];
         let (p, per) = (t0.parents.len(), t0.per);
         let parents = lab.template.len();
-        let fresh_per_dart = per - 1;
-        let base = self.map.alloc_darts_raw(parents * p * fresh_per_dart);
-        let cap = self.map.capacity();
+        let fresh = p * (per - 1);
+        let base = self.map.capacity() as u32;
+        self.map.reserve_darts_raw(parents * fresh);
+        let cap = base as usize + parents * fresh;
         let mu = Mu { edge: level, face: level, tet: if N == 3 { level } else { 0 } };
         self.dart_level.resize(cap, level);
         self.mu.resize(cap, mu);
         self.flat.resize(cap, false);
-        self.history.resize(cap, Vec::new());
+        self.history.resize(cap);
+        self.history.reserve(lab.darts.len());
         let next: Vec<u32> = (0..=N).map(|i| self.map.id_alloc_raw(i).0).collect();
         let (ne, nf) = (lab.edges.len() as u32, lab.faces);
-        // First fresh id of the per-parent (inner) cells of each dimension.
+        // Ids shared between parents (per parent edge / face), then the per-parent ones.
         let shared = [ne, ne + if N == 3 { 3 * nf } else { 0 }, if N == 3 { 3 * nf } else { 0 }, 0];
         let inner_base: Vec<u32> = (0..=N).map(|i| next[i] + shared[i]).collect();
-        let mut ids: Vec<Vec<u32>> = (0..=N).map(|i| vec![0; t0.rules[i].len()]).collect();
+        let mut ids = [0u32; FLAT];
+        let mut dart = [0u32; 192];
+        let (mut new_alpha, mut new_cell) = (vec![0u32; fresh * (N + 1)], vec![0u32; fresh * (N + 1)]);
         let mut child_ids = Vec::with_capacity(parents * t0.children.len());
-        let dart_of = |parent: usize, f: usize, k: usize, old: u32| -> u32 {
-            if k == 0 {
-                old
-            } else {
-                base + ((parent * p + f) * fresh_per_dart + k - 1) as u32
-            }
-        };
         for parent in 0..parents {
             let tp = &tpl[lab.template[parent] as usize];
             let darts = &lab.darts[parent * p..(parent + 1) * p];
             self.local_ids(tp, darts, parent as u32, &next, &inner_base, lab, &mut ids);
-            child_ids.extend(tp.child_cell.iter().map(|&local| ids[N][local as usize]));
-            let (alpha, cell) = self.map.rows_mut_raw();
+            child_ids.extend(tp.child_cell.iter().map(|&local| ids[tp.offset[N] + local as usize]));
+            let first = base + (parent * fresh) as u32;
             for (f, &old) in darts.iter().enumerate() {
-                let old_alpha0 = alpha[old as usize * (N + 1)];
-                let across = alpha[old as usize * (N + 1) + N];
+                dart[f * per] = old;
+                for k in 1..per {
+                    dart[f * per + k] = first + (f * (per - 1) + k - 1) as u32;
+                }
+            }
+            let (alpha, cell) = self.map.rows_mut_raw();
+            // Old darts (slot 0) are rewritten in place; the new ones go to a buffer appended
+            // below in id order.
+            for (f, &old) in darts.iter().enumerate() {
+                let old_row = old as usize * (N + 1);
+                let old_alpha0 = alpha[old_row];
+                let across = alpha[old_row + N];
+                // Child k of the dart across the facet: the same slot of αn(old).
+                let (q_parent, q_flag) =
+                    (lab.parent_of[across as usize] as usize, lab.flag_of[across as usize] as usize);
+                let q_first = base as usize + q_parent * fresh + q_flag * (per - 1);
                 for k in 0..per {
                     let s = f * per + k;
-                    let d = dart_of(parent, f, k, old) as usize;
-                    let row = d * (N + 1);
                     let links = &tp.link[s];
+                    let mut a = [0u32; 4];
                     for j in 0..N {
-                        let t = links[j] as usize;
-                        alpha[row + j] = dart_of(parent, t / per, t % per, darts[t / per]);
+                        a[j] = dart[links[j] as usize];
                     }
-                    alpha[row + N] = if links[N] != BORDER {
-                        let t = links[N] as usize;
-                        dart_of(parent, t / per, t % per, darts[t / per])
+                    a[N] = if links[N] != BORDER {
+                        dart[links[N] as usize]
                     } else if across == old {
-                        d as u32
+                        dart[s]
+                    } else if k == 0 {
+                        across
                     } else {
-                        let q = across as usize;
-                        dart_of(lab.parent_of[q] as usize, lab.flag_of[q] as usize, k, across)
+                        (q_first + k - 1) as u32
                     };
-                    for (i, local) in tp.cell[s].iter().enumerate().take(N + 1) {
-                        cell[row + i] = ids[i][*local as usize];
+                    let fc = &tp.flat_cell[s];
+                    let (alpha_row, cell_row) = if k == 0 {
+                        let row = old as usize * (N + 1);
+                        (&mut alpha[row..row + N + 1], &mut cell[row..row + N + 1])
+                    } else {
+                        let row = (f * (per - 1) + k - 1) * (N + 1);
+                        (&mut new_alpha[row..row + N + 1], &mut new_cell[row..row + N + 1])
+                    };
+                    for i in 0..=N {
+                        alpha_row[i] = a[i];
+                        cell_row[i] = ids[fc[i] as usize];
                     }
                 }
-                self.history[old as usize].push(LinkChange { level, j: 0, old: old_alpha0 });
+                self.history.push(old as usize, LinkChange { level, j: 0, old: old_alpha0 });
                 self.mu[old as usize] = mu;
             }
+            let at = self.map.push_rows_raw(&new_alpha, &new_cell);
+            debug_assert_eq!(at, first);
         }
-        let counts = [ne, ne + if N == 3 { 3 * nf } else { 0 }, if N == 3 { 3 * nf } else { 0 }, 0];
         for i in 0..=N {
             let free = self.map.id_alloc_raw(i).1.to_vec();
-            let added = counts[i] + parents as u32 * t0.inner[i];
+            let added = shared[i] + parents as u32 * t0.inner[i];
             self.map.set_id_alloc_raw(i, next[i] + added, free);
         }
         self.write_midpoints(next[0], lab);
@@ -569,7 +619,8 @@ impl<const N: usize> LeveledMap<N> {
         child_ids
     }
 
-    /// The global id of every local cell of one parent, by the template's rules.
+    /// The global id of every local cell of one parent, by the template's rules, into the flat
+    /// table `ids` (dimension i at `tp.offset[i]..`).
     #[allow(clippy::too_many_arguments)]
     fn local_ids(
         &self,
@@ -579,41 +630,53 @@ impl<const N: usize> LeveledMap<N> {
         next: &[u32],
         inner_base: &[u32],
         lab: &Labelled,
-        ids: &mut [Vec<u32>],
+        ids: &mut [u32; FLAT],
     ) {
         let map = &self.map;
-        let vid = |x: u8| map.vertex_id(DartId(darts[tp.corner_parent[x as usize] as usize])).0;
+        let mut vid = [0u32; 4];
+        for x in 0..=N {
+            vid[x] = map.vertex_id(DartId(darts[tp.corner_parent[x] as usize])).0;
+        }
+        let mut edge = [0u32; 6];
+        let mut edge_rank = [0u32; 6];
+        for k in 0..tp.pair_parent.len() {
+            edge[k] = map.cell_id(1, DartId(darts[tp.pair_parent[k] as usize])).0;
+            edge_rank[k] = lab.edge_rank[edge[k] as usize];
+        }
+        let (mut face, mut face_rank) = ([0u32; 4], [0u32; 4]);
+        if N == 3 {
+            for w in 0..4 {
+                face[w] = map.cell_id(2, DartId(darts[tp.face_parent[w] as usize])).0;
+                face_rank[w] = lab.face_rank[face[w] as usize];
+            }
+        }
+        let old = map.cell_id(N, DartId(darts[0])).0;
         let pr_index = |x: u8, y: u8| -> usize {
             let (a, b) = (x.min(y) as usize, x.max(y) as usize);
             // Pair index in lexicographic order of (a, b) over 0..=N.
             (0..a).map(|i| N - i).sum::<usize>() + (b - a - 1)
         };
-        let edge_id = |k: usize| map.cell_id(1, DartId(darts[tp.pair_parent[k] as usize])).0;
-        let edge_rank = |k: usize| lab.edge_rank[edge_id(k) as usize];
-        let face_id = |w: u8| map.cell_id(2, DartId(darts[tp.face_parent[w as usize] as usize])).0;
-        let face_rank = |w: u8| lab.face_rank[face_id(w) as usize];
         let rank_in_face = |w: u8, x: u8| -> u32 {
-            (0..4u8).filter(|&c| c != w && c != x && vid(c) < vid(x)).count() as u32
+            (0..4u8).filter(|&c| c != w && c != x && vid[c as usize] < vid[x as usize]).count() as u32
         };
+        let ne = lab.edges.len() as u32;
         for (dim, rules) in tp.rules.iter().enumerate() {
             for (local, rule) in rules.iter().enumerate() {
-                ids[dim][local] = match *rule {
-                    Rule::Corner(x) => vid(x),
-                    Rule::Mid(k) => next[0] + edge_rank(k as usize),
+                ids[tp.offset[dim] + local] = match *rule {
+                    Rule::Corner(x) => vid[x as usize],
+                    Rule::Mid(k) => next[0] + edge_rank[k as usize],
                     Rule::Half { x, y } => {
                         let k = pr_index(x, y);
-                        if vid(x) < vid(y) {
-                            edge_id(k)
+                        if vid[x as usize] < vid[y as usize] {
+                            edge[k]
                         } else {
-                            next[1] + edge_rank(k)
+                            next[1] + edge_rank[k]
                         }
                     }
-                    Rule::FaceInner { w, x } => {
-                        next[1] + lab.edges.len() as u32 + 3 * face_rank(w) + rank_in_face(w, x)
-                    }
-                    Rule::FaceCorner { w, x } => next[2] + 3 * face_rank(w) + rank_in_face(w, x),
-                    Rule::FaceCenter { w } => face_id(w),
-                    Rule::Old => map.cell_id(N, DartId(darts[0])).0,
+                    Rule::FaceInner { w, x } => next[1] + ne + 3 * face_rank[w as usize] + rank_in_face(w, x),
+                    Rule::FaceCorner { w, x } => next[2] + 3 * face_rank[w as usize] + rank_in_face(w, x),
+                    Rule::FaceCenter { w } => face[w as usize],
+                    Rule::Old => old,
                     Rule::Inner(q) => inner_base[dim] + parent * tp.inner[dim] + q as u32,
                 };
             }
@@ -708,7 +771,7 @@ impl LeveledMap<3> {
         for x in 0..4 {
             pos[x] = self.vertex_pos(self.map.vertex_id(DartId(darts[tp.corner_parent[x] as usize])).0);
         }
-        for (k, (x, y)) in pairs(3).into_iter().enumerate() {
+        for (k, &(x, y)) in tp.pairs.iter().enumerate() {
             let (a, b) = (pos[x as usize], pos[y as usize]);
             pos[4 + k] = [0, 1, 2].map(|i| 0.5 * (a[i] + b[i]));
         }

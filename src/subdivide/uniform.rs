@@ -285,8 +285,7 @@ impl Template {
         while head < order.len() {
             let s = order[head];
             head += 1;
-            for j in 0..n {
-                let t = act[s as usize][j];
+            for (j, &t) in act[s as usize].iter().enumerate().take(n) {
                 if !seen[t as usize] {
                     seen[t as usize] = true;
                     order.push(t);

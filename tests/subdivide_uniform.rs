@@ -289,6 +289,15 @@ fn refusals_leave_the_map_unchanged() {
     open.unsew::<1>(d).unwrap();
     let mut o = LeveledMap::new(open, vec![]);
     assert!(matches!(o.refine_uniform(1), Err(SubdivideError::OpenEdge(_))));
+    // 3D: a tet with one α2-free edge is refused, map and masses unchanged.
+    let (mut map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    let d = map.darts().next().unwrap();
+    map.unsew::<2>(d).unwrap();
+    let mut open3 = LeveledMap::new(map, vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
+    let mut masses = TetMasses { mass: vec![1.0] };
+    let snap = open3.to_parts();
+    assert!(matches!(open3.refine_uniform(1, &mut masses), Err(SubdivideError::OpenEdge(_))));
+    assert_eq!((open3.to_parts(), masses.mass), (snap, vec![1.0]));
 }
 
 #[test]

@@ -29,8 +29,9 @@
 //! id, so both sides agree), per parent the inner cells.
 //!
 //! # Cost
-//! Two sequential passes, O(darts) each, no hashing and no orbit walk: a check-and-label pass
-//! (which refuses before any change), then the write pass.
+//! O(darts), no hashing and no orbit walk: a check pass over the darts and a labelling pass over
+//! the parents (both refuse before any change), then the write pass (old rows rewritten in place,
+//! new rows appended in id order).
 
 use super::tet::{child_tets, choose_diagonal};
 use super::{LeveledMap, LinkChange, Mu, Refinement, SubdivideError, TetMasses};

@@ -2,8 +2,10 @@
 //! benchmark, `--red`), with levels and the tet masses shared among the children, timed as CPU
 //! time per tet. Prints one line and one JSON object.
 //!
-//!     cargo run --release --example bench_refine -- 10
-//!     cargo run --release --example bench_refine -- --2d 100     # triangle 1→4 on an n×n grid
+//!     cargo run --release --example bench_refine -- 10                # bulk path (refine_around → refine_uniform)
+//!     cargo run --release --example bench_refine -- 10 --per-op       # op by op (refine_around_per_op)
+//!     cargo run --release --example bench_refine -- --2d 100          # triangle 1→4 on an n×n grid, bulk
+//!     cargo run --release --example bench_refine -- --2d 100 --per-op # subdivide_triangle on every face
 //!
 //! Pair it with `target/cgal_bench K --red` (3D) or `target/cgal_bench 1 --no-3d --n2d=N` (2D) in
 //! the same run (see docs/BENCHMARKS.md).
@@ -14,25 +16,44 @@ use topomech::generate::kuhn_cube;
 use topomech::subdivide::{LeveledMap, TetMasses};
 use topomech::GMap;
 
-/// The thread's user + system CPU time in seconds (10 ms ticks), or `None` where /proc is missing.
+/// The calling thread's CPU time (user + system) in seconds, from `CLOCK_THREAD_CPUTIME_ID` (the
+/// clock of CGAL's anchor benchmark, nanosecond resolution), or `None` where it is missing.
+#[cfg(all(target_os = "linux", target_pointer_width = "64"))]
 fn thread_cpu_seconds() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/thread-self/stat").ok()?;
-    let after_name = &stat[stat.rfind(')')? + 1..];
-    let fields: Vec<&str> = after_name.split_whitespace().collect();
-    let utime: f64 = fields.get(11)?.parse().ok()?;
-    let stime: f64 = fields.get(12)?.parse().ok()?;
-    Some((utime + stime) / 100.0)
+    #[repr(C)]
+    struct Timespec {
+        tv_sec: i64,
+        tv_nsec: i64,
+    }
+    extern "C" {
+        fn clock_gettime(clock: i32, ts: *mut Timespec) -> i32;
+    }
+    const CLOCK_THREAD_CPUTIME_ID: i32 = 3;
+    let mut ts = Timespec { tv_sec: 0, tv_nsec: 0 };
+    // SAFETY: `ts` is a valid, writable timespec of the platform's layout (64-bit Linux).
+    let rc = unsafe { clock_gettime(CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+    (rc == 0).then_some(ts.tv_sec as f64 + 1e-9 * ts.tv_nsec as f64)
+}
+
+/// Elsewhere: no thread CPU clock; the caller falls back to wall time.
+#[cfg(not(all(target_os = "linux", target_pointer_width = "64")))]
+fn thread_cpu_seconds() -> Option<f64> {
+    None
 }
 
 /// Uniform triangle 1→4 of every face of `grid_triangles(n)` at level 1, CPU time per triangle.
-fn bench_2d(n: usize) {
+fn bench_2d(n: usize, per_op: bool) {
     let (points, tris) = topomech::generate::grid_triangles(n);
     let (map, _) = GMap::<2>::from_triangles(points.len(), &tris).expect("the grid builds");
     let mut m = LeveledMap::new(map, points);
     let faces = m.map().one_dart_per_cell(2);
     let (cpu0, wall0) = (thread_cpu_seconds(), Instant::now());
-    for d in faces {
-        m.subdivide_triangle(d, 1).expect("an unsplit triangle");
+    if per_op {
+        for d in faces {
+            m.subdivide_triangle(d, 1).expect("an unsplit triangle");
+        }
+    } else {
+        m.refine_uniform(1).expect("a uniform triangle mesh");
     }
     let (cpu1, wall) = (thread_cpu_seconds(), wall0.elapsed().as_secs_f64());
     let cpu = match (cpu0, cpu1) {
@@ -42,7 +63,8 @@ fn bench_2d(n: usize) {
     m.check_all().expect("every law holds after the refinement");
     let t = tris.len() as f64;
     println!(
-        "[refine2d] n={n} triangles={} -> {}: {:.0} ns/triangle CPU ({:.0} ns wall)",
+        "[refine2d] {} n={n} triangles={} -> {}: {:.0} ns/triangle CPU ({:.0} ns wall)",
+        if per_op { "per-op" } else { "bulk" },
         tris.len(),
         m.map().count_cells().0[2],
         1e9 * cpu / t,
@@ -51,9 +73,11 @@ fn bench_2d(n: usize) {
 }
 
 fn main() {
-    let args: Vec<String> = std::env::args().collect();
+    let all: Vec<String> = std::env::args().collect();
+    let per_op = all.iter().any(|a| a == "--per-op");
+    let args: Vec<String> = all.into_iter().filter(|a| a != "--per-op").collect();
     if args.get(1).map(String::as_str) == Some("--2d") {
-        bench_2d(args.get(2).and_then(|s| s.parse().ok()).unwrap_or(100));
+        bench_2d(args.get(2).and_then(|s| s.parse().ok()).unwrap_or(100), per_op);
         return;
     }
     let k: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(10);
@@ -62,7 +86,12 @@ fn main() {
     let mut m = LeveledMap::new(map, points);
     let mut masses = TetMasses::from_density(&m, 1.0).expect("tets");
     let (cpu0, wall0) = (thread_cpu_seconds(), Instant::now());
-    let r = m.refine_around([0.0; 3], f64::MAX, 1, &mut masses).expect("uniform refinement");
+    let r = if per_op {
+        m.refine_around_per_op([0.0; 3], f64::MAX, 1, &mut masses)
+    } else {
+        m.refine_around([0.0; 3], f64::MAX, 1, &mut masses)
+    };
+    let r = r.expect("uniform refinement");
     let (cpu1, wall) = (thread_cpu_seconds(), wall0.elapsed().as_secs_f64());
     let cpu = match (cpu0, cpu1) {
         (Some(a), Some(b)) => b - a,
@@ -72,14 +101,16 @@ fn main() {
     m.check_all().expect("every law holds after the refinement");
     let rel = (r.total_mass_after - r.total_mass_before).abs() / r.total_mass_before;
     println!(
-        "[refine] k={k} tets={} -> {}: {:.1} us/tet CPU ({:.1} us/tet wall), mass residual {rel:.1e}",
+        "[refine] {} k={k} tets={} -> {}: {:.2} us/tet CPU ({:.2} us/tet wall), mass residual {rel:.1e}",
+        if per_op { "per-op" } else { "bulk" },
         tets.len(),
         m.map().count_cells().0[3],
         1e6 * cpu / n,
         1e6 * wall / n
     );
     println!(
-        "{{\"k\":{k},\"tets\":{},\"us_per_tet_cpu\":{:.3},\"us_per_tet_wall\":{:.3},\"mass_residual\":{rel:e}}}",
+        "{{\"path\":\"{}\",\"k\":{k},\"tets\":{},\"us_per_tet_cpu\":{:.3},\"us_per_tet_wall\":{:.3},\"mass_residual\":{rel:e}}}",
+        if per_op { "per-op" } else { "bulk" },
         tets.len(),
         1e6 * cpu / n,
         1e6 * wall / n

@@ -560,6 +560,40 @@ impl<const N: usize> GMap<N> {
         first as u32
     }
 
+    /// Reserves room for `count` more darts (rows), so that [`Self::push_rows_raw`] does not
+    /// reallocate. O(1) amortized.
+    pub(crate) fn reserve_darts_raw(&mut self, count: usize) {
+        self.alpha.reserve_exact(count * (N + 1));
+        self.cell.reserve_exact(count * (N + 1));
+        self.alive.reserve_exact(count.div_ceil(64) + 1);
+    }
+
+    /// Appends live darts whose rows are given (`alpha` and `cell`, n + 1 entries per dart, the
+    /// layout of [`Self::rows_mut_raw`]): the write pass of a bulk refinement, one sequential
+    /// write per row. Returns the first new index. The caller must leave every law true.
+    /// O(rows).
+    pub(crate) fn push_rows_raw(&mut self, alpha: &[u32], cell: &[u32]) -> u32 {
+        debug_assert_eq!(alpha.len(), cell.len());
+        let first = self.capacity();
+        let count = alpha.len() / (N + 1);
+        let total = first + count;
+        self.alpha.extend_from_slice(alpha);
+        self.cell.extend_from_slice(cell);
+        self.alive.resize(total.div_ceil(64), 0);
+        let mut d = first;
+        while d < total {
+            if d % 64 == 0 && d + 64 <= total {
+                self.alive[d / 64] = u64::MAX;
+                d += 64;
+            } else {
+                self.alive[d / 64] |= 1u64 << (d % 64);
+                d += 1;
+            }
+        }
+        self.n_alive += count;
+        first as u32
+    }
+
     /// A map whose darts are the rows of `alpha` and `cell` (n + 1 entries per dart), all live:
     /// the end of a bulk build, which sets the id allocators next and must leave every law true.
     pub(crate) fn from_rows_raw(alpha: Vec<u32>, cell: Vec<u32>) -> Self {
@@ -570,6 +604,12 @@ impl<const N: usize> GMap<N> {
             alive.push((1u64 << (darts % 64)) - 1);
         }
         GMap { alpha, cell, alive, n_alive: darts, ..Self::new() }
+    }
+
+    /// The raw rows (αi and i-cell id of dart d at `d * (n + 1) + i`) for a bulk rewrite in place
+    /// (`subdivide`'s uniform refinement). The caller must leave every law true.
+    pub(crate) fn rows_mut_raw(&mut self) -> (&mut [u32], &mut [u32]) {
+        (&mut self.alpha, &mut self.cell)
     }
 
     /// Sets the id allocator of dimension i to "ids 0..next are used but those in `free`".

@@ -31,6 +31,7 @@ mod conform;
 mod cut;
 mod cut_error;
 pub mod fuzz;
+mod history;
 mod ops;
 mod parts;
 mod region;
@@ -38,6 +39,7 @@ mod springs;
 mod springs_check;
 mod tet;
 mod tri;
+mod uniform;
 
 pub use conform::{triangulate_polygon, ConformingMesh};
 pub use cut_error::{cut_error, measure_cut, CutSurfaceError};
@@ -193,6 +195,17 @@ pub enum SubdivideError {
     /// The edge has an α0-free dart: it has no second vertex to split between.
     #[error("the edge of {0} is open (α0-free)")]
     OpenEdge(DartId),
+    /// Uniform refinement ([`LeveledMap::refine_uniform`]) needs every dart at one resolution
+    /// level m (μa = μf = m, μt = m in 3D and 0 in 2D) and no inserted (flat) vertex.
+    #[error("uniform refinement needs every cell at one level {expected} and no inserted vertex: {dart} has μa = {}, μf = {}, μt = {}", .mu.edge, .mu.face, .mu.tet)]
+    NotUniform {
+        /// The first dart found off the common level (or flat).
+        dart: DartId,
+        /// Its levels.
+        mu: Mu,
+        /// The level of the first live dart, which every dart must share.
+        expected: u8,
+    },
     /// The conforming closure met a face polygon it cannot triangulate (zero area or a reflex
     /// corner) or a cone tet of zero volume, at the face or volume of this dart.
     #[error("the face or volume of {0} is degenerate: no conforming triangulation")]
@@ -307,7 +320,7 @@ pub struct LeveledMap<const N: usize> {
     /// Whether the vertex of the dart inside its face is an inserted (flat) vertex of a side of
     /// the face rather than one of its corners.
     flat: Vec<bool>,
-    history: Vec<Vec<LinkChange>>,
+    history: history::LinkHistory,
     max_level: u8,
     points: Vec<[f64; 3]>,
     /// Every inserted vertex as [new vertex id, end vertex ids] (see [`LeveledMap::split_log`]).
@@ -341,7 +354,7 @@ impl<const N: usize> LeveledMap<N> {
             dart_level: vec![0; cap],
             mu: vec![Mu::default(); cap],
             flat: vec![false; cap],
-            history: vec![Vec::new(); cap],
+            history: history::LinkHistory::new(cap),
             max_level: 0,
             points,
             splits: Vec::new(),
@@ -538,8 +551,8 @@ impl<const N: usize> LeveledMap<N> {
     pub fn alpha_at(&self, i: u8, j: usize, d: DartId) -> DartId {
         // The history of d is in non-decreasing level order; the first change made after level i
         // holds the value the link had at level i.
-        self.history[d.index()]
-            .iter()
+        self.history
+            .of(d.index())
             .find(|c| c.j as usize == j && c.level > i)
             .map_or_else(|| self.map.alpha_dyn(j, d), |c| DartId(c.old))
     }

@@ -54,10 +54,9 @@ impl<const N: usize> LeveledMap<N> {
                 self.op.old_ids.push(self.map.cell_id(dim, d).0);
             }
         }
-        let hist = &mut self.history[d.index()];
-        if !hist.iter().any(|c| c.level == level && c.j as usize == j) {
+        if !self.history.of(d.index()).any(|c| c.level == level && c.j as usize == j) {
             let old = self.map.alpha_dyn(j, d).0;
-            hist.push(LinkChange { level, j: j as u8, old });
+            self.history.push(d.index(), LinkChange { level, j: j as u8, old });
         }
     }
 
@@ -97,7 +96,7 @@ impl<const N: usize> LeveledMap<N> {
         self.dart_level.resize(cap, 0);
         self.mu.resize(cap, Mu::default());
         self.flat.resize(cap, false);
-        self.history.resize(cap, Vec::new());
+        self.history.resize(cap);
         self.dart_level[d.index()] = self.op.level;
         self.mu[d.index()] = mu;
         self.flat[d.index()] = flat;

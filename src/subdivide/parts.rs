@@ -230,7 +230,7 @@ impl<const N: usize> LeveledMap<N> {
                 level: self.dart_level[k],
                 mu: self.mu[k],
                 flat: self.flat[k],
-                history: self.history[k].iter().map(|c| HistoryEntry { level: c.level, j: c.j, old: c.old }).collect(),
+                history: self.history.of(k).map(|c| HistoryEntry { level: c.level, j: c.j, old: c.old }).collect(),
             })
             .collect();
         LevelParts { max_level: self.max_level, darts, points: self.points.clone() }
@@ -314,7 +314,9 @@ impl<const N: usize> LeveledMap<N> {
             m.dart_level[k] = rec.level;
             m.mu[k] = rec.mu;
             m.flat[k] = rec.flat;
-            m.history[k] = rec.history.iter().map(|e| LinkChange { level: e.level, j: e.j, old: e.old }).collect();
+            for e in &rec.history {
+                m.history.push(k, LinkChange { level: e.level, j: e.j, old: e.old });
+            }
         }
         m
     }

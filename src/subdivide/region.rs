@@ -311,8 +311,11 @@ impl LeveledMap<3> {
 
     /// Refines the zone of the ball B(center, radius) up to level `levels` (module docs): for
     /// L = max(1, k)..=levels, every tet with μt = L − 1 meeting the ball is subdivided at level L,
-    /// its mass shared by [`Self::subdivide_tet_with_mass`]. Returns the count per level and the
-    /// mass totals. O(Σ_L (volumes + refined · touched)).
+    /// its mass shared by [`Self::subdivide_tet_with_mass`]. When the ball holds every vertex and
+    /// every tet is at level L − 1, level L is done by the bulk [`Self::refine_uniform`] (same
+    /// result, numbering aside); otherwise, or if it refuses, op by op
+    /// ([`Self::refine_around_per_op`]). Returns the count per level and the mass totals.
+    /// O(Σ_L (volumes + refined · touched)); O(darts) per bulk level.
     ///
     /// Errors: those of [`Self::subdivide_tet`] (the map keeps the operations done before it);
     /// [`SubdivideError::LevelTooHigh`] for `levels` above [`super::MAX_LEVEL`].
@@ -337,20 +340,94 @@ impl LeveledMap<3> {
         masses: &mut TetMasses,
     ) -> Result<Refinement, SubdivideError> {
         self.check_op_level(levels)?;
+        // Mass totals: a bulk level reports them (Σ over every volume), so O(darts) sweeps are
+        // only made around per-op levels.
+        let (mut before, mut after) = (None, None);
+        let mut per_level = vec![0; levels as usize + 1];
+        for level in self.max_level.max(1)..=levels {
+            if self.ball_holds_all(center, radius) && self.all_tets_at(level - 1) {
+                if let Ok(r) = self.refine_uniform(level, masses) {
+                    per_level[level as usize] = r.subdivided_per_level[level as usize];
+                    before.get_or_insert(r.total_mass_before);
+                    after = Some(r.total_mass_after);
+                    continue;
+                }
+            }
+            if before.is_none() {
+                before = Some(masses.total(self));
+            }
+            after = None;
+            per_level[level as usize] = self.refine_level_per_op(level, center, radius, masses)?;
+        }
+        Ok(Refinement {
+            subdivided_per_level: per_level,
+            total_mass_before: before.unwrap_or_else(|| masses.total(self)),
+            total_mass_after: after.unwrap_or_else(|| masses.total(self)),
+        })
+    }
+
+    /// [`Self::refine_around`] op by op only ([`Self::subdivide_tet_with_mass`] on every tet of
+    /// the zone, level by level), never the bulk path: the reference the bulk path is tested and
+    /// benchmarked against. Same errors and result (numbering aside).
+    ///
+    /// ```
+    /// use topomech::subdivide::{LeveledMap, TetMasses};
+    /// use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let points = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mut m = LeveledMap::new(map, points);
+    /// let mut masses = TetMasses::from_density(&m, 6.0).unwrap();
+    /// let r = m.refine_around_per_op([0.1, 0.1, 0.1], 10.0, 1, &mut masses).unwrap();
+    /// assert_eq!(r.subdivided_per_level, vec![0, 1]);
+    /// ```
+    pub fn refine_around_per_op(
+        &mut self,
+        center: [f64; 3],
+        radius: f64,
+        levels: u8,
+        masses: &mut TetMasses,
+    ) -> Result<Refinement, SubdivideError> {
+        self.check_op_level(levels)?;
         let before = masses.total(self);
         let mut per_level = vec![0; levels as usize + 1];
         for level in self.max_level.max(1)..=levels {
-            let zone = self.zone_tets(level - 1, center, radius)?;
-            for d in zone {
-                self.subdivide_tet_with_mass(d, level, masses)?;
-                per_level[level as usize] += 1;
-            }
+            per_level[level as usize] = self.refine_level_per_op(level, center, radius, masses)?;
         }
         Ok(Refinement {
             subdivided_per_level: per_level,
             total_mass_before: before,
             total_mass_after: masses.total(self),
         })
+    }
+
+    /// Subdivides, op by op, every tet with μt = level − 1 meeting the ball. Returns the count.
+    fn refine_level_per_op(
+        &mut self,
+        level: u8,
+        center: [f64; 3],
+        radius: f64,
+        masses: &mut TetMasses,
+    ) -> Result<usize, SubdivideError> {
+        let zone = self.zone_tets(level - 1, center, radius)?;
+        for &d in &zone {
+            self.subdivide_tet_with_mass(d, level, masses)?;
+        }
+        Ok(zone.len())
+    }
+
+    /// Whether every stored vertex position lies in the closed ball (then every tet meets it).
+    /// O(points).
+    fn ball_holds_all(&self, center: [f64; 3], radius: f64) -> bool {
+        let inside = |p: &[f64; 3]| dot(sub(*p, center), sub(*p, center)).sqrt() <= radius;
+        if self.points.is_empty() {
+            return inside(&[0.0; 3]);
+        }
+        self.points.iter().all(inside)
+    }
+
+    /// Whether every live dart has μt = `lt` (a quick filter before the bulk path). O(darts).
+    fn all_tets_at(&self, lt: u8) -> bool {
+        self.map.darts().all(|d| self.mu[d.index()].tet == lt)
     }
 
     /// One dart of every tet with μt = `lt` meeting the ball. O(darts).

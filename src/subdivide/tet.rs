@@ -36,7 +36,7 @@ struct FaceSide {
 }
 
 /// The label of the midpoint of the edge between corners x and y.
-fn mid_label(x: u8, y: u8) -> u8 {
+pub(super) fn mid_label(x: u8, y: u8) -> u8 {
     let (x, y) = (x.min(y), x.max(y));
     4 + PAIRS.iter().position(|&p| p == (x, y)).expect("x ≠ y are corners 0..3") as u8
 }
@@ -50,7 +50,7 @@ fn opposite(m: u8) -> u8 {
 
 /// The eight child tets as label sets, for the chosen diagonal (a midpoint label and its
 /// opposite): four corner tets, then four tets around the diagonal.
-fn child_tets(diag: u8) -> Vec<[u8; 4]> {
+pub(super) fn child_tets(diag: u8) -> Vec<[u8; 4]> {
     let mut tets: Vec<[u8; 4]> = (0..4u8)
         .map(|x| {
             let others: Vec<u8> = (0..4).filter(|&y| y != x).map(|y| mid_label(x, y)).collect();
@@ -67,12 +67,59 @@ fn child_tets(diag: u8) -> Vec<[u8; 4]> {
     tets
 }
 
+/// The midpoint label (4, 5 or 6) of the shortest of the three diagonals of the octahedron, from
+/// the positions and vertex ids of the six midpoints (index = label − 4). Ties (within 1e-12
+/// relative) go to the diagonal whose endpoint positions are lexicographically smaller (smaller
+/// end first, then larger end), then to the smaller pair of vertex ids. The tie-break reads
+/// positions before ids so that every refinement path (op by op or bulk, whatever order it numbers
+/// the midpoints in) makes the same choice; ids only decide between coincident midpoints. O(1).
+pub(super) fn choose_diagonal(pos: &[[f64; 3]; 6], vid: &[u32; 6]) -> u8 {
+    let key = |l: u8| {
+        let (i, j) = ((l - 4) as usize, (opposite(l) - 4) as usize);
+        let (p, q) = (pos[i], pos[j]);
+        let len2: f64 = (0..3).map(|k| (p[k] - q[k]) * (p[k] - q[k])).sum();
+        let (lo, hi) = if lex_less(q, p) { (q, p) } else { (p, q) };
+        (len2, lo, hi, vid[i].min(vid[j]), vid[i].max(vid[j]))
+    };
+    let tie_less = |a: &([f64; 3], [f64; 3], u32, u32), b: &([f64; 3], [f64; 3], u32, u32)| {
+        if a.0 != b.0 {
+            return lex_less(a.0, b.0);
+        }
+        if a.1 != b.1 {
+            return lex_less(a.1, b.1);
+        }
+        (a.2, a.3) < (b.2, b.3)
+    };
+    let mut best = 4u8;
+    for l in [mid_label(0, 2), mid_label(0, 3)] {
+        let (kb, kl) = (key(best), key(l));
+        let tol = 1e-12 * kb.0.max(kl.0);
+        let tie = (kl.0 - kb.0).abs() <= tol;
+        if kl.0 < kb.0 - tol || (tie && tie_less(&(kl.1, kl.2, kl.3, kl.4), &(kb.1, kb.2, kb.3, kb.4))) {
+            best = l;
+        }
+    }
+    best
+}
+
+/// Lexicographic order of two points (NaN coordinates compare as equal).
+fn lex_less(a: [f64; 3], b: [f64; 3]) -> bool {
+    for k in 0..3 {
+        match a[k].partial_cmp(&b[k]) {
+            Some(std::cmp::Ordering::Less) => return true,
+            Some(std::cmp::Ordering::Greater) => return false,
+            _ => {}
+        }
+    }
+    false
+}
+
 impl LeveledMap<3> {
     /// Subdivides the tetrahedron of `d` into eight at level `level` (the paper's tetrahedron
     /// subdivision, §4.3.3): its four faces are split 1→4 (faces a neighbour already split are
     /// reused), then four corner tets are cut off by the triangles joining the three edge
     /// midpoints at each corner, and the inner octahedron is split into four tets around its
-    /// shortest diagonal (ties broken by the smaller vertex ids). The 8 children take μt = level;
+    /// shortest diagonal (ties broken by the midpoint positions, then by vertex ids). The 8 children take μt = level;
     /// their faces and edges take μf, μa ≥ level (the corollary μt ≤ μf ≤ μa). Returns one dart of
     /// each child: the corner tets (in the order of the corners found), then the four around the
     /// diagonal. Cost O(volume + touched cells).
@@ -319,25 +366,10 @@ impl LeveledMap<3> {
         vid
     }
 
-    /// The midpoint label of the shortest of the three diagonals of the octahedron; ties (within
-    /// 1e-12 relative) go to the diagonal with the smaller pair of vertex ids.
+    /// The midpoint label of the shortest diagonal of the octahedron ([`choose_diagonal`]).
     fn shortest_diagonal(&self, vid: &[u32; 6]) -> u8 {
-        let pos = |l: u8| self.points.get(vid[(l - 4) as usize] as usize).copied().unwrap_or([0.0; 3]);
-        let key = |l: u8| {
-            let (p, q) = (pos(l), pos(opposite(l)));
-            let len2: f64 = (0..3).map(|k| (p[k] - q[k]) * (p[k] - q[k])).sum();
-            let (a, b) = (vid[(l - 4) as usize], vid[(opposite(l) - 4) as usize]);
-            (len2, a.min(b), a.max(b))
-        };
-        let mut best = 4u8;
-        for l in [mid_label(0, 2), mid_label(0, 3)] {
-            let (kb, kl) = (key(best), key(l));
-            let tol = 1e-12 * kb.0.max(kl.0);
-            if kl.0 < kb.0 - tol || ((kl.0 - kb.0).abs() <= tol && (kl.1, kl.2) < (kb.1, kb.2)) {
-                best = l;
-            }
-        }
-        best
+        let pos = vid.map(|v| self.points.get(v as usize).copied().unwrap_or([0.0; 3]));
+        choose_diagonal(&pos, vid)
     }
 
     /// Creates a triangle face with two sides (12 darts, α0, α1 and α3 linked). Returns the darts

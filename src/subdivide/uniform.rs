@@ -1,0 +1,830 @@
+//! Bulk uniform refinement: every cell of the finest level refined at once from fixed local
+//! templates (issue 5, performance). Tetrahedra 1→8 in 3-G-maps, triangles 1→4 in 2-G-maps.
+//!
+//! # Template
+//! A parent simplex has its corners labelled 0..=n from a root dart, and each of its darts is a
+//! flag written as an ordered n-tuple of distinct corners (vertex, other end of the edge, third
+//! corner of the face): 24 darts for a tet, 6 for a triangle. Edge midpoints get labels
+//! n + 1 + (index of the corner pair), and the children are label sets (for tets the octahedron is
+//! split around its shortest diagonal, [`super::tet`]'s rule, so there are three templates).
+//! Each parent dart p owns a fixed number of child darts (8 for a tet, 4 for a triangle),
+//! slot k of p, and slot 0 is p itself, which stays at its corner (only its α0 changes). For
+//! p = (a, b, c) with missing corner d and midpoints m_xy:
+//!
+//! ```text
+//!   tet   k = 0 (a, m_ab, m_ac)   k = 1 (m_ab, a, m_ac)   k = 2 (m_ab, m_ac, a)   in the corner child of a
+//!         k = 3 (m_ab, m_ac, m_bc) in the child holding the face centre
+//!         k = 4, 5 (m_ab, m_ac, m_ad) on both sides of the cut at corner a; k = 6, 7 the diagonal faces
+//!   tri   k = 0 (a, m_ab)   k = 1 (m_ab, a)   k = 2 (m_ab, m_ac) in the corner child of a;   k = 3 (m_ab, m_ac) centre
+//! ```
+//! Slots 0..=3 (tets) and 0..=1 (triangles) lie on the parent's facets, and are defined from the
+//! facet's corners only; so αn of child k of p is child k of αn(p), for any diagonal choice on
+//! either side. Every other link is a template entry inside the parent.
+//!
+//! # Cell ids
+//! Old ids stay where they were (corner vertices; the half of each parent edge at its end of
+//! smaller vertex id; the centre child of each parent face; the corner child of label 0); new ids
+//! are numbered from each allocator's `next`: per parent edge (first met) its midpoint and other
+//! half, per parent face (3D) three cut edges and three corner faces (ordered by corner vertex
+//! id, so both sides agree), per parent the inner cells.
+//!
+//! # Cost
+//! O(darts), no hashing and no orbit walk: a check pass over the darts and a labelling pass over
+//! the parents (both refuse before any change), then the write pass (old rows rewritten in place,
+//! new rows appended in id order).
+
+use super::tet::{child_tets, choose_diagonal};
+use super::{LeveledMap, LinkChange, Mu, Refinement, SubdivideError, TetMasses};
+use crate::gmap::DartId;
+
+/// αn target of a slot on the parent's facet: child k of αn(parent dart).
+const BORDER: u8 = u8::MAX;
+
+/// Capacity of a parent's flat table of local cell ids (a tet has 10 + 25 + 24 + 8 = 67).
+const FLAT: usize = 80;
+
+/// How one local cell of a refined parent gets its global id.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Rule {
+    /// A corner: its vertex id.
+    Corner(u8),
+    /// The midpoint of the parent edge with this pair index.
+    Mid(u8),
+    /// The half at corner x of the parent edge (x, y).
+    Half { x: u8, y: u8 },
+    /// The cut edge at corner x of the parent face missing corner w (3D).
+    FaceInner { w: u8, x: u8 },
+    /// The child face at corner x of the parent face missing corner w (3D).
+    FaceCorner { w: u8, x: u8 },
+    /// The centre child of the parent face missing corner w (3D): keeps the face's id.
+    FaceCenter { w: u8 },
+    /// The child of label set 0: keeps the parent's n-cell id.
+    Old,
+    /// The q-th cell of this dimension inside the parent: a fresh id.
+    Inner(u8),
+}
+
+/// A refinement template for one dimension (and, for tets, one diagonal).
+#[derive(Clone, Debug)]
+struct Template {
+    n: usize,
+    /// Child darts per parent dart.
+    per: usize,
+    /// Parent darts as label tuples (first n entries used); index 0 is (0, 1, …).
+    parents: Vec<[u8; 3]>,
+    /// `act[p][j]`: the parent index of αj(p), j < n.
+    act: Vec<[u8; 3]>,
+    /// Spanning tree from parent 0: (target, source, j) with target = αj(source).
+    tree: Vec<(u8, u8, u8)>,
+    /// Per slot (p · per + k): the slot of αj, j ≤ n, or [`BORDER`] for αn on a facet.
+    link: Vec<[u8; 4]>,
+    /// Per slot: its local cell index in each dimension.
+    cell: Vec<[u8; 4]>,
+    /// Per dimension, per local cell: how its global id is found.
+    rules: Vec<Vec<Rule>>,
+    /// Per dimension: the number of [`Rule::Inner`] cells.
+    inner: [u32; 4],
+    /// Per corner pair index: a parent dart (x, y, …) on that edge.
+    pair_parent: Vec<u8>,
+    /// Per corner: a parent dart at it.
+    corner_parent: [u8; 4],
+    /// Per missing corner w (3D): a parent dart of the face without w.
+    face_parent: [u8; 4],
+    /// The children as label sets (n + 1 labels each).
+    children: Vec<[u8; 4]>,
+    /// The corner pairs (midpoint of pair i: label n + 1 + i).
+    pairs: Vec<(u8, u8)>,
+    /// Per child: its local n-cell index.
+    child_cell: Vec<u8>,
+    /// Per slot and dimension: the index of its cell in the flat id table of a parent (local
+    /// index + offset of the dimension), filled by [`Template::flatten`].
+    flat_cell: Vec<[u8; 4]>,
+    /// Offset of each dimension in the flat id table.
+    offset: [usize; 5],
+}
+
+/// The corner pairs of an n-simplex in order; the midpoint of pair i has label n + 1 + i.
+fn pairs(n: usize) -> Vec<(u8, u8)> {
+    let mut out = Vec::new();
+    for x in 0..=n as u8 {
+        for y in x + 1..=n as u8 {
+            out.push((x, y));
+        }
+    }
+    out
+}
+
+/// The ordered n-tuples of distinct labels of `set` (n + 1 labels), in lexicographic order of
+/// positions in `set`.
+fn tuples(n: usize, set: &[u8]) -> Vec<[u8; 3]> {
+    let mut out = Vec::new();
+    for a in 0..set.len() {
+        for b in (0..set.len()).filter(|&b| b != a) {
+            if n == 2 {
+                out.push([set[a], set[b], 0]);
+                continue;
+            }
+            for c in (0..set.len()).filter(|&c| c != a && c != b) {
+                out.push([set[a], set[b], set[c]]);
+            }
+        }
+    }
+    out
+}
+
+/// αj of the flag `t` of the simplex with label set `set`: j < n − 1 swaps entries j and j + 1,
+/// j = n − 1 replaces the last entry by the label of `set` not in the tuple.
+fn flag_alpha(n: usize, set: &[u8], t: [u8; 3], j: usize) -> [u8; 3] {
+    let mut out = t;
+    if j + 1 < n {
+        out.swap(j, j + 1);
+    } else {
+        let missing = set.iter().copied().find(|l| !t[..n].contains(l)).expect("n + 1 labels");
+        out[n - 1] = missing;
+    }
+    out
+}
+
+impl Template {
+    /// The template of an n-simplex (n ∈ {2, 3}) whose children are `children`.
+    fn new(n: usize, children: Vec<[u8; 4]>) -> Self {
+        let corners: Vec<u8> = (0..=n as u8).collect();
+        let pr = pairs(n);
+        let mid = |x: u8, y: u8| n as u8 + 1 + pr.iter().position(|&p| p == (x.min(y), x.max(y))).expect("pair") as u8;
+        let parents = tuples(n, &corners);
+        let index_of = |t: [u8; 3]| parents.iter().position(|&p| p[..n] == t[..n]).expect("a parent flag") as u8;
+        let act: Vec<[u8; 3]> = parents
+            .iter()
+            .map(|&p| {
+                let mut a = [0u8; 3];
+                for (j, slot) in a.iter_mut().enumerate().take(n) {
+                    *slot = index_of(flag_alpha(n, &corners, p, j));
+                }
+                a
+            })
+            .collect();
+        let tree = Self::spanning_tree(n, &act);
+        // Child darts: (child, tuple).
+        let mut flags: Vec<(u8, [u8; 3])> = Vec::new();
+        for (c, set) in children.iter().enumerate() {
+            flags.extend(tuples(n, &set[..=n]).into_iter().map(|t| (c as u8, t)));
+        }
+        let holder = |face: &[u8], not: Option<u8>| -> u8 {
+            let found = children
+                .iter()
+                .enumerate()
+                .position(|(c, set)| Some(c as u8) != not && face.iter().all(|l| set[..=n].contains(l)));
+            found.expect("a child holds the face") as u8
+        };
+        let per = if n == 3 { 8 } else { 4 };
+        let mut slot_flag: Vec<Option<(u8, [u8; 3])>> = vec![None; parents.len() * per];
+        for (pi, &p) in parents.iter().enumerate() {
+            let (a, b) = (p[0], p[1]);
+            let c = if n == 3 { p[2] } else { corners.iter().copied().find(|&x| x != a && x != b).expect("3") };
+            let ca = a; // the corner child of a is child a
+            let fixed: Vec<(u8, [u8; 3])> = if n == 2 {
+                vec![
+                    (ca, [a, mid(a, b), 0]),
+                    (ca, [mid(a, b), a, 0]),
+                    (ca, [mid(a, b), mid(a, c), 0]),
+                    (3, [mid(a, b), mid(a, c), 0]),
+                ]
+            } else {
+                let d = corners.iter().copied().find(|x| !p.contains(x)).expect("4 corners");
+                let centre = [mid(a, b), mid(a, c), mid(b, c)];
+                let cut = [mid(a, b), mid(a, c), mid(a, d)];
+                vec![
+                    (ca, [a, mid(a, b), mid(a, c)]),
+                    (ca, [mid(a, b), a, mid(a, c)]),
+                    (ca, [mid(a, b), mid(a, c), a]),
+                    (holder(&centre, None), centre),
+                    (ca, cut),
+                    (holder(&cut, Some(ca)), cut),
+                ]
+            };
+            for (k, f) in fixed.into_iter().enumerate() {
+                slot_flag[pi * per + k] = Some(f);
+            }
+        }
+        let rest: Vec<(u8, [u8; 3])> = flags.iter().copied().filter(|f| !slot_flag.contains(&Some(*f))).collect();
+        let mut rest = rest.into_iter();
+        for s in slot_flag.iter_mut().filter(|s| s.is_none()) {
+            *s = rest.next();
+        }
+        let slot_flag: Vec<(u8, [u8; 3])> = slot_flag.into_iter().map(|f| f.expect("a bijection")).collect();
+        assert_eq!(slot_flag.len(), flags.len(), "template bug: slot count");
+        let slot_of = |f: (u8, [u8; 3])| slot_flag.iter().position(|&g| g == f).expect("template bug: a flag") as u8;
+        let link: Vec<[u8; 4]> = slot_flag
+            .iter()
+            .map(|&(c, t)| {
+                let set = &children[c as usize][..=n];
+                let mut l = [BORDER; 4];
+                for (j, slot) in l.iter_mut().enumerate().take(n) {
+                    *slot = slot_of((c, flag_alpha(n, set, t, j)));
+                }
+                let other = children
+                    .iter()
+                    .enumerate()
+                    .position(|(o, s)| o as u8 != c && t[..n].iter().all(|x| s[..=n].contains(x)));
+                l[n] = other.map_or(BORDER, |o| slot_of((o as u8, t)));
+                l
+            })
+            .collect();
+        let mut template = Template {
+            n,
+            per,
+            act,
+            tree,
+            link,
+            cell: vec![[0; 4]; slot_flag.len()],
+            rules: vec![Vec::new(); n + 1],
+            inner: [0; 4],
+            pair_parent: pr
+                .iter()
+                .map(|&(x, y)| {
+                    let z = corners.iter().copied().find(|&z| z != x && z != y).expect("n ≥ 2");
+                    index_of([x, y, z])
+                })
+                .collect(),
+            child_cell: Vec::new(),
+            pairs: pr.clone(),
+            flat_cell: Vec::new(),
+            offset: [0; 5],
+            corner_parent: [0; 4],
+            face_parent: [0; 4],
+            children,
+            parents,
+        };
+        template.fill_corner_and_face_parents();
+        template.fill_cells(&slot_flag, &pr);
+        template.flatten();
+        template
+    }
+
+    /// The flat id table layout: dimension i's cells at `offset[i]..offset[i + 1]`.
+    fn flatten(&mut self) {
+        for i in 0..=self.n {
+            self.offset[i + 1] = self.offset[i] + self.rules[i].len();
+        }
+        for i in self.n + 1..4 {
+            self.offset[i + 1] = self.offset[i];
+        }
+        assert!(self.offset[self.n + 1] <= FLAT, "template bug: {} local cells", self.offset[self.n + 1]);
+        self.flat_cell = self
+            .cell
+            .iter()
+            .map(|c| [0, 1, 2, 3].map(|i| (self.offset[i.min(self.n)] + c[i] as usize) as u8))
+            .collect();
+    }
+
+    /// BFS tree over the parent flags from flag 0.
+    fn spanning_tree(n: usize, act: &[[u8; 3]]) -> Vec<(u8, u8, u8)> {
+        let mut seen = vec![false; act.len()];
+        seen[0] = true;
+        let (mut order, mut tree) = (vec![0u8], Vec::new());
+        let mut head = 0;
+        while head < order.len() {
+            let s = order[head];
+            head += 1;
+            for (j, &t) in act[s as usize].iter().enumerate().take(n) {
+                if !seen[t as usize] {
+                    seen[t as usize] = true;
+                    order.push(t);
+                    tree.push((t, s, j as u8));
+                }
+            }
+        }
+        tree
+    }
+
+    fn fill_corner_and_face_parents(&mut self) {
+        let n = self.n;
+        for x in 0..=n {
+            self.corner_parent[x] = self.parents.iter().position(|p| p[0] as usize == x).expect("corner") as u8;
+            if n == 3 {
+                let found = self.parents.iter().position(|p| !p[..3].contains(&(x as u8)));
+                self.face_parent[x] = found.expect("face") as u8;
+            }
+        }
+    }
+
+    /// Local cells (label sets, or the child for dimension n) and their rules.
+    fn fill_cells(&mut self, slot_flag: &[(u8, [u8; 3])], pr: &[(u8, u8)]) {
+        let n = self.n;
+        for dim in 0..=n {
+            let mut keys: Vec<[u8; 3]> = Vec::new();
+            for (s, &(c, t)) in slot_flag.iter().enumerate() {
+                let key = if dim == n {
+                    [c, 0, 0]
+                } else {
+                    let mut k = [u8::MAX; 3];
+                    k[..=dim].copy_from_slice(&t[..=dim]);
+                    k.sort_unstable();
+                    k
+                };
+                let local = match keys.iter().position(|&k| k == key) {
+                    Some(i) => i,
+                    None => {
+                        if dim == n {
+                            self.child_cell.resize(self.children.len(), 0);
+                            self.child_cell[c as usize] = keys.len() as u8;
+                        }
+                        keys.push(key);
+                        let rule = self.rule(dim, key, pr);
+                        self.rules[dim].push(rule);
+                        keys.len() - 1
+                    }
+                };
+                self.cell[s][dim] = local as u8;
+            }
+        }
+    }
+
+    /// The rule of the local cell with key `key` (sorted labels, or [child, …] for dimension n).
+    fn rule(&mut self, dim: usize, key: [u8; 3], pr: &[(u8, u8)]) -> Rule {
+        let n = self.n;
+        let nc = n as u8 + 1;
+        let pair = |l: u8| pr[(l - nc) as usize];
+        let mut fresh = || {
+            self.inner[dim] += 1;
+            Rule::Inner((self.inner[dim] - 1) as u8)
+        };
+        if dim == n {
+            return if key[0] == 0 { Rule::Old } else { fresh() };
+        }
+        let labels = &key[..=dim];
+        let corner: Vec<u8> = labels.iter().copied().filter(|&l| l < nc).collect();
+        let mids: Vec<(u8, u8)> = labels.iter().copied().filter(|&l| l >= nc).map(pair).collect();
+        let mut span: Vec<u8> = corner.iter().copied().chain(mids.iter().flat_map(|&(x, y)| [x, y])).collect();
+        span.sort_unstable();
+        span.dedup();
+        let missing = (0..nc).find(|x| !span.contains(x)).unwrap_or(u8::MAX);
+        match (dim, corner.len()) {
+            (0, 1) => Rule::Corner(corner[0]),
+            (0, _) => Rule::Mid(labels[0] - nc),
+            (1, 1) => {
+                let (x, y) = mids[0];
+                Rule::Half { x: corner[0], y: if x == corner[0] { y } else { x } }
+            }
+            (1, _) if n == 3 && span.len() == 3 => {
+                let shared = if mids[0].0 == mids[1].0 || mids[0].0 == mids[1].1 { mids[0].0 } else { mids[0].1 };
+                Rule::FaceInner { w: missing, x: shared }
+            }
+            (2, 1) => Rule::FaceCorner { w: missing, x: corner[0] },
+            (2, 0) if span.len() == 3 => Rule::FaceCenter { w: missing },
+            _ => fresh(),
+        }
+    }
+}
+
+/// The templates of tets (one per diagonal label 4, 5, 6) or of triangles.
+fn templates(n: usize) -> Vec<Template> {
+    if n == 3 {
+        (4..7u8).map(|diag| Template::new(3, child_tets(diag).into_iter().collect())).collect()
+    } else {
+        vec![Template::new(2, vec![[0, 3, 4, 0], [1, 3, 5, 0], [2, 4, 5, 0], [3, 4, 5, 0]])]
+    }
+}
+
+/// What the check-and-label pass found: every parent's darts, its template, the parent edges
+/// and faces (3D) with their first-met rank.
+struct Labelled {
+    /// Parent darts, `parents × P` (P = 24 or 6), in template order.
+    darts: Vec<u32>,
+    /// Template index per parent (the diagonal in 3D).
+    template: Vec<u8>,
+    /// Parent index of every old dart, and its flag index.
+    parent_of: Vec<u32>,
+    flag_of: Vec<u8>,
+    /// Rank of each edge id (first met), `u32::MAX` if none.
+    edge_rank: Vec<u32>,
+    /// The parent edges by rank, as (vertex id, vertex id).
+    edges: Vec<(u32, u32)>,
+    /// Rank of each face id (3D).
+    face_rank: Vec<u32>,
+    faces: u32,
+}
+
+impl<const N: usize> LeveledMap<N> {
+    /// The common resolution level m of every dart, checking the uniform preconditions: μ = (m, m,
+    /// m) in 3D ((m, m, 0) in 2D), m < level, no inserted (flat) vertex, α0…α(n−1) closed.
+    fn uniform_level(&self, level: u8) -> Result<u8, SubdivideError> {
+        self.check_op_level(level)?;
+        let Some(first) = self.map.darts().next() else { return Ok(0) };
+        let m = self.mu[first.index()].face;
+        let expected = Mu { edge: m, face: m, tet: if N == 3 { m } else { 0 } };
+        for d in self.map.darts() {
+            let mu = self.mu[d.index()];
+            if mu != expected || self.flat[d.index()] {
+                return Err(SubdivideError::NotUniform { dart: d, mu, expected: m });
+            }
+            if (0..N).any(|j| self.map.is_free(j, d)) {
+                return Err(SubdivideError::OpenEdge(d));
+            }
+        }
+        if m >= level {
+            return Err(SubdivideError::AlreadyAtLevel { dart: first, dim: N, cell_level: m, level });
+        }
+        Ok(m)
+    }
+
+    /// Labels every n-cell as a parent simplex (refusing cells that are not simplices with n + 1
+    /// distinct corners) and ranks the parent edges and faces. No change to the map.
+    fn label_parents(&self, tpl: &[Template]) -> Result<Labelled, SubdivideError> {
+        let t0 = &tpl[0];
+        let p = t0.parents.len();
+        let cap = self.map.capacity();
+        let mut out = Labelled {
+            darts: Vec::with_capacity(self.map.dart_count()),
+            template: Vec::new(),
+            parent_of: vec![u32::MAX; cap],
+            flag_of: vec![0; cap],
+            edge_rank: vec![u32::MAX; self.map.cell_id_bound(1)],
+            edges: Vec::new(),
+            face_rank: vec![u32::MAX; if N == 3 { self.map.cell_id_bound(2) } else { 0 }],
+            faces: 0,
+        };
+        let mut lab = vec![0u32; p];
+        for d in self.map.darts() {
+            if out.parent_of[d.index()] != u32::MAX {
+                continue;
+            }
+            let parent = out.template.len() as u32;
+            lab[0] = d.0;
+            for &(t, s, j) in &t0.tree {
+                lab[t as usize] = self.map.alpha_dyn(j as usize, DartId(lab[s as usize])).0;
+            }
+            let not_simplex = |corners| SubdivideError::NotATetrahedron { dart: d, corners };
+            for (f, &x) in lab.iter().enumerate() {
+                if out.parent_of[x as usize] != u32::MAX {
+                    return Err(not_simplex(0));
+                }
+                out.parent_of[x as usize] = parent;
+                out.flag_of[x as usize] = f as u8;
+            }
+            for (f, &x) in lab.iter().enumerate() {
+                for j in 0..N {
+                    if self.map.alpha_dyn(j, DartId(x)).0 != lab[t0.act[f][j] as usize] {
+                        return Err(not_simplex(0));
+                    }
+                }
+            }
+            let mut vids = [0u32; 4];
+            for (c, v) in vids.iter_mut().enumerate().take(N + 1) {
+                *v = self.map.vertex_id(DartId(lab[t0.corner_parent[c] as usize])).0;
+            }
+            let distinct = (0..=N).all(|a| (a + 1..=N).all(|b| vids[a] != vids[b]));
+            if !distinct {
+                let mut v = vids[..=N].to_vec();
+                v.sort_unstable();
+                v.dedup();
+                return Err(not_simplex(v.len()));
+            }
+            out.template.push(if N == 3 { self.diagonal_template(&vids, &lab, t0) } else { 0 });
+            self.rank_cells(&lab, t0, &vids, &mut out);
+            out.darts.extend_from_slice(&lab);
+        }
+        Ok(out)
+    }
+
+    /// Ranks the parent's edges and faces at first meeting.
+    fn rank_cells(&self, lab: &[u32], t0: &Template, vids: &[u32], out: &mut Labelled) {
+        for (k, &(x, y)) in t0.pairs.iter().enumerate() {
+            let e = self.map.cell_id(1, DartId(lab[t0.pair_parent[k] as usize])).index();
+            if out.edge_rank[e] == u32::MAX {
+                out.edge_rank[e] = out.edges.len() as u32;
+                out.edges.push((vids[x as usize], vids[y as usize]));
+            }
+        }
+        if N == 3 {
+            for w in 0..4 {
+                let f = self.map.cell_id(2, DartId(lab[t0.face_parent[w] as usize])).index();
+                if out.face_rank[f] == u32::MAX {
+                    out.face_rank[f] = out.faces;
+                    out.faces += 1;
+                }
+            }
+        }
+    }
+
+    /// The template index (diagonal label − 4) of a parent tet, by [`choose_diagonal`].
+    fn diagonal_template(&self, vids: &[u32], lab: &[u32], t0: &Template) -> u8 {
+        let corner = [0, 1, 2, 3].map(|c| self.vertex_pos(vids[c]));
+        let pr = [(0u8, 1u8), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
+        let mut pos = [[0.0; 3]; 6];
+        let mut mid_vid = [0u32; 6];
+        for (k, &(x, y)) in pr.iter().enumerate() {
+            let (a, b) = (corner[x as usize], corner[y as usize]);
+            pos[k] = [0, 1, 2].map(|i| 0.5 * (a[i] + b[i]));
+            // Ids only break ties between coincident midpoints; any per-edge number will do.
+            mid_vid[k] = self.map.cell_id(1, DartId(lab[t0.pair_parent[k] as usize])).0;
+        }
+        choose_diagonal(&pos, &mid_vid) - 4
+    }
+
+    fn vertex_pos(&self, v: u32) -> [f64; 3] {
+        self.points.get(v as usize).copied().unwrap_or([0.0; 3])
+    }
+
+    /// The write pass: grows the map and every record, writes the children of every parent.
+    /// Returns the new n-cell ids per parent (child c at `parent * children + c`).
+    fn write_uniform(&mut self, level: u8, tpl: &[Template], lab: &Labelled) -> Vec<u32> {
+        let t0 = &tpl[0];
+        let (p, per) = (t0.parents.len(), t0.per);
+        let parents = lab.template.len();
+        let fresh = p * (per - 1);
+        let base = self.map.capacity() as u32;
+        self.map.reserve_darts_raw(parents * fresh);
+        let cap = base as usize + parents * fresh;
+        let mu = Mu { edge: level, face: level, tet: if N == 3 { level } else { 0 } };
+        self.dart_level.resize(cap, level);
+        self.mu.resize(cap, mu);
+        self.flat.resize(cap, false);
+        self.history.resize(cap);
+        self.history.reserve(lab.darts.len());
+        let next: Vec<u32> = (0..=N).map(|i| self.map.id_alloc_raw(i).0).collect();
+        let (ne, nf) = (lab.edges.len() as u32, lab.faces);
+        // Ids shared between parents (per parent edge / face), then the per-parent ones.
+        let shared = [ne, ne + if N == 3 { 3 * nf } else { 0 }, if N == 3 { 3 * nf } else { 0 }, 0];
+        let inner_base: Vec<u32> = (0..=N).map(|i| next[i] + shared[i]).collect();
+        let mut ids = [0u32; FLAT];
+        let mut dart = [0u32; 192];
+        let (mut new_alpha, mut new_cell) = (vec![0u32; fresh * (N + 1)], vec![0u32; fresh * (N + 1)]);
+        let mut child_ids = Vec::with_capacity(parents * t0.children.len());
+        for parent in 0..parents {
+            let tp = &tpl[lab.template[parent] as usize];
+            let darts = &lab.darts[parent * p..(parent + 1) * p];
+            self.local_ids(tp, darts, parent as u32, &next, &inner_base, lab, &mut ids);
+            child_ids.extend(tp.child_cell.iter().map(|&local| ids[tp.offset[N] + local as usize]));
+            let first = base + (parent * fresh) as u32;
+            for (f, &old) in darts.iter().enumerate() {
+                dart[f * per] = old;
+                for k in 1..per {
+                    dart[f * per + k] = first + (f * (per - 1) + k - 1) as u32;
+                }
+            }
+            let (alpha, cell) = self.map.rows_mut_raw();
+            // Old darts (slot 0) are rewritten in place; the new ones go to a buffer appended
+            // below in id order.
+            for (f, &old) in darts.iter().enumerate() {
+                let old_row = old as usize * (N + 1);
+                let old_alpha0 = alpha[old_row];
+                let across = alpha[old_row + N];
+                // Child k of the dart across the facet: the same slot of αn(old).
+                let (q_parent, q_flag) =
+                    (lab.parent_of[across as usize] as usize, lab.flag_of[across as usize] as usize);
+                let q_first = base as usize + q_parent * fresh + q_flag * (per - 1);
+                for k in 0..per {
+                    let s = f * per + k;
+                    let links = &tp.link[s];
+                    let mut a = [0u32; 4];
+                    for j in 0..N {
+                        a[j] = dart[links[j] as usize];
+                    }
+                    a[N] = if links[N] != BORDER {
+                        dart[links[N] as usize]
+                    } else if across == old {
+                        dart[s]
+                    } else if k == 0 {
+                        across
+                    } else {
+                        (q_first + k - 1) as u32
+                    };
+                    let fc = &tp.flat_cell[s];
+                    let (alpha_row, cell_row) = if k == 0 {
+                        let row = old as usize * (N + 1);
+                        (&mut alpha[row..row + N + 1], &mut cell[row..row + N + 1])
+                    } else {
+                        let row = (f * (per - 1) + k - 1) * (N + 1);
+                        (&mut new_alpha[row..row + N + 1], &mut new_cell[row..row + N + 1])
+                    };
+                    for i in 0..=N {
+                        alpha_row[i] = a[i];
+                        cell_row[i] = ids[fc[i] as usize];
+                    }
+                }
+                self.history.push(old as usize, LinkChange { level, j: 0, old: old_alpha0 });
+                self.mu[old as usize] = mu;
+            }
+            let at = self.map.push_rows_raw(&new_alpha, &new_cell);
+            debug_assert_eq!(at, first);
+        }
+        for i in 0..=N {
+            let free = self.map.id_alloc_raw(i).1.to_vec();
+            let added = shared[i] + parents as u32 * t0.inner[i];
+            self.map.set_id_alloc_raw(i, next[i] + added, free);
+        }
+        self.write_midpoints(next[0], lab);
+        self.max_level = level;
+        child_ids
+    }
+
+    /// The global id of every local cell of one parent, by the template's rules, into the flat
+    /// table `ids` (dimension i at `tp.offset[i]..`).
+    #[allow(clippy::too_many_arguments)]
+    fn local_ids(
+        &self,
+        tp: &Template,
+        darts: &[u32],
+        parent: u32,
+        next: &[u32],
+        inner_base: &[u32],
+        lab: &Labelled,
+        ids: &mut [u32; FLAT],
+    ) {
+        let map = &self.map;
+        let mut vid = [0u32; 4];
+        for x in 0..=N {
+            vid[x] = map.vertex_id(DartId(darts[tp.corner_parent[x] as usize])).0;
+        }
+        let mut edge = [0u32; 6];
+        let mut edge_rank = [0u32; 6];
+        for k in 0..tp.pair_parent.len() {
+            edge[k] = map.cell_id(1, DartId(darts[tp.pair_parent[k] as usize])).0;
+            edge_rank[k] = lab.edge_rank[edge[k] as usize];
+        }
+        let (mut face, mut face_rank) = ([0u32; 4], [0u32; 4]);
+        if N == 3 {
+            for w in 0..4 {
+                face[w] = map.cell_id(2, DartId(darts[tp.face_parent[w] as usize])).0;
+                face_rank[w] = lab.face_rank[face[w] as usize];
+            }
+        }
+        let old = map.cell_id(N, DartId(darts[0])).0;
+        let pr_index = |x: u8, y: u8| -> usize {
+            let (a, b) = (x.min(y) as usize, x.max(y) as usize);
+            // Pair index in lexicographic order of (a, b) over 0..=N.
+            (0..a).map(|i| N - i).sum::<usize>() + (b - a - 1)
+        };
+        let rank_in_face = |w: u8, x: u8| -> u32 {
+            (0..4u8).filter(|&c| c != w && c != x && vid[c as usize] < vid[x as usize]).count() as u32
+        };
+        let ne = lab.edges.len() as u32;
+        for (dim, rules) in tp.rules.iter().enumerate() {
+            for (local, rule) in rules.iter().enumerate() {
+                ids[tp.offset[dim] + local] = match *rule {
+                    Rule::Corner(x) => vid[x as usize],
+                    Rule::Mid(k) => next[0] + edge_rank[k as usize],
+                    Rule::Half { x, y } => {
+                        let k = pr_index(x, y);
+                        if vid[x as usize] < vid[y as usize] {
+                            edge[k]
+                        } else {
+                            next[1] + edge_rank[k]
+                        }
+                    }
+                    Rule::FaceInner { w, x } => next[1] + ne + 3 * face_rank[w as usize] + rank_in_face(w, x),
+                    Rule::FaceCorner { w, x } => next[2] + 3 * face_rank[w as usize] + rank_in_face(w, x),
+                    Rule::FaceCenter { w } => face[w as usize],
+                    Rule::Old => old,
+                    Rule::Inner(q) => inner_base[dim] + parent * tp.inner[dim] + q as u32,
+                };
+            }
+        }
+    }
+
+    /// Positions of the new vertices (edge midpoints) and the split log.
+    fn write_midpoints(&mut self, first: u32, lab: &Labelled) {
+        let end = first as usize + lab.edges.len();
+        if !self.points.is_empty() && self.points.len() < end {
+            self.points.resize(end, [0.0; 3]);
+        }
+        for (r, &(a, b)) in lab.edges.iter().enumerate() {
+            let v = first + r as u32;
+            self.splits.push([v, a, b]);
+            if !self.points.is_empty() {
+                let (pa, pb) = (self.vertex_pos(a), self.vertex_pos(b));
+                self.points[v as usize] = [0, 1, 2].map(|k| 0.5 * (pa[k] + pb[k]));
+            }
+        }
+    }
+}
+
+impl LeveledMap<3> {
+    /// Refines every tetrahedron of the finest level 1→8 at level `level` in one bulk pass (module
+    /// docs of `uniform`), with the same result, up to dart and cell numbering, as
+    /// [`Self::subdivide_tet`] on every tet in any order: same levels G_0..G_level, dart levels, μ,
+    /// link history, midpoints and diagonal choice. The tet masses are shared among the children
+    /// by [`Self::subdivide_tet_with_mass`]'s rule. Returns the count (at index `level`) and the
+    /// mass totals. O(darts), no hashing.
+    ///
+    /// Preconditions, refused with the map and the masses unchanged: the level-order errors;
+    /// [`SubdivideError::NotUniform`] (a dart off the common level m, or an inserted vertex);
+    /// [`SubdivideError::AlreadyAtLevel`] (m ≥ `level`); [`SubdivideError::OpenEdge`] (an α0-,
+    /// α1- or α2-free dart); [`SubdivideError::NotATetrahedron`] (a volume that is not a tet of
+    /// 24 darts with four distinct corner vertices).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::subdivide::{LeveledMap, TetMasses};
+    /// use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mut m = LeveledMap::new(map, pts);
+    /// let mut masses = TetMasses::from_density(&m, 6.0).unwrap();
+    /// let r = m.refine_uniform(1, &mut masses).unwrap();
+    /// assert_eq!((r.subdivided_per_level, m.map().count_cells().0), (vec![0, 1], vec![10, 25, 24, 8]));
+    /// assert!((r.total_mass_after - 1.0).abs() < 1e-12);
+    /// assert!(m.refine_uniform(1, &mut masses).is_err()); // already at level 1
+    /// assert!(m.check_all().is_ok());
+    /// ```
+    pub fn refine_uniform(&mut self, level: u8, masses: &mut TetMasses) -> Result<Refinement, SubdivideError> {
+        self.uniform_level(level)?;
+        let tpl = templates(3);
+        let lab = self.label_parents(&tpl)?;
+        let parents = lab.template.len();
+        let parent_mass: Vec<f64> = (0..parents)
+            .map(|t| masses.mass.get(self.map.cell_id(3, DartId(lab.darts[t * 24])).index()).copied().unwrap_or(0.0))
+            .collect();
+        let child = self.write_uniform(level, &tpl, &lab);
+        masses.mass.resize(self.map.cell_id_bound(3).max(masses.mass.len()), 0.0);
+        let (mut before, mut after) = (0.0, 0.0);
+        for (t, &m) in parent_mass.iter().enumerate() {
+            let tp = &tpl[lab.template[t] as usize];
+            let volumes = self.child_volumes(tp, &lab.darts[t * 24..(t + 1) * 24]);
+            let total: f64 = volumes.iter().sum();
+            let mut given = 0.0;
+            for (c, &v) in volumes.iter().enumerate() {
+                let share = if c + 1 == volumes.len() {
+                    m - given
+                } else if total > 0.0 {
+                    m * v / total
+                } else {
+                    m / volumes.len() as f64
+                };
+                given += share;
+                masses.mass[child[t * 8 + c] as usize] = share;
+                after += share;
+            }
+            before += m;
+        }
+        self.after_uniform();
+        let mut per_level = vec![0; level as usize + 1];
+        per_level[level as usize] = parents;
+        Ok(Refinement { subdivided_per_level: per_level, total_mass_before: before, total_mass_after: after })
+    }
+
+    /// |volume| of each child of a refined parent, from the corner positions and the midpoints.
+    fn child_volumes(&self, tp: &Template, darts: &[u32]) -> [f64; 8] {
+        let mut pos = [[0.0; 3]; 10];
+        for x in 0..4 {
+            pos[x] = self.vertex_pos(self.map.vertex_id(DartId(darts[tp.corner_parent[x] as usize])).0);
+        }
+        for (k, &(x, y)) in tp.pairs.iter().enumerate() {
+            let (a, b) = (pos[x as usize], pos[y as usize]);
+            pos[4 + k] = [0, 1, 2].map(|i| 0.5 * (a[i] + b[i]));
+        }
+        let mut out = [0.0; 8];
+        for (c, set) in tp.children.iter().enumerate() {
+            let p = set.map(|l| pos[l as usize]);
+            out[c] = crate::mesh::signed_volume(p[0], p[1], p[2], p[3]).abs();
+        }
+        out
+    }
+}
+
+impl LeveledMap<2> {
+    /// Refines every triangle of the finest level 1→4 at level `level` in one bulk pass (module
+    /// docs of `uniform`), with the same result, up to dart and cell numbering, as
+    /// [`Self::subdivide_triangle`] on every face: same levels G_0..G_level, dart levels, μ, link
+    /// history and midpoints. Returns the number of triangles refined. O(darts), no hashing.
+    ///
+    /// Preconditions, refused with the map unchanged: the level-order errors;
+    /// [`SubdivideError::NotUniform`]; [`SubdivideError::AlreadyAtLevel`];
+    /// [`SubdivideError::OpenEdge`] (an α0- or α1-free dart); [`SubdivideError::NotATetrahedron`]
+    /// (here: a face that is not a triangle of 6 darts with three distinct corner vertices).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::subdivide::LeveledMap;
+    /// use topomech::GMap;
+    /// let (map, _) = GMap::<2>::from_triangles(4, &[[0, 1, 2], [1, 3, 2]]).unwrap();
+    /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]];
+    /// let mut m = LeveledMap::new(map, pts);
+    /// assert_eq!(m.refine_uniform(1).unwrap(), 2);
+    /// assert_eq!(m.map().count_cells().0, vec![9, 16, 8]);
+    /// assert_eq!(m.level(0).unwrap().map.count_cells().0, vec![4, 5, 2]);
+    /// assert!(m.check_all().is_ok());
+    /// ```
+    pub fn refine_uniform(&mut self, level: u8) -> Result<usize, SubdivideError> {
+        self.uniform_level(level)?;
+        let tpl = templates(2);
+        let lab = self.label_parents(&tpl)?;
+        self.write_uniform(level, &tpl, &lab);
+        self.after_uniform();
+        Ok(lab.template.len())
+    }
+}
+
+impl<const N: usize> LeveledMap<N> {
+    /// The checks after a bulk refinement: the whole map in debug builds and under
+    /// `expensive-checks` (a failure is a bug of this module).
+    fn after_uniform(&self) {
+        #[cfg(any(debug_assertions, feature = "expensive-checks"))]
+        if let Err(e) = self.map.validate() {
+            panic!("topomech bug: uniform refinement broke the map: {e}");
+        }
+    }
+}

@@ -120,6 +120,36 @@ fn split_set<const N: usize>(m: &LeveledMap<N>) -> Vec<[u64; 9]> {
     out
 }
 
+/// The ids of the edge cells joining vertex ids a and b in `map` (darts whose vertex is a and
+/// whose α0 image's is b), sorted: two when an edge was cut apart but its ends were not. O(darts).
+fn edges_between<const N: usize>(map: &GMap<N>, a: u32, b: u32) -> Vec<u32> {
+    let mut ids: Vec<u32> = map
+        .darts()
+        .filter(|&d| map.vertex_id(d).0 == a && map.vertex_id(map.alpha::<0>(d)).0 == b)
+        .map(|d| map.cell_id(1, d).0)
+        .collect();
+    ids.sort_unstable();
+    ids.dedup();
+    ids
+}
+
+/// The edge split log entries from `start` on, written by one refinement step from `before`:
+/// same vertices as the split log, `edge` = the id the split edge had before the step, `halves`
+/// = the ids of the two new edges at ends[0] and ends[1] after it. O(entries · darts).
+fn assert_edge_splits<const N: usize>(before: &GMap<N>, m: &LeveledMap<N>, start: usize) {
+    let (log, splits) = (m.edge_split_log(), m.split_log());
+    assert_eq!(log.len(), splits.len(), "one edge split per inserted vertex");
+    assert!(log.len() > start, "the step split edges");
+    for (s, &[v, a, b]) in log[start..].iter().zip(&splits[start..]) {
+        assert_eq!((s.vertex, s.ends), (v, [a, b]), "edge split log vs split log");
+        assert!(edges_between(before, a, b).contains(&s.edge), "id of the split edge {a}-{b}");
+        for k in 0..2 {
+            assert_eq!(vec![s.halves[k]], edges_between(m.map(), s.ends[k], v), "half at {}", s.ends[k]);
+        }
+        assert_ne!(s.halves[0], s.halves[1]);
+    }
+}
+
 /// Refines `m` to `levels` both ways (3D) and compares everything, masses included.
 fn compare_tets(m: LeveledMap<3>, levels: u8) {
     let mut bulk = m.clone();
@@ -127,7 +157,9 @@ fn compare_tets(m: LeveledMap<3>, levels: u8) {
     let mut mb = TetMasses::from_density(&bulk, 2.5).unwrap();
     let mut mp = mb.clone();
     for level in 1..=levels {
+        let (before, start) = (bulk.map().clone(), bulk.edge_split_log().len());
         let r = bulk.refine_uniform(level, &mut mb).unwrap();
+        assert_edge_splits(&before, &bulk, start);
         let rel = (r.total_mass_after - r.total_mass_before).abs() / r.total_mass_before.max(1e-300);
         assert!(rel < 1e-12, "mass residual {rel}");
     }
@@ -150,7 +182,9 @@ fn compare_tris(m: LeveledMap<2>, levels: u8) {
     let mut perop = m;
     for level in 1..=levels {
         let faces = perop.map().one_dart_per_cell(2);
+        let (before, start) = (bulk.map().clone(), bulk.edge_split_log().len());
         assert_eq!(bulk.refine_uniform(level).unwrap(), faces.len());
+        assert_edge_splits(&before, &bulk, start);
         for d in faces {
             perop.subdivide_triangle(d, level).unwrap();
         }

@@ -400,6 +400,8 @@ struct Labelled {
     edge_rank: Vec<u32>,
     /// The parent edges by rank, as (vertex id, vertex id).
     edges: Vec<(u32, u32)>,
+    /// The edge cell id of each parent edge, by rank.
+    edge_ids: Vec<u32>,
     /// Rank of each face id (3D).
     face_rank: Vec<u32>,
     faces: u32,
@@ -441,6 +443,7 @@ impl<const N: usize> LeveledMap<N> {
             flag_of: vec![0; cap],
             edge_rank: vec![u32::MAX; self.map.cell_id_bound(1)],
             edges: Vec::new(),
+            edge_ids: Vec::new(),
             face_rank: vec![u32::MAX; if N == 3 { self.map.cell_id_bound(2) } else { 0 }],
             faces: 0,
         };
@@ -494,6 +497,7 @@ impl<const N: usize> LeveledMap<N> {
             if out.edge_rank[e] == u32::MAX {
                 out.edge_rank[e] = out.edges.len() as u32;
                 out.edges.push((vids[x as usize], vids[y as usize]));
+                out.edge_ids.push(e as u32);
             }
         }
         if N == 3 {
@@ -614,7 +618,7 @@ impl<const N: usize> LeveledMap<N> {
             let added = shared[i] + parents as u32 * t0.inner[i];
             self.map.set_id_alloc_raw(i, next[i] + added, free);
         }
-        self.write_midpoints(next[0], lab);
+        self.write_midpoints(&next, lab);
         self.max_level = level;
         child_ids
     }
@@ -683,8 +687,10 @@ impl<const N: usize> LeveledMap<N> {
         }
     }
 
-    /// Positions of the new vertices (edge midpoints) and the split log.
-    fn write_midpoints(&mut self, first: u32, lab: &Labelled) {
+    /// Positions of the new vertices (edge midpoints), the split log and the edge split log (the
+    /// half at the smaller end vertex keeps the parent edge's id, `local_ids`' `Half` rule).
+    fn write_midpoints(&mut self, next: &[u32], lab: &Labelled) {
+        let first = next[0];
         let end = first as usize + lab.edges.len();
         if !self.points.is_empty() && self.points.len() < end {
             self.points.resize(end, [0.0; 3]);
@@ -692,6 +698,9 @@ impl<const N: usize> LeveledMap<N> {
         for (r, &(a, b)) in lab.edges.iter().enumerate() {
             let v = first + r as u32;
             self.splits.push([v, a, b]);
+            let (edge, fresh) = (lab.edge_ids[r], next[1] + r as u32);
+            let halves = if a < b { [edge, fresh] } else { [fresh, edge] };
+            self.edge_splits.push(super::EdgeSplit { vertex: v, ends: [a, b], edge, halves });
             if !self.points.is_empty() {
                 let (pa, pb) = (self.vertex_pos(a), self.vertex_pos(b));
                 self.points[v as usize] = [0, 1, 2].map(|k| 0.5 * (pa[k] + pb[k]));

@@ -367,3 +367,34 @@ impl<const N: usize> GMap<N> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::generate::kuhn_cube;
+    use crate::{AlphaMask, GMap};
+
+    /// `count_orbits_in_one_sweep` (one forest per mask, one to sixteen masks per sweep) counts
+    /// what the orbit sweep behind `count_orbits` counts, mask by mask, on a map with free
+    /// faces, split edges and pinched vertices (every third tet removed) and freed darts.
+    #[test]
+    fn one_sweep_counts_like_one_sweep_per_mask() {
+        let (points, tets) = kuhn_cube(3);
+        let kept: Vec<[u32; 4]> = tets.iter().enumerate().filter(|(t, _)| t % 3 != 1).map(|(_, &t)| t).collect();
+        let (mut map, _) = GMap::<3>::from_tets(points.len(), &kept).unwrap();
+        let sewn: Vec<_> = map.darts().filter(|&d| !map.is_free(3, d)).step_by(7).collect();
+        for d in sewn {
+            if !map.is_free(3, d) {
+                map.unsew::<3>(d).unwrap();
+            }
+        }
+        let masks: Vec<AlphaMask> =
+            (0u8..16).map(|bits| AlphaMask::of(&(0..4).filter(|&i| bits >> i & 1 == 1).collect::<Vec<_>>())).collect();
+        let one_by_one: Vec<usize> = masks.iter().map(|&m| map.count_orbits(m)).collect();
+        assert_eq!(map.count_orbits_in_one_sweep(&masks), one_by_one);
+        for (k, &mask) in masks.iter().enumerate() {
+            assert_eq!(map.count_orbits_in_one_sweep(&[mask]), vec![one_by_one[k]], "mask {k}");
+        }
+        assert_eq!(map.count_cells_by_traversal(), map.count_cells());
+        assert!(one_by_one[0] == map.dart_count() && one_by_one[15] < one_by_one[1]);
+    }
+}

@@ -126,13 +126,16 @@ pub fn run(args: SimulateArgs) -> Result<(), CliError> {
     pool.install(|| simulate(&args, threads > 1))
 }
 
+/// A point renumbering of a mesh: the new mesh and `new_of_old`.
+type Renumbering = fn(&TetMesh) -> (TetMesh, Vec<u32>);
+
 fn simulate(args: &SimulateArgs, parallel: bool) -> Result<(), CliError> {
     let loaded = load::load_tet_map(&args.mesh)?;
     print_warnings(&loaded);
     let material =
         Material { density: args.density, young: args.young, damping: args.damping, viscosity: args.viscosity };
     let (mut mesh, mut pin_ids) = (loaded.mesh, args.pin.clone());
-    let reorders: [(bool, fn(&TetMesh) -> (TetMesh, Vec<u32>)); 2] =
+    let reorders: [(bool, Renumbering); 2] =
         [(args.spatial_order, TetMesh::spatially_ordered), (args.rcm_order, TetMesh::bandwidth_ordered)];
     for (_, reorder) in reorders.into_iter().filter(|(wanted, _)| *wanted) {
         let (ordered, new_of_old) = reorder(&mesh);

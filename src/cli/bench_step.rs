@@ -46,8 +46,8 @@ pub struct OrderBenchArgs {
     /// euler, symplectic, rk4 or implicit.
     #[arg(long, default_value = "rk4")]
     pub integrator: Integrator,
-    /// Rounds (each times one batch of each variant).
-    #[arg(long, default_value_t = 7)]
+    /// Rounds (each times one batch of each variant, the first variant rotating).
+    #[arg(long, default_value_t = 9)]
     pub rounds: usize,
     /// Steps per batch.
     #[arg(long, default_value_t = 3)]
@@ -183,10 +183,20 @@ fn order_report(args: OrderBenchArgs) -> Result<OrderJson, CliError> {
     let two = rayon::ThreadPoolBuilder::new().num_threads(2).build().map_err(other)?;
     let batch = args.batch.max(1);
     let (mut zt, mut rt, mut r2t, mut ratio, mut speedup) = (vec![], vec![], vec![], vec![], vec![]);
-    for _ in 0..args.rounds.max(1) {
-        let z = time_batch(&mut z1, batch)?;
-        let r = time_batch(&mut r1, batch)?;
-        let r_two = two.install(|| time_batch(&mut r2, batch))?;
+    for round in 0..args.rounds.max(1) {
+        // The variants take turns at going first, so that a bias of the position in the round
+        // (a batch run right after another on the same thread absorbs more preemptions on a
+        // loaded host) hits each alike.
+        let mut t = [0.0; 3];
+        for k in 0..3 {
+            let v = (round + k) % 3;
+            t[v] = match v {
+                0 => time_batch(&mut z1, batch)?,
+                1 => time_batch(&mut r1, batch)?,
+                _ => two.install(|| time_batch(&mut r2, batch))?,
+            };
+        }
+        let [z, r, r_two] = t;
         zt.push(z);
         rt.push(r);
         r2t.push(r_two);

@@ -1,5 +1,7 @@
 //! `topomech bench step MESH [--integrator rk4] [--json]`: median time of one step of the
 //! map-driven simulation and of the flat-array baseline, measured in the same run, interleaved.
+//! `topomech bench order MESH [--json]`: the same kind of same-run comparison between two point
+//! orders of the flat model (Z-order vs Z-order + reverse Cuthill–McKee) and 1 vs 2 threads.
 //!
 //! Both models are built from the same mesh with the same material, gravity and pins (the tenth
 //! of the mesh with the smallest x is fixed) and started at rest. Each round times a batch of
@@ -13,6 +15,7 @@ use std::time::Instant;
 
 use topomech::load;
 use topomech::mechanics::{Body, FlatModel, Integrator, Material, PinSpec, Simulation, StepConfig, Stepper};
+use topomech::mesh::TetMesh;
 
 use super::simulate::median;
 use super::{print_warnings, CliError};
@@ -30,6 +33,52 @@ pub struct BenchArgs {
 pub enum BenchWhat {
     /// Step time of the map-driven simulation vs the flat-array baseline.
     Step(StepBenchArgs),
+    /// Step time of the flat model under two point orders (Z-order, then Z-order + reverse
+    /// Cuthill–McKee) and of the second on 2 threads, batches interleaved in one run.
+    Order(OrderBenchArgs),
+}
+
+/// Arguments of `topomech bench order`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct OrderBenchArgs {
+    /// Tetrahedral mesh file.
+    pub mesh: PathBuf,
+    /// euler, symplectic, rk4 or implicit.
+    #[arg(long, default_value = "rk4")]
+    pub integrator: Integrator,
+    /// Rounds (each times one batch of each variant, the first variant rotating).
+    #[arg(long, default_value_t = 9)]
+    pub rounds: usize,
+    /// Steps per batch.
+    #[arg(long, default_value_t = 3)]
+    pub batch: usize,
+    /// Print one JSON object (the keys of [`OrderJson`]).
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The JSON report of `bench order`: exactly these keys, in this order. Times are medians over
+/// rounds of the per-step time of a batch (µs).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct OrderJson {
+    /// Z-order (`--spatial-order`), 1 thread.
+    pub zorder_step_us: f64,
+    /// Z-order then reverse Cuthill–McKee (`--spatial-order --rcm-order`), 1 thread.
+    pub rcm_step_us: f64,
+    /// The same on 2 threads.
+    pub rcm_2_threads_step_us: f64,
+    /// Median over rounds of the per-round ratio rcm / zorder.
+    pub rcm_over_zorder: f64,
+    /// Median over rounds of the per-round ratio 1 thread / 2 threads (the speedup).
+    pub speedup_2_threads: f64,
+    /// rcm_step_us per spring (ns).
+    pub rcm_ns_per_spring: f64,
+    /// Springs (edges).
+    pub springs: usize,
+    /// Points.
+    pub vertices: usize,
+    /// Instruction set of the hot loops.
+    pub kernel: &'static str,
 }
 
 /// Arguments of `topomech bench step`.
@@ -72,13 +121,105 @@ fn other(e: impl std::error::Error + Send + Sync + 'static) -> CliError {
     CliError::Other(Box::new(e))
 }
 
-/// Runs the benchmark and prints the report. Cost: 2 · rounds · batch steps.
+/// Runs the benchmark and prints the report. Cost: 2 · rounds · batch steps (`step`),
+/// 3 · rounds · batch steps (`order`).
 ///
 /// # Errors
 /// [`CliError::Load`] for a bad mesh, [`CliError::Other`] if a model cannot be built or a step
 /// blows up.
 pub fn run(args: BenchArgs) -> Result<(), CliError> {
-    let BenchWhat::Step(args) = args.what;
+    match args.what {
+        BenchWhat::Step(args) => run_step(args),
+        BenchWhat::Order(args) => run_order(args),
+    }
+}
+
+/// A flat model of `mesh` pinned on its low-x tenth, at rest, with its stepper (dt = 0.5/ω_max).
+fn flat_case(mesh: &TetMesh, integrator: Integrator, parallel: bool) -> Result<(FlatModel, Stepper), CliError> {
+    let points = &mesh.points;
+    let (lo, hi) = points.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p[0]), hi.max(p[0])));
+    let pinned: Vec<bool> = points.iter().map(|p| p[0] <= lo + 0.1 * (hi - lo)).collect();
+    let flat =
+        FlatModel::from_tets(points, &mesh.tets, Material::default(), [0.0, 0.0, -9.81], &pinned).map_err(other)?;
+    let config = StepConfig { parallel, ..StepConfig::new(integrator, 0.5 / flat.system.omega_max()) };
+    let stepper = Stepper::new(config, &flat.system, &flat.position, &flat.velocity).map_err(other)?;
+    Ok((flat, stepper))
+}
+
+/// Per-step time (µs) of a batch of `batch` steps of `case`.
+fn time_batch(case: &mut (FlatModel, Stepper), batch: usize) -> Result<f64, CliError> {
+    let (flat, stepper) = case;
+    let start = Instant::now();
+    for _ in 0..batch {
+        stepper.step(&flat.system, &mut flat.position, &mut flat.velocity).map_err(other)?;
+    }
+    Ok(start.elapsed().as_secs_f64() * 1e6 / batch as f64)
+}
+
+fn run_order(args: OrderBenchArgs) -> Result<(), CliError> {
+    let json = args.json;
+    let report = order_report(args)?;
+    let mut out = std::io::stdout().lock();
+    if json {
+        serde_json::to_writer(&mut out, &report)?;
+    } else {
+        write!(out, "{report:#?}")?;
+    }
+    writeln!(out)?;
+    out.flush()?;
+    Ok(())
+}
+
+/// The measurements of `bench order` (see [`OrderJson`]). Cost: 3 · rounds · batch steps plus
+/// three flat builds and two renumberings.
+fn order_report(args: OrderBenchArgs) -> Result<OrderJson, CliError> {
+    let loaded = load::load_tet_map(&args.mesh)?;
+    print_warnings(&loaded);
+    let (zorder, _) = loaded.mesh.spatially_ordered();
+    let (rcm, _) = zorder.bandwidth_ordered();
+    let mut z1 = flat_case(&zorder, args.integrator, false)?;
+    let mut r1 = flat_case(&rcm, args.integrator, false)?;
+    let mut r2 = flat_case(&rcm, args.integrator, true)?;
+    let two = rayon::ThreadPoolBuilder::new().num_threads(2).build().map_err(other)?;
+    let batch = args.batch.max(1);
+    let (mut zt, mut rt, mut r2t, mut ratio, mut speedup) = (vec![], vec![], vec![], vec![], vec![]);
+    for round in 0..args.rounds.max(1) {
+        // The variants take turns at going first, so that a bias of the position in the round
+        // (a batch run right after another on the same thread absorbs more preemptions on a
+        // loaded host) hits each alike.
+        let mut t = [0.0; 3];
+        for k in 0..3 {
+            let v = (round + k) % 3;
+            t[v] = match v {
+                0 => time_batch(&mut z1, batch)?,
+                1 => time_batch(&mut r1, batch)?,
+                _ => two.install(|| time_batch(&mut r2, batch))?,
+            };
+        }
+        let [z, r, r_two] = t;
+        zt.push(z);
+        rt.push(r);
+        r2t.push(r_two);
+        ratio.push(r / z);
+        speedup.push(r / r_two);
+    }
+    let springs = r1.0.system.springs();
+    let rcm_us = median(&mut rt);
+    let report = OrderJson {
+        zorder_step_us: median(&mut zt),
+        rcm_step_us: rcm_us,
+        rcm_2_threads_step_us: median(&mut r2t),
+        rcm_over_zorder: median(&mut ratio),
+        speedup_2_threads: median(&mut speedup),
+        rcm_ns_per_spring: rcm_us * 1e3 / springs.max(1) as f64,
+        springs,
+        vertices: rcm.points.len(),
+        kernel: r1.1.kernel().name(),
+    };
+    Ok(report)
+}
+
+fn run_step(args: StepBenchArgs) -> Result<(), CliError> {
     let loaded = load::load_tet_map(&args.mesh)?;
     print_warnings(&loaded);
     let (points, tets) = (&loaded.mesh.points, &loaded.mesh.tets);
@@ -137,4 +278,23 @@ pub fn run(args: BenchArgs) -> Result<(), CliError> {
     }
     out.flush()?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bench_order_reports_the_liver_and_positive_times() {
+        let mesh = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("data/liver_547_v22.msh");
+        let args = OrderBenchArgs { mesh, integrator: Integrator::Rk4, rounds: 3, batch: 2, json: true };
+        let r = order_report(args).unwrap();
+        assert_eq!((r.springs, r.vertices), (2833, 547)); // renumbering keeps every spring and point
+        let times = [r.zorder_step_us, r.rcm_step_us, r.rcm_2_threads_step_us, r.rcm_over_zorder, r.speedup_2_threads];
+        assert!(times.iter().all(|t| t.is_finite() && *t > 0.0), "{r:?}");
+        assert!((r.rcm_ns_per_spring - r.rcm_step_us * 1e3 / 2833.0).abs() < 1e-9);
+        let missing = PathBuf::from("/nonexistent/mesh.msh");
+        let args = OrderBenchArgs { mesh: missing, integrator: Integrator::Rk4, rounds: 1, batch: 1, json: false };
+        assert!(matches!(order_report(args), Err(CliError::Load(_))));
+    }
 }

@@ -736,13 +736,25 @@ fn spring_pass_body(springs: Springs<'_>, x: &[Vec3], v: &[Vec3], out: &mut [Vec
 /// A padded state record: x, y, z and a zero.
 pub(crate) type Rec4 = [f64; 4];
 
+/// The state of one slot as the spring pass reads it: padded position and velocity in one
+/// 64-byte record aligned to 64 bytes, so a spring end costs one bounds check and one cache line
+/// (two separate arrays cost two of each).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(C, align(64))]
+pub(crate) struct SlotState {
+    /// Position (x, y, z, +0).
+    pub(crate) x: Rec4,
+    /// Velocity (x, y, z, +0).
+    pub(crate) v: Rec4,
+}
+
 multiversion! {
-    /// [`spring_pass`] on padded records.
-    pub(crate) fn spring_pass4(springs: Springs<'_>, x: &[Rec4], v: &[Rec4], out: &mut [Vec3]) = spring_pass4_body;
+    /// [`spring_pass`] on padded slot records.
+    pub(crate) fn spring_pass4(springs: Springs<'_>, y: &[SlotState], out: &mut [Vec3]) = spring_pass4_body;
 }
 
 #[inline(always)]
-fn spring_pass4_body(springs: Springs<'_>, x: &[Rec4], v: &[Rec4], out: &mut [Vec3]) {
+fn spring_pass4_body(springs: Springs<'_>, y: &[SlotState], out: &mut [Vec3]) {
     let mut d = [[0.0f64; 4]; BLOCK];
     let mut dv = [[0.0f64; 4]; BLOCK];
     let mut s = [0.0f64; BLOCK];
@@ -754,7 +766,8 @@ fn spring_pass4_body(springs: Springs<'_>, x: &[Rec4], v: &[Rec4], out: &mut [Ve
         let (dd, ddv) = (&mut d[..n], &mut dv[..n]);
         for j in 0..n {
             let [a, b] = ends[j];
-            let (xa, xb, va, vb) = (x[a as usize], x[b as usize], v[a as usize], v[b as usize]);
+            let (ya, yb) = (&y[a as usize], &y[b as usize]);
+            let (xa, xb, va, vb) = (ya.x, yb.x, ya.v, yb.v);
             dd[j] = [xb[0] - xa[0], xb[1] - xa[1], xb[2] - xa[2], xb[3] - xa[3]];
             ddv[j] = [vb[0] - va[0], vb[1] - va[1], vb[2] - va[2], vb[3] - va[3]];
         }
@@ -777,9 +790,9 @@ fn spring_pass4_body(springs: Springs<'_>, x: &[Rec4], v: &[Rec4], out: &mut [Ve
 }
 
 impl SpringSystem {
-    /// Pass 1 on padded records (the RK4 stepper's layout).
-    pub(crate) fn spring_forces4(&self, kernel: Kernel, x: &[Rec4], v: &[Rec4], sf: &mut [Vec3], parallel: bool) {
-        self.by_spring_chunks(sf, parallel, |springs, out| spring_pass4(kernel, springs, x, v, out));
+    /// Pass 1 on padded slot records (the RK4 stepper's layout).
+    pub(crate) fn spring_forces4(&self, kernel: Kernel, y: &[SlotState], sf: &mut [Vec3], parallel: bool) {
+        self.by_spring_chunks(sf, parallel, |springs, out| spring_pass4(kernel, springs, y, out));
     }
 }
 

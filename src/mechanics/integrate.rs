@@ -21,7 +21,7 @@ use std::str::FromStr;
 
 use rayon::prelude::*;
 
-use super::force::{Rec4, SpringSystem, PARALLEL_CHUNK};
+use super::force::{Rec4, SlotState, SpringSystem, PARALLEL_CHUNK};
 use super::geom::{dot, norm, sub, Vec3};
 use super::simd::{multiversion, Kernel};
 
@@ -229,9 +229,9 @@ pub struct Stepper {
     step: u64,
     energy_scale: f64,
     sf: Vec<Vec3>,
-    /// Stage state (xs, vs) of RK4, padded to 4 lanes (one vector load per spring end).
-    xs: Vec<Rec4>,
-    vs: Vec<Rec4>,
+    /// Stage state (xs, vs) of RK4, padded to 4 lanes, both in one 64-byte record per slot (one
+    /// cache line per spring end).
+    ys: Vec<SlotState>,
     acc: Vec<Vec3>,
     ax: Vec<Vec3>,
     av: Vec<Vec3>,
@@ -286,8 +286,7 @@ impl Stepper {
             step: 0,
             energy_scale: energy_scale(sys, x, v),
             sf: z(s),
-            xs: vec![[0.0; 4]; n],
-            vs: vec![[0.0; 4]; n],
+            ys: vec![SlotState::default(); n],
             acc: z(n),
             ax: z(n),
             av: z(n),
@@ -440,23 +439,16 @@ impl Stepper {
         let (h, par, kernel) = (self.config.dt, self.config.parallel, self.kernel);
         let stages = [Stage::First(0.5 * h), Stage::Middle(0.5 * h), Stage::Middle(h), Stage::Last(h / 6.0)];
         // Stage 1 evaluates at y0: its padded copy.
-        let copy = |((xs, vs), (xi, vi)): ((&mut Rec4, &mut Rec4), (&Vec3, &Vec3))| (*xs, *vs) = (pad(*xi), pad(*vi));
+        let copy = |(y, (xi, vi)): (&mut SlotState, (&Vec3, &Vec3))| *y = SlotState { x: pad(*xi), v: pad(*vi) };
         if par && x.len() > PARALLEL_CHUNK {
-            self.xs.par_iter_mut().zip(self.vs.par_iter_mut()).zip(x.par_iter().zip(v.par_iter())).for_each(copy);
+            self.ys.par_iter_mut().zip(x.par_iter().zip(v.par_iter())).for_each(copy);
         } else {
-            self.xs.iter_mut().zip(self.vs.iter_mut()).zip(x.iter().zip(v.iter())).for_each(copy);
+            self.ys.iter_mut().zip(x.iter().zip(v.iter())).for_each(copy);
         }
         for stage in stages {
-            sys.spring_forces4(kernel, &self.xs, &self.vs, &mut self.sf, par);
+            sys.spring_forces4(kernel, &self.ys, &mut self.sf, par);
             let sf: &[Vec3] = &self.sf;
-            let state = Rk4State {
-                x: &mut *x,
-                v: &mut *v,
-                xs: &mut self.xs,
-                vs: &mut self.vs,
-                ax: &mut self.ax,
-                av: &mut self.av,
-            };
+            let state = Rk4State { x: &mut *x, v: &mut *v, ys: &mut self.ys, ax: &mut self.ax, av: &mut self.av };
             state.run(par, &mut self.partials, |first, chunk| rk4_stage(kernel, sys, sf, stage, first, chunk));
         }
     }
@@ -536,12 +528,11 @@ enum Stage {
     Last(f64),
 }
 
-/// The RK4 state over a range of slots.
+/// The RK4 state over a range of slots (the stage state `ys` as (xs, vs) records).
 struct Rk4State<'a> {
     x: &'a mut [Vec3],
     v: &'a mut [Vec3],
-    xs: &'a mut [Rec4],
-    vs: &'a mut [Rec4],
+    ys: &'a mut [SlotState],
     ax: &'a mut [Vec3],
     av: &'a mut [Vec3],
 }
@@ -551,28 +542,26 @@ impl Rk4State<'_> {
     /// the probes go to `partials` in chunk order.
     fn run(self, par: bool, partials: &mut Vec<Probe>, pass: impl Fn(usize, Rk4State<'_>) -> Probe + Sync + Send) {
         let c = PARALLEL_CHUNK;
-        let Rk4State { x, v, xs, vs, ax, av } = self;
+        let Rk4State { x, v, ys, ax, av } = self;
         if par && x.len() > c {
             let chunks = (
                 x.par_chunks_mut(c),
                 v.par_chunks_mut(c),
-                xs.par_chunks_mut(c),
-                vs.par_chunks_mut(c),
+                ys.par_chunks_mut(c),
                 ax.par_chunks_mut(c),
                 av.par_chunks_mut(c),
             );
             chunks
                 .into_par_iter()
                 .enumerate()
-                .map(|(k, (x, v, xs, vs, ax, av))| pass(k * c, Rk4State { x, v, xs, vs, ax, av }))
+                .map(|(k, (x, v, ys, ax, av))| pass(k * c, Rk4State { x, v, ys, ax, av }))
                 .collect_into_vec(partials);
         } else {
             partials.clear();
-            let chunks =
-                x.chunks_mut(c).zip(v.chunks_mut(c)).zip(xs.chunks_mut(c)).zip(vs.chunks_mut(c)).zip(ax.chunks_mut(c));
-            for (k, ((((x, v), xs), vs), ax)) in chunks.enumerate() {
+            let chunks = x.chunks_mut(c).zip(v.chunks_mut(c)).zip(ys.chunks_mut(c)).zip(ax.chunks_mut(c));
+            for (k, (((x, v), ys), ax)) in chunks.enumerate() {
                 let av = &mut av[k * c..k * c + x.len()];
-                partials.push(pass(k * c, Rk4State { x, v, xs, vs, ax, av }));
+                partials.push(pass(k * c, Rk4State { x, v, ys, ax, av }));
             }
         }
     }
@@ -586,7 +575,7 @@ multiversion! {
 #[inline(always)]
 fn rk4_stage_body(sys: &SpringSystem, sf: &[Vec3], stage: Stage, first: usize, s: Rk4State<'_>) -> Probe {
     let n = s.x.len();
-    let (x, v, xs, vs, ax, av) = (s.x, &mut s.v[..n], &mut s.xs[..n], &mut s.vs[..n], &mut s.ax[..n], &mut s.av[..n]);
+    let (x, v, ys, ax, av) = (s.x, &mut s.v[..n], &mut s.ys[..n], &mut s.ax[..n], &mut s.av[..n]);
     let mut probe = Probe::default();
     match stage {
         Stage::First(c) => {
@@ -595,23 +584,21 @@ fn rk4_stage_body(sys: &SpringSystem, sf: &[Vec3], stage: Stage, first: usize, s
                 let a = sys.acceleration(first + k, vi, sf);
                 ax[k] = vi;
                 av[k] = a;
-                xs[k] = pad(madd(xi, c, vi));
-                vs[k] = pad(madd(vi, c, a));
+                ys[k] = SlotState { x: pad(madd(xi, c, vi)), v: pad(madd(vi, c, a)) };
             }
         }
         Stage::Middle(c) => {
             for k in 0..n {
-                let vi = unpad(vs[k]);
+                let vi = unpad(ys[k].v);
                 let a = sys.acceleration(first + k, vi, sf);
                 ax[k] = madd(ax[k], 2.0, vi);
                 av[k] = madd(av[k], 2.0, a);
-                xs[k] = pad(madd(x[k], c, vi));
-                vs[k] = pad(madd(v[k], c, a));
+                ys[k] = SlotState { x: pad(madd(x[k], c, vi)), v: pad(madd(v[k], c, a)) };
             }
         }
         Stage::Last(c) => {
             for k in 0..n {
-                let vi = unpad(vs[k]);
+                let vi = unpad(ys[k].v);
                 let a = sys.acceleration(first + k, vi, sf);
                 x[k] = madd(x[k], c, add(ax[k], vi));
                 v[k] = madd(v[k], c, add(av[k], a));

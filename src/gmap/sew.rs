@@ -627,7 +627,8 @@ struct QuickLinks {
 /// `endpoint_index_is_the_linear_scan`): a dart that is the endpoint of two pairs (impossible
 /// for a real unsew) keeps its first index, as the scan would.
 struct EndpointIndex {
-    /// Dart + 1 per slot (0: empty).
+    /// Dart + 1 per slot (0: empty; live darts are below `u32::MAX - 1`, `create_dart`'s limit,
+    /// so dart + 1 is never 0).
     keys: [u32; EndpointIndex::SLOTS],
     values: [u8; EndpointIndex::SLOTS],
 }

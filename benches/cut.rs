@@ -159,6 +159,9 @@ fn dissociate_once(f: &mut Fixture, i: usize) -> Duration {
 /// One dissociation of the incision's next face (in its order) + projection update, timed;
 /// undone untimed: the same operation as [`dissociate_once`], on spatially coherent faces.
 fn incision_face_once(f: &mut Fixture, i: usize) -> Duration {
+    if f.incision.is_empty() {
+        return Duration::ZERO;
+    }
     let d = f.incision[i % f.incision.len()];
     dissociate_undone(f, d)
 }
@@ -175,6 +178,9 @@ fn dissociate_undone(f: &mut Fixture, d: DartId) -> Duration {
 /// The next face of the incision, dissociated + projection update, timed; after the last face
 /// the whole incision is undone, untimed.
 fn incise_once(f: &mut Fixture, _: usize) -> Duration {
+    if f.incision.is_empty() {
+        return Duration::ZERO; // the plane separates no inner face of this mesh
+    }
     if f.done.len() == f.incision.len() {
         let done = std::mem::take(&mut f.done);
         undo(f, &done);

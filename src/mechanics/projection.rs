@@ -585,22 +585,25 @@ impl TouchedCells {
 
 /// Per id, the latest record whose dart still carries the id in dimension `dim`, or `None`.
 /// Sorted by id. O(r log r) for r records: the records sorted by (id, latest first), then one
-/// pass per id (no hash map).
+/// pass (no hash map), reading the map only until each id has a valid dart.
 fn resolve(map: &GMap<3>, dim: usize, records: &[(CellId, Option<DartId>)]) -> Vec<(CellId, Option<DartId>)> {
     let mut order: Vec<(u32, u32)> =
         records.iter().enumerate().map(|(k, r)| (r.0 .0, (records.len() - 1 - k) as u32)).collect();
     order.sort_unstable();
     let mut out: Vec<(CellId, Option<DartId>)> = Vec::with_capacity(order.len());
     for (id, rev) in order {
-        let d = records[records.len() - 1 - rev as usize].1;
-        let valid = d.filter(|&d| map.contains(d) && map.cell_id(dim, d).0 == id);
+        // Only until an id has its dart: the map is read for no record older than that one.
+        let valid = || {
+            let d = records[records.len() - 1 - rev as usize].1;
+            d.filter(|&d| map.contains(d) && map.cell_id(dim, d).0 == id)
+        };
         match out.last_mut() {
             Some(last) if last.0 .0 == id => {
                 if last.1.is_none() {
-                    last.1 = valid;
+                    last.1 = valid();
                 }
             }
-            _ => out.push((CellId(id), valid)),
+            _ => out.push((CellId(id), valid())),
         }
     }
     out

@@ -1,9 +1,28 @@
 //! Face dissociation including mechanics (split rules) and the incremental projection update, on
 //! liver_547 and on a large mesh (`target/liver_1M.msh` if present, else the Kuhn cube k = 40,
-//! 384 000 tets); and tearing one fan (an interior vertex). Each timed operation is undone untimed
-//! (`Body::sew3` back + projection update), so the body stays the same size however many
-//! iterations criterion asks for. Besides criterion's figures, every single operation is timed
-//! and the p50 / p90 and the large / small p50 ratio are printed (the O(local) claim: ≤ 1.3).
+//! 384 000 tets); and tearing one fan (an interior vertex). Besides criterion's figures, every
+//! single operation is timed and the p50 / p90 and the large / small p50 ratio are printed (the
+//! O(local) claim: ≤ 1.3).
+//!
+//! Two orders of faces:
+//! - `random faces, cold cache`: 4096 inner faces drawn uniformly over the whole map, each
+//!   dissociation undone untimed (`Body::sew3` back + projection update) before the next. On a
+//!   1 GB map every operation starts from DRAM misses: this measures the memory system as much as
+//!   the algorithm.
+//! - `incision order`: the inner faces that the plane through the centre of the bounding box
+//!   (normal (1, 0.3, 0.2)) separates, in the order `cut::incise_plane` visits them (dart order),
+//!   dissociated one after the other as the incision does — later faces split the vertices and
+//!   edges the earlier ones left hanging — and the whole incision undone untimed when the list is
+//!   exhausted. This is what a user's cut costs per face; it includes the vertex and edge
+//!   splits that a whole cut makes (more of them, per face, on a small mesh).
+//! - `incision faces, undone`: the same faces in the same order, each undone before the next, as
+//!   for the random faces: the same operation as the first, with the locality of a real cut.
+//!
+//! The meshes are renumbered along a Z-order curve (`TetMesh::spatially_ordered`) before the map
+//! is built, as a user loading a large mesh would (it also builds 2x faster); the bench prints
+//! how spatially coherent the tet order is (mean distance between consecutive tets' centroids over
+//! the mean edge length) in file order and in Z-order. `TOPOMECH_CUT_ORDER=file` builds in file
+//! order instead (for A/B runs against older bench binaries, which built in file order).
 //!
 //! `cargo bench --bench cut` (release, without `expensive-checks`). `TOPOMECH_CUT_LARGE=kuhn`
 //! forces the Kuhn cube.
@@ -26,10 +45,66 @@ struct Fixture {
     projection: Projection,
     faces: Vec<DartId>,
     vertices: Vec<DartId>,
+    /// The faces of the mid-plane incision, in the order `incise_plane` visits them.
+    incision: Vec<DartId>,
+    /// The incision's dissociations done so far (undone when the list is exhausted).
+    done: Vec<cut::Dissociation>,
+}
+
+/// Mean distance between the centroids of consecutive tets, over the mean edge length: ~1 for a
+/// spatially coherent order, large for a scattered one. O(T).
+fn order_coherence(points: &[Vec3], tets: &[[u32; 4]]) -> f64 {
+    let p = |v: u32| points[v as usize];
+    let dist = |a: Vec3, b: Vec3| ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
+    let centroid = |t: &[u32; 4]| {
+        t.iter().fold([0.0; 3], |c, &v| [c[0] + p(v)[0] / 4.0, c[1] + p(v)[1] / 4.0, c[2] + p(v)[2] / 4.0])
+    };
+    let step: f64 = tets.windows(2).map(|w| dist(centroid(&w[0]), centroid(&w[1]))).sum::<f64>();
+    let edge: f64 = tets.iter().map(|t| dist(p(t[0]), p(t[1]))).sum::<f64>();
+    (step / (tets.len() - 1) as f64) / (edge / tets.len() as f64)
+}
+
+/// Builds the fixture from `mesh`, in Z-order unless `TOPOMECH_CUT_ORDER=file`.
+fn fixture_of(name: &str, mesh: &topomech::mesh::TetMesh) -> Fixture {
+    let file_order = order_coherence(&mesh.points, &mesh.tets);
+    if std::env::var("TOPOMECH_CUT_ORDER").as_deref() == Ok("file") {
+        eprintln!("{name}: built in file order (coherence {file_order:.1})");
+        return fixture(name, &mesh.points, &mesh.tets);
+    }
+    let (z, _) = mesh.spatially_ordered();
+    eprintln!(
+        "{name}: built in Z-order; tet order coherence (mean centroid step / mean edge): file {file_order:.1}, \
+         Z-order {:.1}",
+        order_coherence(&z.points, &z.tets)
+    );
+    fixture(name, &z.points, &z.tets)
+}
+
+/// The inner faces that the plane through the bounding box's centre with normal (1, 0.3, 0.2)
+/// separates, in `incise_plane`'s order (its own selection rule, on the fixture's map).
+fn incision_faces(body: &Body, points: &[Vec3]) -> Vec<DartId> {
+    let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
+    for p in points {
+        for c in 0..3 {
+            lo[c] = lo[c].min(p[c]);
+            hi[c] = hi[c].max(p[c]);
+        }
+    }
+    let plane = cut::Plane { point: std::array::from_fn(|c| (lo[c] + hi[c]) / 2.0), normal: [1.0, 0.3, 0.2] };
+    let side = cut::tet_sides(body, &plane);
+    let map = body.map();
+    map.one_dart_per_cell(2)
+        .into_iter()
+        .filter(|&d| {
+            let other = map.alpha::<3>(d);
+            other != d && side[map.cell_id(3, d).index()] != side[map.cell_id(3, other).index()]
+        })
+        .collect()
 }
 
 fn fixture(name: &str, points: &[Vec3], tets: &[[u32; 4]]) -> Fixture {
     let (body, _) = Body::from_tets(points, tets, Material::default()).expect("mesh");
+    let incision = incision_faces(&body, points);
     let projection = Projection::build(&body, G);
     let map = body.map();
     let mut rng = SplitMix64(547);
@@ -44,21 +119,21 @@ fn fixture(name: &str, points: &[Vec3], tets: &[[u32; 4]]) -> Fixture {
         vertices.swap(i, rng.below(i + 1));
     }
     vertices.truncate(256);
-    Fixture { name: name.to_string(), body, projection, faces, vertices }
+    Fixture { name: name.to_string(), body, projection, faces, vertices, incision, done: Vec::new() }
 }
 
 fn small() -> Option<Fixture> {
     let mesh =
         topomech::io::read_mesh(Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes/liver_547.msh")))
             .ok()?;
-    Some(fixture("liver_547", &mesh.points, &mesh.tets))
+    Some(fixture_of("liver_547", &mesh))
 }
 
 fn large() -> Fixture {
     let liver = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/liver_1M.msh");
     if std::env::var("TOPOMECH_CUT_LARGE").as_deref() != Ok("kuhn") && liver.exists() {
         if let Ok(mesh) = topomech::io::read_mesh(&liver) {
-            return fixture("liver_1M", &mesh.points, &mesh.tets);
+            return fixture_of("liver_1M", &mesh);
         }
     }
     let (points, tets) = kuhn_cube(40);
@@ -75,14 +150,47 @@ fn undo(f: &mut Fixture, dissociations: &[cut::Dissociation]) {
     f.projection.update(&f.body, &touched);
 }
 
-/// One dissociation + projection update, timed.
+/// One dissociation of a random face + projection update, timed; undone untimed.
 fn dissociate_once(f: &mut Fixture, i: usize) -> Duration {
     let d = f.faces[i % f.faces.len()];
+    dissociate_undone(f, d)
+}
+
+/// One dissociation of the incision's next face (in its order) + projection update, timed;
+/// undone untimed: the same operation as [`dissociate_once`], on spatially coherent faces.
+fn incision_face_once(f: &mut Fixture, i: usize) -> Duration {
+    if f.incision.is_empty() {
+        return Duration::ZERO;
+    }
+    let d = f.incision[i % f.incision.len()];
+    dissociate_undone(f, d)
+}
+
+fn dissociate_undone(f: &mut Fixture, d: DartId) -> Duration {
     let t = Instant::now();
     let dis = cut::dissociate_face(&mut f.body, d).expect("inner face");
     f.projection.update(&f.body, &dis.touched);
     let dt = t.elapsed();
     undo(f, std::slice::from_ref(&dis));
+    dt
+}
+
+/// The next face of the incision, dissociated + projection update, timed; after the last face
+/// the whole incision is undone, untimed.
+fn incise_once(f: &mut Fixture, _: usize) -> Duration {
+    if f.incision.is_empty() {
+        return Duration::ZERO; // the plane separates no inner face of this mesh
+    }
+    if f.done.len() == f.incision.len() {
+        let done = std::mem::take(&mut f.done);
+        undo(f, &done);
+    }
+    let d = f.incision[f.done.len()];
+    let t = Instant::now();
+    let dis = cut::dissociate_face(&mut f.body, d).expect("inner face");
+    f.projection.update(&f.body, &dis.touched);
+    let dt = t.elapsed();
+    f.done.push(dis);
     dt
 }
 
@@ -99,6 +207,9 @@ fn tear_once(f: &mut Fixture, i: usize) -> Duration {
 }
 
 fn percentile(samples: &mut [Duration], q: f64) -> f64 {
+    if samples.is_empty() {
+        return f64::NAN; // filtered out by criterion's command line
+    }
     samples.sort_unstable();
     samples[((samples.len() - 1) as f64 * q) as usize].as_nanos() as f64 / 1000.0
 }
@@ -137,8 +248,19 @@ fn cut_bench(c: &mut Criterion) {
     let mut large = large();
     eprintln!("large fixture {} built in {:?}", large.name, t.elapsed());
     let mut report = Vec::new();
-    for (group, op) in [("dissociate_face+projection", dissociate_once as Op), ("tear_fan+projection", tear_once as Op)]
-    {
+    eprintln!(
+        "incision: {} faces on {}, {} faces on {}",
+        small.incision.len(),
+        small.name,
+        large.incision.len(),
+        large.name
+    );
+    for (group, op) in [
+        ("dissociate_face+projection_random_cold", dissociate_once as Op),
+        ("dissociate_face+projection_incision_faces_undone", incision_face_once as Op),
+        ("dissociate_face+projection_incision_order", incise_once as Op),
+        ("tear_fan+projection", tear_once as Op),
+    ] {
         let (s50, s90) = measure(c, group, &mut small, op);
         let (l50, l90) = measure(c, group, &mut large, op);
         report.push(format!(

@@ -33,8 +33,6 @@
 //! [`forces_by_coverage`] computes the same forces the paper's first way, by covering the
 //! map's edges and vertices with a dart set: the reference the projection is tested against.
 
-use rustc_hash::FxHashMap;
-
 use crate::gmap::{CellChanges, DartSet};
 use crate::{AlphaMask, CellId, DartId, GMap};
 
@@ -514,12 +512,31 @@ impl TouchedCells {
         }
     }
 
-    /// Every edge of the star of the vertex of `d`. O(vertex orbit).
+    /// Every edge of the star of the vertex of `d`, once each, with the last dart of the vertex
+    /// orbit that lies on it (the record [`Projection::update`] would have picked among one
+    /// record per dart, which is what was pushed before: ~150 records for ~20 edges). Past
+    /// [`TouchedCells::STAR_EDGES`] distinct edges the rest are pushed per dart (duplicates are
+    /// harmless). O(vertex orbit · star edges), no allocation beyond the records.
     fn edges_around(&mut self, map: &GMap<3>, d: DartId) {
+        let start = self.edges.len();
+        let mut ids = [u32::MAX; Self::STAR_EDGES];
+        let mut len = 0;
         for x in map.cell_darts(0, d) {
-            self.edges.push((map.cell_id(1, x), Some(x)));
+            let e = map.cell_id(1, x);
+            match ids[..len].iter().position(|&id| id == e.0) {
+                Some(k) => self.edges[start + k].1 = Some(x),
+                None if len < Self::STAR_EDGES => {
+                    ids[len] = e.0;
+                    len += 1;
+                    self.edges.push((e, Some(x)));
+                }
+                None => self.edges.push((e, Some(x))),
+            }
         }
     }
+
+    /// Distinct edges of a star deduplicated by [`TouchedCells::record`].
+    const STAR_EDGES: usize = 64;
 
     /// Appends the records of `other` (a later operation of the same batch). O(|other|).
     ///
@@ -567,9 +584,36 @@ impl TouchedCells {
 }
 
 /// Per id, the latest record whose dart still carries the id in dimension `dim`, or `None`.
+/// Sorted by id. O(r log r) for r records: the records sorted by (id, latest first), then one
+/// pass (no hash map), reading the map only until each id has a valid dart.
 fn resolve(map: &GMap<3>, dim: usize, records: &[(CellId, Option<DartId>)]) -> Vec<(CellId, Option<DartId>)> {
-    let mut out: FxHashMap<CellId, Option<DartId>> = FxHashMap::default();
-    out.reserve(records.len());
+    let mut order: Vec<(u32, u32)> =
+        records.iter().enumerate().map(|(k, r)| (r.0 .0, (records.len() - 1 - k) as u32)).collect();
+    order.sort_unstable();
+    let mut out: Vec<(CellId, Option<DartId>)> = Vec::with_capacity(order.len());
+    for (id, rev) in order {
+        // Only until an id has its dart: the map is read for no record older than that one.
+        let valid = || {
+            let d = records[records.len() - 1 - rev as usize].1;
+            d.filter(|&d| map.contains(d) && map.cell_id(dim, d).0 == id)
+        };
+        match out.last_mut() {
+            Some(last) if last.0 .0 == id => {
+                if last.1.is_none() {
+                    last.1 = valid();
+                }
+            }
+            _ => out.push((CellId(id), valid())),
+        }
+    }
+    out
+}
+
+/// [`resolve`] as it was written first (a hash map filled from the latest record back): the
+/// reference of the unit test.
+#[cfg(test)]
+fn resolve_by_hash(map: &GMap<3>, dim: usize, records: &[(CellId, Option<DartId>)]) -> Vec<(CellId, Option<DartId>)> {
+    let mut out: rustc_hash::FxHashMap<CellId, Option<DartId>> = Default::default();
     for &(id, d) in records.iter().rev() {
         let slot = out.entry(id).or_insert(None);
         if slot.is_none() {
@@ -654,4 +698,93 @@ pub fn forces_by_coverage(body: &Body, gravity: Vec3) -> Vec<Vec3> {
         }
     }
     f
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cut::ops::{jittered_cube, material};
+    use crate::generate::SplitMix64;
+    use crate::mechanics::Body;
+
+    /// [`TouchedCells::record`] as it was first written: one edge record per dart of each
+    /// renamed vertex's orbit.
+    fn record_per_dart(t: &mut TouchedCells, map: &GMap<3>, changes: &CellChanges) {
+        let star = |t: &mut TouchedCells, d: DartId| {
+            for x in map.cell_darts(0, d) {
+                t.edges.push((map.cell_id(1, x), Some(x)));
+            }
+        };
+        for (kept, new, dk, dn) in changes.splits(0) {
+            t.vertices.push((kept, Some(dk)));
+            t.vertices.push((new, Some(dn)));
+            star(t, dn);
+        }
+        for (kept, new, dk, dn) in changes.splits(1) {
+            t.edges.push((kept, Some(dk)));
+            t.edges.push((new, Some(dn)));
+        }
+        let darts = || changes.pairs.iter().flat_map(|&(a, b)| [a, b]);
+        for (kept, absorbed) in changes.merges(0) {
+            t.vertices.push((absorbed, None));
+            if let Some(d) = darts().find(|&d| map.vertex_id(d) == kept) {
+                t.vertices.push((kept, Some(d)));
+                star(t, d);
+            }
+        }
+        for (kept, absorbed) in changes.merges(1) {
+            t.edges.push((absorbed, None));
+            if let Some(d) = darts().find(|&d| map.cell_id(1, d) == kept) {
+                t.edges.push((kept, Some(d)));
+            }
+        }
+    }
+
+    /// Batches of random α3-unsews and sews back on a jittered Kuhn cube: the deduplicated star
+    /// records resolve exactly as one record per dart (same ids, same darts), the sort-based
+    /// `resolve` equals the hash-map one on both record lists, and the incrementally updated
+    /// projection equals a fresh one. Vertex splits and merges must have happened.
+    #[test]
+    fn deduplicated_records_resolve_as_per_dart_records() {
+        let (points, tets) = jittered_cube(3, 7);
+        let (mut body, _) = Body::from_tets(&points, &tets, material()).unwrap();
+        let mut projection = Projection::build(&body, [0.0, 0.0, -1.0]);
+        let mut rng = SplitMix64(19);
+        let mut cut: Vec<(DartId, DartId)> = Vec::new();
+        let (mut vertex_splits, mut vertex_merges) = (0, 0);
+        for _batch in 0..40 {
+            let (mut fast, mut reference) = (TouchedCells::default(), TouchedCells::default());
+            for _ in 0..1 + rng.below(12) {
+                let changes = if !cut.is_empty() && rng.below(4) == 0 {
+                    let (a, b) = cut.swap_remove(rng.below(cut.len()));
+                    body.sew3(a, b).unwrap()
+                } else {
+                    let d = DartId(rng.below(body.map().capacity()) as u32);
+                    if !body.map().contains(d) || body.map().is_free(3, d) {
+                        continue;
+                    }
+                    let e = body.map().alpha::<3>(d);
+                    let changes = body.unsew3(d).unwrap();
+                    cut.push((d, e));
+                    changes
+                };
+                vertex_splits += changes.splits(0).count();
+                vertex_merges += changes.merges(0).count();
+                fast.record(body.map(), &changes);
+                record_per_dart(&mut reference, body.map(), &changes);
+            }
+            let map = body.map();
+            assert!(fast.edges.len() <= reference.edges.len());
+            for dim in [0, 1] {
+                let pick = |t: &TouchedCells| if dim == 0 { t.vertices.clone() } else { t.edges.clone() };
+                let (f, r) = (pick(&fast), pick(&reference));
+                assert_eq!(resolve(map, dim, &f), resolve(map, dim, &r), "dimension {dim}");
+                assert_eq!(resolve(map, dim, &f), resolve_by_hash(map, dim, &f));
+                assert_eq!(resolve(map, dim, &r), resolve_by_hash(map, dim, &r));
+            }
+            projection.update(&body, &fast);
+            projection.equivalent(&Projection::build(&body, [0.0, 0.0, -1.0])).unwrap();
+        }
+        assert!(vertex_splits > 10 && vertex_merges > 10, "splits {vertex_splits}, merges {vertex_merges}");
+    }
 }

@@ -41,6 +41,21 @@ fn decoding_is_total_and_follows_the_documented_layout() {
     assert_eq!(decode(&[2, 2, 1, 0, 9]).1, vec![Op::Tet { pick: 256, up: false }], "a trailing partial op is dropped");
 }
 
+#[test]
+fn a_ball_on_a_uniform_triangle_grid_takes_the_bulk_path_and_a_mixed_one_falls_back() {
+    // Grid (8 triangles), then a ball op: the bulk path refines all 8 triangles 1→4.
+    let r = run_bytes(&[0, 0x83, 0, 0]).unwrap();
+    assert_eq!((r.applied, r.refused, r.max_level, r.darts), (1, 0, 1, 8 * 4 * 6));
+    // A triangle split first makes the levels mixed: the ball op is refused by the bulk path
+    // (checked unchanged) and becomes one more triangle split (3 + 3 new triangles, not 32 + …).
+    let r = run_bytes(&[0, 0x81, 0, 0, 0x03, 0, 1]).unwrap();
+    assert_eq!((r.applied, r.refused), (2, 0));
+    assert!(r.darts < 8 * 4 * 6, "fell back to a single split: {} darts", r.darts);
+    // Twice in a row: levels 1 then 2, every triangle each time.
+    let r = run_bytes(&[0, 0x83, 0, 0, 0x83, 0, 0]).unwrap();
+    assert_eq!((r.applied, r.max_level, r.darts), (2, 2, 8 * 16 * 6));
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 32, ..ProptestConfig::default() })]
     #[test]

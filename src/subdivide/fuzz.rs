@@ -5,8 +5,10 @@
 //! # Decoding
 //! Byte 0 picks the mesh: a 2×2 triangle grid (2-G-map), the Kuhn cube k = 1 (6 tets) or one
 //! tetrahedron (3-G-maps). Then every 3 bytes make one [`Op`]: byte a picks the kind (a % 4: edge
-//! split, triangle 1→4, tet 1→8, refinement around a ball; the two last are 3D only and become a
-//! triangle split in 2D), bit 7 of a whether the level goes up by one; bytes b, c pick the dart
+//! split, triangle 1→4, tet 1→8, refinement around a ball; in 2D a tet 1→8 becomes a triangle
+//! split and a ball becomes the bulk uniform refinement one level up, `refine_uniform`, or, where
+//! that is refused as `NotUniform` (the map checked unchanged), a triangle split), bit 7 of a
+//! whether the level goes up by one; bytes b, c pick the dart
 //! (any live dart, `(b·256 + c) mod darts`) or, for a ball, its centre and radius. Levels stay
 //! ≤ [`MAX_FUZZ_LEVEL`]; the map stops growing at [`MAX_DARTS`] darts.
 //!
@@ -16,7 +18,7 @@
 //!   that of the input; a refinement around a ball keeps Σ tet mass and leaves every tet meeting
 //!   the ball at the top level;
 //! - refused op: only the documented refusals (`AlreadyAtLevel`, `NotATriangle`,
-//!   `NotATetrahedron`, `FaceRefinedTooFar`, `OpenEdge`), and the map is unchanged (same darts,
+//!   `NotATetrahedron`, `FaceRefinedTooFar`, `OpenEdge`, `NotUniform`), and the map is unchanged (same darts,
 //!   isomorphic, same maximum level).
 //! - 3D: every op goes through a [`LeveledMechanics`] (springs and masses follow the map); after an
 //!   accepted op its laws hold ([`LeveledMechanics::check`]), after a refused one it is unchanged.
@@ -237,8 +239,16 @@ fn apply_2d(m: &mut LeveledMap<2>, op: Op) -> Applied {
             m.subdivide_triangle(pick_dart(m, pick), level_of(m, up)).map(drop)
         }
         Op::Around { center, radius } => {
-            let pick = u16::from_be_bytes(center) ^ u16::from(radius);
-            m.subdivide_triangle(pick_dart(m, pick), level_of(m, true)).map(drop)
+            let level = level_of(m, true);
+            let before = m.clone();
+            match m.refine_uniform(level) {
+                Err(e @ SubdivideError::NotUniform { .. }) => {
+                    check_refused(&before, m, &e).map_err(|msg| format!("bulk refusal ({e}): {msg}"))?;
+                    let pick = u16::from_be_bytes(center) ^ u16::from(radius);
+                    m.subdivide_triangle(pick_dart(m, pick), level).map(drop)
+                }
+                r => r.map(drop),
+            }
         }
     })
 }
@@ -367,6 +377,7 @@ pub fn check_refused<const N: usize>(
             | SubdivideError::NotATetrahedron { .. }
             | SubdivideError::FaceRefinedTooFar { .. }
             | SubdivideError::OpenEdge(_)
+            | SubdivideError::NotUniform { .. }
     );
     if !documented {
         return Err("not a documented refusal for a live dart at a valid level".into());

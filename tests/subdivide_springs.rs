@@ -573,3 +573,59 @@ fn a_ring_opened_twice_gives_doubled_edges_that_survive_refinement() {
     let doubled = run_cut(&[(0, 0, 3)], &[], &[1, 0x82, 0, 0, 3, 128, 128]).unwrap();
     assert!(doubled >= 1, "{doubled}");
 }
+
+/// The springs of `mech` as (end positions sorted, as bits; rest, stiffness, damping), sorted.
+fn springs_by_position(mech: &LeveledMechanics, m: &LeveledMap<3>) -> Vec<([[u64; 3]; 2], [f64; 3])> {
+    let bits = |v: u32| m.points()[v as usize].map(f64::to_bits);
+    let mut out: Vec<_> = mech
+        .springs()
+        .map(|(e, s)| {
+            let (mut x, mut y) = (bits(e.a), bits(e.b));
+            if y < x {
+                std::mem::swap(&mut x, &mut y);
+            }
+            ([x, y], [s.rest, s.stiffness, s.damping])
+        })
+        .collect();
+    out.sort_by_key(|a| a.0);
+    out
+}
+
+#[test]
+fn a_ball_holding_everything_takes_the_bulk_path_with_the_per_tet_springs() {
+    // Kuhn cube k = 2 on [0, 2]³, jittered inner vertex: a ball of radius 1.5 at the centre meets
+    // every tet (each is within 0.82 of it) but misses the corners, so it runs tet by tet (1.7 at
+    // level 2: the corner children are within 0.9); a ball of radius 10 holds every vertex, so
+    // the map's bulk path runs.
+    let (mut points, tets) = kuhn_cube(2);
+    for (i, p) in points.iter_mut().enumerate() {
+        if p.iter().all(|&c| c > 0.5 && c < 1.5) {
+            let j = jitter(i as u64);
+            *p = [0, 1, 2].map(|k| p[k] + 0.1 * j[k]);
+        }
+    }
+    let base = leveled(points, &tets);
+    let (mut bulk, mut perop) = (base.clone(), base.clone());
+    let mut mb = LeveledMechanics::new(&bulk, material()).unwrap();
+    let mut mp = mb.clone();
+    let rb = mb.refine_around(&mut bulk, [1.0; 3], 10.0, 2).unwrap();
+    let rp = mp.refine_around(&mut perop, [1.0; 3], 1.5, 1).unwrap();
+    let rp2 = mp.refine_around(&mut perop, [1.0; 3], 1.7, 2).unwrap();
+    assert_eq!(rb.subdivided_per_level, vec![0, tets.len(), 8 * tets.len()]);
+    assert_eq!(rp.subdivided_per_level, vec![0, tets.len()]);
+    assert_eq!(rp2.subdivided_per_level[2], 8 * tets.len());
+    mb.check(&bulk).unwrap();
+    mp.check(&perop).unwrap();
+    assert_eq!(bulk.map().count_cells(), perop.map().count_cells());
+    let (sb, sp) = (springs_by_position(&mb, &bulk), springs_by_position(&mp, &perop));
+    assert_eq!(sb.len(), sp.len());
+    assert_eq!(sb.len(), bulk.map().count_cells().0[1], "one spring per edge cell");
+    for ((kb, vb), (kp, vp)) in sb.iter().zip(&sp) {
+        assert_eq!(kb, kp, "same edges by end positions");
+        for (x, y) in vb.iter().zip(vp) {
+            assert!((x - y).abs() <= 1e-12 * y.abs().max(1e-300), "spring {kb:?}: {vb:?} vs {vp:?}");
+        }
+    }
+    let (tb, tp) = (mb.masses.total(&bulk), mp.masses.total(&perop));
+    assert!((tb - tp).abs() <= 1e-12 * tp, "Σ tet mass {tb} vs {tp}");
+}

@@ -417,7 +417,7 @@ impl LeveledMap<3> {
 
     /// Whether every stored vertex position lies in the closed ball (then every tet meets it).
     /// O(points).
-    fn ball_holds_all(&self, center: [f64; 3], radius: f64) -> bool {
+    pub(super) fn ball_holds_all(&self, center: [f64; 3], radius: f64) -> bool {
         let inside = |p: &[f64; 3]| dot(sub(*p, center), sub(*p, center)).sqrt() <= radius;
         if self.points.is_empty() {
             return inside(&[0.0; 3]);
@@ -426,7 +426,7 @@ impl LeveledMap<3> {
     }
 
     /// Whether every live dart has μt = `lt` (a quick filter before the bulk path). O(darts).
-    fn all_tets_at(&self, lt: u8) -> bool {
+    pub(super) fn all_tets_at(&self, lt: u8) -> bool {
         self.map.darts().all(|d| self.mu[d.index()].tet == lt)
     }
 

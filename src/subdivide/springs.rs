@@ -703,7 +703,8 @@ impl LeveledMechanics {
     }
 
     /// [`LeveledMap::refine_around`] through [`Self::subdivide_tet`]: level by level, every tet with
-    /// μt = L − 1 meeting the ball B(center, radius) is split 1→8 with its springs and masses.
+    /// μt = L − 1 meeting the ball B(center, radius) is split 1→8 with its springs and masses (by the
+    /// bulk path for a level where the ball holds everything, with the same springs up to rounding).
     /// O(Σ_L (volumes + refined · touched)).
     ///
     /// Errors: those of [`Self::subdivide_tet`] (the operations before the error stay done, map and
@@ -735,6 +736,10 @@ impl LeveledMechanics {
         let before = self.masses.total(m);
         let mut per_level = vec![0; levels as usize + 1];
         for level in m.max_level().max(1)..=levels {
+            if let Some(count) = self.refine_level_in_bulk(m, center, radius, level)? {
+                per_level[level as usize] = count;
+                continue;
+            }
             for d in m.zone_tets(level - 1, center, radius)? {
                 self.split_tet(m, d, level)?;
                 per_level[level as usize] += 1;
@@ -743,6 +748,28 @@ impl LeveledMechanics {
         self.expensive_check(m);
         let after = self.masses.total(m);
         Ok(Refinement { subdivided_per_level: per_level, total_mass_before: before, total_mass_after: after })
+    }
+
+    /// One level of [`Self::refine_around`] by the map's bulk path ([`LeveledMap::refine_uniform`])
+    /// when the ball holds every vertex and every tet is at level − 1, then the same rules as per
+    /// tet ([`Self::follow`] with every tet a child: series splits from the edge split log, law 2
+    /// on the new edges). `None` (nothing changed) where the bulk path does not apply or refuses.
+    /// O(darts · log springs).
+    fn refine_level_in_bulk(
+        &mut self,
+        m: &mut LeveledMap<3>,
+        center: [f64; 3],
+        radius: f64,
+        level: u8,
+    ) -> Result<Option<usize>, CouplingError> {
+        if !(m.ball_holds_all(center, radius) && m.all_tets_at(level - 1)) {
+            return Ok(None);
+        }
+        self.in_sync(m)?;
+        let Ok(r) = m.refine_uniform(level, &mut self.masses) else { return Ok(None) };
+        let children = m.map().one_dart_per_cell(3);
+        self.follow(m, &[], &children)?;
+        Ok(Some(r.subdivided_per_level[level as usize]))
     }
 
     /// Applies the rules after an operation of the map: series splits from the new entries of its

@@ -268,6 +268,12 @@ impl<const N: usize> LeveledMap<N> {
     /// (generators in increasing index order), skipping and marking darts in `seen`: when `seen`
     /// holds only darts of other orbits, `out` is the whole orbit. O(orbit · n).
     pub(super) fn walk_orbit(&self, start: DartId, mask: AlphaMask, seen: &mut EpochSet, out: &mut Vec<DartId>) {
+        let mut gens = [0usize; 8];
+        let mut len = 0;
+        for j in (0..=N.min(7)).filter(|&j| mask.contains(j)) {
+            gens[len] = j;
+            len += 1;
+        }
         out.clear();
         out.push(start);
         seen.insert(start.0);
@@ -275,7 +281,7 @@ impl<const N: usize> LeveledMap<N> {
         while head < out.len() {
             let x = out[head];
             head += 1;
-            for j in (0..=N).filter(|&j| mask.contains(j)) {
+            for &j in &gens[..len] {
                 let y = self.map.alpha_dyn(j, x);
                 if seen.insert(y.0) {
                     out.push(y);

@@ -281,10 +281,10 @@ impl<const N: usize> LeveledMap<N> {
         while head < out.len() {
             let x = out[head];
             head += 1;
+            let row = self.map.alpha_row(x.0);
             for &j in &gens[..len] {
-                let y = self.map.alpha_dyn(j, x);
-                if seen.insert(y.0) {
-                    out.push(y);
+                if seen.insert(row[j]) {
+                    out.push(DartId(row[j]));
                 }
             }
         }

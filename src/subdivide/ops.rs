@@ -3,22 +3,85 @@
 
 use super::{LeveledMap, LinkChange, Mu, SubdivideError, MAX_LEVEL};
 use crate::gmap::{AlphaMask, DartId};
-use rustc_hash::{FxHashMap, FxHashSet};
 
-/// What the running operation touched. Empty between operations.
+/// A set of u32 slots (dart slots or cell ids) as epoch stamps: slot i is in the set iff
+/// `marks[i] == tag`. [`EpochSet::clear`] takes a new tag, so emptying is O(1) and a test or an
+/// insert is one load or store, with no hashing. The array grows to the largest slot inserted.
+/// A set must be cleared once before its first use (tag 0 would match every unwritten slot).
+#[derive(Clone, Debug, Default)]
+pub(super) struct EpochSet {
+    marks: Vec<u32>,
+    tag: u32,
+}
+
+impl EpochSet {
+    /// Empties the set. O(1) amortised (O(len) when the 32-bit tags wrap).
+    pub(super) fn clear(&mut self) {
+        if self.tag == u32::MAX {
+            self.marks.fill(0);
+            self.tag = 0;
+        }
+        self.tag += 1;
+    }
+
+    /// Adds slot i; returns whether it was absent. O(1) amortised.
+    #[inline]
+    pub(super) fn insert(&mut self, i: u32) -> bool {
+        debug_assert!(self.tag != 0, "EpochSet used before its first clear");
+        let i = i as usize;
+        if i >= self.marks.len() {
+            self.marks.resize((i + 1).max(2 * self.marks.len()), 0);
+        }
+        let absent = self.marks[i] != self.tag;
+        self.marks[i] = self.tag;
+        absent
+    }
+
+    /// Whether slot i is in the set. O(1).
+    #[inline]
+    pub(super) fn contains(&self, i: u32) -> bool {
+        self.marks.get(i as usize).is_some_and(|&m| m == self.tag)
+    }
+}
+
+/// Reusable scratch of the operations: per-slot sets and buffers kept across operations so that
+/// no operation hashes or allocates per orbit. Holds nothing meaningful between uses.
+#[derive(Clone, Debug, Default)]
+pub(super) struct Scratch {
+    /// Darts touched by the running operation (see `OpLog::touched`).
+    touched: EpochSet,
+    /// Index in `OpLog::touched` of each touched dart slot (valid where `touched` holds it).
+    touched_at: Vec<u32>,
+    /// Darts created by the running operation.
+    created: EpochSet,
+    /// General dart sets for walks (visited orbits).
+    pub(super) seen: EpochSet,
+    pub(super) seen2: EpochSet,
+    /// Cell ids kept by an orbit during one relabelling.
+    claimed: EpochSet,
+    /// Breadth-first queue of the orbit being relabelled.
+    orbit: Vec<DartId>,
+    /// General orbit buffers.
+    pub(super) buf: Vec<DartId>,
+    pub(super) buf2: Vec<DartId>,
+    /// Old ids of the touched darts (one dimension), sorted.
+    pool: Vec<u32>,
+}
+
+/// What the running operation touched. Empty between operations (except the scratch).
 #[derive(Clone, Debug, Default)]
 pub(super) struct OpLog {
     level: u8,
     /// Pre-existing darts whose links changed, in first-touch order.
     touched: Vec<DartId>,
-    /// Index of each touched dart in `touched`.
-    touched_at: FxHashMap<u32, usize>,
     /// (N + 1) cell ids per touched dart, as they were before the operation.
     old_ids: Vec<u32>,
     /// Darts created by the operation.
     created: Vec<DartId>,
     /// Inserted vertices: (a dart at the new vertex, darts at the two end vertices).
     midpoints: Vec<(DartId, DartId, DartId)>,
+    /// Reusable sets and buffers.
+    pub(super) scratch: Scratch,
 }
 
 impl<const N: usize> LeveledMap<N> {
@@ -38,17 +101,23 @@ impl<const N: usize> LeveledMap<N> {
         debug_assert!(self.check_op_level(level).is_ok());
         debug_assert!(self.op.touched.is_empty() && self.op.created.is_empty());
         self.op.level = level;
+        self.op.scratch.touched.clear();
+        self.op.scratch.created.clear();
     }
 
     /// Records that `d` is about to change (its old cell ids and, once per level and αj, the old
     /// link value).
     fn touch(&mut self, j: usize, d: DartId) {
         let level = self.op.level;
-        if self.dart_level[d.index()] == level && self.op.created.contains(&d) {
+        if self.dart_level[d.index()] == level && self.op.scratch.created.contains(d.0) {
             return; // a dart of this operation: nothing to restore below its level
         }
-        if !self.op.touched_at.contains_key(&d.0) {
-            self.op.touched_at.insert(d.0, self.op.touched.len());
+        if self.op.scratch.touched.insert(d.0) {
+            let at = &mut self.op.scratch.touched_at;
+            if at.len() <= d.index() {
+                at.resize((d.index() + 1).max(2 * at.len()), 0);
+            }
+            at[d.index()] = self.op.touched.len() as u32;
             self.op.touched.push(d);
             for dim in 0..=N {
                 self.op.old_ids.push(self.map.cell_id(dim, d).0);
@@ -101,6 +170,7 @@ impl<const N: usize> LeveledMap<N> {
         self.mu[d.index()] = mu;
         self.flat[d.index()] = flat;
         self.op.created.push(d);
+        self.op.scratch.created.insert(d.0);
         d
     }
 
@@ -138,13 +208,17 @@ impl<const N: usize> LeveledMap<N> {
             }
         }
         self.max_level = self.max_level.max(self.op.level);
-        let touched: Vec<DartId> = self.op.touched.iter().chain(&self.op.created).copied().collect();
-        self.op = OpLog::default();
-        debug_assert!(
-            self.map.validate_local(&touched).is_ok(),
-            "subdivide bug: {:?}",
-            self.map.validate_local(&touched)
-        );
+        if cfg!(debug_assertions) {
+            let touched: Vec<DartId> = self.op.touched.iter().chain(&self.op.created).copied().collect();
+            debug_assert!(
+                self.map.validate_local(&touched).is_ok(),
+                "subdivide bug: {:?}",
+                self.map.validate_local(&touched)
+            );
+        }
+        self.op.touched.clear();
+        self.op.old_ids.clear();
+        self.op.created.clear();
         #[cfg(feature = "expensive-checks")]
         if let Err(e) = self.map.validate() {
             panic!("topomech bug: subdivision broke the map: {e}");
@@ -153,44 +227,110 @@ impl<const N: usize> LeveledMap<N> {
 
     /// Re-derives the dim-cell ids of every cell that contains a touched or created dart. An
     /// orbit keeps an id one of its darts had before the operation when it can (untouched darts
-    /// first), otherwise gets a fresh one; old ids no orbit kept are released. O(touched cells).
+    /// first, in breadth-first orbit order, then the old ids of touched darts in the same order),
+    /// otherwise gets a fresh one; old ids no orbit kept are released in increasing order.
+    /// O(touched cells); the visited and claimed sets are epoch stamps ([`EpochSet`]).
     fn relabel_dim(&mut self, dim: usize) {
-        let mask = AlphaMask::cell(N, dim);
-        let starts: Vec<DartId> = self.op.touched.iter().chain(&self.op.created).copied().collect();
-        let mut seen: FxHashSet<u32> = FxHashSet::default();
-        let mut claimed: FxHashSet<u32> = FxHashSet::default();
-        let created: FxHashSet<u32> = self.op.created.iter().map(|d| d.0).collect();
-        for s in starts {
-            if seen.contains(&s.0) {
+        let mut s = std::mem::take(&mut self.op.scratch);
+        s.seen.clear();
+        s.claimed.clear();
+        let nt = self.op.touched.len();
+        for k in 0..nt + self.op.created.len() {
+            let start = if k < nt { self.op.touched[k] } else { self.op.created[k - nt] };
+            if s.seen.contains(start.0) {
                 continue;
             }
-            let orbit = self.map.orbit(s, mask);
-            let mut untouched = Vec::new();
-            let mut old = Vec::new();
-            for &x in &orbit {
-                seen.insert(x.0);
-                match self.op.touched_at.get(&x.0) {
-                    Some(&k) => old.push(self.op.old_ids[k * (N + 1) + dim]),
-                    None if !created.contains(&x.0) => untouched.push(self.map.cell_id(dim, x).0),
-                    None => {}
-                }
-            }
-            let id = match untouched.into_iter().chain(old).find(|id| !claimed.contains(id)) {
-                Some(id) => id,
-                None => self.map.alloc_cell_id(dim),
-            };
-            claimed.insert(id);
-            for x in orbit {
+            self.walk_orbit(start, AlphaMask::cell(N, dim), &mut s.seen, &mut s.orbit);
+            let id = self.kept_id(dim, &s).unwrap_or_else(|| self.map.alloc_cell_id(dim));
+            s.claimed.insert(id);
+            for &x in &s.orbit {
                 self.map.set_cell_raw(dim, x, id);
             }
         }
-        let mut pool: Vec<u32> = (0..self.op.touched.len()).map(|k| self.op.old_ids[k * (N + 1) + dim]).collect();
-        pool.sort_unstable();
-        pool.dedup();
-        for id in pool {
-            if !claimed.contains(&id) {
+        s.pool.clear();
+        s.pool.extend((0..nt).map(|k| self.op.old_ids[k * (N + 1) + dim]));
+        s.pool.sort_unstable();
+        s.pool.dedup();
+        for &id in &s.pool {
+            if !s.claimed.contains(id) {
                 self.map.release_cell_id(dim, id);
             }
         }
+        self.op.scratch = s;
+    }
+
+    /// The reusable scratch sets and buffers (empty of meaning between uses).
+    pub(super) fn scratch(&mut self) -> &mut Scratch {
+        &mut self.op.scratch
+    }
+
+    /// The orbit ⟨mask⟩(start) into `out`, in the breadth-first order of [`crate::GMap::orbit`]
+    /// (generators in increasing index order), skipping and marking darts in `seen`: when `seen`
+    /// holds only darts of other orbits, `out` is the whole orbit. O(orbit · n).
+    pub(super) fn walk_orbit(&self, start: DartId, mask: AlphaMask, seen: &mut EpochSet, out: &mut Vec<DartId>) {
+        let mut gens = [0usize; 8];
+        let mut len = 0;
+        for j in (0..=N.min(7)).filter(|&j| mask.contains(j)) {
+            gens[len] = j;
+            len += 1;
+        }
+        out.clear();
+        out.push(start);
+        seen.insert(start.0);
+        let mut head = 0;
+        while head < out.len() {
+            let x = out[head];
+            head += 1;
+            let row = self.map.alpha_row(x.0);
+            for &j in &gens[..len] {
+                if seen.insert(row[j]) {
+                    out.push(DartId(row[j]));
+                }
+            }
+        }
+    }
+
+    /// The id the orbit in `s.orbit` keeps: the first unclaimed current id of an untouched,
+    /// pre-existing dart, else the first unclaimed old id of a touched dart (orbit order). O(orbit).
+    fn kept_id(&self, dim: usize, s: &Scratch) -> Option<u32> {
+        let untouched = s.orbit.iter().filter(|x| !s.touched.contains(x.0) && !s.created.contains(x.0));
+        let fresh = untouched.map(|&x| self.map.cell_id(dim, x).0).find(|&id| !s.claimed.contains(id));
+        fresh.or_else(|| {
+            let old = s.orbit.iter().filter(|x| s.touched.contains(x.0));
+            old.map(|x| self.op.old_ids[s.touched_at[x.index()] as usize * (N + 1) + dim])
+                .find(|&id| !s.claimed.contains(id))
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::EpochSet;
+
+    #[test]
+    fn epoch_set_clear_empties_and_insert_reports_absence() {
+        let mut s = EpochSet::default();
+        s.clear();
+        assert!(!s.contains(7) && !s.contains(1_000));
+        assert!(s.insert(7));
+        assert!(!s.insert(7), "a second insert finds the slot present");
+        assert!(s.contains(7) && !s.contains(6) && !s.contains(8));
+        assert!(s.insert(100), "the array grows past its length");
+        s.clear();
+        assert!(!s.contains(7) && !s.contains(100), "a new tag empties the set");
+        assert!(s.insert(7));
+    }
+
+    #[test]
+    fn epoch_set_survives_tag_wrap() {
+        let mut s = EpochSet::default();
+        s.clear();
+        s.insert(3);
+        s.tag = u32::MAX; // next clear wraps
+        s.insert(4);
+        s.clear();
+        assert_eq!(s.tag, 1);
+        assert!(!s.contains(3) && !s.contains(4), "marks from before the wrap are stale");
+        assert!(s.insert(3) && s.contains(3));
     }
 }

@@ -14,8 +14,8 @@
 //! the coarser levels keep them).
 
 use super::{LeveledMap, Mu, SubdivideError};
-use crate::gmap::{AlphaMask, DartId};
-use rustc_hash::{FxHashMap, FxHashSet};
+use crate::gmap::{with_stamps, AlphaMask, DartId};
+use rustc_hash::FxHashMap;
 
 /// The six midpoint labels, as the pairs of corners of their edge (label = 4 + index).
 const PAIRS: [(u8, u8); 6] = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
@@ -209,23 +209,27 @@ impl LeveledMap<3> {
         }
     }
 
-    /// The ⟨α0, α1, α2⟩ orbit of `d` in G_lt. O(orbit).
+    /// The ⟨α0, α1, α2⟩ orbit of `d` in G_lt, breadth-first. O(orbit); the visited set is the
+    /// thread's epoch stamps (no hashing).
     fn orbit_at(&self, lt: u8, d: DartId) -> Vec<DartId> {
-        let mut seen: FxHashSet<u32> = FxHashSet::default();
-        let mut out = vec![d];
-        seen.insert(d.0);
-        let mut k = 0;
-        while k < out.len() {
-            let x = out[k];
-            k += 1;
-            for j in 0..3 {
-                let y = self.alpha_at(lt, j, x);
-                if seen.insert(y.0) {
-                    out.push(y);
+        with_stamps(|stamps| {
+            let tag = stamps.fresh(self.map.capacity(), 1);
+            let mut out = vec![d];
+            stamps.mark(d.0, tag);
+            let mut k = 0;
+            while k < out.len() {
+                let x = out[k];
+                k += 1;
+                for j in 0..3 {
+                    let y = self.alpha_at(lt, j, x);
+                    if !stamps.has(y.0, tag) {
+                        stamps.mark(y.0, tag);
+                        out.push(y);
+                    }
                 }
             }
-        }
-        out
+            out
+        })
     }
 
     /// Checks that every face of the volume of `d` is a triangle that is either unsplit (three
@@ -257,20 +261,24 @@ impl LeveledMap<3> {
         Ok(unsplit)
     }
 
-    /// One dart of each face side (⟨α0, α1⟩ orbit) of the volume of `d`. O(volume).
+    /// One dart of each face side (⟨α0, α1⟩ orbit) of the volume of `d`: the first of the side
+    /// in the breadth-first order of the volume. O(volume); the face sides are walked as α0/α1
+    /// cycles and marked in the thread's epoch stamps (no hashing).
     fn volume_faces(&self, d: DartId) -> Vec<DartId> {
-        let mut seen: FxHashSet<u32> = FxHashSet::default();
-        let mut faces = Vec::new();
-        for x in self.map.orbit(d, AlphaMask::of(&[0, 1, 2])) {
-            if seen.contains(&x.0) {
-                continue;
+        // Walked before taking the stamps: a large orbit walk takes them too.
+        let volume = self.map.orbit(d, AlphaMask::of(&[0, 1, 2]));
+        with_stamps(|stamps| {
+            let tag = stamps.fresh(self.map.capacity(), 1);
+            let mut faces = Vec::new();
+            for x in volume {
+                if stamps.has(x.0, tag) {
+                    continue;
+                }
+                self.map.for_each_dihedral(x, 0, 1, |y| stamps.mark(y.0, tag));
+                faces.push(x);
             }
-            for y in self.map.orbit(x, AlphaMask::of(&[0, 1])) {
-                seen.insert(y.0);
-            }
-            faces.push(x);
-        }
-        faces
+            faces
+        })
     }
 
     /// Builds the 8 children once the four faces are split: labels the vertices, creates the 8
@@ -423,26 +431,31 @@ impl LeveledMap<3> {
 
     /// μt = level on the child volume of `c`; μf and μa raised to at least `level` on its faces
     /// and edges (both sides), so μt ≤ μf ≤ μa holds. O(volume · face).
+    /// The raises are idempotent (max), so each face and edge orbit is walked once, with the
+    /// scratch epoch sets as visited sets (no hashing, no allocation per orbit).
     fn set_tet_levels(&mut self, c: DartId, level: u8) {
-        let mut faces_done: FxHashSet<u32> = FxHashSet::default();
-        let mut edges_done: FxHashSet<u32> = FxHashSet::default();
+        let mut s = std::mem::take(self.scratch());
+        let (mut faces, mut edges) = (std::mem::take(&mut s.buf), std::mem::take(&mut s.buf2));
+        s.seen.clear();
+        s.seen2.clear();
         for x in self.map.orbit(c, AlphaMask::of(&[0, 1, 2])) {
             self.mu[x.index()].tet = level;
-            if faces_done.contains(&x.0) {
+            if s.seen.contains(x.0) {
                 continue;
             }
-            for y in self.map.orbit(x, AlphaMask::cell(3, 2)) {
-                faces_done.insert(y.0);
+            self.walk_orbit(x, AlphaMask::cell(3, 2), &mut s.seen, &mut faces);
+            for &y in &faces {
                 self.mu[y.index()].face = self.mu[y.index()].face.max(level);
-                if edges_done.contains(&y.0) {
+                if s.seen2.contains(y.0) {
                     continue;
                 }
-                // Each edge orbit is walked once: its darts in this face side are marked done.
-                for z in self.map.orbit(y, AlphaMask::cell(3, 1)) {
-                    edges_done.insert(z.0);
+                self.walk_orbit(y, AlphaMask::cell(3, 1), &mut s.seen2, &mut edges);
+                for &z in &edges {
                     self.mu[z.index()].edge = self.mu[z.index()].edge.max(level);
                 }
             }
         }
+        (s.buf, s.buf2) = (faces, edges);
+        *self.scratch() = s;
     }
 }

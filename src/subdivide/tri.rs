@@ -258,11 +258,24 @@ impl<const N: usize> LeveledMap<N> {
 
     /// μf = level on the face of `c`, μa = level on its edges (both sides). O(face).
     fn set_child_levels(&mut self, c: DartId, level: u8) {
-        for x in self.map.orbit(c, AlphaMask::cell(N, 2)) {
+        // The assignments are idempotent, so each edge orbit is walked once (scratch epoch sets
+        // as visited sets: no hashing, no allocation per orbit).
+        let mut s = std::mem::take(self.scratch());
+        let (mut face, mut edge) = (std::mem::take(&mut s.buf), std::mem::take(&mut s.buf2));
+        s.seen.clear();
+        s.seen2.clear();
+        self.walk_orbit(c, AlphaMask::cell(N, 2), &mut s.seen, &mut face);
+        for &x in &face {
             self.mu[x.index()].face = level;
-            for y in self.map.orbit(x, AlphaMask::cell(N, 1)) {
+            if s.seen2.contains(x.0) {
+                continue;
+            }
+            self.walk_orbit(x, AlphaMask::cell(N, 1), &mut s.seen2, &mut edge);
+            for &y in &edge {
                 self.mu[y.index()].edge = level;
             }
         }
+        (s.buf, s.buf2) = (face, edge);
+        *self.scratch() = s;
     }
 }

@@ -487,10 +487,15 @@ impl TouchedCells {
     /// assert!(!touched.is_empty() && !touched.vertices.is_empty());
     /// ```
     pub fn record(&mut self, map: &GMap<3>, changes: &CellChanges) {
+        self.record_with(map, changes, |t, d| t.edges_around(map, d));
+    }
+
+    /// [`Self::record`] with `star(self, d)` recording the edges around the renamed vertex of d.
+    fn record_with(&mut self, map: &GMap<3>, changes: &CellChanges, mut star: impl FnMut(&mut Self, DartId)) {
         for (kept, new, dk, dn) in changes.splits(0) {
             self.vertices.push((kept, Some(dk)));
             self.vertices.push((new, Some(dn)));
-            self.edges_around(map, dn);
+            star(self, dn);
         }
         for (kept, new, dk, dn) in changes.splits(1) {
             self.edges.push((kept, Some(dk)));
@@ -501,7 +506,7 @@ impl TouchedCells {
             self.vertices.push((absorbed, None));
             if let Some(d) = darts().find(|&d| map.vertex_id(d) == kept) {
                 self.vertices.push((kept, Some(d)));
-                self.edges_around(map, d);
+                star(self, d);
             }
         }
         for (kept, absorbed) in changes.merges(1) {
@@ -708,36 +713,13 @@ mod tests {
     use crate::mechanics::Body;
 
     /// [`TouchedCells::record`] as it was first written: one edge record per dart of each
-    /// renamed vertex's orbit.
+    /// renamed vertex's orbit (the same walk over the changes, another star).
     fn record_per_dart(t: &mut TouchedCells, map: &GMap<3>, changes: &CellChanges) {
-        let star = |t: &mut TouchedCells, d: DartId| {
+        t.record_with(map, changes, |t, d| {
             for x in map.cell_darts(0, d) {
                 t.edges.push((map.cell_id(1, x), Some(x)));
             }
-        };
-        for (kept, new, dk, dn) in changes.splits(0) {
-            t.vertices.push((kept, Some(dk)));
-            t.vertices.push((new, Some(dn)));
-            star(t, dn);
-        }
-        for (kept, new, dk, dn) in changes.splits(1) {
-            t.edges.push((kept, Some(dk)));
-            t.edges.push((new, Some(dn)));
-        }
-        let darts = || changes.pairs.iter().flat_map(|&(a, b)| [a, b]);
-        for (kept, absorbed) in changes.merges(0) {
-            t.vertices.push((absorbed, None));
-            if let Some(d) = darts().find(|&d| map.vertex_id(d) == kept) {
-                t.vertices.push((kept, Some(d)));
-                star(t, d);
-            }
-        }
-        for (kept, absorbed) in changes.merges(1) {
-            t.edges.push((absorbed, None));
-            if let Some(d) = darts().find(|&d| map.cell_id(1, d) == kept) {
-                t.edges.push((kept, Some(d)));
-            }
-        }
+        });
     }
 
     /// Batches of random α3-unsews and sews back on a jittered Kuhn cube: the deduplicated star

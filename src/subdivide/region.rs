@@ -345,7 +345,7 @@ impl LeveledMap<3> {
         let (mut before, mut after) = (None, None);
         let mut per_level = vec![0; levels as usize + 1];
         for level in self.max_level.max(1)..=levels {
-            if self.ball_holds_all(center, radius) && self.all_tets_at(level - 1) {
+            if self.bulk_applies(center, radius, level) {
                 if let Ok(r) = self.refine_uniform(level, masses) {
                     per_level[level as usize] = r.subdivided_per_level[level as usize];
                     before.get_or_insert(r.total_mass_before);
@@ -415,9 +415,15 @@ impl LeveledMap<3> {
         Ok(zone.len())
     }
 
+    /// Whether a level of `refine_around` may take the bulk path: the ball holds every vertex and
+    /// every tet is at level − 1 (so the zone is the whole mesh). O(points + darts).
+    pub(super) fn bulk_applies(&self, center: [f64; 3], radius: f64, level: u8) -> bool {
+        self.ball_holds_all(center, radius) && self.all_tets_at(level - 1)
+    }
+
     /// Whether every stored vertex position lies in the closed ball (then every tet meets it).
     /// O(points).
-    pub(super) fn ball_holds_all(&self, center: [f64; 3], radius: f64) -> bool {
+    fn ball_holds_all(&self, center: [f64; 3], radius: f64) -> bool {
         let inside = |p: &[f64; 3]| dot(sub(*p, center), sub(*p, center)).sqrt() <= radius;
         if self.points.is_empty() {
             return inside(&[0.0; 3]);
@@ -426,7 +432,7 @@ impl LeveledMap<3> {
     }
 
     /// Whether every live dart has μt = `lt` (a quick filter before the bulk path). O(darts).
-    pub(super) fn all_tets_at(&self, lt: u8) -> bool {
+    fn all_tets_at(&self, lt: u8) -> bool {
         self.map.darts().all(|d| self.mu[d.index()].tet == lt)
     }
 

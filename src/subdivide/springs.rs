@@ -762,7 +762,7 @@ impl LeveledMechanics {
         radius: f64,
         level: u8,
     ) -> Result<Option<usize>, CouplingError> {
-        if !(m.ball_holds_all(center, radius) && m.all_tets_at(level - 1)) {
+        if !m.bulk_applies(center, radius, level) {
             return Ok(None);
         }
         self.in_sync(m)?;

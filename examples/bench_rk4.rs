@@ -1,0 +1,87 @@
+//! The RK4 step of the flat mass/spring model (Z-order + reverse Cuthill–McKee point order, one
+//! thread), timed as the calling thread's CPU time per step over many short batches: prints the
+//! minimum, the 10th percentile and the median per step and per spring. Short batches and the
+//! minimum filter out preemptions on a shared host, so two builds (or two stack placements) can be
+//! compared while other processes run.
+//!
+//!     cargo run --release --example bench_rk4                        # built-in liver_547
+//!     cargo run --release --example bench_rk4 -- MESH [BATCHES] [STEPS_PER_BATCH]
+
+use std::path::Path;
+
+use topomech::load;
+use topomech::mechanics::{FlatModel, Integrator, Material, StepConfig, Stepper};
+
+/// The calling thread's CPU time in seconds, from `CLOCK_THREAD_CPUTIME_ID` (nanosecond
+/// resolution), or `None` where it is missing.
+#[cfg(all(target_os = "linux", target_pointer_width = "64"))]
+fn thread_cpu_seconds() -> Option<f64> {
+    #[repr(C)]
+    struct Timespec {
+        tv_sec: i64,
+        tv_nsec: i64,
+    }
+    extern "C" {
+        fn clock_gettime(clock: i32, ts: *mut Timespec) -> i32;
+    }
+    const CLOCK_THREAD_CPUTIME_ID: i32 = 3;
+    let mut ts = Timespec { tv_sec: 0, tv_nsec: 0 };
+    // SAFETY: `ts` is a valid, writable timespec of the platform's layout (64-bit Linux).
+    let rc = unsafe { clock_gettime(CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+    (rc == 0).then_some(ts.tv_sec as f64 + 1e-9 * ts.tv_nsec as f64)
+}
+
+/// Elsewhere: wall time.
+#[cfg(not(all(target_os = "linux", target_pointer_width = "64")))]
+fn thread_cpu_seconds() -> Option<f64> {
+    None
+}
+
+fn now() -> f64 {
+    thread_cpu_seconds().unwrap_or_else(|| {
+        std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0.0, |d| d.as_secs_f64())
+    })
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let loaded = match args.first() {
+        Some(path) => load::load_tet_map(Path::new(path)),
+        None => load::load_builtin(),
+    }
+    .expect("the mesh loads");
+    let batches: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(300);
+    let steps: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(20);
+    let (zorder, _) = loaded.mesh.spatially_ordered();
+    let (mesh, _) = zorder.bandwidth_ordered();
+    let points = &mesh.points;
+    let (lo, hi) = points.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p[0]), hi.max(p[0])));
+    let pinned: Vec<bool> = points.iter().map(|p| p[0] <= lo + 0.1 * (hi - lo)).collect();
+    let mut flat = Box::new(
+        FlatModel::from_tets(points, &mesh.tets, Material::default(), [0.0, 0.0, -9.81], &pinned)
+            .expect("the model builds"),
+    );
+    let config = StepConfig::new(Integrator::Rk4, 0.5 / flat.system.omega_max());
+    let mut stepper =
+        Box::new(Stepper::new(config, &flat.system, &flat.position, &flat.velocity).expect("the stepper builds"));
+    let mut per_step = Vec::with_capacity(batches);
+    for _ in 0..batches {
+        let t0 = now();
+        for _ in 0..steps {
+            stepper.step(&flat.system, &mut flat.position, &mut flat.velocity).expect("the step is finite");
+        }
+        per_step.push((now() - t0) * 1e6 / steps as f64);
+    }
+    per_step.sort_by(f64::total_cmp);
+    let springs = flat.system.springs() as f64;
+    let (min, p10, med) = (per_step[0], per_step[batches / 10], per_step[batches / 2]);
+    println!(
+        "[rk4] springs {} kernel {}: min {:.2} us/step ({:.2} ns/spring), p10 {:.2}, median {:.2} us/step",
+        springs,
+        stepper.kernel().name(),
+        min,
+        min * 1e3 / springs,
+        p10,
+        med
+    );
+}

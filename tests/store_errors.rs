@@ -291,3 +291,21 @@ fn every_broken_conservation_law_is_listed() {
     assert_eq!(short.findings.len(), 2);
     assert!(short.truncated && !short.valid);
 }
+
+/// A binary header whose declared payload fits but whose 8-byte checksum does not (found by the
+/// `readers` fuzz target: the decoder used to slice past the end): every such length is a
+/// `Truncated` error.
+#[test]
+fn a_checksum_cut_short_is_truncated_not_a_panic() {
+    let full = store::encode(&Document::from_map(&two_tets()), Format::Binary).unwrap();
+    let header = &full[..28]; // magic, version, dimension, flags, payload length
+    for payload in 0u64..4 {
+        for tail in 0..8 {
+            let mut bytes = header[..20].to_vec();
+            bytes.extend_from_slice(&payload.to_le_bytes());
+            bytes.extend(std::iter::repeat_n(0u8, payload as usize + tail)); // payload + a short checksum
+            let err = store::decode(&bytes).expect_err("the checksum is missing bytes");
+            assert!(matches!(err, StoreError::Truncated { .. }), "payload {payload}, {tail} checksum bytes: {err}");
+        }
+    }
+}

@@ -18,6 +18,7 @@ use std::path::{Path, PathBuf};
 use crate::mesh::{MeshError, TetMesh, TriMesh};
 
 mod build;
+pub mod fuzz;
 mod msh1;
 mod msh22;
 mod msh41;

@@ -185,8 +185,9 @@ pub(super) fn decode(bytes: &[u8]) -> Result<Document, StoreError> {
     }
     let len_at = r.pos;
     let len = r.u64("the payload length")?;
-    let available = (bytes.len() - HEADER).saturating_sub(8) as u64;
-    if len > available {
+    // The payload and the 8-byte checksum must both fit after the header.
+    let available = bytes.len().saturating_sub(HEADER) as u64;
+    if len.checked_add(8).is_none_or(|needed| needed > available) {
         return Err(StoreError::Truncated {
             at: Where::Byte(bytes.len()),
             expected: format!("a payload of {len} bytes (header at byte {len_at}) and an 8-byte checksum"),

@@ -76,8 +76,18 @@ fn every_check_passes_and_mass_is_kept_or_accounted_for() {
     assert!((num(&s, "final_mass") + num(&s, "removed_mass") - m0).abs() <= 1e-9 * m0);
     assert_eq!(int(&s, "checks_passed"), int(stage(&s, "refinement"), "checks_passed"));
     assert_eq!(s["mesh"]["vertices"], 547, "the built-in liver");
-    assert_eq!(s["refinement_mechanics"], false, "the simulation does not follow the refinement yet");
+    assert_eq!(s["refinement_mechanics"], true, "the simulation goes on on the refined network");
     let refined = stage(&s, "refinement");
+    // The refined network is projected (one slot per vertex id, one spring per edge cell) and
+    // stepped N/4 times with the scene's pins.
+    let sim = &s["refined_simulation"];
+    assert_eq!(int(sim, "steps"), 40 / 4);
+    assert_eq!(int(sim, "springs"), int(refined, "edges"), "one spring per edge cell of the finest level");
+    assert!(int(sim, "slots") >= int(refined, "vertices"), "a slot per vertex id (dead ids massless)");
+    assert!(int(sim, "pinned") >= int(&s["scene"], "pinned"), "the body's pins are kept");
+    assert!(num(sim, "kinetic_energy").is_finite() && num(sim, "kinetic_energy") >= 0.0, "{sim}");
+    assert!(num(sim, "max_displacement") > 0.0 && num(sim, "max_displacement").is_finite(), "{sim}");
+    assert_eq!(int(sim, "checks"), 3);
     assert!(num(refined, "mass_residual").abs() <= 1e-9, "the children share their parents' masses");
     assert!((num(refined, "total_mass") - num(&s, "final_mass")).abs() <= 1e-9 * m0);
     // Springs follow the refinement, one per edge cell before and after; a 1→8 only adds stiffness.
@@ -169,7 +179,7 @@ fn the_text_report_ends_with_a_table_of_every_stage() {
     }
     assert!(report.contains("checks passed"), "{report}");
     assert!(report.contains("springs carried, one per edge cell"), "{report}");
-    assert!(report.contains("the simulation does not follow subdivision"), "{report}");
+    assert!(report.contains("on the refined network") && report.contains("pins held"), "{report}");
     assert!(dir.join("pictures/scene.pvd").is_file(), "--out is used");
     assert!(!dir.join("out").exists(), "and the default is not");
 }

@@ -24,6 +24,9 @@ use crate::mesh::{TetMesh, TriMesh};
 use crate::store::{self, Format};
 use crate::GMap;
 
+/// One reader under test: books its verdict in the outcome, returns a broken law.
+type Reader = fn(&[u8], &mut Outcome) -> Result<(), String>;
+
 /// The name every rejected input must carry in its message.
 pub const FUZZ_PATH: &str = "fuzz-input";
 
@@ -59,7 +62,7 @@ pub fn run_bytes(data: &[u8]) -> Result<Outcome, String> {
         return Ok(Outcome::default());
     };
     let mut out = Outcome::default();
-    let readers: &[fn(&[u8], &mut Outcome) -> Result<(), String>] = &[msh_tets, msh_triangles, tetgen, obj, store_doc];
+    let readers: &[Reader] = &[msh_tets, msh_triangles, tetgen, obj, store_doc];
     match readers.get(pick as usize) {
         Some(reader) => reader(rest, &mut out)?,
         None => readers.iter().try_for_each(|reader| reader(rest, &mut out))?,
@@ -215,13 +218,16 @@ fn store_doc(bytes: &[u8], out: &mut Outcome) -> Result<(), String> {
     };
     out.accepted += 1;
     for format in [Format::Text, Format::Binary] {
-        let encoded = store::encode(&doc, format).map_err(|e| format!("store: an accepted document fails to encode: {e}"))?;
-        let again = store::decode(&encoded).map_err(|e| format!("store: its own {format:?} encoding is rejected: {e}"))?;
+        let encoded =
+            store::encode(&doc, format).map_err(|e| format!("store: an accepted document fails to encode: {e}"))?;
+        let again =
+            store::decode(&encoded).map_err(|e| format!("store: its own {format:?} encoding is rejected: {e}"))?;
         if again != doc {
             return Err(format!("store: the {format:?} round trip changes the document"));
         }
     }
-    let check = |r: Result<(), crate::InvariantViolation>| r.map_err(|e| format!("store: an accepted map breaks a law: {e}"));
+    let check =
+        |r: Result<(), crate::InvariantViolation>| r.map_err(|e| format!("store: an accepted map breaks a law: {e}"));
     match doc.map.dimension {
         2 => doc.into_map::<2>().map_or(Ok(()), |m| check(m.validate())),
         3 => doc.into_map::<3>().map_or(Ok(()), |m| check(m.validate())),

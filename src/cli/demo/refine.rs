@@ -11,18 +11,21 @@
 //! [`LeveledMechanics::check`] (one spring per edge cell, rest lengths, the series rule along
 //! every split spring, law 2 for the rest, vertex masses) and that the projected spring system has
 //! one spring per edge cell; and the level laws ([`LeveledMap::check_all`]: finest map valid,
-//! μt ≤ μf ≤ μa, every level extracted and valid). The simulation does not run on the refined
-//! network (the stage ends the demo).
+//! μt ≤ μf ≤ μa, every level extracted and valid). Then the simulation goes on on the refined
+//! network ([`simulate_refined`]): the finest level projected as a flat spring system (slots =
+//! vertex ids, one spring per edge cell, vertex masses from the child tets), stepped with the
+//! scene's integrator and pins; checked: Σ slot mass = Σ tet mass, no blow-up, pinned vertices
+//! unmoved.
 
 use std::time::Instant;
 
 use indicatif::ProgressBar;
-use topomech::mechanics::{Body, Vec3};
+use topomech::mechanics::{Body, Integrator, StepConfig, Stepper, Vec3};
 use topomech::subdivide::{EdgeKey, LeveledMap, LeveledMechanics, TetMasses};
 use topomech::surface::Surface;
 use topomech::{AlphaMask, CellId, DartId, GMap};
 
-use super::scene::{centroid, StageRun};
+use super::scene::{centroid, SceneConfig, StageRun};
 use super::DemoError;
 
 /// The level the incision zone is refined to.
@@ -99,6 +102,98 @@ pub fn refine(body: &Body, tets: &[CellId], run: &mut StageRun, bar: &ProgressBa
     }
     let doubled_split = doubled.iter().filter(|&&e| mech.root(e).is_some()).count();
     Ok(Refined { lm, mech, checks: CHECKS, springs_before, doubled_edges: doubled.len(), doubled_split })
+}
+
+/// Checks run by [`simulate_refined`] when it succeeds: mass balance of the projected system,
+/// the steps without blow-up, pinned vertices unmoved.
+pub const SIM_CHECKS: usize = 3;
+
+/// What [`simulate_refined`] measured.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct RefinedSim {
+    /// Steps made on the refined network.
+    pub steps: u64,
+    /// Slots (vertex ids of the finest level) and springs (edge cells) of the projected system.
+    pub slots: usize,
+    /// See `slots`.
+    pub springs: usize,
+    /// Pinned slots (the body's pins, and new vertices whose rest position is in the pinned zone).
+    pub pinned: usize,
+    /// Median wall time of a step in µs.
+    pub step_us_median: f64,
+    /// Largest distance of a vertex from its rest position at the end.
+    pub max_displacement: f64,
+    /// Kinetic energy at the end.
+    pub kinetic_energy: f64,
+    /// Checks passed ([`SIM_CHECKS`]).
+    pub checks: usize,
+}
+
+/// Runs `steps` steps of the scene's integrator (symplectic Euler at `config.dt`, gravity
+/// `config.gravity`) on the finest level of `refined`, in place on its positions and velocities.
+/// Pins: a vertex id the body has keeps the body's pin; a new vertex is pinned when its rest
+/// coordinate along the long axis is ≤ `config.pin_limit` (the scene's rule). O(steps · (slots +
+/// springs)) plus O(darts + E) to project.
+///
+/// # Errors
+/// [`DemoError::Balance`] when Σ slot mass differs from Σ tet mass, [`DemoError::RefinedStep`] on
+/// a blow-up (naming the step), [`DemoError::RefinedPin`] when a pinned vertex moved.
+pub fn simulate_refined(
+    refined: &mut Refined,
+    body: &Body,
+    config: &SceneConfig,
+    steps: u64,
+) -> Result<RefinedSim, DemoError> {
+    let (lm, mech) = (&refined.lm, &mut refined.mech);
+    let pins = body.attrs().pinned.as_slice();
+    let rest = lm.points();
+    let fixed: Vec<bool> = (0..mech.position.len())
+        .map(|v| {
+            pins.get(v).copied().unwrap_or_else(|| rest.get(v).is_some_and(|p| p[config.long_axis] <= config.pin_limit))
+        })
+        .collect();
+    let sys = mech.spring_system(lm, config.gravity, &fixed);
+    let (slot_mass, tet_mass) = (sys.mass.iter().sum::<f64>(), mech.masses.total(lm));
+    let residual = (slot_mass - tet_mass) / tet_mass;
+    if residual.is_nan() || residual.abs() > super::checks::TOLERANCE {
+        return Err(DemoError::Balance { stage: "refinement", step: 0, quantity: "slot mass", residual });
+    }
+    // A pinned vertex does not move: a new one may have inherited a velocity from a free end.
+    for (v, _) in fixed.iter().enumerate().filter(|(_, &f)| f) {
+        mech.velocity[v] = [0.0; 3];
+    }
+    let held: Vec<(usize, Vec3)> = (0..sys.slots()).filter(|&v| fixed[v]).map(|v| (v, mech.position[v])).collect();
+    let step_error = |step| move |source| DemoError::RefinedStep { step, source };
+    let config_step = StepConfig::new(Integrator::Symplectic, config.dt);
+    let mut stepper = Stepper::new(config_step, &sys, &mech.position, &mech.velocity).map_err(step_error(0))?;
+    let mut times = Vec::with_capacity(steps as usize);
+    for step in 1..=steps {
+        let t = Instant::now();
+        stepper.step(&sys, &mut mech.position, &mut mech.velocity).map_err(step_error(step))?;
+        times.push(t.elapsed().as_secs_f64() * 1e6);
+    }
+    if let Some(&(vertex, at)) = held.iter().find(|&&(v, p)| mech.position[v] != p) {
+        return Err(DemoError::RefinedPin { vertex, at, now: mech.position[vertex] });
+    }
+    let max_displacement = (0..sys.slots().min(rest.len()))
+        .filter(|&v| sys.mass[v] > 0.0)
+        .map(|v| dist(mech.position[v], rest[v]))
+        .fold(0.0, f64::max);
+    Ok(RefinedSim {
+        steps,
+        slots: sys.slots(),
+        springs: sys.springs(),
+        pinned: fixed.iter().filter(|&&f| f).count(),
+        step_us_median: crate::cli::simulate::median(&mut times),
+        max_displacement,
+        kinetic_energy: sys.kinetic_energy(&mech.velocity),
+        checks: SIM_CHECKS,
+    })
+}
+
+fn dist(a: Vec3, b: Vec3) -> f64 {
+    let d = sub(a, b);
+    dot(d, d).sqrt()
 }
 
 /// Errors unless every spring of the level-0 coupling has the rest length, stiffness and damping of

@@ -8,7 +8,7 @@ use topomech::gmap::GMap;
 use topomech::mechanics::Vec3;
 
 use super::checks::{total_mass, total_stiffness};
-use super::refine::Refined;
+use super::refine::{Refined, RefinedSim};
 use super::scene::{Scene, StageRun};
 use crate::cli::simulate::median;
 use crate::cli::InfoJson;
@@ -194,11 +194,14 @@ pub struct DemoJson {
     pub final_mass: f64,
     /// Mass removed.
     pub removed_mass: f64,
-    /// Whether the whole mechanics (springs and the simulation) follows the refinement (not yet:
-    /// the tet masses and springs do, see `refinement_springs`, the simulation does not).
+    /// Whether the whole mechanics follows the refinement: the tet masses and springs are carried
+    /// (`refinement_springs`) and the simulation goes on on the refined network
+    /// (`refined_simulation`).
     pub refinement_mechanics: bool,
     /// The springs carried through the refinement.
     pub refinement_springs: SpringsJson,
+    /// The steps made on the refined network after the refinement.
+    pub refined_simulation: RefinedSim,
     /// Output files.
     pub files: FilesJson,
     /// Wall time of the whole run in ms.

@@ -12,34 +12,13 @@
 
 use std::time::Instant;
 
+#[path = "common/cpu_time.rs"]
+mod cpu_time;
+use cpu_time::thread_cpu_seconds;
+
 use topomech::generate::kuhn_cube;
 use topomech::subdivide::{LeveledMap, TetMasses};
 use topomech::GMap;
-
-/// The calling thread's CPU time (user + system) in seconds, from `CLOCK_THREAD_CPUTIME_ID` (the
-/// clock of CGAL's anchor benchmark, nanosecond resolution), or `None` where it is missing.
-#[cfg(all(target_os = "linux", target_pointer_width = "64"))]
-fn thread_cpu_seconds() -> Option<f64> {
-    #[repr(C)]
-    struct Timespec {
-        tv_sec: i64,
-        tv_nsec: i64,
-    }
-    extern "C" {
-        fn clock_gettime(clock: i32, ts: *mut Timespec) -> i32;
-    }
-    const CLOCK_THREAD_CPUTIME_ID: i32 = 3;
-    let mut ts = Timespec { tv_sec: 0, tv_nsec: 0 };
-    // SAFETY: `ts` is a valid, writable timespec of the platform's layout (64-bit Linux).
-    let rc = unsafe { clock_gettime(CLOCK_THREAD_CPUTIME_ID, &mut ts) };
-    (rc == 0).then_some(ts.tv_sec as f64 + 1e-9 * ts.tv_nsec as f64)
-}
-
-/// Elsewhere: no thread CPU clock; the caller falls back to wall time.
-#[cfg(not(all(target_os = "linux", target_pointer_width = "64")))]
-fn thread_cpu_seconds() -> Option<f64> {
-    None
-}
 
 /// Uniform triangle 1→4 of every face of `grid_triangles(n)` at level 1, CPU time per triangle.
 fn bench_2d(n: usize, per_op: bool) {

@@ -37,7 +37,7 @@
 //! - volume split (an unsew inside a tet) has no mechanical meaning: the new volume gets zero mass
 //!   and the conservation check reports it.
 
-use crate::embedding::{CellArray, CellRules, Embedded};
+use crate::embedding::{CellArray, CellRules, Embedded, Split};
 use crate::gmap::CellChanges;
 use crate::{AlphaMask, BuildError, BuildReport, CellId, DartId, GMap};
 
@@ -610,9 +610,40 @@ impl Mechanics {
 
     /// Sets the mass and viscosity of the vertex of `d` from law 1 and law 4.
     fn recompute_vertex(&mut self, map: &GMap<3>, d: DartId) {
-        let v = map.vertex_id(d);
-        self.vertex_mass[v] = self.vertex_mass_from_map(map, d);
-        self.vertex_viscosity[v] = self.material.viscosity * self.vertex_mass[v];
+        let mass = self.vertex_mass_from_map(map, d);
+        self.set_vertex_mass(map.vertex_id(d), mass);
+    }
+
+    /// Sets the mass of vertex `v` and its viscosity from law 4.
+    fn set_vertex_mass(&mut self, v: CellId, mass: f64) {
+        self.vertex_mass[v] = mass;
+        self.vertex_viscosity[v] = self.material.viscosity * mass;
+    }
+
+    /// Law 1 for the vertex whose orbit is exactly `darts` (in any order): Σ m_t/4 over their
+    /// distinct volumes, summed in increasing id order as [`Mechanics::vertex_mass_from_map`]
+    /// does, so the two agree bit for bit. O(|darts| log |darts|), no walk.
+    fn vertex_mass_of_darts(&self, map: &GMap<3>, darts: &[DartId]) -> f64 {
+        // Distinct volumes in a small array (a corner's darts share one, and the kernel's walk
+        // meets them close together); past its size, the general path.
+        let mut volumes = [CellId(u32::MAX); 64];
+        let mut len = 0;
+        for &x in darts {
+            let t = map.cell_id(3, x);
+            if volumes[..len].contains(&t) {
+                continue;
+            }
+            if len == volumes.len() {
+                return distinct(darts.iter().map(|&x| map.cell_id(3, x)))
+                    .iter()
+                    .map(|&t| self.tet_mass[t] / 4.0)
+                    .sum();
+            }
+            volumes[len] = t;
+            len += 1;
+        }
+        volumes[..len].sort_unstable();
+        volumes[..len].iter().map(|&t| self.tet_mass[t] / 4.0).sum()
     }
 
     /// Sets the stiffness and damping of the edge of `d` from laws 2 and 3.
@@ -711,12 +742,19 @@ impl CellRules<3> for Mechanics {
         self.pinned.grow(nv, false);
     }
 
-    fn on_split(&mut self, map: &GMap<3>, dim: usize, kept: CellId, new: CellId, dart_kept: DartId, dart_new: DartId) {
+    fn on_split(&mut self, map: &GMap<3>, split: &Split<'_>) {
+        let Split { dim, kept, new, dart_kept, dart_new, new_side } = *split;
         match dim {
             0 => {
                 self.copy_vertex(kept, new);
                 self.recompute_vertex(map, dart_kept);
-                self.recompute_vertex(map, dart_new);
+                // The new side's darts are known: its volumes without walking it again.
+                let mass = if new_side.is_empty() {
+                    self.vertex_mass_from_map(map, dart_new)
+                } else {
+                    self.vertex_mass_of_darts(map, new_side)
+                };
+                self.set_vertex_mass(new, mass);
             }
             1 => {
                 self.edge_rest_length[new] = self.edge_rest_length[kept];

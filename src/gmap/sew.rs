@@ -233,15 +233,17 @@ impl CellChanges {
     /// # Examples
     ///
     /// ```
+    /// use topomech::gmap::CellChange;
     /// use topomech::GMap;
     ///
     /// let (mut map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
     /// let d = map.darts().find(|&d| !map.is_free(3, d)).unwrap();
     /// let e = map.alpha::<3>(d);
     /// let changes = map.unsew::<3>(d).unwrap();
-    /// for k in 0..changes.changes.len() {
+    /// for (k, change) in changes.changes.iter().enumerate() {
+    ///     let CellChange::Split { dim, dart_new, .. } = *change else { unreachable!() };
     ///     let side = changes.new_side(k); // each empty, or the whole new cell
-    ///     assert!(side.is_empty() || side.len() == 6);
+    ///     assert!(side.is_empty() || side.len() == map.cell_darts(dim, dart_new).len());
     /// }
     /// let merged = map.sew::<3>(d, e).unwrap();
     /// assert!(merged.new_side(0).is_empty());

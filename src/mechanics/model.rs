@@ -1110,4 +1110,36 @@ mod tests {
         }
         assert!(nonzero > 0);
     }
+
+    /// A vertex split's new-side mass read off the kernel's side list equals law 1 from the map,
+    /// bit for bit, and both sides' stored masses are the map's: on a jittered cube cut face by
+    /// face in a scrambled order.
+    #[test]
+    fn new_side_mass_is_the_map_mass() {
+        let (points, tets) = crate::cut::ops::jittered_cube(3, 5);
+        let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+        let map = body.map();
+        let mut faces: Vec<DartId> = map.one_dart_per_cell(2).into_iter().filter(|&d| !map.is_free(3, d)).collect();
+        let mut rng = crate::generate::SplitMix64(23);
+        for k in (1..faces.len()).rev() {
+            faces.swap(k, rng.below(k + 1));
+        }
+        let (mut with_side, mut without) = (0, 0);
+        for d in faces {
+            let changes = body.unsew3(d).unwrap();
+            let (map, mech) = (body.map(), body.attrs());
+            for (k, (kept, new, dart_kept, dart_new)) in changes.splits_with_index(0) {
+                let side = changes.new_side(k);
+                if side.is_empty() {
+                    without += 1;
+                } else {
+                    with_side += 1;
+                    assert_eq!(mech.vertex_mass_of_darts(map, side), mech.vertex_mass_from_map(map, dart_new));
+                }
+                assert_eq!(mech.vertex_mass(new), mech.vertex_mass_from_map(map, dart_new), "new side {new}");
+                assert_eq!(mech.vertex_mass(kept), mech.vertex_mass_from_map(map, dart_kept), "kept side {kept}");
+            }
+        }
+        assert!(with_side > 10, "with a side {with_side}, without {without}");
+    }
 }

@@ -217,10 +217,10 @@ fn walk(map: &GMap<3>, start: DartId, mut visit: impl FnMut(DartId)) -> bool {
     false
 }
 
-/// Unit normal of the face of `d` from current positions (zero if degenerate). O(face).
-fn face_normal(body: &Body, d: DartId) -> Vec3 {
-    let (map, mech) = (body.map(), body.attrs());
-    let Some([a, b, c]) = triangle_vertices(map, d) else { return [0.0; 3] };
+/// Unit normal of the triangle with sorted vertex ids `[a, b, c]` from current positions (zero
+/// if degenerate). O(1).
+fn triangle_normal(body: &Body, [a, b, c]: [CellId; 3]) -> Vec3 {
+    let mech = body.attrs();
     let p = |v: CellId| mech.position[v];
     let n = cross(sub(p(b), p(a)), sub(p(c), p(a)));
     let len = dot(n, n).sqrt();
@@ -228,6 +228,55 @@ fn face_normal(body: &Body, d: DartId) -> Vec3 {
         return [0.0; 3];
     }
     [n[0] / len, n[1] / len, n[2] / len]
+}
+
+/// Unit normal of the face of `d` from current positions (zero if it is not a triangle with
+/// three distinct vertices, or degenerate). O(face).
+fn face_normal(body: &Body, d: DartId) -> Vec3 {
+    triangle_vertices(body.map(), d).map_or([0.0; 3], |t| triangle_normal(body, t))
+}
+
+/// [`face_normal`] for a dart `x` of the vertex being torn, reading the face's vertices off
+/// three darts instead of walking its orbit: when the face ⟨α0, α1⟩(x) closes after six darts
+/// (x, α0 x, α1 α0 x, α0 α1 α0 x = α1 α0 α1 x, α0 α1 x, α1 x) its vertices are those of x,
+/// α0 x and α0 α1 x; if they are distinct, that is [`triangle_vertices`]' sorted triple and the
+/// normal is the same bit for bit. Otherwise falls back to [`face_normal`]. O(1).
+fn face_normal_at(body: &Body, x: DartId) -> Vec3 {
+    let map = body.map();
+    let (a, b) = (map.alpha::<0>(x), map.alpha::<1>(x));
+    let c = map.alpha::<0>(b);
+    let closed = a != x && b != x && c != b && map.alpha::<0>(map.alpha::<1>(a)) == map.alpha::<1>(c);
+    let mut ids = [map.vertex_id(x), map.vertex_id(a), map.vertex_id(c)];
+    ids.sort_unstable();
+    if !closed || ids[0] == ids[1] || ids[1] == ids[2] {
+        return face_normal(body, x);
+    }
+    triangle_normal(body, ids)
+}
+
+/// The dart starting the fan of the vertex of `start`: among its inner darts, the one whose face
+/// normal is closest to ±`direction` (highest |n · direction|), the smallest dart on ties;
+/// `None` if every face at the vertex is on the boundary.
+///
+/// A face's score depends only on its vertices, shared by x, α1(x), α3(x), α1α3(x): only the
+/// smallest of the four is scored, with the O(1) normal of [`face_normal_at`]. The choice is
+/// that of scoring every inner dart (unit test): every dart left out has a smaller one with the
+/// same score that is kept. The vertex orbit is walked once, corner by corner, with no list.
+/// O(vertex orbit).
+fn start_face(body: &Body, start: DartId, direction: Vec3) -> Option<DartId> {
+    let map = body.map();
+    let mut best: Option<(DartId, f64)> = None;
+    map.for_each_corner(start, |_, x| {
+        let (a1, a3) = (map.alpha::<1>(x), map.alpha::<3>(x));
+        if a3 == x || x > a1 || x > a3 || x > map.alpha::<1>(a3) {
+            return;
+        }
+        let score = dot(face_normal_at(body, x), direction).abs();
+        if best.is_none_or(|(d, s)| score.total_cmp(&s).then(d.cmp(&x)).is_gt()) {
+            best = Some((x, score));
+        }
+    });
+    best.map(|(d, _)| d)
 }
 
 /// Tears vertex `v` along `direction`: among the inner faces around v, the one whose normal is
@@ -261,20 +310,7 @@ pub fn tear_vertex(body: &mut Body, v: CellId, direction: Vec3, hint: Option<Dar
     let on_v = |d: DartId| map.contains(d) && map.vertex_id(d) == v;
     let start = hint.filter(|&d| on_v(d)).or_else(|| map.darts().find(|&d| on_v(d)));
     let start = start.ok_or(CutError::NoSuchVertex(v))?;
-    // A face's score depends only on its vertices, shared by d, α1(d), α3(d), α1α3(d): only the
-    // smallest of the four is scored. The choice is unchanged (highest score, then smallest
-    // dart): every dart left out has a smaller one with the same score that is kept.
-    let kept = |d: DartId| {
-        let (a1, a3) = (map.alpha::<1>(d), map.alpha::<3>(d));
-        !map.is_free(3, d) && d <= a1 && d <= a3 && d <= map.alpha::<1>(a3)
-    };
-    let best = map
-        .cell_darts(0, start)
-        .into_iter()
-        .filter(|&d| kept(d))
-        .map(|d| (d, dot(face_normal(body, d), direction).abs()))
-        .max_by(|a, b| a.1.total_cmp(&b.1).then(b.0.cmp(&a.0)))
-        .map(|(d, _)| d);
+    let best = start_face(body, start, direction);
     let mut tear =
         Tear { vertex: v, fan: Vec::new(), dissociations: Vec::new(), split: false, touched: TouchedCells::default() };
     let Some(d0) = best else { return Ok(tear) };

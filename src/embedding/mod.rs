@@ -197,14 +197,14 @@ impl<T> std::ops::IndexMut<CellId> for CellArray<T> {
 ///
 /// ```
 /// use std::convert::Infallible;
-/// use topomech::embedding::{CellRules, Embedded};
-/// use topomech::{CellId, DartId, GMap};
+/// use topomech::embedding::{CellRules, Embedded, Split};
+/// use topomech::{CellId, GMap};
 ///
 /// struct SplitCount(usize); // counts cell splits, keeps no attribute
 /// impl CellRules<3> for SplitCount {
 ///     type Error = Infallible;
 ///     fn grow_to(&mut self, _: &GMap<3>) {}
-///     fn on_split(&mut self, _: &GMap<3>, _: usize, _: CellId, _: CellId, _: DartId, _: DartId) { self.0 += 1 }
+///     fn on_split(&mut self, _: &GMap<3>, _: &Split<'_>) { self.0 += 1 }
 ///     fn on_merge(&mut self, _: &GMap<3>, _: usize, _: CellId, _: CellId) {}
 /// }
 /// let (map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
@@ -221,9 +221,10 @@ pub trait CellRules<const N: usize> {
     /// Called before the rules of an operation run.
     fn grow_to(&mut self, map: &GMap<N>);
 
-    /// The `dim`-cell `kept` (containing `dart_kept`) was split: the darts of the other side,
-    /// `dart_new` among them, now form the cell `new`.
-    fn on_split(&mut self, map: &GMap<N>, dim: usize, kept: CellId, new: CellId, dart_kept: DartId, dart_new: DartId);
+    /// The `split.dim`-cell `split.kept` (containing `split.dart_kept`) was split: the darts of
+    /// the other side, `split.dart_new` among them, now form the cell `split.new`; when the
+    /// kernel reported them, `split.new_side` lists every one of them (no need to walk it).
+    fn on_split(&mut self, map: &GMap<N>, split: &Split<'_>);
 
     /// The `dim`-cell `absorbed` was merged into `kept`, which now holds the darts of both.
     fn on_merge(&mut self, map: &GMap<N>, dim: usize, kept: CellId, absorbed: CellId);
@@ -242,6 +243,52 @@ pub trait CellRules<const N: usize> {
         let _ = map;
         Ok(())
     }
+}
+
+/// One cell split, as handed to [`CellRules::on_split`]: a [`CellChange::Split`] with the darts
+/// of its new side.
+///
+/// # Examples
+///
+/// ```
+/// use std::convert::Infallible;
+/// use topomech::embedding::{CellRules, Embedded, Split};
+/// use topomech::{CellId, GMap};
+///
+/// // Checks that each reported new side is empty (not walked) or the whole new cell.
+/// struct SideCheck(usize);
+/// impl CellRules<3> for SideCheck {
+///     type Error = Infallible;
+///     fn grow_to(&mut self, _: &GMap<3>) {}
+///     fn on_split(&mut self, map: &GMap<3>, s: &Split<'_>) {
+///         assert_eq!(map.cell_id(s.dim, s.dart_new), s.new);
+///         assert!(s.new_side.iter().all(|&x| map.cell_id(s.dim, x) == s.new));
+///         assert!(s.new_side.is_empty() || s.new_side.len() == map.cell_darts(s.dim, s.dart_new).len());
+///         self.0 += 1;
+///     }
+///     fn on_merge(&mut self, _: &GMap<3>, _: usize, _: CellId, _: CellId) {}
+/// }
+/// let (map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+/// let d = map.darts().find(|&d| !map.is_free(3, d)).unwrap();
+/// let mut e = Embedded::new(map, SideCheck(0));
+/// e.unsew(3, d).unwrap();
+/// assert_eq!(e.attrs().0, 7); // 3 vertices, 3 edges and the face
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Split<'a> {
+    /// Dimension of the cell.
+    pub dim: usize,
+    /// The id that stays with one side.
+    pub kept: CellId,
+    /// The fresh id of the other side.
+    pub new: CellId,
+    /// A dart of the side that kept the id.
+    pub dart_kept: DartId,
+    /// A dart of the side with the new id.
+    pub dart_new: DartId,
+    /// Every dart of the new side, in no particular order ([`CellChanges::new_side`]); empty when
+    /// the kernel did not report them (rules must then walk the cell of `dart_new`).
+    pub new_side: &'a [DartId],
 }
 
 /// Errors of the embedding-aware mutators.
@@ -462,10 +509,11 @@ impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
     fn apply(&mut self, changes: &CellChanges) {
         self.version += 1;
         self.attrs.grow_to(&self.map);
-        for change in &changes.changes {
+        for (k, change) in changes.changes.iter().enumerate() {
             match *change {
                 CellChange::Split { dim, kept, new, dart_kept, dart_new } => {
-                    self.attrs.on_split(&self.map, dim, kept, new, dart_kept, dart_new)
+                    let new_side = changes.new_side(k);
+                    self.attrs.on_split(&self.map, &Split { dim, kept, new, dart_kept, dart_new, new_side })
                 }
                 CellChange::Merged { dim, kept, absorbed } => self.attrs.on_merge(&self.map, dim, kept, absorbed),
             }

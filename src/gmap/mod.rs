@@ -34,7 +34,7 @@ pub use cmap::CombinatorialMap;
 pub use dart::{CellId, DartId};
 pub use mark::{DartSet, Mark};
 pub use mask::AlphaMask;
-pub use sew::{CellChange, CellChanges, SewError};
+pub use sew::{CellChange, CellChanges, SewError, SplitSides};
 pub use validate::{InvariantViolation, Law};
 
 pub(crate) use orbit::{find_root, join_with_smaller, with_stamps};

@@ -437,25 +437,79 @@ impl GMap<3> {
     /// joined by α3, one id per corner, no list of darts. O(vertex orbit).
     pub(crate) fn vertex_volumes(&self, d: DartId) -> Vec<CellId> {
         let mut volumes = Vec::with_capacity(32);
-        let mut corners = Vec::with_capacity(32);
-        with_stamps(|stamps| {
-            let tag = stamps.fresh(self.capacity(), 1);
-            self.for_each_dihedral(d, 1, 2, |x| stamps.mark(x.0, tag));
-            corners.push(d);
-            while let Some(c) = corners.pop() {
-                volumes.push(self.cell_id(3, c));
-                self.for_each_dihedral(c, 1, 2, |x| {
-                    let y = self.alpha::<3>(x);
-                    if y != x && !stamps.has(y.0, tag) {
-                        self.for_each_dihedral(y, 1, 2, |z| stamps.mark(z.0, tag));
-                        corners.push(y);
-                    }
-                });
+        self.for_each_corner(d, |c, x| {
+            if x == c {
+                volumes.push(self.cell_id(3, c)); // once per corner: the corner's first dart
             }
         });
         volumes.sort_unstable();
         volumes.dedup();
         volumes
+    }
+
+    /// Calls `visit(c, x)` once on every dart x of the vertex orbit ⟨α1, α2, α3⟩(d), corner by
+    /// corner: the darts of one corner ⟨α1, α2⟩ (inside one volume) come together, c being the
+    /// dart the corner was entered by (d for the first), visited first. Corners are joined by α3
+    /// and marked with this thread's stamps; no list of darts is built. A corner that is a closed
+    /// hexagon (every corner of a tetrahedron) is read by [`GMap::hexagon`] — two chains of three
+    /// dependent loads instead of a cycle of six, its darts kept until visited — others by
+    /// [`GMap::for_each_dihedral`]. `visit` must not walk orbits itself (a nested walk would get
+    /// private stamps: correct, but it allocates). O(vertex orbit).
+    pub(crate) fn for_each_corner(&self, d: DartId, mut visit: impl FnMut(DartId, DartId)) {
+        // A corner waiting to be visited: its six darts, or (entry dart, `None`) for another shape.
+        type Pending = (DartId, Option<[DartId; 6]>);
+        let mut stack: [Pending; 32] = [(d, None); 32];
+        let mut spill: Vec<Pending> = Vec::new();
+        let mut len = 0;
+        with_stamps(|stamps| {
+            let tag = stamps.fresh(self.capacity(), 1);
+            let enter = |c: DartId, stamps: &mut Stamps| -> Pending {
+                let six = self.hexagon(c);
+                match six {
+                    Some(darts) => darts.iter().for_each(|x| stamps.mark(x.0, tag)),
+                    None => self.for_each_dihedral(c, 1, 2, |x| stamps.mark(x.0, tag)),
+                }
+                (c, six)
+            };
+            let first = enter(d, stamps);
+            let mut next = Some(first);
+            while let Some((c, six)) = next {
+                let mut step = |x: DartId| {
+                    visit(c, x);
+                    let y = self.alpha::<3>(x);
+                    if y != x && !stamps.has(y.0, tag) {
+                        let pending = enter(y, stamps);
+                        if len < stack.len() {
+                            stack[len] = pending;
+                            len += 1;
+                        } else {
+                            spill.push(pending);
+                        }
+                    }
+                };
+                match six {
+                    Some(darts) => darts.into_iter().for_each(&mut step),
+                    None => self.for_each_dihedral(c, 1, 2, step),
+                }
+                next = spill.pop().or_else(|| {
+                    len = len.checked_sub(1)?;
+                    Some(stack[len])
+                });
+            }
+        });
+    }
+
+    /// The corner ⟨α1, α2⟩(c) as six distinct darts (c, α1 c, α2 c, α2 α1 c, α1 α2 c,
+    /// α1 α2 α1 c) if it is a closed hexagon, i.e. α1 α2 α1 c = α2 α1 α2 c (every corner of a
+    /// tetrahedron); `None` otherwise. Two independent chains of three loads. O(1).
+    #[inline]
+    pub(crate) fn hexagon(&self, c: DartId) -> Option<[DartId; 6]> {
+        let (a1, a2) = (self.alpha::<1>(c), self.alpha::<2>(c));
+        let (a21, a12) = (self.alpha::<2>(a1), self.alpha::<1>(a2));
+        let (a121, a212) = (self.alpha::<1>(a21), self.alpha::<2>(a12));
+        let darts = [c, a1, a2, a21, a12, a121];
+        let distinct = (0..6).all(|i| (i + 1..6).all(|j| darts[i] != darts[j]));
+        (a121 == a212 && distinct).then_some(darts)
     }
 
     /// The darts w(d) for the 24 words w of [`TetWords`] if they are closed under α0, α1, α2 —
@@ -701,6 +755,57 @@ mod tests {
             want.dedup();
             assert_eq!(map.vertex_volumes(d), want);
         }
+    }
+
+    /// The corner walk visits every dart of the vertex orbit once, corner by corner, each
+    /// corner's entry dart first — on hexagonal corners and, after some α2 unsews, on open ones
+    /// (the general path); `hexagon` answers only for closed hexagons.
+    #[test]
+    fn corner_walk_visits_the_vertex_orbit_once() {
+        let mut map = cut_cube();
+        let some: Vec<DartId> = map.darts().filter(|d| d.0 % 53 == 0).collect();
+        for d in some {
+            if !map.is_free(2, d) {
+                map.unsew::<2>(d).unwrap();
+            }
+        }
+        let (mut open, mut closed) = (0, 0);
+        for d in map.darts().step_by(3) {
+            let mut seen: Vec<(DartId, DartId)> = Vec::new();
+            map.for_each_corner(d, |c, x| seen.push((c, x)));
+            assert_eq!(seen[0], (d, d));
+            let mut got: Vec<DartId> = seen.iter().map(|&(_, x)| x).collect();
+            let mut want = map.cell_darts(0, d);
+            got.sort_unstable();
+            want.sort_unstable();
+            assert_eq!(got, want, "vertex orbit of {d}");
+            let mut groups: Vec<DartId> = Vec::new();
+            for (k, &(c, x)) in seen.iter().enumerate() {
+                let corner = map.orbit(c, AlphaMask::of(&[1, 2]));
+                assert!(corner.contains(&x));
+                if k == 0 || seen[k - 1].0 != c {
+                    assert_eq!(x, c, "a corner starts with its entry dart");
+                    assert!(!groups.contains(&c), "corner of {c} visited twice");
+                    groups.push(c);
+                }
+                match map.hexagon(c) {
+                    Some(six) => {
+                        let mut six = six.to_vec();
+                        let mut corner = corner.clone();
+                        six.sort_unstable();
+                        corner.sort_unstable();
+                        assert_eq!(six, corner);
+                        closed += 1;
+                    }
+                    None => {
+                        let path = corner.iter().any(|&y| map.is_free(1, y) || map.is_free(2, y));
+                        assert!(path || corner.len() != 6, "a closed hexagon at {c} was missed");
+                        open += 1;
+                    }
+                }
+            }
+        }
+        assert!(open > 0 && closed > 0, "open {open}, closed {closed}");
     }
 
     /// Closed tets give their 24 darts; a tet opened inside (α2 unsewn) gives `None`.

@@ -153,15 +153,131 @@ pub enum CellChange {
 /// assert!(changes.pairs.iter().all(|&(a, b)| map.is_free(3, a) && map.is_free(3, b)));
 /// assert_eq!(changes.merges(2).count(), 0); // an unsew only splits
 /// ```
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Default)]
 pub struct CellChanges {
     /// The changes.
     pub changes: Vec<CellChange>,
     /// The pairs of darts linked or unlinked by αi.
     pub pairs: Vec<(DartId, DartId)>,
+    /// For the splits an unsew found by walking, every dart of the new side (the cell that got
+    /// the fresh id): [`CellChanges::new_side`]. Empty for a sew. Not compared by `==`.
+    pub new_sides: SplitSides,
 }
 
+/// The darts of the new side of the splits an unsew found by walking (the lockstep walk of
+/// [`GMap::split_side`] lists the new side, the smaller one, before relabelling it): handed on
+/// so that the rules and the projection records need not walk that cell again. Splits settled
+/// without a walk (cheap proofs, small cells) have no entry. A by-product of how the kernel
+/// found the splits, not part of the outcome: [`CellChanges`]' equality ignores it.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate::kuhn_cube;
+/// use topomech::GMap;
+///
+/// // Cut the cube k = 2 along the plane x = 1: the last face unsewn splits the centre vertex.
+/// let (points, tets) = kuhn_cube(2);
+/// let (mut map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+/// let x = |d| points[map.vertex_id(d).index()][0];
+/// let on_plane: Vec<_> = map.one_dart_per_cell(2).into_iter().filter(|&d| {
+///     !map.is_free(3, d) && map.cell_darts(2, d).iter().all(|&e| x(e) == 1.0)
+/// }).collect();
+/// let mut walked = 0;
+/// for d in on_plane {
+///     let changes = map.unsew::<3>(d).unwrap();
+///     for (k, (_, new, _, dart_new)) in changes.splits_with_index(0) {
+///         let side = changes.new_side(k);
+///         assert!(side.iter().all(|&e| map.vertex_id(e) == new));
+///         assert!(side.is_empty() || side.len() == map.cell_darts(0, dart_new).len());
+///         walked += usize::from(!side.is_empty());
+///     }
+/// }
+/// assert!(walked > 0);
+/// ```
+#[derive(Debug, Clone, Default)]
+pub struct SplitSides {
+    /// (index of the split in `changes`, every dart of its new side).
+    entries: Vec<(u32, Vec<DartId>)>,
+}
+
+impl SplitSides {
+    /// Records `side` as the new side of change k.
+    pub(crate) fn push(&mut self, k: usize, side: Vec<DartId>) {
+        self.entries.push((k as u32, side));
+    }
+
+    /// The darts of change k's new side; empty if none was recorded. O(entries).
+    fn get(&self, k: usize) -> &[DartId] {
+        self.entries.iter().find(|e| e.0 as usize == k).map_or(&[], |e| &e.1)
+    }
+}
+
+/// Two reports are equal when they list the same changes and the same pairs; `new_sides` is not
+/// compared (which splits carry their side depends on the proofs the kernel found, not on the
+/// outcome).
+impl PartialEq for CellChanges {
+    fn eq(&self, other: &Self) -> bool {
+        self.changes == other.changes && self.pairs == other.pairs
+    }
+}
+
+impl Eq for CellChanges {}
+
 impl CellChanges {
+    /// Every dart of the new side of `changes[k]` (the whole cell that got the fresh id, in no
+    /// particular order) when the unsew found that split by walking it ([`SplitSides`]); empty
+    /// otherwise (a split settled without a walk, a merge, an index past the end). O(walked
+    /// splits).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::gmap::CellChange;
+    /// use topomech::GMap;
+    ///
+    /// let (mut map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+    /// let d = map.darts().find(|&d| !map.is_free(3, d)).unwrap();
+    /// let e = map.alpha::<3>(d);
+    /// let changes = map.unsew::<3>(d).unwrap();
+    /// for (k, change) in changes.changes.iter().enumerate() {
+    ///     let CellChange::Split { dim, dart_new, .. } = *change else { unreachable!() };
+    ///     let side = changes.new_side(k); // each empty, or the whole new cell
+    ///     assert!(side.is_empty() || side.len() == map.cell_darts(dim, dart_new).len());
+    /// }
+    /// let merged = map.sew::<3>(d, e).unwrap();
+    /// assert!(merged.new_side(0).is_empty());
+    /// ```
+    pub fn new_side(&self, k: usize) -> &[DartId] {
+        self.new_sides.get(k)
+    }
+
+    /// [`CellChanges::splits`] with the index of each split in `changes` (for
+    /// [`CellChanges::new_side`]).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let (mut map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+    /// let d = map.darts().find(|&d| !map.is_free(3, d)).unwrap();
+    /// let changes = map.unsew::<3>(d).unwrap();
+    /// let edges: Vec<_> = changes.splits_with_index(1).map(|(_, split)| split).collect();
+    /// assert_eq!(edges, changes.splits(1).collect::<Vec<_>>());
+    /// ```
+    pub fn splits_with_index(
+        &self,
+        dim: usize,
+    ) -> impl Iterator<Item = (usize, (CellId, CellId, DartId, DartId))> + '_ {
+        self.changes.iter().enumerate().filter_map(move |(k, c)| match *c {
+            CellChange::Split { dim: d, kept, new, dart_kept, dart_new } if d == dim => {
+                Some((k, (kept, new, dart_kept, dart_new)))
+            }
+            _ => None,
+        })
+    }
+
     /// The splits of `dim`-cells, as (kept, new, dart_kept, dart_new).
     ///
     /// # Examples
@@ -395,7 +511,7 @@ impl<const N: usize> GMap<N> {
             self.link_raw(i, x, y);
         }
         let keep: Vec<u32> = (0..=N).map(|dim| self.cell_id(dim, d1).0).collect();
-        let mut report = CellChanges { changes: Vec::new(), pairs };
+        let mut report = CellChanges { changes: Vec::new(), pairs, new_sides: SplitSides::default() };
         for k in 0..report.pairs.len() {
             let (x, y) = report.pairs[k];
             for dim in (0..=N).filter(|&dim| dim != i) {
@@ -494,13 +610,14 @@ impl<const N: usize> GMap<N> {
             std::hint::black_box((self.cell_row(x.0)[0], self.cell_row(y.0)[0]));
             self.unlink_raw(i, x);
         }
-        let mut report = CellChanges { changes: Vec::new(), pairs };
+        let mut report = CellChanges { changes: Vec::new(), pairs, new_sides: SplitSides::default() };
         let links = if quick { QuickLinks::find(self, i, &report.pairs) } else { QuickLinks::none() };
         // The per-dimension lists of `split_cells`, kept per thread between unsews (no
         // allocation in the steady state; they are cleared before use).
         let mut scratch = SPLIT_SCRATCH.take();
         for dim in (0..=N).filter(|&dim| dim != i) {
-            self.split_cells(dim, &report.pairs, &links, &mut scratch, &mut report.changes);
+            let CellChanges { changes, pairs, new_sides } = &mut report;
+            self.split_cells(dim, pairs, &links, &mut scratch, (changes, new_sides));
         }
         SPLIT_SCRATCH.set(scratch);
         #[cfg(debug_assertions)]
@@ -524,7 +641,7 @@ impl<const N: usize> GMap<N> {
         pairs: &[(DartId, DartId)],
         links: &QuickLinks,
         (anchors, complete): &mut SplitScratch,
-        changes: &mut Vec<CellChange>,
+        (changes, sides): (&mut Vec<CellChange>, &mut SplitSides),
     ) {
         let mask = AlphaMask::cell(N, dim);
         let classes = links.classes(dim);
@@ -559,6 +676,7 @@ impl<const N: usize> GMap<N> {
                     for &w in &side {
                         self.set_cell_raw(dim, w, new);
                     }
+                    sides.push(changes.len(), side);
                     (new, is_z_side)
                 }
             };
@@ -895,6 +1013,7 @@ mod tests {
         let (points, tets) = kuhn_cube(2);
         let (cube, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
         let mut splits = [0usize; 4];
+        let mut sides = 0;
         for i in 0..=3 {
             let (mut fast, mut slow) = (cube.clone(), cube.clone());
             let mut darts: Vec<DartId> = cube.darts().collect();
@@ -908,6 +1027,23 @@ mod tests {
                 }
                 let (a, b) = (fast.unsew_with(i, d, true).unwrap(), slow.unsew_with(i, d, false).unwrap());
                 assert_eq!(a, b, "alpha{i} unsew of {d}");
+                // Each reported new side is exactly the new cell (as a set), on both paths; the
+                // slow path walks every split, so it reports every side.
+                for (map, changes, all) in [(&fast, &a, false), (&slow, &b, true)] {
+                    for dim in 0..=3 {
+                        for (k, (_, new, _, dart_new)) in changes.splits_with_index(dim) {
+                            let mut side = changes.new_side(k).to_vec();
+                            if side.is_empty() && !all {
+                                continue;
+                            }
+                            let mut cell = map.cell_darts(dim, dart_new);
+                            side.sort_unstable();
+                            cell.sort_unstable();
+                            assert_eq!(side, cell, "alpha{i} unsew of {d}: new side of {dim}-cell {new}");
+                            sides += 1;
+                        }
+                    }
+                }
                 for (dim, n) in splits.iter_mut().enumerate() {
                     *n += a.splits(dim).count();
                 }
@@ -917,6 +1053,7 @@ mod tests {
             assert_eq!(fast.count_cells(), fast.count_cells_by_traversal());
         }
         assert!(splits.iter().all(|&n| n > 0), "splits per dimension {splits:?}");
+        assert!(sides > splits.iter().sum::<usize>(), "sides checked {sides}");
     }
 
     /// The hashed endpoint index answers as the linear scan it replaces, for endpoints and for

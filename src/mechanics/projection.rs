@@ -487,15 +487,25 @@ impl TouchedCells {
     /// assert!(!touched.is_empty() && !touched.vertices.is_empty());
     /// ```
     pub fn record(&mut self, map: &GMap<3>, changes: &CellChanges) {
-        self.record_with(map, changes, |t, d| t.edges_around(map, d));
+        self.record_with(map, changes, |t, d, side| match side {
+            Some(side) => t.edges_around(map, side.iter().copied()),
+            None => t.edges_around(map, map.cell_darts(0, d)),
+        });
     }
 
-    /// [`Self::record`] with `star(self, d)` recording the edges around the renamed vertex of d.
-    fn record_with(&mut self, map: &GMap<3>, changes: &CellChanges, mut star: impl FnMut(&mut Self, DartId)) {
-        for (kept, new, dk, dn) in changes.splits(0) {
+    /// [`Self::record`] with `star(self, d, side)` recording the edges around the renamed vertex
+    /// of d, whose darts are `side` when the kernel reported them (a split's new side).
+    fn record_with(
+        &mut self,
+        map: &GMap<3>,
+        changes: &CellChanges,
+        mut star: impl FnMut(&mut Self, DartId, Option<&[DartId]>),
+    ) {
+        for (k, (kept, new, dk, dn)) in changes.splits_with_index(0) {
             self.vertices.push((kept, Some(dk)));
             self.vertices.push((new, Some(dn)));
-            star(self, dn);
+            let side = changes.new_side(k);
+            star(self, dn, (!side.is_empty()).then_some(side));
         }
         for (kept, new, dk, dn) in changes.splits(1) {
             self.edges.push((kept, Some(dk)));
@@ -506,7 +516,7 @@ impl TouchedCells {
             self.vertices.push((absorbed, None));
             if let Some(d) = darts().find(|&d| map.vertex_id(d) == kept) {
                 self.vertices.push((kept, Some(d)));
-                star(self, d);
+                star(self, d, None);
             }
         }
         for (kept, absorbed) in changes.merges(1) {
@@ -517,16 +527,16 @@ impl TouchedCells {
         }
     }
 
-    /// Every edge of the star of the vertex of `d`, once each, with the last dart of the vertex
-    /// orbit that lies on it (the record [`Projection::update`] would have picked among one
+    /// Every edge of the star of a vertex whose orbit is `darts`, once each, with the last of
+    /// `darts` that lies on it (the record [`Projection::update`] would have picked among one
     /// record per dart, which is what was pushed before: ~150 records for ~20 edges). Past
     /// [`TouchedCells::STAR_EDGES`] distinct edges the rest are pushed per dart (duplicates are
     /// harmless). O(vertex orbit · star edges), no allocation beyond the records.
-    fn edges_around(&mut self, map: &GMap<3>, d: DartId) {
+    fn edges_around(&mut self, map: &GMap<3>, darts: impl IntoIterator<Item = DartId>) {
         let start = self.edges.len();
         let mut ids = [u32::MAX; Self::STAR_EDGES];
         let mut len = 0;
-        for x in map.cell_darts(0, d) {
+        for x in darts {
             let e = map.cell_id(1, x);
             match ids[..len].iter().position(|&id| id == e.0) {
                 Some(k) => self.edges[start + k].1 = Some(x),
@@ -713,10 +723,12 @@ mod tests {
     use crate::mechanics::Body;
 
     /// [`TouchedCells::record`] as it was first written: one edge record per dart of each
-    /// renamed vertex's orbit (the same walk over the changes, another star).
+    /// renamed vertex's orbit, in the order of the new side the kernel reported (else of the
+    /// orbit walk) — the same walk over the changes, another star.
     fn record_per_dart(t: &mut TouchedCells, map: &GMap<3>, changes: &CellChanges) {
-        t.record_with(map, changes, |t, d| {
-            for x in map.cell_darts(0, d) {
+        t.record_with(map, changes, |t, d, side| {
+            let darts = side.map_or_else(|| map.cell_darts(0, d), <[DartId]>::to_vec);
+            for x in darts {
                 t.edges.push((map.cell_id(1, x), Some(x)));
             }
         });

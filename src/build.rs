@@ -199,14 +199,32 @@ impl GMap<3> {
         check_elements(points, tets)?;
         let darts = tets.len().checked_mul(24).filter(|&n| n < u32::MAX as usize - 1);
         let darts = darts.ok_or(BuildError::TooLarge(tets.len().saturating_mul(24)))?;
+        Self::from_tets_swept(points, tets, darts, None)
+    }
+
+    /// [`Self::from_tets`] after the checks, with the labelling union-finds swept in breadth-first
+    /// order when `breadth_first` says so (`None`: when the input order is not local, see
+    /// [`SweepOrder::choose`]). The map does not depend on the sweep order.
+    fn from_tets_swept(
+        points: usize,
+        tets: &[[u32; 4]],
+        darts: usize,
+        breadth_first: Option<bool>,
+    ) -> Result<(GMap<3>, BuildReport), BuildError> {
         let faces = match_tet_faces(points, tets)?;
         let (face_of, face_count) = number_tet_faces(&faces.partner);
-        let (edge_of, edges) = label_tet_edges(&faces);
-        let (corner_of, vertex_ids, orbits_of) = label_tet_corners(points, tets, &faces);
+        let sweep = SweepOrder::choose(&faces, breadth_first);
+        let local = sweep.as_ref().map_or(&faces, |s| &s.faces);
+        let tet_at = |s: usize| sweep.as_ref().map_or(s, |w| w.tet_at[s] as usize);
+        let (edge_of, edges, edge_keys) = label_tet_edges(tets, local, tet_at);
+        let (corner_of, vertex_ids, orbits_of) = label_tet_corners(points, tets, local, tet_at);
+        let position = |t: usize| sweep.as_ref().map_or(t, |w| w.position[t] as usize);
         let mut alpha = Vec::with_capacity(darts * 4);
         let mut cell = Vec::with_capacity(darts * 4);
         for t in 0..tets.len() {
             let base = (t * 24) as u32;
+            let s = position(t);
+            let (corners, edges_of_t) = (&corner_of[s * 4..s * 4 + 4], &edge_of[s * 6..s * 6 + 6]);
             for f in 0..4 {
                 let tf = t * 4 + f;
                 let alpha3 = faces.alpha3(tf);
@@ -214,8 +232,8 @@ impl GMap<3> {
                     let k = f * 6 + j;
                     let [a0, a1, a2] = TET_LINKS[k];
                     alpha.extend_from_slice(&[base + a0, base + a1, base + a2, a3]);
-                    let v = corner_of[t * 4 + TET.vertex[k] as usize];
-                    let e = edge_of[t * 6 + TET_DART_EDGE[k] as usize];
+                    let v = corners[TET.vertex[k] as usize];
+                    let e = edges_of_t[TET_DART_EDGE[k] as usize];
                     cell.extend_from_slice(&[v, e, face_of[tf], t as u32]);
                 }
             }
@@ -226,9 +244,84 @@ impl GMap<3> {
         map.set_id_alloc_raw(3, tets.len() as u32, Vec::new());
         let mut report = vertex_report(&orbits_of);
         map.set_id_alloc_raw(0, vertex_ids, report.unreferenced_points.clone());
-        report.split_edges = split_edges(edge_points(tets, &edge_of, edges));
+        report.split_edges = split_edges(edge_keys);
         map.after_build();
         Ok((map, report))
+    }
+}
+
+/// An internal order in which the labelling union-finds visit the tets, with the face matching
+/// renumbered into it: tet at sweep position s is `tet_at[s]`, and `faces` is the [`FaceMatch`]
+/// of the tets in that order (partner faces as 4·position + local face). A breadth-first walk
+/// over shared faces puts the neighbours of a tet at nearby positions, so the union-find forests
+/// are read in a small window even when the input order is scattered (a mesh file whose tets
+/// and points are numbered at random); the ids do not depend on it.
+struct SweepOrder {
+    /// The tet at each sweep position.
+    tet_at: Vec<u32>,
+    /// The sweep position of each tet (inverse of `tet_at`).
+    position: Vec<u32>,
+    /// The face matching in sweep positions.
+    faces: FaceMatch,
+}
+
+/// A face link is "far" when its two tets are more than this many positions apart.
+const FAR_LINK: usize = 4096;
+
+impl SweepOrder {
+    /// The breadth-first sweep order when `forced` asks for it (`Some(true)`), or, with `None`,
+    /// when more than a quarter of a sample of the face links are far in the input order; `None`
+    /// means "sweep in input order". O(tets).
+    fn choose(faces: &FaceMatch, forced: Option<bool>) -> Option<SweepOrder> {
+        let scattered = || {
+            let (mut links, mut far) = (0usize, 0usize);
+            for tf in (0..faces.partner.len()).step_by(7) {
+                let g = faces.partner[tf];
+                if g != NO_FACE {
+                    links += 1;
+                    far += usize::from((g as usize / 4).abs_diff(tf / 4) > FAR_LINK);
+                }
+            }
+            far * 4 > links
+        };
+        forced.unwrap_or_else(scattered).then(|| Self::breadth_first(faces))
+    }
+
+    /// Tets in breadth-first order over shared faces (each component started at its first tet
+    /// in input order), and the face matching renumbered. Each tet's partners are read once,
+    /// when it leaves the queue. O(tets).
+    fn breadth_first(faces: &FaceMatch) -> SweepOrder {
+        let n = faces.partner.len() / 4;
+        let mut position = vec![u32::MAX; n];
+        let mut tet_at: Vec<u32> = Vec::with_capacity(n);
+        let mut partner = vec![NO_FACE; 4 * n];
+        let mut corner_map = vec![0u8; 4 * n];
+        let mut head = 0;
+        for seed in 0..n {
+            if position[seed] != u32::MAX {
+                continue;
+            }
+            position[seed] = tet_at.len() as u32;
+            tet_at.push(seed as u32);
+            while head < tet_at.len() {
+                let t = tet_at[head] as usize;
+                for f in 0..4 {
+                    let g = faces.partner[t * 4 + f];
+                    if g == NO_FACE {
+                        continue;
+                    }
+                    let tg = g as usize / 4;
+                    if position[tg] == u32::MAX {
+                        position[tg] = tet_at.len() as u32;
+                        tet_at.push(tg as u32);
+                    }
+                    partner[head * 4 + f] = position[tg] * 4 + g % 4;
+                    corner_map[head * 4 + f] = faces.corner_map[t * 4 + f];
+                }
+                head += 1;
+            }
+        }
+        SweepOrder { tet_at, position, faces: FaceMatch { partner, corner_map } }
     }
 }
 
@@ -426,48 +519,81 @@ fn number_tet_faces(partner: &[u32]) -> (Vec<u32>, u32) {
 }
 
 /// Labels `per_tet` local items of every tet (edges or corners) by the orbits of a relation
-/// that joins items of tets sharing a face. `neighbours(t, item)` lists the related items of
-/// earlier tets (`NONE_ITEM` for none; each relation is met once, from its later tet).
+/// that joins items of tets sharing a face, with the tets visited in a sweep order (`tet_at(s)`
+/// is the tet at sweep position s; items are numbered `s · per_tet + item`).
+/// `neighbours(s, item)` lists the related items at earlier sweep positions (`NONE_ITEM` for
+/// none; each relation is met once, from its later position).
 ///
-/// A union-find forest over the items is built in one sweep, each item joining the trees of
-/// its related items below it (roots are the smallest item of their tree, so the root of an
-/// orbit is its item in its first tet); then items are visited
-/// tet by tet, in `order` within a tet, and `new_id(item)` names each orbit at its root. Since
-/// an orbit has at most one item per tet, this numbers orbits exactly as a flood started at each
-/// unlabelled item in that visiting order would. Returns the id of every item. O(items · α).
+/// A union-find forest over the swept items is built in one sweep, each item joining the trees
+/// of its related items below it (roots are the smallest swept item of their tree). Each orbit
+/// then gets the smallest input key `tet · per_tet + rank` of its items (`rank` = place of the
+/// item in `order`), and orbits are named by `new_id(tet, item)` in increasing key order, i.e.
+/// tet by tet in input order, in `order` within a tet. Since an orbit has at most one item per
+/// tet, this numbers orbits exactly as a flood started at each unlabelled item in that visiting
+/// order would, whatever the sweep order. Returns the id of every swept item. O(items · α).
 fn label_orbits(
     tets: usize,
     per_tet: usize,
     order: &[usize],
+    tet_at: impl Fn(usize) -> usize,
     neighbours: impl Fn(usize, usize) -> [u32; 3],
-    mut new_id: impl FnMut(usize) -> u32,
+    mut new_id: impl FnMut(usize, usize) -> u32,
 ) -> Vec<u32> {
-    let mut forest: Vec<u32> = (0..(tets * per_tet) as u32).collect();
-    for t in 0..tets {
+    let items = tets * per_tet;
+    let mut forest: Vec<u32> = (0..items as u32).collect();
+    for s in 0..tets {
         for item in 0..per_tet {
-            let x = (t * per_tet + item) as u32;
+            let x = (s * per_tet + item) as u32;
             // NONE_ITEM is never below x, so it is skipped.
-            join_with_smaller(&mut forest, x, &neighbours(t, item), &[0, 1, 2]);
+            join_with_smaller(&mut forest, x, &neighbours(s, item), &[0, 1, 2]);
         }
     }
-    let mut label = vec![u32::MAX; tets * per_tet];
-    for t in 0..tets {
-        for &item in order {
-            let x = t * per_tet + item;
-            let root = find_root(&mut forest, x as u32) as usize;
-            label[x] = if root == x { new_id(x) } else { label[root] };
+    let mut rank = [0u32; 6];
+    for (r, &item) in order.iter().enumerate() {
+        rank[item] = r as u32;
+    }
+    // Smallest input key of each root's orbit (every forest entry then points to its root).
+    let mut best = vec![u32::MAX; items];
+    for s in 0..tets {
+        let key = (tet_at(s) * per_tet) as u32;
+        for item in 0..per_tet {
+            let x = s * per_tet + item;
+            let root = find_root(&mut forest, x as u32);
+            forest[x] = root;
+            let slot = &mut best[root as usize];
+            *slot = (*slot).min(key + rank[item]);
         }
     }
-    label
+    // The root of the orbit whose smallest key is k, at k; then ids in increasing key order.
+    let mut root_at_key = vec![NONE_ITEM; items];
+    for (x, &root) in forest.iter().enumerate() {
+        if root as usize == x {
+            root_at_key[best[x] as usize] = root;
+        }
+    }
+    for (key, &root) in root_at_key.iter().enumerate() {
+        if root != NONE_ITEM {
+            best[root as usize] = new_id(key / per_tet, order[key % per_tet]);
+        }
+    }
+    for x in forest.iter_mut() {
+        *x = best[*x as usize];
+    }
+    forest
 }
 
-/// Edge ids of every (tet, local edge) pair: the edge orbits ⟨α0, α2, α3⟩ of the built map
-/// (tet edges joined across shared faces), numbered as a flood over darts in increasing order
-/// would. Returns the ids (6 per tet) and the number of edges. O(tets · α).
-fn label_tet_edges(faces: &FaceMatch) -> (Vec<u32>, u32) {
-    let tets = faces.partner.len() / 4;
+/// Edge ids of every (swept tet, local edge) pair: the edge orbits ⟨α0, α2, α3⟩ of the built
+/// map (tet edges joined across shared faces), numbered as a flood over darts in increasing
+/// order would. `faces` is the face matching in sweep positions, `tet_at` the tet at each.
+/// Returns the ids (6 per swept tet), the number of edges and the sorted point pair of every
+/// edge id packed in a u64. O(tets · α).
+fn label_tet_edges(
+    tets: &[[u32; 4]],
+    faces: &FaceMatch,
+    tet_at: impl Fn(usize) -> usize,
+) -> (Vec<u32>, u32, Vec<u64>) {
     let order = items_by_first_dart(6, |k| TET_DART_EDGE[k] as usize);
-    let mut next = 0u32;
+    let mut keys: Vec<u64> = Vec::new();
     let neighbours = |t: usize, e: usize| {
         let [u, w] = TET_EDGES[e];
         let mut out = [NONE_ITEM; 3];
@@ -481,15 +607,28 @@ fn label_tet_edges(faces: &FaceMatch) -> (Vec<u32>, u32) {
         }
         out
     };
-    let label = label_orbits(tets, 6, &order, neighbours, |_| (next, next += 1).0);
-    (label, next)
+    let new_id = |t: usize, e: usize| {
+        let [u, w] = TET_EDGES[e];
+        let [a, b] = sorted([tets[t][u], tets[t][w]]);
+        keys.push((u64::from(a) << 32) | u64::from(b));
+        keys.len() as u32 - 1
+    };
+    let label = label_orbits(tets.len(), 6, &order, tet_at, neighbours, new_id);
+    let edges = keys.len() as u32;
+    (label, edges, keys)
 }
 
-/// Vertex ids of every (tet, corner) pair: the vertex orbits ⟨α1, α2, α3⟩ (tet corners joined
-/// across shared faces); the first orbit of point p gets id p, any further one a fresh id, in
-/// the order of a flood over darts in increasing order. Returns the ids (4 per tet), the id
-/// bound, and the number of orbits of each point. O(tets · α + points).
-fn label_tet_corners(points: usize, tets: &[[u32; 4]], faces: &FaceMatch) -> (Vec<u32>, u32, Vec<usize>) {
+/// Vertex ids of every (swept tet, corner) pair: the vertex orbits ⟨α1, α2, α3⟩ (tet corners
+/// joined across shared faces); the first orbit of point p gets id p, any further one a fresh
+/// id, in the order of a flood over darts in increasing order. `faces` and `tet_at` as for
+/// [`label_tet_edges`]. Returns the ids (4 per swept tet), the id bound, and the number of
+/// orbits of each point. O(tets · α + points).
+fn label_tet_corners(
+    points: usize,
+    tets: &[[u32; 4]],
+    faces: &FaceMatch,
+    tet_at: impl Fn(usize) -> usize,
+) -> (Vec<u32>, u32, Vec<usize>) {
     let order = items_by_first_dart(4, |k| TET.vertex[k] as usize);
     let mut orbits_of = vec![0usize; points];
     let mut next = points as u32;
@@ -505,8 +644,8 @@ fn label_tet_corners(points: usize, tets: &[[u32; 4]], faces: &FaceMatch) -> (Ve
         }
         out
     };
-    let new_id = |x: usize| {
-        let p = tets[x / 4][x % 4];
+    let new_id = |t: usize, v: usize| {
+        let p = tets[t][v];
         orbits_of[p as usize] += 1;
         if orbits_of[p as usize] == 1 {
             p
@@ -514,21 +653,8 @@ fn label_tet_corners(points: usize, tets: &[[u32; 4]], faces: &FaceMatch) -> (Ve
             (next, next += 1).0
         }
     };
-    let label = label_orbits(tets.len(), 4, &order, neighbours, new_id);
+    let label = label_orbits(tets.len(), 4, &order, tet_at, neighbours, new_id);
     (label, next, orbits_of)
-}
-
-/// The sorted point pair of every edge id, from the per-(tet, local edge) ids.
-fn edge_points(tets: &[[u32; 4]], edge_of: &[u32], edges: u32) -> Vec<u64> {
-    let mut keys = vec![u64::MAX; edges as usize];
-    for (node, &id) in edge_of.iter().enumerate() {
-        if keys[id as usize] == u64::MAX {
-            let [u, w] = TET_EDGES[node % 6];
-            let [a, b] = sorted([tets[node / 6][u], tets[node / 6][w]]);
-            keys[id as usize] = (u64::from(a) << 32) | u64::from(b);
-        }
-    }
-    keys
 }
 
 /// Point pairs carried by more than one edge, from the packed pair of every edge. O(E log E).

@@ -22,7 +22,7 @@
 
 use rustc_hash::FxHashMap;
 
-use crate::gmap::{find_root, join_with_smaller, AlphaMask, DartId, GMap};
+use crate::gmap::{join_with_smaller, AlphaMask, DartId, GMap};
 
 /// Why a mesh could not be turned into a map. Nothing is built when one is returned.
 ///
@@ -212,19 +212,17 @@ impl GMap<3> {
         breadth_first: Option<bool>,
     ) -> Result<(GMap<3>, BuildReport), BuildError> {
         let faces = match_tet_faces(points, tets)?;
-        let (face_of, face_count) = number_tet_faces(&faces.partner);
+        let (face_of, face_count) = number_tet_faces(&faces.link);
         let sweep = SweepOrder::choose(&faces, breadth_first);
         let local = sweep.as_ref().map_or(&faces, |s| &s.faces);
         let tet_at = |s: usize| sweep.as_ref().map_or(s, |w| w.tet_at[s] as usize);
         let (edge_of, edges, edge_keys) = label_tet_edges(tets, local, tet_at);
         let (corner_of, vertex_ids, orbits_of) = label_tet_corners(points, tets, local, tet_at);
-        let position = |t: usize| sweep.as_ref().map_or(t, |w| w.position[t] as usize);
         let mut alpha = Vec::with_capacity(darts * 4);
         let mut cell = Vec::with_capacity(darts * 4);
         for t in 0..tets.len() {
             let base = (t * 24) as u32;
-            let s = position(t);
-            let (corners, edges_of_t) = (&corner_of[s * 4..s * 4 + 4], &edge_of[s * 6..s * 6 + 6]);
+            let (corners, edges_of_t) = (&corner_of[t * 4..t * 4 + 4], &edge_of[t * 6..t * 6 + 6]);
             for f in 0..4 {
                 let tf = t * 4 + f;
                 let alpha3 = faces.alpha3(tf);
@@ -259,8 +257,6 @@ impl GMap<3> {
 struct SweepOrder {
     /// The tet at each sweep position.
     tet_at: Vec<u32>,
-    /// The sweep position of each tet (inverse of `tet_at`).
-    position: Vec<u32>,
     /// The face matching in sweep positions.
     faces: FaceMatch,
 }
@@ -275,8 +271,8 @@ impl SweepOrder {
     fn choose(faces: &FaceMatch, forced: Option<bool>) -> Option<SweepOrder> {
         let scattered = || {
             let (mut links, mut far) = (0usize, 0usize);
-            for tf in (0..faces.partner.len()).step_by(7) {
-                let g = faces.partner[tf];
+            for tf in (0..faces.link.len()).step_by(7) {
+                let g = faces.link[tf].0;
                 if g != NO_FACE {
                     links += 1;
                     far += usize::from((g as usize / 4).abs_diff(tf / 4) > FAR_LINK);
@@ -291,11 +287,10 @@ impl SweepOrder {
     /// in input order), and the face matching renumbered. Each tet's partners are read once,
     /// when it leaves the queue. O(tets).
     fn breadth_first(faces: &FaceMatch) -> SweepOrder {
-        let n = faces.partner.len() / 4;
+        let n = faces.link.len() / 4;
         let mut position = vec![u32::MAX; n];
         let mut tet_at: Vec<u32> = Vec::with_capacity(n);
-        let mut partner = vec![NO_FACE; 4 * n];
-        let mut corner_map = vec![0u8; 4 * n];
+        let mut link = vec![(NO_FACE, 0u8); 4 * n];
         let mut head = 0;
         for seed in 0..n {
             if position[seed] != u32::MAX {
@@ -306,7 +301,7 @@ impl SweepOrder {
             while head < tet_at.len() {
                 let t = tet_at[head] as usize;
                 for f in 0..4 {
-                    let g = faces.partner[t * 4 + f];
+                    let (g, map) = faces.link[t * 4 + f];
                     if g == NO_FACE {
                         continue;
                     }
@@ -315,13 +310,12 @@ impl SweepOrder {
                         position[tg] = tet_at.len() as u32;
                         tet_at.push(tg as u32);
                     }
-                    partner[head * 4 + f] = position[tg] * 4 + g % 4;
-                    corner_map[head * 4 + f] = faces.corner_map[t * 4 + f];
+                    link[head * 4 + f] = (position[tg] * 4 + g % 4, map);
                 }
                 head += 1;
             }
         }
-        SweepOrder { tet_at, position, faces: FaceMatch { partner, corner_map } }
+        SweepOrder { tet_at, faces: FaceMatch { link } }
     }
 }
 
@@ -330,6 +324,9 @@ const NO_FACE: u32 = u32::MAX;
 
 /// Marks "no related item" in the lists of `label_orbits`.
 const NONE_ITEM: u32 = u32::MAX;
+
+/// Marks a root's slot in `label_orbits`' forest (items and keys stay below 2^30: darts < 2^32).
+const TAG: u32 = 1 << 31;
 
 /// The flag k of a face with (vertex, other end of its edge) = (local corners v, o): the inverse
 /// of (FLAG_VERTEX, FLAG_OTHER). The diagonal is unused.
@@ -390,11 +387,11 @@ fn items_by_first_dart(count: usize, item_of_dart: impl Fn(usize) -> usize) -> V
 /// points (`NO_FACE` on the boundary), and where each local corner of t lands in the partner's
 /// tet. With the corner map, sewing and labelling never read the partner tet's points.
 struct FaceMatch {
-    /// The partner tet face of every tet face, or `NO_FACE`.
-    partner: Vec<u32>,
-    /// Two bits per local corner v ≠ f of tet t: the local corner of the partner's tet that
-    /// carries the same point (0 for boundary faces and for v = f).
-    corner_map: Vec<u8>,
+    /// For every tet face 4t + f: the partner tet face (or `NO_FACE`), and the corner map: two
+    /// bits per local corner v ≠ f of t, the local corner of the partner's tet that carries the
+    /// same point (0 for boundary faces and for v = f). One pair per face, so that both are
+    /// read from one cache line.
+    link: Vec<(u32, u8)>,
 }
 
 impl FaceMatch {
@@ -402,8 +399,8 @@ impl FaceMatch {
     /// corner of the partner's tet with the same point; `None` on the boundary.
     #[inline(always)]
     fn across(&self, tf: usize) -> Option<(u32, u8)> {
-        let g = self.partner[tf];
-        (g != NO_FACE).then(|| (g, self.corner_map[tf]))
+        let (g, map) = self.link[tf];
+        (g != NO_FACE).then_some((g, map))
     }
 
     /// α3 of the six darts 6·tf + j of tet face tf: themselves on the boundary, else the dart of
@@ -464,24 +461,25 @@ fn match_tet_faces(points: usize, tets: &[[u32; 4]]) -> Result<FaceMatch, BuildE
             fill[a as usize] += 1;
         }
     }
-    let mut partner = vec![NO_FACE; tets.len() * 4];
-    let mut corner_map = vec![0u8; tets.len() * 4];
+    let mut link = vec![(NO_FACE, 0u8); tets.len() * 4];
     // (third face, points, first face, second face) of the earliest face seen three times.
     let mut third: Option<(u32, [u32; 3], u32, u32)> = None;
     for a in 0..points {
         let faces = &mut bucket[start[a] as usize..start[a + 1] as usize];
-        faces.sort_unstable();
+        // Faces were bucketed in increasing tet-face order: a stable sort by points keeps it.
+        faces.sort_by_key(|x| x.0);
         for run in faces.chunk_by(|x, y| x.0 == y.0) {
             match run {
                 [_] => {}
                 [(_, f1, c1), (_, f2, c2)] => {
-                    partner[*f1 as usize] = *f2;
-                    partner[*f2 as usize] = *f1;
+                    let (mut m1, mut m2) = (0u8, 0u8);
                     for i in 0..3 {
                         let (v1, v2) = ((c1 >> (2 * i)) & 3, (c2 >> (2 * i)) & 3);
-                        corner_map[*f1 as usize] |= v2 << (2 * v1);
-                        corner_map[*f2 as usize] |= v1 << (2 * v2);
+                        m1 |= v2 << (2 * v1);
+                        m2 |= v1 << (2 * v2);
                     }
+                    link[*f1 as usize] = (*f2, m1);
+                    link[*f2 as usize] = (*f1, m2);
                 }
                 [(bc, f1, _), (_, f2, _), (_, f3, _), ..] => {
                     if third.is_none_or(|w| *f3 < w.0) {
@@ -493,7 +491,7 @@ fn match_tet_faces(points: usize, tets: &[[u32; 4]]) -> Result<FaceMatch, BuildE
         }
     }
     match third {
-        None => Ok(FaceMatch { partner, corner_map }),
+        None => Ok(FaceMatch { link }),
         Some((f3, points, f1, f2)) => Err(BuildError::NonManifold {
             what: "face",
             points: points.to_vec(),
@@ -504,10 +502,10 @@ fn match_tet_faces(points: usize, tets: &[[u32; 4]]) -> Result<FaceMatch, BuildE
 
 /// Face ids of every tet face in order of first appearance (a matched pair shares the id of its
 /// first face), and the number of faces. O(tets).
-fn number_tet_faces(partner: &[u32]) -> (Vec<u32>, u32) {
-    let mut face_of = vec![0u32; partner.len()];
+fn number_tet_faces(link: &[(u32, u8)]) -> (Vec<u32>, u32) {
+    let mut face_of = vec![0u32; link.len()];
     let mut faces = 0u32;
-    for (tf, &other) in partner.iter().enumerate() {
+    for (tf, &(other, _)) in link.iter().enumerate() {
         if other == NO_FACE || other as usize > tf {
             face_of[tf] = faces;
             faces += 1;
@@ -530,7 +528,8 @@ fn number_tet_faces(partner: &[u32]) -> (Vec<u32>, u32) {
 /// item in `order`), and orbits are named by `new_id(tet, item)` in increasing key order, i.e.
 /// tet by tet in input order, in `order` within a tet. Since an orbit has at most one item per
 /// tet, this numbers orbits exactly as a flood started at each unlabelled item in that visiting
-/// order would, whatever the sweep order. Returns the id of every swept item. O(items · α).
+/// order would, whatever the sweep order. Returns the id of every item `tet · per_tet + item`
+/// (input order). O(items · α).
 fn label_orbits(
     tets: usize,
     per_tet: usize,
@@ -552,40 +551,55 @@ fn label_orbits(
     for (r, &item) in order.iter().enumerate() {
         rank[item] = r as u32;
     }
-    // Smallest input key of each root's orbit (every forest entry then points to its root).
-    let mut best = vec![u32::MAX; items];
+    // Every root's slot becomes TAG | the smallest input key of its orbit, every other slot its
+    // root. Slots point to smaller items and the items below x already point to their root or
+    // are tagged roots, so one step from x finds its root.
+    let mut roots = vec![0u64; items.div_ceil(64)];
     for s in 0..tets {
         let key = (tet_at(s) * per_tet) as u32;
         for item in 0..per_tet {
-            let x = s * per_tet + item;
-            let root = find_root(&mut forest, x as u32);
-            forest[x] = root;
-            let slot = &mut best[root as usize];
-            *slot = (*slot).min(key + rank[item]);
+            let (x, k) = (s * per_tet + item, key + rank[item]);
+            let parent = forest[x] as usize;
+            if parent == x {
+                forest[x] = TAG | k;
+                roots[x / 64] |= 1 << (x % 64);
+            } else {
+                let root = if forest[parent] & TAG != 0 { parent } else { forest[parent] as usize };
+                forest[x] = root as u32;
+                forest[root] = forest[root].min(TAG | k);
+            }
         }
     }
-    // The root of the orbit whose smallest key is k, at k; then ids in increasing key order.
+    let is_root = |x: usize| roots[x / 64] >> (x % 64) & 1 != 0;
+    // The root of the orbit whose smallest key is k, at k; then ids in increasing key order,
+    // each written in its root's slot.
     let mut root_at_key = vec![NONE_ITEM; items];
-    for (x, &root) in forest.iter().enumerate() {
-        if root as usize == x {
-            root_at_key[best[x] as usize] = root;
+    for (x, &slot) in forest.iter().enumerate() {
+        if is_root(x) {
+            root_at_key[(slot & !TAG) as usize] = x as u32;
         }
     }
     for (key, &root) in root_at_key.iter().enumerate() {
         if root != NONE_ITEM {
-            best[root as usize] = new_id(key / per_tet, order[key % per_tet]);
+            forest[root as usize] = new_id(key / per_tet, order[key % per_tet]);
         }
     }
-    for x in forest.iter_mut() {
-        *x = best[*x as usize];
+    // The ids in input order, written over the key table (whose index space is the input's).
+    let mut label = root_at_key;
+    for s in 0..tets {
+        let (t, x) = (tet_at(s) * per_tet, s * per_tet);
+        for item in 0..per_tet {
+            let slot = forest[x + item];
+            label[t + item] = if is_root(x + item) { slot } else { forest[slot as usize] };
+        }
     }
-    forest
+    label
 }
 
-/// Edge ids of every (swept tet, local edge) pair: the edge orbits ⟨α0, α2, α3⟩ of the built
+/// Edge ids of every (tet, local edge) pair: the edge orbits ⟨α0, α2, α3⟩ of the built
 /// map (tet edges joined across shared faces), numbered as a flood over darts in increasing
 /// order would. `faces` is the face matching in sweep positions, `tet_at` the tet at each.
-/// Returns the ids (6 per swept tet), the number of edges and the sorted point pair of every
+/// Returns the ids (6 per tet, input order), the number of edges and the sorted point pair of every
 /// edge id packed in a u64. O(tets · α).
 fn label_tet_edges(
     tets: &[[u32; 4]],
@@ -618,10 +632,10 @@ fn label_tet_edges(
     (label, edges, keys)
 }
 
-/// Vertex ids of every (swept tet, corner) pair: the vertex orbits ⟨α1, α2, α3⟩ (tet corners
+/// Vertex ids of every (tet, corner) pair: the vertex orbits ⟨α1, α2, α3⟩ (tet corners
 /// joined across shared faces); the first orbit of point p gets id p, any further one a fresh
 /// id, in the order of a flood over darts in increasing order. `faces` and `tet_at` as for
-/// [`label_tet_edges`]. Returns the ids (4 per swept tet), the id bound, and the number of
+/// [`label_tet_edges`]. Returns the ids (4 per tet, input order), the id bound, and the number of
 /// orbits of each point. O(tets · α + points).
 fn label_tet_corners(
     points: usize,

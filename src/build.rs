@@ -17,7 +17,10 @@
 //! smallest point, which also records where each corner of a face lands in the neighbouring tet;
 //! edges and vertices labelled by a union-find over the 6 edges and 4 corners of each tet (not
 //! over its 24 darts) that reads only the face matching, never the neighbour's points; every
-//! dart's α row and cell row written once, in order. O(triangles) expected for triangles (one
+//! dart's α row and cell row written once, in order. When the input order is scattered (far
+//! face links, as in a mesh file whose tets and points are numbered at random), the union-finds
+//! sweep the tets in a breadth-first order over shared faces, so their forests are read in a
+//! small window, and the ids are written back in input order; the map is the same either way. O(triangles) expected for triangles (one
 //! hash-map look-up per edge).
 
 use rustc_hash::FxHashMap;
@@ -557,8 +560,8 @@ fn label_orbits(
     let mut roots = vec![0u64; items.div_ceil(64)];
     for s in 0..tets {
         let key = (tet_at(s) * per_tet) as u32;
-        for item in 0..per_tet {
-            let (x, k) = (s * per_tet + item, key + rank[item]);
+        for (item, &r) in rank[..per_tet].iter().enumerate() {
+            let (x, k) = (s * per_tet + item, key + r);
             let parent = forest[x] as usize;
             if parent == x {
                 forest[x] = TAG | k;
@@ -601,11 +604,7 @@ fn label_orbits(
 /// order would. `faces` is the face matching in sweep positions, `tet_at` the tet at each.
 /// Returns the ids (6 per tet, input order), the number of edges and the sorted point pair of every
 /// edge id packed in a u64. O(tets · α).
-fn label_tet_edges(
-    tets: &[[u32; 4]],
-    faces: &FaceMatch,
-    tet_at: impl Fn(usize) -> usize,
-) -> (Vec<u32>, u32, Vec<u64>) {
+fn label_tet_edges(tets: &[[u32; 4]], faces: &FaceMatch, tet_at: impl Fn(usize) -> usize) -> (Vec<u32>, u32, Vec<u64>) {
     let order = items_by_first_dart(6, |k| TET_DART_EDGE[k] as usize);
     let mut keys: Vec<u64> = Vec::new();
     let neighbours = |t: usize, e: usize| {
@@ -827,5 +826,83 @@ impl<const N: usize> GMap<N> {
         if let Err(e) = self.validate() {
             panic!("topomech bug: a built map is invalid: {e}");
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::generate::{kuhn_cube, SplitMix64};
+
+    /// Kuhn cube k with about `percent` % of its tets removed (pinched vertices and split edges
+    /// appear), in a shuffled order when `shuffle` (far face links in the input order).
+    fn damaged_cube(k: usize, percent: usize, shuffle: bool) -> (usize, Vec<[u32; 4]>) {
+        let (points, tets) = kuhn_cube(k);
+        let mut rng = SplitMix64(k as u64 * 1000 + percent as u64);
+        let mut kept: Vec<[u32; 4]> = tets.into_iter().filter(|_| rng.below(100) >= percent).collect();
+        if shuffle {
+            for i in (1..kept.len()).rev() {
+                kept.swap(i, rng.below(i + 1));
+            }
+        }
+        (points.len(), kept)
+    }
+
+    /// Every α link and cell id of every dart, each id allocator (next, free list), the report.
+    type Everything = (Vec<u32>, Vec<(u32, Vec<u32>)>, BuildReport);
+
+    fn everything(built: &(GMap<3>, BuildReport)) -> Everything {
+        let (map, report) = built;
+        let rows =
+            map.darts().flat_map(|d| (0..=3).flat_map(move |i| [map.alpha_dyn(i, d).0, map.cell_id(i, d).0])).collect();
+        let allocs = (0..=3).map(|i| (map.id_alloc_raw(i).0, map.id_alloc_raw(i).1.to_vec())).collect();
+        (rows, allocs, report.clone())
+    }
+
+    #[test]
+    fn the_breadth_first_sweep_builds_the_same_map_as_the_input_order_sweep() {
+        let mut pinched = 0;
+        for (k, percent, shuffle) in [(3, 0, true), (3, 40, true), (5, 60, false), (6, 30, true), (6, 80, true)] {
+            let (points, tets) = damaged_cube(k, percent, shuffle);
+            let darts = tets.len() * 24;
+            let input = GMap::<3>::from_tets_swept(points, &tets, darts, Some(false)).unwrap();
+            let swept = GMap::<3>::from_tets_swept(points, &tets, darts, Some(true)).unwrap();
+            assert_eq!(everything(&input), everything(&swept), "k = {k}, -{percent} %, shuffled {shuffle}");
+            pinched += input.1.pinched_vertices.len() + input.1.split_edges.len();
+        }
+        assert!(pinched > 0, "the inputs exercise fresh vertex ids and split edges");
+    }
+
+    #[test]
+    fn the_breadth_first_order_is_a_permutation_and_renumbers_the_face_matching() {
+        let (points, tets) = damaged_cube(4, 50, true);
+        let faces = match_tet_faces(points, &tets).unwrap();
+        let sweep = SweepOrder::breadth_first(&faces);
+        let mut seen = sweep.tet_at.clone();
+        seen.sort_unstable();
+        assert_eq!(seen, (0..tets.len() as u32).collect::<Vec<_>>());
+        let mut position = vec![0u32; tets.len()];
+        for (s, &t) in sweep.tet_at.iter().enumerate() {
+            position[t as usize] = s as u32;
+        }
+        for (s, &t) in sweep.tet_at.iter().enumerate() {
+            for f in 0..4 {
+                let (g, map) = faces.link[t as usize * 4 + f];
+                let expected = if g == NO_FACE { NO_FACE } else { position[g as usize / 4] * 4 + g % 4 };
+                assert_eq!(sweep.faces.link[s * 4 + f], (expected, map), "tet {t} face {f}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_sweep_order_is_breadth_first_only_on_scattered_input() {
+        let (points, tets) = damaged_cube(12, 0, false);
+        let faces = match_tet_faces(points, &tets).unwrap();
+        assert!(SweepOrder::choose(&faces, None).is_none(), "generation order is local");
+        assert!(SweepOrder::choose(&faces, Some(true)).is_some());
+        let (points, tets) = damaged_cube(12, 0, true);
+        let faces = match_tet_faces(points, &tets).unwrap();
+        assert!(SweepOrder::choose(&faces, None).is_some(), "a shuffled order is scattered");
+        assert!(SweepOrder::choose(&faces, Some(false)).is_none());
     }
 }

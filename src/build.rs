@@ -215,30 +215,14 @@ impl GMap<3> {
         breadth_first: Option<bool>,
     ) -> Result<(GMap<3>, BuildReport), BuildError> {
         let faces = match_tet_faces(points, tets)?;
-        let (face_of, face_count) = number_tet_faces(&faces.link);
         let sweep = SweepOrder::choose(&faces, breadth_first);
         let local = sweep.as_ref().map_or(&faces, |s| &s.faces);
         let tet_at = |s: usize| sweep.as_ref().map_or(s, |w| w.tet_at[s] as usize);
         let (edge_of, edges, edge_keys) = label_tet_edges(tets, local, tet_at);
         let (corner_of, vertex_ids, orbits_of) = label_tet_corners(points, tets, local, tet_at);
-        let mut alpha = Vec::with_capacity(darts * 4);
-        let mut cell = Vec::with_capacity(darts * 4);
-        for t in 0..tets.len() {
-            let base = (t * 24) as u32;
-            let (corners, edges_of_t) = (&corner_of[t * 4..t * 4 + 4], &edge_of[t * 6..t * 6 + 6]);
-            for f in 0..4 {
-                let tf = t * 4 + f;
-                let alpha3 = faces.alpha3(tf);
-                for (j, &a3) in alpha3.iter().enumerate() {
-                    let k = f * 6 + j;
-                    let [a0, a1, a2] = TET_LINKS[k];
-                    alpha.extend_from_slice(&[base + a0, base + a1, base + a2, a3]);
-                    let v = corners[TET.vertex[k] as usize];
-                    let e = edges_of_t[TET_DART_EDGE[k] as usize];
-                    cell.extend_from_slice(&[v, e, face_of[tf], t as u32]);
-                }
-            }
-        }
+        drop(sweep);
+        let (face_of, face_count) = number_tet_faces(&faces.link);
+        let (alpha, cell) = tet_rows(&faces, &face_of, &edge_of, &corner_of, darts);
         let mut map = GMap::<3>::from_rows_raw(alpha, cell);
         map.set_id_alloc_raw(1, edges, Vec::new());
         map.set_id_alloc_raw(2, face_count, Vec::new());
@@ -519,6 +503,36 @@ fn number_tet_faces(link: &[(u32, u8)]) -> (Vec<u32>, u32) {
     (face_of, faces)
 }
 
+/// The α rows and cell rows of all darts (dart 24t + 6f + j: tet t, face f, flag j), written
+/// once, in order, from the face matching and the face, edge and vertex ids of every (tet,
+/// local item) in input order. O(darts).
+fn tet_rows(
+    faces: &FaceMatch,
+    face_of: &[u32],
+    edge_of: &[u32],
+    corner_of: &[u32],
+    darts: usize,
+) -> (Vec<u32>, Vec<u32>) {
+    let mut alpha = Vec::with_capacity(darts * 4);
+    let mut cell = Vec::with_capacity(darts * 4);
+    for t in 0..darts / 24 {
+        let base = (t * 24) as u32;
+        let (corners, edges_of_t) = (&corner_of[t * 4..t * 4 + 4], &edge_of[t * 6..t * 6 + 6]);
+        for f in 0..4 {
+            let (tf, face) = (t * 4 + f, face_of[t * 4 + f]);
+            for (j, &a3) in faces.alpha3(tf).iter().enumerate() {
+                let k = f * 6 + j;
+                let [a0, a1, a2] = TET_LINKS[k];
+                alpha.extend_from_slice(&[base + a0, base + a1, base + a2, a3]);
+                let v = corners[TET.vertex[k] as usize];
+                let e = edges_of_t[TET_DART_EDGE[k] as usize];
+                cell.extend_from_slice(&[v, e, face, t as u32]);
+            }
+        }
+    }
+    (alpha, cell)
+}
+
 /// Labels `per_tet` local items of every tet (edges or corners) by the orbits of a relation
 /// that joins items of tets sharing a face, with the tets visited in a sweep order (`tet_at(s)`
 /// is the tet at sweep position s; items are numbered `s · per_tet + item`).
@@ -670,18 +684,31 @@ fn label_tet_corners(
     (label, next, orbits_of)
 }
 
-/// Point pairs carried by more than one edge, from the packed pair of every edge. O(E log E).
-fn split_edges(mut keys: Vec<u64>) -> Vec<([u32; 2], usize)> {
-    keys.sort_unstable();
+/// Point pairs carried by more than one edge, in increasing order, from the packed pair
+/// `a << 32 | b` (a < b) of every edge: pairs bucketed by their first point (a counting sort),
+/// then each bucket's second points sorted. O(E + points) and the sorts of the small buckets.
+fn split_edges(keys: Vec<u64>) -> Vec<([u32; 2], usize)> {
+    let first = |key: u64| (key >> 32) as usize;
+    let points = keys.iter().map(|&key| first(key) + 1).max().unwrap_or(0);
+    let mut start = vec![0u32; points + 1];
+    for &key in &keys {
+        start[first(key) + 1] += 1;
+    }
+    for a in 0..points {
+        start[a + 1] += start[a];
+    }
+    let mut fill = start.clone();
+    let mut second = vec![0u32; keys.len()];
+    for &key in &keys {
+        second[fill[first(key)] as usize] = key as u32;
+        fill[first(key)] += 1;
+    }
     let mut out: Vec<([u32; 2], usize)> = Vec::new();
-    for w in keys.windows(2) {
-        if w[0] == w[1] {
-            let pair = [(w[0] >> 32) as u32, w[0] as u32];
-            match out.last_mut() {
-                Some(last) if last.0 == pair => last.1 += 1,
-                _ => out.push((pair, 2)),
-            }
-        }
+    for a in 0..points {
+        let bucket = &mut second[start[a] as usize..start[a + 1] as usize];
+        bucket.sort_unstable();
+        let repeated = bucket.chunk_by(|x, y| x == y).filter(|run| run.len() > 1);
+        out.extend(repeated.map(|run| ([a as u32, run[0]], run.len())));
     }
     out
 }

@@ -17,12 +17,15 @@
 //! smallest point, which also records where each corner of a face lands in the neighbouring tet;
 //! edges and vertices labelled by a union-find over the 6 edges and 4 corners of each tet (not
 //! over its 24 darts) that reads only the face matching, never the neighbour's points; every
-//! dart's α row and cell row written once, in order. O(triangles) expected for triangles (one
+//! dart's α row and cell row written once, in order. When the input order is scattered (far
+//! face links, as in a mesh file whose tets and points are numbered at random), the union-finds
+//! sweep the tets in a breadth-first order over shared faces, so their forests are read in a
+//! small window, and the ids are written back in input order; the map is the same either way. O(triangles) expected for triangles (one
 //! hash-map look-up per edge).
 
 use rustc_hash::FxHashMap;
 
-use crate::gmap::{find_root, join_with_smaller, AlphaMask, DartId, GMap};
+use crate::gmap::{join_with_smaller, AlphaMask, DartId, GMap};
 
 /// Why a mesh could not be turned into a map. Nothing is built when one is returned.
 ///
@@ -199,36 +202,107 @@ impl GMap<3> {
         check_elements(points, tets)?;
         let darts = tets.len().checked_mul(24).filter(|&n| n < u32::MAX as usize - 1);
         let darts = darts.ok_or(BuildError::TooLarge(tets.len().saturating_mul(24)))?;
+        Self::from_tets_swept(points, tets, darts, None)
+    }
+
+    /// [`Self::from_tets`] after the checks, with the labelling union-finds swept in breadth-first
+    /// order when `breadth_first` says so (`None`: when the input order is not local, see
+    /// [`SweepOrder::choose`]). The map does not depend on the sweep order.
+    fn from_tets_swept(
+        points: usize,
+        tets: &[[u32; 4]],
+        darts: usize,
+        breadth_first: Option<bool>,
+    ) -> Result<(GMap<3>, BuildReport), BuildError> {
         let faces = match_tet_faces(points, tets)?;
-        let (face_of, face_count) = number_tet_faces(&faces.partner);
-        let (edge_of, edges) = label_tet_edges(&faces);
-        let (corner_of, vertex_ids, orbits_of) = label_tet_corners(points, tets, &faces);
-        let mut alpha = Vec::with_capacity(darts * 4);
-        let mut cell = Vec::with_capacity(darts * 4);
-        for t in 0..tets.len() {
-            let base = (t * 24) as u32;
-            for f in 0..4 {
-                let tf = t * 4 + f;
-                let alpha3 = faces.alpha3(tf);
-                for (j, &a3) in alpha3.iter().enumerate() {
-                    let k = f * 6 + j;
-                    let [a0, a1, a2] = TET_LINKS[k];
-                    alpha.extend_from_slice(&[base + a0, base + a1, base + a2, a3]);
-                    let v = corner_of[t * 4 + TET.vertex[k] as usize];
-                    let e = edge_of[t * 6 + TET_DART_EDGE[k] as usize];
-                    cell.extend_from_slice(&[v, e, face_of[tf], t as u32]);
-                }
-            }
-        }
+        let sweep = SweepOrder::choose(&faces, breadth_first);
+        let local = sweep.as_ref().map_or(&faces, |s| &s.faces);
+        let tet_at = |s: usize| sweep.as_ref().map_or(s, |w| w.tet_at[s] as usize);
+        let (edge_of, edges, edge_keys) = label_tet_edges(tets, local, tet_at);
+        let (corner_of, vertex_ids, orbits_of) = label_tet_corners(points, tets, local, tet_at);
+        drop(sweep);
+        let (face_of, face_count) = number_tet_faces(&faces.link);
+        let (alpha, cell) = tet_rows(&faces, &face_of, &edge_of, &corner_of, darts);
         let mut map = GMap::<3>::from_rows_raw(alpha, cell);
         map.set_id_alloc_raw(1, edges, Vec::new());
         map.set_id_alloc_raw(2, face_count, Vec::new());
         map.set_id_alloc_raw(3, tets.len() as u32, Vec::new());
         let mut report = vertex_report(&orbits_of);
         map.set_id_alloc_raw(0, vertex_ids, report.unreferenced_points.clone());
-        report.split_edges = split_edges(edge_points(tets, &edge_of, edges));
+        report.split_edges = split_edges(edge_keys);
         map.after_build();
         Ok((map, report))
+    }
+}
+
+/// An internal order in which the labelling union-finds visit the tets, with the face matching
+/// renumbered into it: tet at sweep position s is `tet_at[s]`, and `faces` is the [`FaceMatch`]
+/// of the tets in that order (partner faces as 4·position + local face). A breadth-first walk
+/// over shared faces puts the neighbours of a tet at nearby positions, so the union-find forests
+/// are read in a small window even when the input order is scattered (a mesh file whose tets
+/// and points are numbered at random); the ids do not depend on it.
+struct SweepOrder {
+    /// The tet at each sweep position.
+    tet_at: Vec<u32>,
+    /// The face matching in sweep positions.
+    faces: FaceMatch,
+}
+
+/// A face link is "far" when its two tets are more than this many positions apart.
+const FAR_LINK: usize = 4096;
+
+impl SweepOrder {
+    /// The breadth-first sweep order when `forced` asks for it (`Some(true)`), or, with `None`,
+    /// when more than a quarter of a sample of the face links are far in the input order; `None`
+    /// means "sweep in input order". O(tets).
+    fn choose(faces: &FaceMatch, forced: Option<bool>) -> Option<SweepOrder> {
+        let scattered = || {
+            let (mut links, mut far) = (0usize, 0usize);
+            for tf in (0..faces.link.len()).step_by(7) {
+                let g = faces.link[tf].0;
+                if g != NO_FACE {
+                    links += 1;
+                    far += usize::from((g as usize / 4).abs_diff(tf / 4) > FAR_LINK);
+                }
+            }
+            far * 4 > links
+        };
+        forced.unwrap_or_else(scattered).then(|| Self::breadth_first(faces))
+    }
+
+    /// Tets in breadth-first order over shared faces (each component started at its first tet
+    /// in input order), and the face matching renumbered. Each tet's partners are read once,
+    /// when it leaves the queue. O(tets).
+    fn breadth_first(faces: &FaceMatch) -> SweepOrder {
+        let n = faces.link.len() / 4;
+        let mut position = vec![u32::MAX; n];
+        let mut tet_at: Vec<u32> = Vec::with_capacity(n);
+        let mut link = vec![(NO_FACE, 0u8); 4 * n];
+        let mut head = 0;
+        for seed in 0..n {
+            if position[seed] != u32::MAX {
+                continue;
+            }
+            position[seed] = tet_at.len() as u32;
+            tet_at.push(seed as u32);
+            while head < tet_at.len() {
+                let t = tet_at[head] as usize;
+                for f in 0..4 {
+                    let (g, map) = faces.link[t * 4 + f];
+                    if g == NO_FACE {
+                        continue;
+                    }
+                    let tg = g as usize / 4;
+                    if position[tg] == u32::MAX {
+                        position[tg] = tet_at.len() as u32;
+                        tet_at.push(tg as u32);
+                    }
+                    link[head * 4 + f] = (position[tg] * 4 + g % 4, map);
+                }
+                head += 1;
+            }
+        }
+        SweepOrder { tet_at, faces: FaceMatch { link } }
     }
 }
 
@@ -237,6 +311,9 @@ const NO_FACE: u32 = u32::MAX;
 
 /// Marks "no related item" in the lists of `label_orbits`.
 const NONE_ITEM: u32 = u32::MAX;
+
+/// Marks a root's slot in `label_orbits`' forest (items and keys stay below 2^30: darts < 2^32).
+const TAG: u32 = 1 << 31;
 
 /// The flag k of a face with (vertex, other end of its edge) = (local corners v, o): the inverse
 /// of (FLAG_VERTEX, FLAG_OTHER). The diagonal is unused.
@@ -297,11 +374,11 @@ fn items_by_first_dart(count: usize, item_of_dart: impl Fn(usize) -> usize) -> V
 /// points (`NO_FACE` on the boundary), and where each local corner of t lands in the partner's
 /// tet. With the corner map, sewing and labelling never read the partner tet's points.
 struct FaceMatch {
-    /// The partner tet face of every tet face, or `NO_FACE`.
-    partner: Vec<u32>,
-    /// Two bits per local corner v ≠ f of tet t: the local corner of the partner's tet that
-    /// carries the same point (0 for boundary faces and for v = f).
-    corner_map: Vec<u8>,
+    /// For every tet face 4t + f: the partner tet face (or `NO_FACE`), and the corner map: two
+    /// bits per local corner v ≠ f of t, the local corner of the partner's tet that carries the
+    /// same point (0 for boundary faces and for v = f). One pair per face, so that both are
+    /// read from one cache line.
+    link: Vec<(u32, u8)>,
 }
 
 impl FaceMatch {
@@ -309,8 +386,8 @@ impl FaceMatch {
     /// corner of the partner's tet with the same point; `None` on the boundary.
     #[inline(always)]
     fn across(&self, tf: usize) -> Option<(u32, u8)> {
-        let g = self.partner[tf];
-        (g != NO_FACE).then(|| (g, self.corner_map[tf]))
+        let (g, map) = self.link[tf];
+        (g != NO_FACE).then_some((g, map))
     }
 
     /// α3 of the six darts 6·tf + j of tet face tf: themselves on the boundary, else the dart of
@@ -371,24 +448,25 @@ fn match_tet_faces(points: usize, tets: &[[u32; 4]]) -> Result<FaceMatch, BuildE
             fill[a as usize] += 1;
         }
     }
-    let mut partner = vec![NO_FACE; tets.len() * 4];
-    let mut corner_map = vec![0u8; tets.len() * 4];
+    let mut link = vec![(NO_FACE, 0u8); tets.len() * 4];
     // (third face, points, first face, second face) of the earliest face seen three times.
     let mut third: Option<(u32, [u32; 3], u32, u32)> = None;
     for a in 0..points {
         let faces = &mut bucket[start[a] as usize..start[a + 1] as usize];
-        faces.sort_unstable();
+        // Faces were bucketed in increasing tet-face order: a stable sort by points keeps it.
+        faces.sort_by_key(|x| x.0);
         for run in faces.chunk_by(|x, y| x.0 == y.0) {
             match run {
                 [_] => {}
                 [(_, f1, c1), (_, f2, c2)] => {
-                    partner[*f1 as usize] = *f2;
-                    partner[*f2 as usize] = *f1;
+                    let (mut m1, mut m2) = (0u8, 0u8);
                     for i in 0..3 {
                         let (v1, v2) = ((c1 >> (2 * i)) & 3, (c2 >> (2 * i)) & 3);
-                        corner_map[*f1 as usize] |= v2 << (2 * v1);
-                        corner_map[*f2 as usize] |= v1 << (2 * v2);
+                        m1 |= v2 << (2 * v1);
+                        m2 |= v1 << (2 * v2);
                     }
+                    link[*f1 as usize] = (*f2, m1);
+                    link[*f2 as usize] = (*f1, m2);
                 }
                 [(bc, f1, _), (_, f2, _), (_, f3, _), ..] => {
                     if third.is_none_or(|w| *f3 < w.0) {
@@ -400,7 +478,7 @@ fn match_tet_faces(points: usize, tets: &[[u32; 4]]) -> Result<FaceMatch, BuildE
         }
     }
     match third {
-        None => Ok(FaceMatch { partner, corner_map }),
+        None => Ok(FaceMatch { link }),
         Some((f3, points, f1, f2)) => Err(BuildError::NonManifold {
             what: "face",
             points: points.to_vec(),
@@ -411,10 +489,10 @@ fn match_tet_faces(points: usize, tets: &[[u32; 4]]) -> Result<FaceMatch, BuildE
 
 /// Face ids of every tet face in order of first appearance (a matched pair shares the id of its
 /// first face), and the number of faces. O(tets).
-fn number_tet_faces(partner: &[u32]) -> (Vec<u32>, u32) {
-    let mut face_of = vec![0u32; partner.len()];
+fn number_tet_faces(link: &[(u32, u8)]) -> (Vec<u32>, u32) {
+    let mut face_of = vec![0u32; link.len()];
     let mut faces = 0u32;
-    for (tf, &other) in partner.iter().enumerate() {
+    for (tf, &(other, _)) in link.iter().enumerate() {
         if other == NO_FACE || other as usize > tf {
             face_of[tf] = faces;
             faces += 1;
@@ -425,49 +503,124 @@ fn number_tet_faces(partner: &[u32]) -> (Vec<u32>, u32) {
     (face_of, faces)
 }
 
+/// The α rows and cell rows of all darts (dart 24t + 6f + j: tet t, face f, flag j), written
+/// once, in order, from the face matching and the face, edge and vertex ids of every (tet,
+/// local item) in input order. O(darts).
+fn tet_rows(
+    faces: &FaceMatch,
+    face_of: &[u32],
+    edge_of: &[u32],
+    corner_of: &[u32],
+    darts: usize,
+) -> (Vec<u32>, Vec<u32>) {
+    let mut alpha = Vec::with_capacity(darts * 4);
+    let mut cell = Vec::with_capacity(darts * 4);
+    for t in 0..darts / 24 {
+        let base = (t * 24) as u32;
+        let (corners, edges_of_t) = (&corner_of[t * 4..t * 4 + 4], &edge_of[t * 6..t * 6 + 6]);
+        for f in 0..4 {
+            let (tf, face) = (t * 4 + f, face_of[t * 4 + f]);
+            for (j, &a3) in faces.alpha3(tf).iter().enumerate() {
+                let k = f * 6 + j;
+                let [a0, a1, a2] = TET_LINKS[k];
+                alpha.extend_from_slice(&[base + a0, base + a1, base + a2, a3]);
+                let v = corners[TET.vertex[k] as usize];
+                let e = edges_of_t[TET_DART_EDGE[k] as usize];
+                cell.extend_from_slice(&[v, e, face, t as u32]);
+            }
+        }
+    }
+    (alpha, cell)
+}
+
 /// Labels `per_tet` local items of every tet (edges or corners) by the orbits of a relation
-/// that joins items of tets sharing a face. `neighbours(t, item)` lists the related items of
-/// earlier tets (`NONE_ITEM` for none; each relation is met once, from its later tet).
+/// that joins items of tets sharing a face, with the tets visited in a sweep order (`tet_at(s)`
+/// is the tet at sweep position s; items are numbered `s · per_tet + item`).
+/// `neighbours(s, item)` lists the related items at earlier sweep positions (`NONE_ITEM` for
+/// none; each relation is met once, from its later position).
 ///
-/// A union-find forest over the items is built in one sweep, each item joining the trees of
-/// its related items below it (roots are the smallest item of their tree, so the root of an
-/// orbit is its item in its first tet); then items are visited
-/// tet by tet, in `order` within a tet, and `new_id(item)` names each orbit at its root. Since
-/// an orbit has at most one item per tet, this numbers orbits exactly as a flood started at each
-/// unlabelled item in that visiting order would. Returns the id of every item. O(items · α).
+/// A union-find forest over the swept items is built in one sweep, each item joining the trees
+/// of its related items below it (roots are the smallest swept item of their tree). Each orbit
+/// then gets the smallest input key `tet · per_tet + rank` of its items (`rank` = place of the
+/// item in `order`), and orbits are named by `new_id(tet, item)` in increasing key order, i.e.
+/// tet by tet in input order, in `order` within a tet. Since an orbit has at most one item per
+/// tet, this numbers orbits exactly as a flood started at each unlabelled item in that visiting
+/// order would, whatever the sweep order. Returns the id of every item `tet · per_tet + item`
+/// (input order). O(items · α).
 fn label_orbits(
     tets: usize,
     per_tet: usize,
     order: &[usize],
+    tet_at: impl Fn(usize) -> usize,
     neighbours: impl Fn(usize, usize) -> [u32; 3],
-    mut new_id: impl FnMut(usize) -> u32,
+    mut new_id: impl FnMut(usize, usize) -> u32,
 ) -> Vec<u32> {
-    let mut forest: Vec<u32> = (0..(tets * per_tet) as u32).collect();
-    for t in 0..tets {
+    let items = tets * per_tet;
+    let mut forest: Vec<u32> = (0..items as u32).collect();
+    for s in 0..tets {
         for item in 0..per_tet {
-            let x = (t * per_tet + item) as u32;
+            let x = (s * per_tet + item) as u32;
             // NONE_ITEM is never below x, so it is skipped.
-            join_with_smaller(&mut forest, x, &neighbours(t, item), &[0, 1, 2]);
+            join_with_smaller(&mut forest, x, &neighbours(s, item), &[0, 1, 2]);
         }
     }
-    let mut label = vec![u32::MAX; tets * per_tet];
-    for t in 0..tets {
-        for &item in order {
-            let x = t * per_tet + item;
-            let root = find_root(&mut forest, x as u32) as usize;
-            label[x] = if root == x { new_id(x) } else { label[root] };
+    let mut rank = [0u32; 6];
+    for (r, &item) in order.iter().enumerate() {
+        rank[item] = r as u32;
+    }
+    // Every root's slot becomes TAG | the smallest input key of its orbit, every other slot its
+    // root. Slots point to smaller items and the items below x already point to their root or
+    // are tagged roots, so one step from x finds its root.
+    let mut roots = vec![0u64; items.div_ceil(64)];
+    for s in 0..tets {
+        let key = (tet_at(s) * per_tet) as u32;
+        for (item, &r) in rank[..per_tet].iter().enumerate() {
+            let (x, k) = (s * per_tet + item, key + r);
+            let parent = forest[x] as usize;
+            if parent == x {
+                forest[x] = TAG | k;
+                roots[x / 64] |= 1 << (x % 64);
+            } else {
+                let root = if forest[parent] & TAG != 0 { parent } else { forest[parent] as usize };
+                forest[x] = root as u32;
+                forest[root] = forest[root].min(TAG | k);
+            }
+        }
+    }
+    let is_root = |x: usize| roots[x / 64] >> (x % 64) & 1 != 0;
+    // The root of the orbit whose smallest key is k, at k; then ids in increasing key order,
+    // each written in its root's slot.
+    let mut root_at_key = vec![NONE_ITEM; items];
+    for (x, &slot) in forest.iter().enumerate() {
+        if is_root(x) {
+            root_at_key[(slot & !TAG) as usize] = x as u32;
+        }
+    }
+    for (key, &root) in root_at_key.iter().enumerate() {
+        if root != NONE_ITEM {
+            forest[root as usize] = new_id(key / per_tet, order[key % per_tet]);
+        }
+    }
+    // The ids in input order, written over the key table (whose index space is the input's).
+    let mut label = root_at_key;
+    for s in 0..tets {
+        let (t, x) = (tet_at(s) * per_tet, s * per_tet);
+        for item in 0..per_tet {
+            let slot = forest[x + item];
+            label[t + item] = if is_root(x + item) { slot } else { forest[slot as usize] };
         }
     }
     label
 }
 
-/// Edge ids of every (tet, local edge) pair: the edge orbits ⟨α0, α2, α3⟩ of the built map
-/// (tet edges joined across shared faces), numbered as a flood over darts in increasing order
-/// would. Returns the ids (6 per tet) and the number of edges. O(tets · α).
-fn label_tet_edges(faces: &FaceMatch) -> (Vec<u32>, u32) {
-    let tets = faces.partner.len() / 4;
+/// Edge ids of every (tet, local edge) pair: the edge orbits ⟨α0, α2, α3⟩ of the built
+/// map (tet edges joined across shared faces), numbered as a flood over darts in increasing
+/// order would. `faces` is the face matching in sweep positions, `tet_at` the tet at each.
+/// Returns the ids (6 per tet, input order), the number of edges and the sorted point pair of every
+/// edge id packed in a u64. O(tets · α).
+fn label_tet_edges(tets: &[[u32; 4]], faces: &FaceMatch, tet_at: impl Fn(usize) -> usize) -> (Vec<u32>, u32, Vec<u64>) {
     let order = items_by_first_dart(6, |k| TET_DART_EDGE[k] as usize);
-    let mut next = 0u32;
+    let mut keys: Vec<u64> = Vec::new();
     let neighbours = |t: usize, e: usize| {
         let [u, w] = TET_EDGES[e];
         let mut out = [NONE_ITEM; 3];
@@ -481,15 +634,28 @@ fn label_tet_edges(faces: &FaceMatch) -> (Vec<u32>, u32) {
         }
         out
     };
-    let label = label_orbits(tets, 6, &order, neighbours, |_| (next, next += 1).0);
-    (label, next)
+    let new_id = |t: usize, e: usize| {
+        let [u, w] = TET_EDGES[e];
+        let [a, b] = sorted([tets[t][u], tets[t][w]]);
+        keys.push((u64::from(a) << 32) | u64::from(b));
+        keys.len() as u32 - 1
+    };
+    let label = label_orbits(tets.len(), 6, &order, tet_at, neighbours, new_id);
+    let edges = keys.len() as u32;
+    (label, edges, keys)
 }
 
-/// Vertex ids of every (tet, corner) pair: the vertex orbits ⟨α1, α2, α3⟩ (tet corners joined
-/// across shared faces); the first orbit of point p gets id p, any further one a fresh id, in
-/// the order of a flood over darts in increasing order. Returns the ids (4 per tet), the id
-/// bound, and the number of orbits of each point. O(tets · α + points).
-fn label_tet_corners(points: usize, tets: &[[u32; 4]], faces: &FaceMatch) -> (Vec<u32>, u32, Vec<usize>) {
+/// Vertex ids of every (tet, corner) pair: the vertex orbits ⟨α1, α2, α3⟩ (tet corners
+/// joined across shared faces); the first orbit of point p gets id p, any further one a fresh
+/// id, in the order of a flood over darts in increasing order. `faces` and `tet_at` as for
+/// [`label_tet_edges`]. Returns the ids (4 per tet, input order), the id bound, and the number of
+/// orbits of each point. O(tets · α + points).
+fn label_tet_corners(
+    points: usize,
+    tets: &[[u32; 4]],
+    faces: &FaceMatch,
+    tet_at: impl Fn(usize) -> usize,
+) -> (Vec<u32>, u32, Vec<usize>) {
     let order = items_by_first_dart(4, |k| TET.vertex[k] as usize);
     let mut orbits_of = vec![0usize; points];
     let mut next = points as u32;
@@ -505,8 +671,8 @@ fn label_tet_corners(points: usize, tets: &[[u32; 4]], faces: &FaceMatch) -> (Ve
         }
         out
     };
-    let new_id = |x: usize| {
-        let p = tets[x / 4][x % 4];
+    let new_id = |t: usize, v: usize| {
+        let p = tets[t][v];
         orbits_of[p as usize] += 1;
         if orbits_of[p as usize] == 1 {
             p
@@ -514,35 +680,35 @@ fn label_tet_corners(points: usize, tets: &[[u32; 4]], faces: &FaceMatch) -> (Ve
             (next, next += 1).0
         }
     };
-    let label = label_orbits(tets.len(), 4, &order, neighbours, new_id);
+    let label = label_orbits(tets.len(), 4, &order, tet_at, neighbours, new_id);
     (label, next, orbits_of)
 }
 
-/// The sorted point pair of every edge id, from the per-(tet, local edge) ids.
-fn edge_points(tets: &[[u32; 4]], edge_of: &[u32], edges: u32) -> Vec<u64> {
-    let mut keys = vec![u64::MAX; edges as usize];
-    for (node, &id) in edge_of.iter().enumerate() {
-        if keys[id as usize] == u64::MAX {
-            let [u, w] = TET_EDGES[node % 6];
-            let [a, b] = sorted([tets[node / 6][u], tets[node / 6][w]]);
-            keys[id as usize] = (u64::from(a) << 32) | u64::from(b);
-        }
+/// Point pairs carried by more than one edge, in increasing order, from the packed pair
+/// `a << 32 | b` (a < b) of every edge: pairs bucketed by their first point (a counting sort),
+/// then each bucket's second points sorted. O(E + points) and the sorts of the small buckets.
+fn split_edges(keys: Vec<u64>) -> Vec<([u32; 2], usize)> {
+    let first = |key: u64| (key >> 32) as usize;
+    let points = keys.iter().map(|&key| first(key) + 1).max().unwrap_or(0);
+    let mut start = vec![0u32; points + 1];
+    for &key in &keys {
+        start[first(key) + 1] += 1;
     }
-    keys
-}
-
-/// Point pairs carried by more than one edge, from the packed pair of every edge. O(E log E).
-fn split_edges(mut keys: Vec<u64>) -> Vec<([u32; 2], usize)> {
-    keys.sort_unstable();
+    for a in 0..points {
+        start[a + 1] += start[a];
+    }
+    let mut fill = start.clone();
+    let mut second = vec![0u32; keys.len()];
+    for &key in &keys {
+        second[fill[first(key)] as usize] = key as u32;
+        fill[first(key)] += 1;
+    }
     let mut out: Vec<([u32; 2], usize)> = Vec::new();
-    for w in keys.windows(2) {
-        if w[0] == w[1] {
-            let pair = [(w[0] >> 32) as u32, w[0] as u32];
-            match out.last_mut() {
-                Some(last) if last.0 == pair => last.1 += 1,
-                _ => out.push((pair, 2)),
-            }
-        }
+    for a in 0..points {
+        let bucket = &mut second[start[a] as usize..start[a + 1] as usize];
+        bucket.sort_unstable();
+        let repeated = bucket.chunk_by(|x, y| x == y).filter(|run| run.len() > 1);
+        out.extend(repeated.map(|run| ([a as u32, run[0]], run.len())));
     }
     out
 }
@@ -687,5 +853,83 @@ impl<const N: usize> GMap<N> {
         if let Err(e) = self.validate() {
             panic!("topomech bug: a built map is invalid: {e}");
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::generate::{kuhn_cube, SplitMix64};
+
+    /// Kuhn cube k with about `percent` % of its tets removed (pinched vertices and split edges
+    /// appear), in a shuffled order when `shuffle` (far face links in the input order).
+    fn damaged_cube(k: usize, percent: usize, shuffle: bool) -> (usize, Vec<[u32; 4]>) {
+        let (points, tets) = kuhn_cube(k);
+        let mut rng = SplitMix64(k as u64 * 1000 + percent as u64);
+        let mut kept: Vec<[u32; 4]> = tets.into_iter().filter(|_| rng.below(100) >= percent).collect();
+        if shuffle {
+            for i in (1..kept.len()).rev() {
+                kept.swap(i, rng.below(i + 1));
+            }
+        }
+        (points.len(), kept)
+    }
+
+    /// Every α link and cell id of every dart, each id allocator (next, free list), the report.
+    type Everything = (Vec<u32>, Vec<(u32, Vec<u32>)>, BuildReport);
+
+    fn everything(built: &(GMap<3>, BuildReport)) -> Everything {
+        let (map, report) = built;
+        let rows =
+            map.darts().flat_map(|d| (0..=3).flat_map(move |i| [map.alpha_dyn(i, d).0, map.cell_id(i, d).0])).collect();
+        let allocs = (0..=3).map(|i| (map.id_alloc_raw(i).0, map.id_alloc_raw(i).1.to_vec())).collect();
+        (rows, allocs, report.clone())
+    }
+
+    #[test]
+    fn the_breadth_first_sweep_builds_the_same_map_as_the_input_order_sweep() {
+        let mut pinched = 0;
+        for (k, percent, shuffle) in [(3, 0, true), (3, 40, true), (5, 60, false), (6, 30, true), (6, 80, true)] {
+            let (points, tets) = damaged_cube(k, percent, shuffle);
+            let darts = tets.len() * 24;
+            let input = GMap::<3>::from_tets_swept(points, &tets, darts, Some(false)).unwrap();
+            let swept = GMap::<3>::from_tets_swept(points, &tets, darts, Some(true)).unwrap();
+            assert_eq!(everything(&input), everything(&swept), "k = {k}, -{percent} %, shuffled {shuffle}");
+            pinched += input.1.pinched_vertices.len() + input.1.split_edges.len();
+        }
+        assert!(pinched > 0, "the inputs exercise fresh vertex ids and split edges");
+    }
+
+    #[test]
+    fn the_breadth_first_order_is_a_permutation_and_renumbers_the_face_matching() {
+        let (points, tets) = damaged_cube(4, 50, true);
+        let faces = match_tet_faces(points, &tets).unwrap();
+        let sweep = SweepOrder::breadth_first(&faces);
+        let mut seen = sweep.tet_at.clone();
+        seen.sort_unstable();
+        assert_eq!(seen, (0..tets.len() as u32).collect::<Vec<_>>());
+        let mut position = vec![0u32; tets.len()];
+        for (s, &t) in sweep.tet_at.iter().enumerate() {
+            position[t as usize] = s as u32;
+        }
+        for (s, &t) in sweep.tet_at.iter().enumerate() {
+            for f in 0..4 {
+                let (g, map) = faces.link[t as usize * 4 + f];
+                let expected = if g == NO_FACE { NO_FACE } else { position[g as usize / 4] * 4 + g % 4 };
+                assert_eq!(sweep.faces.link[s * 4 + f], (expected, map), "tet {t} face {f}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_sweep_order_is_breadth_first_only_on_scattered_input() {
+        let (points, tets) = damaged_cube(12, 0, false);
+        let faces = match_tet_faces(points, &tets).unwrap();
+        assert!(SweepOrder::choose(&faces, None).is_none(), "generation order is local");
+        assert!(SweepOrder::choose(&faces, Some(true)).is_some());
+        let (points, tets) = damaged_cube(12, 0, true);
+        let faces = match_tet_faces(points, &tets).unwrap();
+        assert!(SweepOrder::choose(&faces, None).is_some(), "a shuffled order is scattered");
+        assert!(SweepOrder::choose(&faces, Some(false)).is_none());
     }
 }

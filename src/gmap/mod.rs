@@ -37,7 +37,7 @@ pub use mask::AlphaMask;
 pub use sew::{CellChange, CellChanges, SewError, SplitSides};
 pub use validate::{InvariantViolation, Law};
 
-pub(crate) use orbit::{find_root, join_with_smaller, with_stamps};
+pub(crate) use orbit::{join_with_smaller, with_stamps};
 
 use dart::NONE;
 

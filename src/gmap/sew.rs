@@ -165,7 +165,7 @@ pub struct CellChanges {
 }
 
 /// The darts of the new side of the splits an unsew found by walking (the lockstep walk of
-/// [`GMap::split_side`] lists the new side, the smaller one, before relabelling it): handed on
+/// `GMap::split_side` lists the new side, the smaller one, before relabelling it): handed on
 /// so that the rules and the projection records need not walk that cell again. Splits settled
 /// without a walk (cheap proofs, small cells) have no entry. A by-product of how the kernel
 /// found the splits, not part of the outcome: [`CellChanges`]' equality ignores it.

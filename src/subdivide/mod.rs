@@ -55,7 +55,7 @@ pub const MAX_LEVEL: u8 = 250;
 
 /// The edge cells of one vertex insertion ([`LeveledMap::edge_split_log`]): the edge with cell id
 /// `edge` joining `ends[0]` and `ends[1]` was split at the new vertex `vertex`; afterwards the half
-/// (ends[0], vertex) has edge id `halves[0]` and the half (vertex, ends[1]) has `halves[1]`. One of
+/// `(ends[0], vertex)` has edge id `halves[0]` and the half `(vertex, ends[1])` has `halves[1]`. One of
 /// the halves keeps `edge` (the relabelling keeps an old id when it can), the other gets a fresh id.
 /// Edge ids, unlike vertex pairs, tell apart two edges joining the same two vertices (a cut edge
 /// whose ends stayed joined).

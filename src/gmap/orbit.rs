@@ -132,6 +132,8 @@ impl<const N: usize> GMap<N> {
         let gens = &gens[..len];
         let mut out = vec![d];
         let mut head = 0;
+        // The filter of `Lockstep`: a clear bit proves y absent and skips the scan.
+        let mut seen = Lockstep::bit(d);
         while head < out.len() {
             if out.len() > LINEAR_LIMIT {
                 self.orbit_stamped(&mut out, head, gens);
@@ -142,7 +144,8 @@ impl<const N: usize> GMap<N> {
             let row = self.alpha_row(x.0);
             for &i in gens {
                 let y = DartId(row[i]);
-                if y != x && !out.contains(&y) {
+                if y != x && (seen & Lockstep::bit(y) == 0 || !out.contains(&y)) {
+                    seen |= Lockstep::bit(y);
                     out.push(y);
                 }
             }
@@ -217,27 +220,37 @@ impl<const N: usize> GMap<N> {
             return None;
         }
         let (gens, len) = generators(N, mask);
-        let gens = &gens[..len];
-        let mut walk = Lockstep { queue: [Vec::with_capacity(16), Vec::with_capacity(16)], head: [0, 0] };
-        walk.queue[0].push(a);
-        walk.queue[1].push(b);
+        let [mut q0, mut q1] = LOCKSTEP_QUEUES.take();
+        q0.clear();
+        q1.clear();
+        let mut walk = Lockstep { queue: [q0, q1], head: [0, 0], seen: [0; 2] };
+        let out = self.lockstep(a, b, &gens[..len], &mut walk).map(|side| (walk.queue[side].clone(), side == 1));
+        LOCKSTEP_QUEUES.set(walk.queue);
+        out
+    }
+
+    /// The walk of [`GMap::split_side`] on the empty queues of `walk`: the exhausted side, or
+    /// `None` if the walks met.
+    fn lockstep(&self, a: DartId, b: DartId, gens: &[usize], walk: &mut Lockstep) -> Option<usize> {
+        walk.push(0, a);
+        walk.push(1, b);
         loop {
             if walk.queue[0].len() + walk.queue[1].len() > LINEAR_LIMIT {
                 return with_stamps(|stamps| walk.finish_stamped(self, gens, stamps));
             }
             for side in 0..2 {
-                let Some(x) = walk.next(side) else { return Some(walk.take(side)) };
+                let Some(x) = walk.next(side) else { return Some(side) };
                 let row = self.alpha_row(x.0);
                 for &i in gens {
                     let y = DartId(row[i]);
                     if y == x {
                         continue;
                     }
-                    if walk.queue[1 - side].contains(&y) {
+                    if walk.holds(1 - side, y) {
                         return None;
                     }
-                    if !walk.queue[side].contains(&y) {
-                        walk.queue[side].push(y);
+                    if !walk.holds(side, y) {
+                        walk.push(side, y);
                     }
                 }
             }
@@ -571,14 +584,43 @@ impl TetWords {
     }
 }
 
+thread_local! {
+    /// The two queues of [`GMap::split_side`], kept per thread between walks (no allocation in
+    /// the steady state but the copy of a split's side; cleared before use).
+    static LOCKSTEP_QUEUES: std::cell::Cell<[Vec<DartId>; 2]> = const { std::cell::Cell::new([Vec::new(), Vec::new()]) };
+}
+
 /// The state of [`GMap::split_side`]: two breadth-first walks, each queue holding every dart its
 /// side has found (so the queues are also the visited sets while they are small).
 struct Lockstep {
     queue: [Vec<DartId>; 2],
     head: [usize; 2],
+    /// Per side, a 64-bit filter of the queued darts (bit [`Lockstep::bit`] of each): a clear
+    /// bit proves a dart absent, so most membership tests of the linear phase skip the scan.
+    /// A set bit proves nothing (the scan decides), so the answers are those of the plain scan.
+    seen: [u64; 2],
 }
 
 impl Lockstep {
+    /// The filter bit of dart `d` (a multiplicative hash: the top six bits of d · φ·2³²).
+    #[inline(always)]
+    fn bit(d: DartId) -> u64 {
+        1 << (d.0.wrapping_mul(0x9E37_79B9) >> 26)
+    }
+
+    /// Queues `d` on `side` (linear phase).
+    #[inline]
+    fn push(&mut self, side: usize, d: DartId) {
+        self.seen[side] |= Self::bit(d);
+        self.queue[side].push(d);
+    }
+
+    /// Whether `d` is queued on `side` (linear phase): the filter, then the scan. O(queue).
+    #[inline]
+    fn holds(&self, side: usize, d: DartId) -> bool {
+        self.seen[side] & Self::bit(d) != 0 && self.queue[side].contains(&d)
+    }
+
     /// The next dart of `side` to expand, or `None` if that side is exhausted.
     #[inline]
     fn next(&mut self, side: usize) -> Option<DartId> {
@@ -587,19 +629,9 @@ impl Lockstep {
         Some(x)
     }
 
-    /// The exhausted side's darts and whether it is b's (side 1).
-    fn take(&mut self, side: usize) -> (Vec<DartId>, bool) {
-        (std::mem::take(&mut self.queue[side]), side == 1)
-    }
-
     /// Continues the lockstep walk with stamps (tag t for side 0, t + 1 for side 1): the same
     /// visiting order and the same answer as the linear phase would give.
-    fn finish_stamped<const N: usize>(
-        &mut self,
-        map: &GMap<N>,
-        gens: &[usize],
-        stamps: &mut Stamps,
-    ) -> Option<(Vec<DartId>, bool)> {
+    fn finish_stamped<const N: usize>(&mut self, map: &GMap<N>, gens: &[usize], stamps: &mut Stamps) -> Option<usize> {
         let tag = stamps.fresh(map.capacity(), 2);
         for side in 0..2 {
             for &x in &self.queue[side] {
@@ -608,7 +640,7 @@ impl Lockstep {
         }
         loop {
             for side in 0..2 {
-                let Some(x) = self.next(side) else { return Some(self.take(side)) };
+                let Some(x) = self.next(side) else { return Some(side) };
                 let (own, other) = (tag + side as u32, tag + 1 - side as u32);
                 let row = map.alpha_row(x.0);
                 for &i in gens {
@@ -725,6 +757,59 @@ mod tests {
             }
         }
         assert!(large > 0, "no orbit exercised the stamped phase");
+    }
+
+    /// The lockstep walk with plain scans only (no filter, no stamps): the reference for
+    /// [`GMap::split_side`]'s answer, side list order included.
+    fn split_side_reference<const N: usize>(
+        map: &GMap<N>,
+        a: DartId,
+        b: DartId,
+        mask: AlphaMask,
+    ) -> Option<(Vec<DartId>, bool)> {
+        if a == b {
+            return None;
+        }
+        let (mut queue, mut head) = ([vec![a], vec![b]], [0, 0]);
+        loop {
+            for side in 0..2 {
+                let Some(&x) = queue[side].get(head[side]) else { return Some((queue[side].clone(), side == 1)) };
+                head[side] += 1;
+                for i in mask.indices().filter(|&i| i <= N) {
+                    let y = map.alpha_dyn(i, x);
+                    if y == x {
+                        continue;
+                    }
+                    if queue[1 - side].contains(&y) {
+                        return None;
+                    }
+                    if !queue[side].contains(&y) {
+                        queue[side].push(y);
+                    }
+                }
+            }
+        }
+    }
+
+    /// The filtered linear phase and the stamped phase of [`GMap::split_side`] give the plain
+    /// scan's answer: the same side, its darts in the same order, on split and joined pairs of
+    /// every cell dimension (vertex orbits exceed [`LINEAR_LIMIT`]).
+    #[test]
+    fn split_side_is_the_plain_lockstep() {
+        let map = cut_cube();
+        let (mut splits, mut joined) = (0, 0);
+        for dim in 0..=3 {
+            let mask = AlphaMask::cell(3, dim);
+            for d in map.darts().step_by(7) {
+                for e in [map.alpha::<0>(d), map.alpha::<3>(d), DartId((d.0 * 7919) % map.capacity() as u32)] {
+                    let got = map.split_side(d, e, mask);
+                    assert_eq!(got, split_side_reference(&map, d, e, mask), "dim {dim}, {d:?} {e:?}");
+                    splits += usize::from(got.is_some());
+                    joined += usize::from(got.is_none());
+                }
+            }
+        }
+        assert!(splits > 0 && joined > 0);
     }
 
     /// The two-generator walk visits each dart of ⟨αj, αk⟩ once, on cycles (inner edges) and

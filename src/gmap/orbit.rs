@@ -132,8 +132,6 @@ impl<const N: usize> GMap<N> {
         let gens = &gens[..len];
         let mut out = vec![d];
         let mut head = 0;
-        // The filter of `Lockstep`: a clear bit proves y absent and skips the scan.
-        let mut seen = Lockstep::bit(d);
         while head < out.len() {
             if out.len() > LINEAR_LIMIT {
                 self.orbit_stamped(&mut out, head, gens);
@@ -144,8 +142,7 @@ impl<const N: usize> GMap<N> {
             let row = self.alpha_row(x.0);
             for &i in gens {
                 let y = DartId(row[i]);
-                if y != x && (seen & Lockstep::bit(y) == 0 || !out.contains(&y)) {
-                    seen |= Lockstep::bit(y);
+                if y != x && !out.contains(&y) {
                     out.push(y);
                 }
             }
@@ -220,37 +217,27 @@ impl<const N: usize> GMap<N> {
             return None;
         }
         let (gens, len) = generators(N, mask);
-        let [mut q0, mut q1] = LOCKSTEP_QUEUES.take();
-        q0.clear();
-        q1.clear();
-        let mut walk = Lockstep { queue: [q0, q1], head: [0, 0], seen: [0; 2] };
-        let out = self.lockstep(a, b, &gens[..len], &mut walk).map(|side| (walk.queue[side].clone(), side == 1));
-        LOCKSTEP_QUEUES.set(walk.queue);
-        out
-    }
-
-    /// The walk of [`GMap::split_side`] on the empty queues of `walk`: the exhausted side, or
-    /// `None` if the walks met.
-    fn lockstep(&self, a: DartId, b: DartId, gens: &[usize], walk: &mut Lockstep) -> Option<usize> {
-        walk.push(0, a);
-        walk.push(1, b);
+        let gens = &gens[..len];
+        let mut walk = Lockstep { queue: [Vec::with_capacity(16), Vec::with_capacity(16)], head: [0, 0] };
+        walk.queue[0].push(a);
+        walk.queue[1].push(b);
         loop {
             if walk.queue[0].len() + walk.queue[1].len() > LINEAR_LIMIT {
                 return with_stamps(|stamps| walk.finish_stamped(self, gens, stamps));
             }
             for side in 0..2 {
-                let Some(x) = walk.next(side) else { return Some(side) };
+                let Some(x) = walk.next(side) else { return Some(walk.take(side)) };
                 let row = self.alpha_row(x.0);
                 for &i in gens {
                     let y = DartId(row[i]);
                     if y == x {
                         continue;
                     }
-                    if walk.holds(1 - side, y) {
+                    if walk.queue[1 - side].contains(&y) {
                         return None;
                     }
-                    if !walk.holds(side, y) {
-                        walk.push(side, y);
+                    if !walk.queue[side].contains(&y) {
+                        walk.queue[side].push(y);
                     }
                 }
             }
@@ -584,43 +571,14 @@ impl TetWords {
     }
 }
 
-thread_local! {
-    /// The two queues of [`GMap::split_side`], kept per thread between walks (no allocation in
-    /// the steady state but the copy of a split's side; cleared before use).
-    static LOCKSTEP_QUEUES: std::cell::Cell<[Vec<DartId>; 2]> = const { std::cell::Cell::new([Vec::new(), Vec::new()]) };
-}
-
 /// The state of [`GMap::split_side`]: two breadth-first walks, each queue holding every dart its
 /// side has found (so the queues are also the visited sets while they are small).
 struct Lockstep {
     queue: [Vec<DartId>; 2],
     head: [usize; 2],
-    /// Per side, a 64-bit filter of the queued darts (bit [`Lockstep::bit`] of each): a clear
-    /// bit proves a dart absent, so most membership tests of the linear phase skip the scan.
-    /// A set bit proves nothing (the scan decides), so the answers are those of the plain scan.
-    seen: [u64; 2],
 }
 
 impl Lockstep {
-    /// The filter bit of dart `d` (a multiplicative hash: the top six bits of d · φ·2³²).
-    #[inline(always)]
-    fn bit(d: DartId) -> u64 {
-        1 << (d.0.wrapping_mul(0x9E37_79B9) >> 26)
-    }
-
-    /// Queues `d` on `side` (linear phase).
-    #[inline]
-    fn push(&mut self, side: usize, d: DartId) {
-        self.seen[side] |= Self::bit(d);
-        self.queue[side].push(d);
-    }
-
-    /// Whether `d` is queued on `side` (linear phase): the filter, then the scan. O(queue).
-    #[inline]
-    fn holds(&self, side: usize, d: DartId) -> bool {
-        self.seen[side] & Self::bit(d) != 0 && self.queue[side].contains(&d)
-    }
-
     /// The next dart of `side` to expand, or `None` if that side is exhausted.
     #[inline]
     fn next(&mut self, side: usize) -> Option<DartId> {
@@ -629,9 +587,19 @@ impl Lockstep {
         Some(x)
     }
 
+    /// The exhausted side's darts and whether it is b's (side 1).
+    fn take(&mut self, side: usize) -> (Vec<DartId>, bool) {
+        (std::mem::take(&mut self.queue[side]), side == 1)
+    }
+
     /// Continues the lockstep walk with stamps (tag t for side 0, t + 1 for side 1): the same
     /// visiting order and the same answer as the linear phase would give.
-    fn finish_stamped<const N: usize>(&mut self, map: &GMap<N>, gens: &[usize], stamps: &mut Stamps) -> Option<usize> {
+    fn finish_stamped<const N: usize>(
+        &mut self,
+        map: &GMap<N>,
+        gens: &[usize],
+        stamps: &mut Stamps,
+    ) -> Option<(Vec<DartId>, bool)> {
         let tag = stamps.fresh(map.capacity(), 2);
         for side in 0..2 {
             for &x in &self.queue[side] {
@@ -640,7 +608,7 @@ impl Lockstep {
         }
         loop {
             for side in 0..2 {
-                let Some(x) = self.next(side) else { return Some(side) };
+                let Some(x) = self.next(side) else { return Some(self.take(side)) };
                 let (own, other) = (tag + side as u32, tag + 1 - side as u32);
                 let row = map.alpha_row(x.0);
                 for &i in gens {
@@ -791,8 +759,8 @@ mod tests {
         }
     }
 
-    /// The filtered linear phase and the stamped phase of [`GMap::split_side`] give the plain
-    /// scan's answer: the same side, its darts in the same order, on split and joined pairs of
+    /// The linear phase and the stamped phase of [`GMap::split_side`] give the plain scan's
+    /// answer: the same side, its darts in the same order, on split and joined pairs of
     /// every cell dimension (vertex orbits exceed [`LINEAR_LIMIT`]).
     #[test]
     fn split_side_is_the_plain_lockstep() {

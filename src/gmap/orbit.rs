@@ -727,6 +727,59 @@ mod tests {
         assert!(large > 0, "no orbit exercised the stamped phase");
     }
 
+    /// The lockstep walk with plain scans only (no filter, no stamps): the reference for
+    /// [`GMap::split_side`]'s answer, side list order included.
+    fn split_side_reference<const N: usize>(
+        map: &GMap<N>,
+        a: DartId,
+        b: DartId,
+        mask: AlphaMask,
+    ) -> Option<(Vec<DartId>, bool)> {
+        if a == b {
+            return None;
+        }
+        let (mut queue, mut head) = ([vec![a], vec![b]], [0, 0]);
+        loop {
+            for side in 0..2 {
+                let Some(&x) = queue[side].get(head[side]) else { return Some((queue[side].clone(), side == 1)) };
+                head[side] += 1;
+                for i in mask.indices().filter(|&i| i <= N) {
+                    let y = map.alpha_dyn(i, x);
+                    if y == x {
+                        continue;
+                    }
+                    if queue[1 - side].contains(&y) {
+                        return None;
+                    }
+                    if !queue[side].contains(&y) {
+                        queue[side].push(y);
+                    }
+                }
+            }
+        }
+    }
+
+    /// The linear phase and the stamped phase of [`GMap::split_side`] give the plain scan's
+    /// answer: the same side, its darts in the same order, on split and joined pairs of
+    /// every cell dimension (vertex orbits exceed [`LINEAR_LIMIT`]).
+    #[test]
+    fn split_side_is_the_plain_lockstep() {
+        let map = cut_cube();
+        let (mut splits, mut joined) = (0, 0);
+        for dim in 0..=3 {
+            let mask = AlphaMask::cell(3, dim);
+            for d in map.darts().step_by(7) {
+                for e in [map.alpha::<0>(d), map.alpha::<3>(d), DartId((d.0 * 7919) % map.capacity() as u32)] {
+                    let got = map.split_side(d, e, mask);
+                    assert_eq!(got, split_side_reference(&map, d, e, mask), "dim {dim}, {d:?} {e:?}");
+                    splits += usize::from(got.is_some());
+                    joined += usize::from(got.is_none());
+                }
+            }
+        }
+        assert!(splits > 0 && joined > 0);
+    }
+
     /// The two-generator walk visits each dart of ⟨αj, αk⟩ once, on cycles (inner edges) and
     /// on paths (boundary edges).
     #[test]

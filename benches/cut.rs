@@ -33,7 +33,10 @@ use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use topomech::cut;
-use topomech::generate::{kuhn_cube, SplitMix64};
+#[path = "common/cut_select.rs"]
+mod cut_select;
+
+use topomech::generate::kuhn_cube;
 use topomech::mechanics::{Body, Material, Projection, TouchedCells, Vec3};
 use topomech::DartId;
 
@@ -107,18 +110,7 @@ fn fixture(name: &str, points: &[Vec3], tets: &[[u32; 4]]) -> Fixture {
     let incision = incision_faces(&body, points);
     let projection = Projection::build(&body, G);
     let map = body.map();
-    let mut rng = SplitMix64(547);
-    let mut faces: Vec<DartId> = map.one_dart_per_cell(2).into_iter().filter(|&d| !map.is_free(3, d)).collect();
-    for i in (1..faces.len()).rev() {
-        faces.swap(i, rng.below(i + 1));
-    }
-    faces.truncate(4096);
-    let interior = |d: DartId| map.cell_darts(0, d).iter().all(|&x| !map.is_free(3, x));
-    let mut vertices: Vec<DartId> = map.one_dart_per_cell(0).into_iter().filter(|&d| interior(d)).collect();
-    for i in (1..vertices.len()).rev() {
-        vertices.swap(i, rng.below(i + 1));
-    }
-    vertices.truncate(256);
+    let (faces, vertices) = cut_select::faces_and_vertices(map);
     Fixture { name: name.to_string(), body, projection, faces, vertices, incision, done: Vec::new() }
 }
 

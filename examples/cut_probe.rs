@@ -10,10 +10,11 @@
 use std::path::Path;
 use std::time::{Duration, Instant};
 
+#[path = "../benches/common/cut_select.rs"]
+mod cut_select;
+
 use topomech::cut;
-use topomech::generate::SplitMix64;
 use topomech::mechanics::{Body, Material, Projection, TouchedCells, Vec3};
-use topomech::DartId;
 
 const G: Vec3 = [0.0, 0.0, -9.81];
 
@@ -64,18 +65,7 @@ fn main() {
     let projection = Projection::build(&body, G);
     let map = body.map();
     // The bench's selection: the same seed, the same shuffles.
-    let mut rng = SplitMix64(547);
-    let mut faces: Vec<DartId> = map.one_dart_per_cell(2).into_iter().filter(|&d| !map.is_free(3, d)).collect();
-    for i in (1..faces.len()).rev() {
-        faces.swap(i, rng.below(i + 1));
-    }
-    faces.truncate(4096);
-    let interior = |d: DartId| map.cell_darts(0, d).iter().all(|&x| !map.is_free(3, x));
-    let mut vertices: Vec<DartId> = map.one_dart_per_cell(0).into_iter().filter(|&d| interior(d)).collect();
-    for i in (1..vertices.len()).rev() {
-        vertices.swap(i, rng.below(i + 1));
-    }
-    vertices.truncate(256);
+    let (faces, vertices) = cut_select::faces_and_vertices(map);
     let mut probe = Probe { body, projection, samples: Vec::new() };
     for _ in 0..passes {
         for &d in &faces {

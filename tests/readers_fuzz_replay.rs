@@ -8,11 +8,17 @@ use std::path::Path;
 use topomech::io::fuzz::{check_error_names_path, check_tet_mesh, run_bytes, FUZZ_PATH};
 use topomech::mesh::TetMesh;
 
-#[test]
-fn every_readers_corpus_input_keeps_the_laws() {
+/// The committed corpus files, sorted.
+fn corpus() -> Vec<std::path::PathBuf> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/corpus/readers");
     let mut entries: Vec<_> = std::fs::read_dir(&dir).expect("corpus directory").map(|e| e.unwrap().path()).collect();
     entries.sort();
+    entries
+}
+
+#[test]
+fn every_readers_corpus_input_keeps_the_laws() {
+    let entries = corpus();
     assert!(entries.len() >= 15, "the corpus should hold the seeds at least, found {}", entries.len());
     let (mut accepted, mut rejected) = (0, 0);
     for path in entries {
@@ -34,9 +40,7 @@ fn every_readers_corpus_input_keeps_the_laws() {
 /// only error paths).
 #[test]
 fn every_seed_is_accepted_by_its_reader() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/corpus/readers");
-    for entry in std::fs::read_dir(&dir).unwrap() {
-        let path = entry.unwrap().path();
+    for path in corpus() {
         let name = path.file_name().unwrap().to_string_lossy().to_string();
         if !name.starts_with("seed_") || name == "seed_empty" {
             continue;

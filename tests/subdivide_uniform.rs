@@ -14,7 +14,7 @@
 
 use proptest::prelude::*;
 use topomech::generate::{grid_triangles, kuhn_cube, SplitMix64};
-use topomech::subdivide::{LeveledMap, SubdivideError, TetMasses};
+use topomech::subdivide::{LeveledMap, Refinement, SubdivideError, TetMasses};
 use topomech::{DartId, GMap};
 
 /// The leveled map of `tets` with one position per vertex id (a point whose tets form several
@@ -334,28 +334,29 @@ fn refusals_leave_the_map_unchanged() {
     assert_eq!((open3.to_parts(), masses.mass), (snap, vec![1.0]));
 }
 
-#[test]
-fn refine_around_takes_the_bulk_path_with_the_same_result() {
+/// The Kuhn cube k = 2 refined around a ball by `refine_around` (bulk path when the ball holds
+/// everything) and by `refine_around_per_op`: both maps and both reports.
+fn refine_both_ways(center: [f64; 3], radius: f64, levels: u8) -> [(LeveledMap<3>, Refinement); 2] {
     let (points, tets) = kuhn_cube(2);
     let m = tets_map(points, &tets);
     let (mut a, mut b) = (m.clone(), m);
     let mut ma = TetMasses::from_density(&a, 1.0).unwrap();
     let mut mb = ma.clone();
-    let ra = a.refine_around([0.5; 3], 100.0, 2, &mut ma).unwrap();
-    let rb = b.refine_around_per_op([0.5; 3], 100.0, 2, &mut mb).unwrap();
+    let ra = a.refine_around(center, radius, levels, &mut ma).unwrap();
+    let rb = b.refine_around_per_op(center, radius, levels, &mut mb).unwrap();
+    [(a, ra), (b, rb)]
+}
+
+#[test]
+fn refine_around_takes_the_bulk_path_with_the_same_result() {
+    let [(a, ra), (b, rb)] = refine_both_ways([0.5; 3], 100.0, 2);
     assert_eq!(ra.subdivided_per_level, rb.subdivided_per_level);
     assert!((ra.total_mass_after - rb.total_mass_after).abs() < 1e-12);
     assert_equivalent(&a, &b);
     // A small ball: not every tet, the per-op path; same counts as per-op.
-    let (points, tets) = kuhn_cube(2);
-    let m = tets_map(points, &tets);
-    let (mut a, mut b) = (m.clone(), m);
-    let mut ma = TetMasses::from_density(&a, 1.0).unwrap();
-    let mut mb = ma.clone();
-    let ra = a.refine_around([0.1; 3], 0.2, 1, &mut ma).unwrap();
-    let rb = b.refine_around_per_op([0.1; 3], 0.2, 1, &mut mb).unwrap();
+    let [(_, ra), (_, rb)] = refine_both_ways([0.1; 3], 0.2, 1);
     assert_eq!(ra.subdivided_per_level, rb.subdivided_per_level);
-    assert!(ra.subdivided_per_level[1] < tets.len());
+    assert!(ra.subdivided_per_level[1] < kuhn_cube(2).1.len());
 }
 
 proptest! {

@@ -417,6 +417,9 @@ struct Labelled {
     template: Vec<u8>,
     /// Slot of every old dart in `darts` (parent index · P + flag index), `u32::MAX` if none.
     slot_of: Vec<u32>,
+    /// Per slot: the slot of αn of its dart (its own slot where αn is free), set when the
+    /// later of the two parents is labelled, so that the write pass reads it in slot order.
+    across: Vec<u32>,
     /// Rank of each edge id (first met), `u32::MAX` if none.
     edge_rank: Vec<u32>,
     /// The parent edges by rank, as (vertex id, vertex id).
@@ -463,6 +466,7 @@ impl<const N: usize> LeveledMap<N> {
             darts: Vec::with_capacity(self.map.dart_count()),
             template: Vec::with_capacity(self.map.dart_count() / p),
             slot_of: vec![u32::MAX; cap],
+            across: Vec::with_capacity(self.map.dart_count()),
             edge_rank: vec![u32::MAX; edge_bound],
             edges: Vec::with_capacity(edge_bound),
             edge_ids: Vec::with_capacity(edge_bound),
@@ -503,6 +507,15 @@ impl<const N: usize> LeveledMap<N> {
                 v.sort_unstable();
                 v.dedup();
                 return Err(not_simplex(v.len()));
+            }
+            for (f, &x) in lab.iter().enumerate() {
+                let s = first_slot + f as u32;
+                let y = self.map.alpha_dyn(N, DartId(x)).0;
+                let t = out.slot_of[y as usize];
+                out.across.push(if y == x { s } else { t });
+                if y != x && t != u32::MAX {
+                    out.across[t as usize] = s;
+                }
             }
             out.template.push(if N == 3 { self.diagonal_template(&vids, &lab, t0) } else { 0 });
             self.rank_cells(&lab, t0, &vids, &mut out);
@@ -605,7 +618,7 @@ impl<const N: usize> LeveledMap<N> {
                 if across == old {
                     table.copy_within(own..own + border, half + own);
                 } else {
-                    let q_first = base + lab.slot_of[across as usize] as usize * (per - 1);
+                    let q_first = base + lab.across[parent * p + f] as usize * (per - 1);
                     table[half + own] = across;
                     for k in 1..border {
                         table[half + own + k] = (q_first + k - 1) as u32;
@@ -613,19 +626,23 @@ impl<const N: usize> LeveledMap<N> {
                 }
             }
             // Old darts (slot 0) are rewritten in place; the new ones go to a buffer appended
-            // below in id order.
-            for (s, (g, fc)) in tp.gather.iter().zip(&tp.flat_cell).enumerate() {
-                let (f, k) = (s / per, s % per);
-                let (alpha_row, cell_row) = if k == 0 {
-                    let row = darts[f] as usize * (N + 1);
-                    (&mut alpha[row..row + N + 1], &mut cell[row..row + N + 1])
-                } else {
-                    let row = (f * (per - 1) + k - 1) * (N + 1);
-                    (&mut new_alpha[row..row + N + 1], &mut new_cell[row..row + N + 1])
-                };
+            // below in id order (slot f · per + k at buffer row f · (per − 1) + k − 1).
+            let rows = new_alpha.chunks_exact_mut(N + 1).zip(new_cell.chunks_exact_mut(N + 1));
+            let mut rows = rows.take(fresh);
+            for (f, &old) in darts.iter().enumerate() {
+                let own = f * per;
+                let row = old as usize * (N + 1);
+                let (g, fc) = (&tp.gather[own], &tp.flat_cell[own]);
                 for i in 0..=N {
-                    alpha_row[i] = table[g[i] as usize];
-                    cell_row[i] = ids[fc[i] as usize];
+                    alpha[row + i] = table[g[i] as usize];
+                    cell[row + i] = ids[fc[i] as usize];
+                }
+                for (s, (alpha_row, cell_row)) in (own + 1..own + per).zip(rows.by_ref()) {
+                    let (g, fc) = (&tp.gather[s], &tp.flat_cell[s]);
+                    for i in 0..=N {
+                        alpha_row[i] = table[g[i] as usize];
+                        cell_row[i] = ids[fc[i] as usize];
+                    }
                 }
             }
             for (&old, &alpha0) in darts.iter().zip(&old_alpha0) {
@@ -870,3 +887,4 @@ fn grow_exact<T: Clone>(v: &mut Vec<T>, len: usize, value: T) {
         v.resize(len, value);
     }
 }
+

@@ -55,6 +55,7 @@ impl LinkHistory {
 
     /// Appends a change to dart slot `d`'s list. O(changes of d), plus amortized O(1) per slot
     /// when d is past the allocated heads.
+    #[inline]
     pub(super) fn push(&mut self, d: usize, change: LinkChange) {
         if d >= self.head.len() {
             self.head.resize(d + 1, NONE);

@@ -887,4 +887,3 @@ fn grow_exact<T: Clone>(v: &mut Vec<T>, len: usize, value: T) {
         v.resize(len, value);
     }
 }
-

@@ -14,7 +14,7 @@ use std::time::Instant;
 
 #[path = "common/cpu_time.rs"]
 mod cpu_time;
-use cpu_time::thread_cpu_seconds;
+use cpu_time::{thread_cpu_seconds, thread_stat, ThreadStat};
 
 use topomech::generate::kuhn_cube;
 use topomech::subdivide::{LeveledMap, TetMasses};
@@ -26,6 +26,7 @@ fn bench_2d(n: usize, per_op: bool) {
     let (map, _) = GMap::<2>::from_triangles(points.len(), &tris).expect("the grid builds");
     let mut m = LeveledMap::new(map, points);
     let faces = m.map().one_dart_per_cell(2);
+    let st0 = thread_stat();
     let (cpu0, wall0) = (thread_cpu_seconds(), Instant::now());
     if per_op {
         for d in faces {
@@ -35,10 +36,12 @@ fn bench_2d(n: usize, per_op: bool) {
         m.refine_uniform(1).expect("a uniform triangle mesh");
     }
     let (cpu1, wall) = (thread_cpu_seconds(), wall0.elapsed().as_secs_f64());
+    let st1 = thread_stat();
     let cpu = match (cpu0, cpu1) {
         (Some(a), Some(b)) => b - a,
         _ => wall,
     };
+    print_split("refine2d", st0, st1, tris.len(), "triangle");
     m.check_all().expect("every law holds after the refinement");
     let t = tris.len() as f64;
     println!(
@@ -49,6 +52,18 @@ fn bench_2d(n: usize, per_op: bool) {
         1e9 * cpu / t,
         1e9 * wall / t
     );
+}
+
+/// The timed call's user / system split (10 ms ticks) and minor page faults per item, from
+/// `/proc/thread-self/stat` read just outside the CPU clock readings.
+fn print_split(tag: &str, st0: Option<ThreadStat>, st1: Option<ThreadStat>, items: usize, what: &str) {
+    if let (Some(a), Some(b)) = (st0, st1) {
+        let (user, sys, faults) = (b.utime - a.utime, b.stime - a.stime, b.minflt - a.minflt);
+        println!(
+            "[{tag}] split: user {user} ticks, system {sys} ticks, {faults} minor faults ({:.3} per {what})",
+            faults as f64 / items as f64
+        );
+    }
 }
 
 fn main() {
@@ -64,6 +79,7 @@ fn main() {
     let (map, _) = GMap::<3>::from_tets(points.len(), &tets).expect("the Kuhn cube builds");
     let mut m = LeveledMap::new(map, points);
     let mut masses = TetMasses::from_density(&m, 1.0).expect("tets");
+    let st0 = thread_stat();
     let (cpu0, wall0) = (thread_cpu_seconds(), Instant::now());
     let r = if per_op {
         m.refine_around_per_op([0.0; 3], f64::MAX, 1, &mut masses)
@@ -72,6 +88,8 @@ fn main() {
     };
     let r = r.expect("uniform refinement");
     let (cpu1, wall) = (thread_cpu_seconds(), wall0.elapsed().as_secs_f64());
+    let st1 = thread_stat();
+    print_split("refine", st0, st1, tets.len(), "tet");
     let cpu = match (cpu0, cpu1) {
         (Some(a), Some(b)) => b - a,
         _ => wall,

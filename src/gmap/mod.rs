@@ -580,15 +580,13 @@ impl<const N: usize> GMap<N> {
         self.alpha.extend_from_slice(alpha);
         self.cell.extend_from_slice(cell);
         self.alive.resize(total.div_ceil(64), 0);
+        // Whole words at once: bits lo..hi of word w.
         let mut d = first;
         while d < total {
-            if d % 64 == 0 && d + 64 <= total {
-                self.alive[d / 64] = u64::MAX;
-                d += 64;
-            } else {
-                self.alive[d / 64] |= 1u64 << (d % 64);
-                d += 1;
-            }
+            let (w, lo) = (d / 64, d % 64);
+            let hi = (total - w * 64).min(64);
+            self.alive[w] |= (u64::MAX >> (64 - (hi - lo))) << lo;
+            d = w * 64 + hi;
         }
         self.n_alive += count;
         first as u32

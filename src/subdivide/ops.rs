@@ -165,7 +165,6 @@ impl<const N: usize> LeveledMap<N> {
         self.dart_level.resize(cap, 0);
         self.mu.resize(cap, Mu::default());
         self.flat.resize(cap, false);
-        self.history.resize(cap);
         self.dart_level[d.index()] = self.op.level;
         self.mu[d.index()] = mu;
         self.flat[d.index()] = flat;

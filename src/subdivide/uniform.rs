@@ -99,6 +99,14 @@ struct Template {
     /// Per slot and dimension: the index of its cell in the flat id table of a parent (local
     /// index + offset of the dimension), filled by [`Template::flatten`].
     flat_cell: Vec<[u8; 4]>,
+    /// Per slot (p · per + k): where each αj, j ≤ n, is found in a parent's dart table of
+    /// 2 · P · per entries: the slot's own index below P · per (a template link), or P · per + the
+    /// slot's index for αn on a facet (the table's second half holds child k of αn(parent dart)).
+    /// Filled by [`Template::flatten`].
+    gather: Vec<[u16; 4]>,
+    /// The slots k < `border` of every parent dart lie on its facet ([`BORDER`] αn); the others
+    /// have every link inside the parent.
+    border: usize,
     /// Offset of each dimension in the flat id table.
     offset: [usize; 5],
 }
@@ -249,6 +257,8 @@ impl Template {
             child_cell: Vec::new(),
             pairs: pr.clone(),
             flat_cell: Vec::new(),
+            gather: Vec::new(),
+            border: 0,
             offset: [0; 5],
             corner_parent: [0; 4],
             face_parent: [0; 4],
@@ -274,6 +284,18 @@ impl Template {
             .cell
             .iter()
             .map(|c| [0, 1, 2, 3].map(|i| (self.offset[i.min(self.n)] + c[i] as usize) as u8))
+            .collect();
+        let (n, per, total) = (self.n, self.per, self.link.len());
+        self.border = (0..per).take_while(|&k| self.link[k][n] == BORDER).count();
+        self.gather = self
+            .link
+            .iter()
+            .enumerate()
+            .map(|(s, l)| {
+                let on_facet = s % per < self.border;
+                assert_eq!(l[n] == BORDER, on_facet, "template bug: facet slots are not the first of each flag");
+                [0, 1, 2, 3].map(|j| if j == n && on_facet { (total + s) as u16 } else { l[j.min(n)] as u16 })
+            })
             .collect();
     }
 
@@ -393,9 +415,11 @@ struct Labelled {
     darts: Vec<u32>,
     /// Template index per parent (the diagonal in 3D).
     template: Vec<u8>,
-    /// Parent index of every old dart, and its flag index.
-    parent_of: Vec<u32>,
-    flag_of: Vec<u8>,
+    /// Slot of every old dart in `darts` (parent index · P + flag index), `u32::MAX` if none.
+    slot_of: Vec<u32>,
+    /// Per slot: the slot of αn of its dart (its own slot where αn is free), set when the
+    /// later of the two parents is labelled, so that the write pass reads it in slot order.
+    across: Vec<u32>,
     /// Rank of each edge id (first met), `u32::MAX` if none.
     edge_rank: Vec<u32>,
     /// The parent edges by rank, as (vertex id, vertex id).
@@ -436,34 +460,35 @@ impl<const N: usize> LeveledMap<N> {
         let t0 = &tpl[0];
         let p = t0.parents.len();
         let cap = self.map.capacity();
+        // Every buffer gets its final size (or an upper bound) at once: no growth by doubling.
+        let edge_bound = self.map.cell_id_bound(1);
         let mut out = Labelled {
             darts: Vec::with_capacity(self.map.dart_count()),
-            template: Vec::new(),
-            parent_of: vec![u32::MAX; cap],
-            flag_of: vec![0; cap],
-            edge_rank: vec![u32::MAX; self.map.cell_id_bound(1)],
-            edges: Vec::new(),
-            edge_ids: Vec::new(),
+            template: Vec::with_capacity(self.map.dart_count() / p),
+            slot_of: vec![u32::MAX; cap],
+            across: Vec::with_capacity(self.map.dart_count()),
+            edge_rank: vec![u32::MAX; edge_bound],
+            edges: Vec::with_capacity(edge_bound),
+            edge_ids: Vec::with_capacity(edge_bound),
             face_rank: vec![u32::MAX; if N == 3 { self.map.cell_id_bound(2) } else { 0 }],
             faces: 0,
         };
         let mut lab = vec![0u32; p];
         for d in self.map.darts() {
-            if out.parent_of[d.index()] != u32::MAX {
+            if out.slot_of[d.index()] != u32::MAX {
                 continue;
             }
-            let parent = out.template.len() as u32;
+            let first_slot = out.darts.len() as u32;
             lab[0] = d.0;
             for &(t, s, j) in &t0.tree {
                 lab[t as usize] = self.map.alpha_dyn(j as usize, DartId(lab[s as usize])).0;
             }
             let not_simplex = |corners| SubdivideError::NotATetrahedron { dart: d, corners };
             for (f, &x) in lab.iter().enumerate() {
-                if out.parent_of[x as usize] != u32::MAX {
+                if out.slot_of[x as usize] != u32::MAX {
                     return Err(not_simplex(0));
                 }
-                out.parent_of[x as usize] = parent;
-                out.flag_of[x as usize] = f as u8;
+                out.slot_of[x as usize] = first_slot + f as u32;
             }
             for (f, &x) in lab.iter().enumerate() {
                 for j in 0..N {
@@ -482,6 +507,15 @@ impl<const N: usize> LeveledMap<N> {
                 v.sort_unstable();
                 v.dedup();
                 return Err(not_simplex(v.len()));
+            }
+            for (f, &x) in lab.iter().enumerate() {
+                let s = first_slot + f as u32;
+                let y = self.map.alpha_dyn(N, DartId(x)).0;
+                let t = out.slot_of[y as usize];
+                out.across.push(if y == x { s } else { t });
+                if y != x && t != u32::MAX {
+                    out.across[t as usize] = s;
+                }
             }
             out.template.push(if N == 3 { self.diagonal_template(&vids, &lab, t0) } else { 0 });
             self.rank_cells(&lab, t0, &vids, &mut out);
@@ -530,21 +564,23 @@ impl<const N: usize> LeveledMap<N> {
         self.points.get(v as usize).copied().unwrap_or([0.0; 3])
     }
 
-    /// The write pass: grows the map and every record, writes the children of every parent.
-    /// Returns the new n-cell ids per parent (child c at `parent * children + c`).
-    fn write_uniform(&mut self, level: u8, tpl: &[Template], lab: &Labelled) -> Vec<u32> {
+    /// The write pass: grows the map and every record once (exact sizes, no doubling), writes
+    /// the children of every parent. Returns the new n-cell ids per parent (child c at
+    /// `parent * children + c`) when `children` is set, else an empty vector.
+    fn write_uniform(&mut self, level: u8, tpl: &[Template], lab: &Labelled, children: bool) -> Vec<u32> {
         let t0 = &tpl[0];
-        let (p, per) = (t0.parents.len(), t0.per);
+        let (p, per, border) = (t0.parents.len(), t0.per, t0.border);
         let parents = lab.template.len();
         let fresh = p * (per - 1);
-        let base = self.map.capacity() as u32;
+        let base = self.map.capacity();
+        let cap = base + parents * fresh;
         self.map.reserve_darts_raw(parents * fresh);
-        let cap = base as usize + parents * fresh;
         let mu = Mu { edge: level, face: level, tet: if N == 3 { level } else { 0 } };
-        self.dart_level.resize(cap, level);
-        self.mu.resize(cap, mu);
-        self.flat.resize(cap, false);
-        self.history.resize(cap);
+        grow_exact(&mut self.dart_level, cap, level);
+        grow_exact(&mut self.mu, cap, mu);
+        grow_exact(&mut self.flat, cap, false);
+        // Only the old darts get a change; the new ones have an empty history (no head).
+        self.history.cover(base);
         self.history.reserve(lab.darts.len());
         let next: Vec<u32> = (0..=N).map(|i| self.map.id_alloc_raw(i).0).collect();
         let (ne, nf) = (lab.edges.len() as u32, lab.faces);
@@ -552,66 +588,69 @@ impl<const N: usize> LeveledMap<N> {
         let shared = [ne, ne + if N == 3 { 3 * nf } else { 0 }, if N == 3 { 3 * nf } else { 0 }, 0];
         let inner_base: Vec<u32> = (0..=N).map(|i| next[i] + shared[i]).collect();
         let mut ids = [0u32; FLAT];
-        let mut dart = [0u32; 192];
+        // The parent's dart table (`Template::gather`): slot s's dart at s, child k of αn(parent
+        // dart f) at P · per + f · per + k.
+        let mut table = [0u32; 2 * 192];
+        let mut old_alpha0 = [0u32; 24];
         let (mut new_alpha, mut new_cell) = (vec![0u32; fresh * (N + 1)], vec![0u32; fresh * (N + 1)]);
-        let mut child_ids = Vec::with_capacity(parents * t0.children.len());
+        let mut child_ids = Vec::with_capacity(if children { parents * t0.children.len() } else { 0 });
+        let half = p * per;
         for parent in 0..parents {
             let tp = &tpl[lab.template[parent] as usize];
             let darts = &lab.darts[parent * p..(parent + 1) * p];
             self.local_ids(tp, darts, parent as u32, &next, &inner_base, lab, &mut ids);
-            child_ids.extend(tp.child_cell.iter().map(|&local| ids[tp.offset[N] + local as usize]));
-            let first = base + (parent * fresh) as u32;
+            if children {
+                child_ids.extend(tp.child_cell.iter().map(|&local| ids[tp.offset[N] + local as usize]));
+            }
+            let first = base + parent * fresh;
+            let (alpha, cell) = self.map.rows_mut_raw();
             for (f, &old) in darts.iter().enumerate() {
-                dart[f * per] = old;
+                let row = old as usize * (N + 1);
+                let across = alpha[row + N];
+                old_alpha0[f] = alpha[row];
+                let own = f * per;
+                table[own] = old;
                 for k in 1..per {
-                    dart[f * per + k] = first + (f * (per - 1) + k - 1) as u32;
+                    table[own + k] = (first + f * (per - 1) + k - 1) as u32;
+                }
+                // Child k of the dart across the facet: the same slot of αn(old), or the own
+                // child on the boundary.
+                if across == old {
+                    table.copy_within(own..own + border, half + own);
+                } else {
+                    let q_first = base + lab.across[parent * p + f] as usize * (per - 1);
+                    table[half + own] = across;
+                    for k in 1..border {
+                        table[half + own + k] = (q_first + k - 1) as u32;
+                    }
                 }
             }
-            let (alpha, cell) = self.map.rows_mut_raw();
             // Old darts (slot 0) are rewritten in place; the new ones go to a buffer appended
-            // below in id order.
+            // below in id order (slot f · per + k at buffer row f · (per − 1) + k − 1).
+            let rows = new_alpha.chunks_exact_mut(N + 1).zip(new_cell.chunks_exact_mut(N + 1));
+            let mut rows = rows.take(fresh);
             for (f, &old) in darts.iter().enumerate() {
-                let old_row = old as usize * (N + 1);
-                let old_alpha0 = alpha[old_row];
-                let across = alpha[old_row + N];
-                // Child k of the dart across the facet: the same slot of αn(old).
-                let (q_parent, q_flag) =
-                    (lab.parent_of[across as usize] as usize, lab.flag_of[across as usize] as usize);
-                let q_first = base as usize + q_parent * fresh + q_flag * (per - 1);
-                for k in 0..per {
-                    let s = f * per + k;
-                    let links = &tp.link[s];
-                    let mut a = [0u32; 4];
-                    for j in 0..N {
-                        a[j] = dart[links[j] as usize];
-                    }
-                    a[N] = if links[N] != BORDER {
-                        dart[links[N] as usize]
-                    } else if across == old {
-                        dart[s]
-                    } else if k == 0 {
-                        across
-                    } else {
-                        (q_first + k - 1) as u32
-                    };
-                    let fc = &tp.flat_cell[s];
-                    let (alpha_row, cell_row) = if k == 0 {
-                        let row = old as usize * (N + 1);
-                        (&mut alpha[row..row + N + 1], &mut cell[row..row + N + 1])
-                    } else {
-                        let row = (f * (per - 1) + k - 1) * (N + 1);
-                        (&mut new_alpha[row..row + N + 1], &mut new_cell[row..row + N + 1])
-                    };
+                let own = f * per;
+                let row = old as usize * (N + 1);
+                let (g, fc) = (&tp.gather[own], &tp.flat_cell[own]);
+                for i in 0..=N {
+                    alpha[row + i] = table[g[i] as usize];
+                    cell[row + i] = ids[fc[i] as usize];
+                }
+                for (s, (alpha_row, cell_row)) in (own + 1..own + per).zip(rows.by_ref()) {
+                    let (g, fc) = (&tp.gather[s], &tp.flat_cell[s]);
                     for i in 0..=N {
-                        alpha_row[i] = a[i];
+                        alpha_row[i] = table[g[i] as usize];
                         cell_row[i] = ids[fc[i] as usize];
                     }
                 }
-                self.history.push(old as usize, LinkChange { level, j: 0, old: old_alpha0 });
+            }
+            for (&old, &alpha0) in darts.iter().zip(&old_alpha0) {
+                self.history.push(old as usize, LinkChange { level, j: 0, old: alpha0 });
                 self.mu[old as usize] = mu;
             }
             let at = self.map.push_rows_raw(&new_alpha, &new_cell);
-            debug_assert_eq!(at, first);
+            debug_assert_eq!(at as usize, first);
         }
         for i in 0..=N {
             let free = self.map.id_alloc_raw(i).1.to_vec();
@@ -693,8 +732,10 @@ impl<const N: usize> LeveledMap<N> {
         let first = next[0];
         let end = first as usize + lab.edges.len();
         if !self.points.is_empty() && self.points.len() < end {
-            self.points.resize(end, [0.0; 3]);
+            grow_exact(&mut self.points, end, [0.0; 3]);
         }
+        self.splits.reserve_exact(lab.edges.len());
+        self.edge_splits.reserve_exact(lab.edges.len());
         for (r, &(a, b)) in lab.edges.iter().enumerate() {
             let v = first + r as u32;
             self.splits.push([v, a, b]);
@@ -746,7 +787,7 @@ impl LeveledMap<3> {
         let parent_mass: Vec<f64> = (0..parents)
             .map(|t| masses.mass.get(self.map.cell_id(3, DartId(lab.darts[t * 24])).index()).copied().unwrap_or(0.0))
             .collect();
-        let child = self.write_uniform(level, &tpl, &lab);
+        let child = self.write_uniform(level, &tpl, &lab, true);
         masses.mass.resize(self.map.cell_id_bound(3).max(masses.mass.len()), 0.0);
         let (mut before, mut after) = (0.0, 0.0);
         for (t, &m) in parent_mass.iter().enumerate() {
@@ -821,7 +862,7 @@ impl LeveledMap<2> {
         self.uniform_level(level)?;
         let tpl = templates(2);
         let lab = self.label_parents(&tpl)?;
-        self.write_uniform(level, &tpl, &lab);
+        self.write_uniform(level, &tpl, &lab, false);
         self.after_uniform();
         Ok(lab.template.len())
     }
@@ -835,5 +876,14 @@ impl<const N: usize> LeveledMap<N> {
         if let Err(e) = self.map.validate() {
             panic!("topomech bug: uniform refinement broke the map: {e}");
         }
+    }
+}
+
+/// Grows `v` to `len` entries of `value` with one allocation of exactly that size (`resize`
+/// alone may double the capacity: a copy and fresh pages for room that is never used).
+fn grow_exact<T: Clone>(v: &mut Vec<T>, len: usize, value: T) {
+    if len > v.len() {
+        v.reserve_exact(len - v.len());
+        v.resize(len, value);
     }
 }

@@ -243,9 +243,9 @@ fn face_normal(body: &Body, d: DartId) -> Vec3 {
 /// normal is the same bit for bit. Otherwise falls back to [`face_normal`]. O(1).
 fn face_normal_at(body: &Body, x: DartId) -> Vec3 {
     let map = body.map();
-    let (a, b) = (map.alpha::<0>(x), map.alpha::<1>(x));
-    let c = map.alpha::<0>(b);
-    let closed = a != x && b != x && c != b && map.alpha::<0>(map.alpha::<1>(a)) == map.alpha::<1>(c);
+    let (a, b) = (map.alpha_local(0, x), map.alpha_local(1, x));
+    let c = map.alpha_local(0, b);
+    let closed = a != x && b != x && c != b && map.alpha_local(0, map.alpha_local(1, a)) == map.alpha_local(1, c);
     let mut ids = [map.vertex_id(x), map.vertex_id(a), map.vertex_id(c)];
     ids.sort_unstable();
     if !closed || ids[0] == ids[1] || ids[1] == ids[2] {

@@ -267,8 +267,12 @@ fn start_face(body: &Body, start: DartId, direction: Vec3) -> Option<DartId> {
     let map = body.map();
     let mut best: Option<(DartId, f64)> = None;
     map.for_each_corner(start, |_, x| {
-        let (a1, a3) = (map.alpha::<1>(x), map.alpha::<3>(x));
-        if a3 == x || x > a1 || x > a3 || x > map.alpha::<1>(a3) {
+        // α1 is computed for tets as built (`alpha_local`): only α3(x) reads a row here.
+        if x > map.alpha_local(1, x) {
+            return;
+        }
+        let a3 = map.alpha::<3>(x);
+        if a3 == x || x > a3 || x > map.alpha_local(1, a3) {
             return;
         }
         let score = dot(face_normal_at(body, x), direction).abs();

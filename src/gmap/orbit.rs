@@ -514,8 +514,9 @@ impl GMap<3> {
 
     /// Whether every live dart is known to lie in a closed tetrahedron as [`GMap::from_tets`]
     /// built it: true from that builder until the first write that may change an αi link with
-    /// i < 3 or add a dart (α3 sews and unsews keep it). When true, [`GMap::closed_tet_darts`]
-    /// succeeds at every dart and need not be asked. False proves nothing. O(1).
+    /// i < 3 or add a dart (α3 sews and unsews keep it). When true, every volume is a closed
+    /// tetrahedron whose darts 24t … 24t + 23 are linked by α0, α1, α2 in the builder's fixed
+    /// pattern, so those links need not be read nor checked. False proves nothing. O(1).
     ///
     /// # Examples
     ///

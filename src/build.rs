@@ -230,6 +230,7 @@ impl GMap<3> {
         let mut report = vertex_report(&orbits_of);
         map.set_id_alloc_raw(0, vertex_ids, report.unreferenced_points.clone());
         report.split_edges = split_edges(edge_keys);
+        map.mark_tets_as_built();
         map.after_build();
         Ok((map, report))
     }
@@ -346,7 +347,7 @@ const TET_DART_EDGE: [u8; 24] = {
 };
 
 /// α0, α1 and α2 of each of the 24 darts of a tet, as offsets from the tet's first dart.
-const TET_LINKS: [[u32; 3]; 24] = {
+pub(crate) const TET_LINKS: [[u32; 3]; 24] = {
     let mut links = [[0u32; 3]; 24];
     let mut k = 0;
     while k < 24 {

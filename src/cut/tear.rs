@@ -243,9 +243,9 @@ fn face_normal(body: &Body, d: DartId) -> Vec3 {
 /// normal is the same bit for bit. Otherwise falls back to [`face_normal`]. O(1).
 fn face_normal_at(body: &Body, x: DartId) -> Vec3 {
     let map = body.map();
-    let (a, b) = (map.alpha::<0>(x), map.alpha::<1>(x));
-    let c = map.alpha::<0>(b);
-    let closed = a != x && b != x && c != b && map.alpha::<0>(map.alpha::<1>(a)) == map.alpha::<1>(c);
+    let (a, b) = (map.alpha_local(0, x), map.alpha_local(1, x));
+    let c = map.alpha_local(0, b);
+    let closed = a != x && b != x && c != b && map.alpha_local(0, map.alpha_local(1, a)) == map.alpha_local(1, c);
     let mut ids = [map.vertex_id(x), map.vertex_id(a), map.vertex_id(c)];
     ids.sort_unstable();
     if !closed || ids[0] == ids[1] || ids[1] == ids[2] {
@@ -267,8 +267,12 @@ fn start_face(body: &Body, start: DartId, direction: Vec3) -> Option<DartId> {
     let map = body.map();
     let mut best: Option<(DartId, f64)> = None;
     map.for_each_corner(start, |_, x| {
-        let (a1, a3) = (map.alpha::<1>(x), map.alpha::<3>(x));
-        if a3 == x || x > a1 || x > a3 || x > map.alpha::<1>(a3) {
+        // α1 is computed for tets as built (`alpha_local`): only α3(x) reads a row here.
+        if x > map.alpha_local(1, x) {
+            return;
+        }
+        let a3 = map.alpha::<3>(x);
+        if a3 == x || x > a3 || x > map.alpha_local(1, a3) {
             return;
         }
         let score = dot(face_normal_at(body, x), direction).abs();

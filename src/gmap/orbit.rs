@@ -417,7 +417,7 @@ impl<const N: usize> GMap<N> {
         for gens in [[j, k], [k, j]] {
             let mut x = d;
             for step in 0..=self.capacity() {
-                let y = self.alpha_dyn(gens[step % 2], x);
+                let y = self.alpha_local(gens[step % 2], x);
                 if y == x {
                     break; // an end of the path: walk the other way from d
                 }
@@ -504,12 +504,43 @@ impl GMap<3> {
     /// tetrahedron); `None` otherwise. Two independent chains of three loads. O(1).
     #[inline]
     pub(crate) fn hexagon(&self, c: DartId) -> Option<[DartId; 6]> {
-        let (a1, a2) = (self.alpha::<1>(c), self.alpha::<2>(c));
-        let (a21, a12) = (self.alpha::<2>(a1), self.alpha::<1>(a2));
-        let (a121, a212) = (self.alpha::<1>(a21), self.alpha::<2>(a12));
+        let (a1, a2) = (self.alpha_local(1, c), self.alpha_local(2, c));
+        let (a21, a12) = (self.alpha_local(2, a1), self.alpha_local(1, a2));
+        let (a121, a212) = (self.alpha_local(1, a21), self.alpha_local(2, a12));
         let darts = [c, a1, a2, a21, a12, a121];
         let distinct = (0..6).all(|i| (i + 1..6).all(|j| darts[i] != darts[j]));
         (a121 == a212 && distinct).then_some(darts)
+    }
+
+    /// Whether every live dart is known to lie in a closed tetrahedron as [`GMap::from_tets`]
+    /// built it: true from that builder until the first write that may change an αi link with
+    /// i < 3 or add a dart (α3 sews and unsews keep it). When true, every volume is a closed
+    /// tetrahedron whose darts 24t … 24t + 23 are linked by α0, α1, α2 in the builder's fixed
+    /// pattern, so those links need not be read nor checked. False proves nothing. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let (mut map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+    /// assert!(map.tets_as_built());
+    /// let d = map.darts().find(|&d| !map.is_free(3, d)).unwrap();
+    /// map.unsew::<3>(d).unwrap(); // a face dissociation keeps every tet closed
+    /// assert!(map.tets_as_built());
+    /// map.unsew::<2>(d).unwrap(); // opens a tet
+    /// assert!(!map.tets_as_built());
+    /// ```
+    #[inline]
+    pub fn tets_as_built(&self) -> bool {
+        self.tets_as_built
+    }
+
+    /// Sets the flag of [`GMap::tets_as_built`]: for the builder, whose tets are closed by
+    /// construction (checked at every dart in debug builds). O(1) (O(darts) in debug builds).
+    pub(crate) fn mark_tets_as_built(&mut self) {
+        debug_assert!(self.darts().all(|d| self.closed_tet_darts(d).is_some()), "a built tet is not closed");
+        self.tets_as_built = true;
     }
 
     /// The darts w(d) for the 24 words w of [`TetWords`] if they are closed under α0, α1, α2 —
@@ -876,5 +907,56 @@ mod tests {
         map.unsew::<2>(d).unwrap();
         assert_eq!(map.closed_tet_darts(d), None);
         assert!(map.closed_tet_darts(DartId(24)).is_some()); // the next tet is intact
+    }
+
+    /// `tets_as_built` is up exactly while only α3 links changed since `from_tets`, and whenever
+    /// it is up every dart's tet is closed: through α3 unsews and sews, then down after an α1
+    /// unsew (and it stays down after sewing back: the flag is conservative), down after a new
+    /// dart.
+    #[test]
+    fn tets_as_built_flag_follows_the_writes() {
+        let all_closed = |map: &GMap<3>| map.darts().all(|d| map.closed_tet_darts(d).is_some());
+        let mut map = cut_cube();
+        assert!(map.tets_as_built() && all_closed(&map));
+        let inner: Vec<DartId> = map.darts().filter(|&d| !map.is_free(3, d)).step_by(5).collect();
+        for &d in &inner {
+            if !map.is_free(3, d) {
+                let e = map.alpha::<3>(d);
+                map.unsew::<3>(d).unwrap();
+                assert!(map.tets_as_built() && all_closed(&map));
+                map.sew::<3>(d, e).unwrap();
+                assert!(map.tets_as_built());
+            }
+        }
+        let d = DartId(5);
+        let e = map.alpha::<1>(d);
+        map.unsew::<1>(d).unwrap();
+        assert!(!map.tets_as_built() && !all_closed(&map));
+        map.sew::<1>(d, e).unwrap();
+        assert!(!map.tets_as_built() && all_closed(&map));
+        let (mut fresh, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+        assert!(fresh.tets_as_built());
+        fresh.create_dart().unwrap();
+        assert!(!fresh.tets_as_built());
+    }
+
+    /// The computed inner links of tets as built are the stored ones at every dart and index,
+    /// after α3 unsews too; once the flag is down (an α2 unsew) `alpha_local` reads the rows.
+    #[test]
+    fn alpha_local_is_the_stored_link() {
+        let same = |map: &GMap<3>| map.darts().all(|d| (0..=3).all(|i| map.alpha_local(i, d) == map.alpha_dyn(i, d)));
+        let (points, tets) = crate::cut::ops::jittered_cube(2, 3);
+        let (mut map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+        assert!(map.tets_as_built() && same(&map));
+        let mut map2 = cut_cube();
+        assert!(map2.tets_as_built() && same(&map2));
+        map2.unsew::<2>(DartId(0)).unwrap();
+        assert!(!map2.tets_as_built() && same(&map2));
+        // Not vacuous: the pattern really is the builder's, and differs between tets only by offset.
+        let d = map.darts().nth(30).unwrap();
+        assert_eq!(map.alpha_local(2, d).0 / 24, d.0 / 24);
+        let inner = map.darts().find(|&d| !map.is_free(3, d)).unwrap();
+        map.unsew::<3>(inner).unwrap();
+        assert!(same(&map));
     }
 }

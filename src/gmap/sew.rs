@@ -844,7 +844,7 @@ impl QuickLinks {
             let x = endpoint(pairs, p);
             out.direct[p] |= 1 << i; // every endpoint is i-free now
             for k in (0..=N).filter(|&k| k.abs_diff(i) >= 2) {
-                let y = map.alpha_dyn(k, x);
+                let y = map.alpha_local(k, x);
                 if y == x {
                     out.direct[p] |= 1 << k;
                 } else if let Some(q) = index(y).filter(|&q| q > p) {
@@ -866,7 +866,7 @@ impl QuickLinks {
                 walks.start(pairs[m], m);
                 for p in [2 * m, 2 * m + 1] {
                     covered[p] = true;
-                    for q in mirrors().filter_map(|k| index(map.alpha_dyn(k, endpoint(pairs, p)))) {
+                    for q in mirrors().filter_map(|k| index(map.alpha_local(k, endpoint(pairs, p)))) {
                         covered[q] = true;
                     }
                 }
@@ -876,7 +876,7 @@ impl QuickLinks {
                 out.push(2 * m, 2 * m + 1, j);
                 let (x, y) = pairs[m];
                 for k in mirrors() {
-                    if let (Some(p), Some(q)) = (index(map.alpha_dyn(k, x)), index(map.alpha_dyn(k, y))) {
+                    if let (Some(p), Some(q)) = (index(map.alpha_local(k, x)), index(map.alpha_local(k, y))) {
                         out.push(p, q, j);
                     }
                 }
@@ -963,7 +963,7 @@ impl RingWalks {
             for (fronts, steps, _, state) in self.walks[..self.len].iter_mut().filter(|w| w.3 == Walk::Running) {
                 for f in 0..2 {
                     let here = fronts[f];
-                    let next = map.alpha_dyn(self.gens[steps[f] as usize], here);
+                    let next = map.alpha_local(self.gens[steps[f] as usize], here);
                     if next == here {
                         *state = Walk::Open;
                         break;

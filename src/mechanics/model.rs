@@ -474,19 +474,20 @@ impl Mechanics {
     /// Unit normal of the face of `d` pointing away from the 4th vertex of d's tet: the face's
     /// three vertex ids a < b < c, the apex the smallest vertex id of the volume not on the face;
     /// zero if the face has not exactly three vertices, the volume no other vertex, or the face
-    /// no area. O(1) for a closed tet ([`GMap::closed_tet_darts`]), else O(volume) by orbits
-    /// ([`Mechanics::outward_normal_by_orbits`], the same definition).
+    /// no area. O(1) for a closed tet: five loads when the map's tets are as built
+    /// ([`GMap::tets_as_built`]), else after [`GMap::closed_tet_darts`]' 36; O(volume) by orbits
+    /// otherwise ([`Mechanics::outward_normal_by_orbits`], the same definition).
     fn outward_normal(&self, map: &GMap<3>, d: DartId) -> Vec3 {
-        if map.closed_tet_darts(d).is_none() {
+        if !map.tets_as_built() && map.closed_tet_darts(d).is_none() {
             return self.outward_normal_by_orbits(map, d);
         }
-        let Some(face) = triangle_vertices(map, d) else { return [0.0; 3] };
+        let Some(face) = closed_triangle_vertices(map, d) else { return [0.0; 3] };
         // In a closed tet the 24 darts' vertex ids are those of its four corners, each corner
         // ⟨α1, α2⟩ carrying one id; α0 α1 α2(d) is on the corner opposite d's face (α2: the other
         // face on d's edge, α1: its edge towards the fourth vertex, α0: that vertex). So the
         // vertices off the face are that corner's id or none: the reference's minimum, in three
         // loads instead of 24.
-        let apex = map.vertex_id(map.alpha::<0>(map.alpha::<1>(map.alpha::<2>(d))));
+        let apex = map.vertex_id(map.alpha_local(0, map.alpha_local(1, map.alpha_local(2, d))));
         self.normal_away_from(face, (!face.contains(&apex)).then_some(apex))
     }
 
@@ -849,6 +850,21 @@ pub(crate) fn triangle_vertices(map: &GMap<3>, d: DartId) -> Option<[CellId; 3]>
     Some(face)
 }
 
+/// [`triangle_vertices`] for a dart `d` of a closed tet ([`GMap::closed_tet_darts`]): its face
+/// ⟨α0, α1⟩(d) is then the closed hexagon d, α1 d, α0 d, α1 α0 d, α0 α1 d, α1 α0 α1 d, whose
+/// ⟨α1⟩ pairs share a vertex (α1 is in the vertex orbit), so its distinct vertex ids are those of
+/// d, α0 d and α0 α1 d: three loads of ids, the links computed for tets as built
+/// ([`GMap::alpha_local`]), else two loads; no walk. O(1).
+fn closed_triangle_vertices(map: &GMap<3>, d: DartId) -> Option<[CellId; 3]> {
+    let mut face = [
+        map.vertex_id(d),
+        map.vertex_id(map.alpha_local(0, d)),
+        map.vertex_id(map.alpha_local(0, map.alpha_local(1, d))),
+    ];
+    face.sort_unstable();
+    (face[0] != face[1] && face[1] != face[2]).then_some(face)
+}
+
 /// A dart carrying the `dim`-cell `id` among the darts an operation (un)linked. O(pairs).
 fn dart_of(map: &GMap<3>, dim: usize, id: CellId, changes: &CellChanges) -> Option<DartId> {
     changes.pairs.iter().flat_map(|&(a, b)| [a, b]).find(|&d| map.cell_id(dim, d) == id)
@@ -1086,29 +1102,35 @@ impl Mechanics {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::generate::kuhn_cube;
 
     /// The O(1) outward normal equals the orbit-based one, bit for bit, at every dart of a body
-    /// with dissociated faces and a tet opened inside (where the fast path must step aside).
+    /// with dissociated faces (tets as built: the five-load path), then with a tet opened inside
+    /// (where the flag is down and the closure check must step aside).
     #[test]
     fn fast_outward_normal_is_the_orbit_one() {
-        let (points, tets) = kuhn_cube(2);
+        let (points, tets) = crate::cut::ops::jittered_cube(2, 7);
         let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
         let map = body.map();
         let inner: Vec<DartId> = map.one_dart_per_cell(2).into_iter().filter(|&d| !map.is_free(3, d)).collect();
         for d in inner.into_iter().step_by(2) {
             body.unsew3(d).unwrap();
         }
+        let same_everywhere = |body: &Body| {
+            let (map, mech) = (body.map(), body.attrs());
+            let mut nonzero = 0;
+            for d in map.darts() {
+                let fast = mech.outward_normal(map, d);
+                assert_eq!(fast, mech.outward_normal_by_orbits(map, d), "dart {d}");
+                nonzero += usize::from(fast != [0.0; 3]);
+            }
+            assert!(nonzero > 0);
+        };
+        assert!(body.map().tets_as_built());
+        same_everywhere(&body);
         let _ = body.unsew(2, DartId(0)); // may report the opened tet under expensive-checks
-        let (map, mech) = (body.map(), body.attrs());
-        assert!(map.closed_tet_darts(DartId(0)).is_none());
-        let mut nonzero = 0;
-        for d in map.darts() {
-            let fast = mech.outward_normal(map, d);
-            assert_eq!(fast, mech.outward_normal_by_orbits(map, d), "dart {d}");
-            nonzero += usize::from(fast != [0.0; 3]);
-        }
-        assert!(nonzero > 0);
+        assert!(!body.map().tets_as_built());
+        assert!(body.map().closed_tet_darts(DartId(0)).is_none());
+        same_everywhere(&body);
     }
 
     /// A vertex split's new-side mass read off the kernel's side list equals law 1 from the map,

@@ -46,6 +46,10 @@ pub enum Law {
     CellIdConstant,
     /// Distinct cells have distinct ids; every live id names a cell.
     CellIdUnique,
+    /// While [`GMap::tets_as_built`] is set, every tet keeps the builder's inner links (α0, α1, α2
+    /// of dart 24t + k are 24t + the builder's pattern), so that computing them instead of
+    /// reading them ([`GMap::tets_as_built`]'s use in cutting) is exact.
+    TetLayout,
 }
 
 /// A broken law, naming the dart(s), the indices and the law.
@@ -144,6 +148,19 @@ pub enum InvariantViolation {
         /// The id.
         id: CellId,
     },
+    /// The map claims [`GMap::tets_as_built`] but αi(dart) is not the builder's link (`built`),
+    /// or a dart slot is dead (`stored` is then the dart itself).
+    #[error("tet-layout law: the map is flagged as built tets but alpha{i}({dart}) = {stored:?}, the builder's link is {built:?}")]
+    TetLayout {
+        /// The dart.
+        dart: DartId,
+        /// The involution (< 3).
+        i: usize,
+        /// The stored αi(dart).
+        stored: DartId,
+        /// The builder's αi(dart).
+        built: DartId,
+    },
 }
 
 impl InvariantViolation {
@@ -166,6 +183,7 @@ impl InvariantViolation {
             QuasiManifold { .. } => Law::QuasiManifold,
             CellIdDiffers { .. } | CellIdNotLive { .. } => Law::CellIdConstant,
             CellIdShared { .. } | CellIdOrphan { .. } => Law::CellIdUnique,
+            TetLayout { .. } => Law::TetLayout,
         }
     }
 }
@@ -215,9 +233,40 @@ impl<const N: usize> GMap<N> {
     /// ```
     pub fn validate(&self) -> Result<(), InvariantViolation> {
         if self.all_laws_hold() {
-            return Ok(());
+            return self.check_tet_layout();
         }
         self.validate_detailed()
+    }
+
+    /// The [`Law::TetLayout`] law: when [`GMap::tets_as_built`] is set, every dart slot is live
+    /// and α0, α1, α2 of dart 24t + k are 24t + the builder's pattern for k. O(darts) when the
+    /// flag is set (one sequential pass over the α rows), O(1) otherwise.
+    fn check_tet_layout(&self) -> Result<(), InvariantViolation> {
+        if !self.tets_as_built {
+            return Ok(());
+        }
+        let row = N + 1;
+        let violation = |d: usize, i: usize| InvariantViolation::TetLayout {
+            dart: DartId(d as u32),
+            i,
+            stored: DartId(self.alpha.get(d * row + i).copied().unwrap_or(d as u32)),
+            built: DartId((d - d % 24) as u32 + crate::build::TET_LINKS[d % 24][i]),
+        };
+        if N != 3 || self.capacity() % 24 != 0 {
+            return Err(violation(self.capacity(), 0));
+        }
+        if let Some(d) = (0..self.capacity()).find(|&d| !self.contains(DartId(d as u32))) {
+            return Err(violation(d, 0));
+        }
+        for (t, rows) in self.alpha.chunks_exact(24 * row).enumerate() {
+            let base = 24 * t as u32;
+            for (k, links) in crate::build::TET_LINKS.iter().enumerate() {
+                if let Some(i) = (0..3).find(|&i| rows[k * row + i] != base + links[i]) {
+                    return Err(violation(24 * t + k, i));
+                }
+            }
+        }
+        Ok(())
     }
 
     /// The detailed path: names the first violation. O(darts · n²).
@@ -237,7 +286,7 @@ impl<const N: usize> GMap<N> {
         for (dim, dead) in dead.iter().enumerate() {
             self.check_ids_unique(dim, dead)?;
         }
-        Ok(())
+        self.check_tet_layout()
     }
 
     /// The fast path: whether every law holds. Same verdict as [`Self::validate_detailed`].
@@ -499,4 +548,42 @@ mod tests {
         assert_eq!(census.minima, vec![1, 2, 1]);
         assert_eq!(census.distinct, vec![1, 2, 1], "id 5 is new for dimension 1");
     }
+
+    /// Exchanges the labels of darts a and b (rows and every link to them): an isomorphic map,
+    /// so every other law still holds.
+    fn swap_labels(map: &mut GMap<3>, a: usize, b: usize) {
+        for k in 0..4 {
+            map.alpha.swap(a * 4 + k, b * 4 + k);
+            map.cell.swap(a * 4 + k, b * 4 + k);
+        }
+        for link in map.alpha.iter_mut() {
+            if *link == a as u32 {
+                *link = b as u32;
+            } else if *link == b as u32 {
+                *link = a as u32;
+            }
+        }
+    }
+
+    /// The tet-layout law binds exactly while the flag is set: two darts of one tet relabelled
+    /// (a valid, isomorphic map) break it and validate() names the first dart whose link is
+    /// not the builder's; with the flag cleared the same map is valid.
+    #[test]
+    fn tet_layout_law_is_checked_while_the_flag_is_set() {
+        let (points, tets) = crate::generate::kuhn_cube(1);
+        let (mut map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+        assert!(map.tets_as_built());
+        assert_eq!(map.validate(), Ok(()));
+        swap_labels(&mut map, 24 + 3, 24 + 17);
+        assert!(map.tets_as_built(), "the raw relabelling must not clear the flag");
+        let err = map.validate().unwrap_err();
+        assert_eq!(err.law(), Law::TetLayout);
+        let InvariantViolation::TetLayout { dart, i, stored, built } = err else { unreachable!() };
+        assert!((24..48).contains(&dart.index()), "{dart:?}");
+        assert_ne!(stored, built);
+        assert_eq!(map.alpha_dyn(i, dart), stored);
+        map.tets_as_built = false;
+        assert_eq!(map.validate(), Ok(()));
+    }
+
 }

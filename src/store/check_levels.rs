@@ -113,5 +113,6 @@ fn translate(v: InvariantViolation, darts: &[DartId]) -> InvariantViolation {
         CellIdNotLive { dart, dim, id } => CellIdNotLive { dart: t(dart), dim, id },
         CellIdShared { dim, id, first, second } => CellIdShared { dim, id, first: t(first), second: t(second) },
         CellIdOrphan { dim, id } => CellIdOrphan { dim, id },
+        TetLayout { dart, i, stored, built } => TetLayout { dart: t(dart), i, stored: t(stored), built: t(built) },
     }
 }

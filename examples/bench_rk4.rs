@@ -67,7 +67,13 @@ fn main() {
         minima.push(min);
         println!(
             "[rk4{}] springs {} kernel {}: min {:.2} us/step ({:.2} ns/spring), p10 {:.2}, median {:.2} us/step",
-            if !ab { "" } else if sums { " sums" } else { " gather" },
+            if !ab {
+                ""
+            } else if sums {
+                " sums"
+            } else {
+                " gather"
+            },
             springs,
             stepper.kernel().name(),
             min,

@@ -772,7 +772,6 @@ fn spring_pass4_body(springs: Springs<'_>, y: &[SlotState], out: &mut [Vec3]) {
 trait BlockSink {
     /// Block of springs `first..first + ends.len()`, their ends, padded d = x_b − x_a and scales s.
     fn emit(&mut self, first: usize, ends: &[[u32; 2]], d: &[Rec4], s: &[f64]);
-
 }
 
 /// Writes F_s into one entry per spring.
@@ -883,9 +882,16 @@ fn spring_force4(springs: &Springs<'_>, s: usize, y: &[SlotState]) -> Vec3 {
     [q * d[0], q * d[1], q * d[2]]
 }
 
-/// Scratch of [`SpringSystem::spring_sums4`] on several threads: per chunk, the forces of its
-/// springs whose second end lies beyond the chunk, in spring order.
-pub(crate) type CrossForces = Vec<Vec<(u32, Vec3)>>;
+/// How [`SpringSystem::spring_sums4`] splits the work on several threads (made by
+/// [`SpringSystem::plan_sums`] from the spring ends, valid while they do not change): slot
+/// ranges `[s0, s1, p0, p1]` (slots s0..s1 and the springs p0..p1 of their first ends) and per
+/// range its cross springs, those whose second end lies in a later range (largest second end,
+/// spring ids in spring order). No ranges: one serial pass.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct SumPlan {
+    bounds: Vec<[usize; 4]>,
+    cross: Vec<(usize, Vec<u32>)>,
+}
 
 impl SpringSystem {
     /// Pass 1 on padded slot records (the RK4 stepper's layout).
@@ -920,56 +926,62 @@ impl SpringSystem {
         self.inc.sorted
     }
 
-    /// The spring part of every slot's force, Σ −F_s (v = b) then +F_s (v = a) in spring order,
-    /// added into `sums` (all zero on entry, one per slot) straight from the springs: no
-    /// per-spring force array, no incidence lists. Bitwise equal to the gather for every kernel
-    /// and thread count. On several threads the slots are cut into ranges, each taking the
-    /// springs of its first ends; the few forces whose second end lies in a later range are
-    /// computed first (`cross`) and added there before that range's own springs, which keeps
-    /// the spring order per slot. Panics unless [`SpringSystem::sorted_by_first_end`].
-    /// O(springs + slots).
-    pub(crate) fn spring_sums4(
-        &self,
-        kernel: Kernel,
-        y: &[SlotState],
-        sums: &mut [Rec4],
-        parallel: bool,
-        cross: &mut CrossForces,
-    ) {
-        assert!(self.sorted_by_first_end() && sums.len() == self.slots(), "spring sums need a sorted system");
+    /// Plans [`SpringSystem::spring_sums4`] on the current thread pool (one range when not
+    /// `parallel` or small): ranges of at most 4 chunks of slots but at least two per thread,
+    /// small enough for work stealing to balance them on a shared core (any split gives the same
+    /// bits). O(springs / threads + log springs) per range.
+    pub(crate) fn plan_sums(&self, parallel: bool, plan: &mut SumPlan) {
         let n = self.slots();
-        let ranges = if parallel { (2 * rayon::current_num_threads()).min(n / PARALLEL_CHUNK) } else { 1 };
-        if ranges <= 1 {
-            scatter_pass4(kernel, self.spring_view(0..self.springs()), y, 0, sums);
+        let ranges = (n / (4 * PARALLEL_CHUNK)).max(2 * rayon::current_num_threads()).min(n / PARALLEL_CHUNK);
+        plan.bounds.clear();
+        if !parallel || ranges <= 1 {
             return;
         }
         let slot_at = |r: usize| r * n / ranges;
         let spring_at = |r: usize| self.ends.partition_point(|e| (e[0] as usize) < slot_at(r));
-        let bounds: Vec<[usize; 4]> =
-            (0..ranges).map(|r| [slot_at(r), slot_at(r + 1), spring_at(r), spring_at(r + 1)]).collect();
-        cross.resize_with(ranges, Vec::new);
-        cross.par_iter_mut().zip(&bounds).for_each(|(list, &[_, s1, p0, p1])| {
+        plan.bounds.extend((0..ranges).map(|r| [slot_at(r), slot_at(r + 1), spring_at(r), spring_at(r + 1)]));
+        plan.cross.resize_with(ranges, Default::default);
+        plan.cross.par_iter_mut().zip(&plan.bounds).for_each(|((reach, list), &[_, s1, p0, p1])| {
             list.clear();
-            let all = self.spring_view(0..self.springs());
-            for s in p0..p1 {
-                let b = self.ends[s][1];
+            *reach = 0;
+            for (s, &[_, b]) in self.ends[p0..p1].iter().enumerate() {
                 if b as usize >= s1 {
-                    list.push((b, spring_force4(&all, s, y)));
+                    list.push((p0 + s) as u32);
+                    *reach = (*reach).max(b as usize);
                 }
             }
         });
-        let mut parts = Vec::with_capacity(ranges);
+    }
+
+    /// The spring part of every slot's force, Σ −F_s (v = b) then +F_s (v = a) in spring order,
+    /// added into `sums` (all zero on entry, one per slot) straight from the springs: no
+    /// per-spring force array, no incidence lists. Bitwise equal to the gather for every kernel
+    /// and thread count. With a `plan` of several ranges (made by [`SpringSystem::plan_sums`]
+    /// for these ends), each range takes the springs of its first ends, but first adds the
+    /// forces of the earlier ranges' springs that end in it (computed there from the records),
+    /// which keeps the spring order per slot. Panics unless [`SpringSystem::sorted_by_first_end`].
+    /// O(springs + slots).
+    pub(crate) fn spring_sums4(&self, kernel: Kernel, y: &[SlotState], sums: &mut [Rec4], plan: &SumPlan) {
+        assert!(self.sorted_by_first_end() && sums.len() == self.slots(), "spring sums need a sorted system");
+        if plan.bounds.is_empty() {
+            scatter_pass4(kernel, self.spring_view(0..self.springs()), y, 0, sums);
+            return;
+        }
+        let mut parts = Vec::with_capacity(plan.bounds.len());
         let mut rest = sums;
-        for &[s0, s1, _, _] in &bounds {
+        for &[s0, s1, _, _] in &plan.bounds {
             let (part, tail) = rest.split_at_mut(s1 - s0);
             parts.push(part);
             rest = tail;
         }
-        let cross: &CrossForces = cross;
-        parts.into_par_iter().zip(&bounds).enumerate().for_each(|(r, (part, &[s0, s1, p0, p1]))| {
-            for &(b, f) in cross[..r].iter().flatten() {
-                if (s0..s1).contains(&(b as usize)) {
-                    let t = &mut part[b as usize - s0];
+        let all = self.spring_view(0..self.springs());
+        parts.into_par_iter().zip(&plan.bounds).enumerate().for_each(|(r, (part, &[s0, s1, p0, p1]))| {
+            let reaching = plan.cross[..r].iter().filter(|(reach, _)| *reach >= s0);
+            for &s in reaching.flat_map(|(_, list)| list) {
+                let b = self.ends[s as usize][1] as usize;
+                if (s0..s1).contains(&b) {
+                    let f = spring_force4(&all, s as usize, y);
+                    let t = &mut part[b - s0];
                     *t = [t[0] - f[0], t[1] - f[1], t[2] - f[2], t[3]];
                 }
             }

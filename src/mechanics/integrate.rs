@@ -21,7 +21,7 @@ use std::str::FromStr;
 
 use rayon::prelude::*;
 
-use super::force::{CrossForces, Rec4, SlotState, SpringSystem, PARALLEL_CHUNK};
+use super::force::{Rec4, SlotState, SpringSystem, SumPlan, PARALLEL_CHUNK};
 use super::geom::{dot, norm, sub, Vec3};
 use super::simd::{multiversion, Kernel};
 
@@ -237,8 +237,8 @@ pub struct Stepper {
     av: Vec<Vec3>,
     /// Per-slot spring force sums of the RK4 stages on a sorted system (zero between stages).
     sums: Vec<Rec4>,
-    /// Scratch of the parallel spring sums.
-    cross: CrossForces,
+    /// How the spring sums split across threads (remade every RK4 step).
+    plan: SumPlan,
     /// Whether RK4 may sum spring forces per slot straight from the springs.
     spring_sums: bool,
     /// (kinetic energy, non-finite probe) per chunk of slots, from the last RK4 stage.
@@ -297,7 +297,7 @@ impl Stepper {
             ax: z(n),
             av: z(n),
             sums: vec![[0.0; 4]; n],
-            cross: Vec::new(),
+            plan: SumPlan::default(),
             spring_sums: true,
             partials: Vec::new(),
             kernel: Kernel::detect(),
@@ -486,9 +486,12 @@ impl Stepper {
         // springs (no force array, no incidence lists); any other uses the two-pass gather.
         let sorted = self.spring_sums && sys.sorted_by_first_end();
         self.sums.resize(x.len(), [0.0; 4]);
+        if sorted {
+            sys.plan_sums(par, &mut self.plan);
+        }
         for stage in stages {
             let forces = if sorted {
-                sys.spring_sums4(kernel, &self.ys, &mut self.sums, par, &mut self.cross);
+                sys.spring_sums4(kernel, &self.ys, &mut self.sums, &self.plan);
                 None
             } else {
                 sys.spring_forces4(kernel, &self.ys, &mut self.sf, par);

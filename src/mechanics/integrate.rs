@@ -385,7 +385,7 @@ impl Stepper {
     }
 
     /// Allows (`true`, the default) or forbids the one-pass spring sums of RK4 on a system sorted
-    /// by first end (`SpringSystem` docs, "Spring sums"); forbidden, RK4 always writes one force
+    /// by first end (`mechanics::force` module docs, "Spring sums"); forbidden, RK4 writes one force
     /// per spring and gathers them per slot. Both give the same bits; the switch is for tests
     /// and same-process benchmarks. O(1).
     ///

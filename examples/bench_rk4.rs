@@ -5,7 +5,14 @@
 //! compared while other processes run.
 //!
 //!     cargo run --release --example bench_rk4                        # built-in liver_547
-//!     cargo run --release --example bench_rk4 -- MESH [BATCHES] [STEPS_PER_BATCH]
+//!     cargo run --release --example bench_rk4 -- MESH [BATCHES] [STEPS_PER_BATCH] [ab]
+//!
+//! With `ab`, the batches alternate between the two force paths of RK4 on the same system (the
+//! one-pass spring sums and the spring forces + per-slot gather, `Stepper::set_spring_sums`), so
+//! their ratio is a same-process, same-minute figure; it prints one line per path and the ratio
+//! of the minima. With `TOPOMECH_BENCH_THREADS=T` (T > 1) the steps run in parallel on a pool of
+//! T threads and the figures are wall-clock (the calling thread's CPU time would miss the
+//! workers).
 
 use std::path::Path;
 
@@ -19,6 +26,10 @@ fn now() -> f64 {
     thread_cpu_seconds().unwrap_or_else(|| {
         std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0.0, |d| d.as_secs_f64())
     })
+}
+
+fn wall() -> f64 {
+    std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0.0, |d| d.as_secs_f64())
 }
 
 fn main() {
@@ -39,27 +50,56 @@ fn main() {
         FlatModel::from_tets(points, &mesh.tets, Material::default(), [0.0, 0.0, -9.81], &pinned)
             .expect("the model builds"),
     );
-    let config = StepConfig::new(Integrator::Rk4, 0.5 / flat.system.omega_max());
+    let threads: usize = std::env::var("TOPOMECH_BENCH_THREADS").ok().and_then(|s| s.parse().ok()).unwrap_or(1);
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads.max(1)).build().expect("the pool builds");
+    let config =
+        StepConfig { parallel: threads > 1, ..StepConfig::new(Integrator::Rk4, 0.5 / flat.system.omega_max()) };
     let mut stepper =
         Box::new(Stepper::new(config, &flat.system, &flat.position, &flat.velocity).expect("the stepper builds"));
-    let mut per_step = Vec::with_capacity(batches);
-    for _ in 0..batches {
-        let t0 = now();
-        for _ in 0..steps {
-            stepper.step(&flat.system, &mut flat.position, &mut flat.velocity).expect("the step is finite");
+    let ab = args.get(3).is_some_and(|s| s == "ab");
+    let paths: &[bool] = if ab { &[true, false] } else { &[true] };
+    let mut per_step = vec![Vec::with_capacity(batches); paths.len()];
+    for batch in 0..batches {
+        let p = batch % paths.len();
+        stepper.set_spring_sums(paths[p]);
+        let clock = if threads > 1 { wall } else { now };
+        let t0 = clock();
+        let mut run = || {
+            for _ in 0..steps {
+                stepper.step(&flat.system, &mut flat.position, &mut flat.velocity).expect("the step is finite");
+            }
+        };
+        if threads > 1 {
+            pool.install(run);
+        } else {
+            run();
         }
-        per_step.push((now() - t0) * 1e6 / steps as f64);
+        per_step[p].push((clock() - t0) * 1e6 / steps as f64);
     }
-    per_step.sort_by(f64::total_cmp);
     let springs = flat.system.springs() as f64;
-    let (min, p10, med) = (per_step[0], per_step[batches / 10], per_step[batches / 2]);
-    println!(
-        "[rk4] springs {} kernel {}: min {:.2} us/step ({:.2} ns/spring), p10 {:.2}, median {:.2} us/step",
-        springs,
-        stepper.kernel().name(),
-        min,
-        min * 1e3 / springs,
-        p10,
-        med
-    );
+    let mut minima = Vec::new();
+    for (times, &sums) in per_step.iter_mut().zip(paths) {
+        times.sort_by(f64::total_cmp);
+        let (min, p10, med) = (times[0], times[times.len() / 10], times[times.len() / 2]);
+        minima.push(min);
+        println!(
+            "[rk4{}] threads {threads} springs {} kernel {}: min {:.2} us/step ({:.2} ns/spring), p10 {:.2}, median {:.2} us/step",
+            if !ab {
+                ""
+            } else if sums {
+                " sums"
+            } else {
+                " gather"
+            },
+            springs,
+            stepper.kernel().name(),
+            min,
+            min * 1e3 / springs,
+            p10,
+            med
+        );
+    }
+    if ab {
+        println!("[rk4 ab] sums / gather (minima): {:.3}", minima[0] / minima[1]);
+    }
 }

@@ -66,6 +66,35 @@ fn random_system(seed: u64, slots: usize, springs: usize) -> Case {
     (sys, x, v)
 }
 
+/// Like [`random_system`], but built at once by `SpringSystem::new` from springs sorted by first
+/// end with a < b (the layout of a fresh `FlatModel`), so RK4 takes the one-pass spring sums.
+/// Large enough to be split into several slot ranges on any thread count, with springs that
+/// reach over one or more later ranges.
+fn sorted_system(seed: u64, slots: usize, springs: usize) -> Case {
+    let (random, mut x, v) = random_system(seed, slots, springs);
+    let mut order: Vec<usize> = (0..springs).collect();
+    let key = |s: usize| {
+        let [a, b] = random.ends[s];
+        (a.min(b), a.max(b))
+    };
+    order.sort_by_key(|&s| key(s));
+    let ends: Vec<[u32; 2]> = order.iter().map(|&s| [key(s).0, key(s).1]).collect();
+    let pick = |field: &[f64]| order.iter().map(|&s| field[s]).collect::<Vec<f64>>();
+    let fixed: Vec<bool> = random.inv_mass.iter().map(|&w| w == 0.0).collect();
+    let sys = SpringSystem::new(
+        ends,
+        pick(&random.rest),
+        pick(&random.stiffness),
+        pick(&random.damping),
+        random.mass.clone(),
+        &fixed,
+        random.viscosity.clone(),
+        random.gravity,
+    );
+    x[sys.ends[0][1] as usize] = x[sys.ends[0][0] as usize]; // a zero-length spring in the sorted order too
+    (sys, x, v)
+}
+
 fn add(a: Vec3, b: Vec3) -> Vec3 {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
@@ -79,7 +108,50 @@ fn bits(a: &[Vec3]) -> Vec<[u64; 3]> {
 }
 
 fn systems() -> Vec<(&'static str, Case)> {
-    vec![("liver", liver()), ("random", random_system(3, 300, 2000)), ("random large", random_system(5, 5000, 9000))]
+    vec![
+        ("liver", liver()),
+        ("random", random_system(3, 300, 2000)),
+        ("random large", random_system(5, 5000, 9000)),
+        ("sorted large", sorted_system(17, 3 * PARALLEL_CHUNK, 40_000)),
+    ]
+}
+
+#[test]
+fn spring_sums_and_the_gather_step_the_same_bits_on_every_kernel_and_thread_count() {
+    for (name, (sys, x0, v0)) in systems() {
+        let sorted = name == "liver" || name.starts_with("sorted");
+        assert_eq!(sys.sorted_by_first_end(), sorted, "{name}");
+        let h = 0.2 / sys.omega_max();
+        let run = |kernel, threads, sums| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| {
+                let (mut x, mut v) = (x0.clone(), v0.clone());
+                let config = StepConfig { parallel: threads > 1, ..StepConfig::new(Integrator::Rk4, h) };
+                let mut stepper = Stepper::new(config, &sys, &x, &v).unwrap();
+                stepper.set_kernel(kernel);
+                stepper.set_spring_sums(sums);
+                for _ in 0..2 {
+                    stepper.step(&sys, &mut x, &mut v).unwrap();
+                }
+                (bits(&x), bits(&v))
+            })
+        };
+        let reference = run(Kernel::portable(), 1, false);
+        assert!(reference.0 != bits(&x0), "{name}: the state must move");
+        for kernel in Kernel::available() {
+            for threads in [1, 2, 3] {
+                let got = run(kernel, threads, true);
+                assert!(got == reference, "{name}: sums, kernel {} on {threads} threads", kernel.name());
+            }
+        }
+    }
+    // A mutator leaves the order of the packed lists: the stepper falls back to the gather.
+    let (mut sys, _, _) = sorted_system(19, 50, 200);
+    let (rest, k, c) = (sys.rest[0], sys.stiffness[0], sys.damping[0]);
+    sys.set_spring(0, sys.ends[0], rest, 2.0 * k, c);
+    assert!(sys.sorted_by_first_end(), "same ends: the lists are untouched");
+    sys.swap_remove_spring(0);
+    assert!(!sys.sorted_by_first_end());
 }
 
 #[test]

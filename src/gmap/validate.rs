@@ -585,5 +585,4 @@ mod tests {
         map.tets_as_built = false;
         assert_eq!(map.validate(), Ok(()));
     }
-
 }

@@ -8,10 +8,22 @@
 //!   b is −F_s (Hooke's law plus damping along the spring).
 //!
 //! [`SpringSystem`] evaluates them in two passes: one over the springs writing F_s into an array,
-//! then one over the vertices gathering, through a list of incident springs per vertex, the F_s of
-//! the springs that start at v minus those that end at v. No two writes go to the same slot, so
-//! both passes split freely across threads and the result is bitwise the same for any thread
-//! count: each vertex sums its own list in its stored order.
+//! then one over the vertices gathering, through a list of incident springs per vertex, minus the
+//! F_s of the springs that end at v (tails), then plus those that start at v (heads). No two
+//! writes go to the same slot, so both passes split freely across threads and the result is
+//! bitwise the same for any thread count: each vertex sums its own lists in their stored order.
+//!
+//! # Spring sums
+//! On a fresh system whose springs are sorted by first end with a < b
+//! ([`SpringSystem::sorted_by_first_end`], the layout of `FlatModel` and of a fresh `Projection`),
+//! the tails of v are the springs before its heads in spring order, each list ascending. Adding
+//! +F_s at a and −F_s at b into a per-slot sum while walking the springs in order then performs
+//! exactly the gather's operations in the gather's order, so the RK4 stepper does that: one pass
+//! over the springs, no per-spring force array written and read back, no incidence lists read
+//! (about 100 fewer bytes per spring and stage on a mesh that does not fit in cache). On several
+//! threads the slots are cut into ranges that each take the springs of their first ends; a range
+//! first adds the forces of earlier ranges' springs that end in it, so every slot still sums in
+//! spring order (the same bits for any split and thread count).
 //!
 //! # Incidence lists with slack
 //! The lists live in one array `adj`; vertex v owns the segment `adj[start..start + cap]`, whose
@@ -389,18 +401,20 @@ impl SpringSystem {
         }
     }
 
-    /// Σ over incident springs (+F_s where v = a, −F_s where v = b). O(degree).
+    /// Σ over incident springs (−F_s where v = b, then +F_s where v = a: tails first, so that a
+    /// fresh system sorted by first end sums in spring order, as [`SpringSystem::spring_sums4`]
+    /// does). O(degree).
     #[inline(always)]
     fn gather(&self, i: usize, sf: &[Vec3]) -> Vec3 {
         let (heads, tails) = self.inc.lists(i);
         let mut f = [0.0; 3];
-        for &s in heads {
-            let g = sf[s as usize];
-            f = [f[0] + g[0], f[1] + g[1], f[2] + g[2]];
-        }
         for &s in tails {
             let g = sf[s as usize];
             f = [f[0] - g[0], f[1] - g[1], f[2] - g[2]];
+        }
+        for &s in heads {
+            let g = sf[s as usize];
+            f = [f[0] + g[0], f[1] + g[1], f[2] + g[2]];
         }
         f
     }
@@ -413,13 +427,13 @@ impl SpringSystem {
         let (heads, tails) = self.inc.lists(i);
         let mut f = [0.0; 3];
         if let Some(last) = sf.len().checked_sub(1) {
-            for &s in heads {
-                let g = sf[(s as usize).min(last)];
-                f = [f[0] + g[0], f[1] + g[1], f[2] + g[2]];
-            }
             for &s in tails {
                 let g = sf[(s as usize).min(last)];
                 f = [f[0] - g[0], f[1] - g[1], f[2] - g[2]];
+            }
+            for &s in heads {
+                let g = sf[(s as usize).min(last)];
+                f = [f[0] + g[0], f[1] + g[1], f[2] + g[2]];
             }
         }
         f
@@ -539,7 +553,13 @@ impl SpringSystem {
     /// `vi` the velocity of slot i; the same arithmetic as [`SpringSystem::vertex_force`] then the scaling.
     #[inline(always)]
     pub(crate) fn acceleration(&self, i: usize, vi: Vec3, sf: &[Vec3]) -> Vec3 {
-        let s = self.gather_full(i, sf);
+        self.acceleration_of_sum(i, self.gather_full(i, sf), vi)
+    }
+
+    /// [`SpringSystem::acceleration`] of slot i given the sum `s` of its spring forces (as the
+    /// gather or [`SpringSystem::spring_sums4`] computes it). O(1).
+    #[inline(always)]
+    pub(crate) fn acceleration_of_sum(&self, i: usize, s: Vec3, vi: Vec3) -> Vec3 {
         let (m, g, w) = (self.mass[i], self.viscosity[i], self.inv_mass[i]);
         let f = [
             s[0] + m * self.gravity[0] - g * vi[0],
@@ -755,10 +775,62 @@ multiversion! {
 
 #[inline(always)]
 fn spring_pass4_body(springs: Springs<'_>, y: &[SlotState], out: &mut [Vec3]) {
+    assert!(out.len() == springs.ends.len(), "one force per spring");
+    spring_blocks4(springs, y, &mut ForceArray(out));
+}
+
+/// What [`spring_blocks4`] does with each block's forces F_s = s·d (a trait, not a closure, so
+/// that it is inlined into each instruction-set copy).
+trait BlockSink {
+    /// Block of springs `first..first + ends.len()`, their ends, padded d = x_b − x_a and scales s.
+    fn emit(&mut self, first: usize, ends: &[[u32; 2]], d: &[Rec4], s: &[f64]);
+}
+
+/// Writes F_s into one entry per spring.
+struct ForceArray<'a>(&'a mut [Vec3]);
+
+impl BlockSink for ForceArray<'_> {
+    #[inline(always)]
+    fn emit(&mut self, first: usize, _: &[[u32; 2]], d: &[Rec4], s: &[f64]) {
+        for (j, f) in self.0[first..first + s.len()].iter_mut().enumerate() {
+            let e = d[j];
+            *f = [s[j] * e[0], s[j] * e[1], s[j] * e[2]];
+        }
+    }
+}
+
+/// Adds +F_s at a and −F_s at b into per-slot sums, slot `first_slot + i` at `sums[i]`; an end
+/// beyond the sums is skipped.
+struct SlotSums<'a> {
+    first_slot: usize,
+    sums: &'a mut [Rec4],
+}
+
+impl BlockSink for SlotSums<'_> {
+    #[inline(always)]
+    fn emit(&mut self, _: usize, ends: &[[u32; 2]], d: &[Rec4], s: &[f64]) {
+        let (first_slot, sums) = (self.first_slot, &mut *self.sums);
+        for (j, &[a, b]) in ends.iter().enumerate() {
+            let (e, q) = (d[j], s[j]);
+            let f = [q * e[0], q * e[1], q * e[2], q * e[3]];
+            let t = &mut sums[(a as usize).wrapping_sub(first_slot)];
+            *t = [t[0] + f[0], t[1] + f[1], t[2] + f[2], t[3] + f[3]];
+            if let Some(t) = sums.get_mut((b as usize).wrapping_sub(first_slot)) {
+                *t = [t[0] - f[0], t[1] - f[1], t[2] - f[2], t[3] - f[3]];
+            }
+        }
+    }
+}
+
+/// Runs the springs of `springs` in blocks of [`BLOCK`]: a scalar gather of the end records, the
+/// vectorised scale s of each spring, then `sink.emit(first, ends, d, s)` with the block's first index,
+/// its ends, its end differences d = x_b − x_a (padded) and scales (F_s = s·d).
+#[inline(always)]
+fn spring_blocks4(springs: Springs<'_>, y: &[SlotState], sink: &mut impl BlockSink) {
     let mut d = [[0.0f64; 4]; BLOCK];
     let mut dv = [[0.0f64; 4]; BLOCK];
     let mut s = [0.0f64; BLOCK];
-    let n_all = out.len();
+    let n_all = springs.ends.len();
     let mut first = 0;
     while first < n_all {
         let n = BLOCK.min(n_all - first);
@@ -781,18 +853,155 @@ fn spring_pass4_body(springs: Springs<'_>, y: &[SlotState], out: &mut [Vec3]) {
             let pads = e[3] * e[3] + w[3] * w[3];
             s[j] = spring_scale_padded(e[0], e[1], e[2], w[0], w[1], w[2], pads, rest[j], k[j], damp[j]);
         }
-        for (j, f) in out[first..first + n].iter_mut().enumerate() {
-            let e = dd[j];
-            *f = [s[j] * e[0], s[j] * e[1], s[j] * e[2]];
-        }
+        sink.emit(first, ends, &d[..n], s);
         first += n;
     }
+}
+
+multiversion! {
+    /// Adds the forces of `springs` (all with first end in `first_slot..first_slot + sums.len()`)
+    /// into `sums`, slot `first_slot + i` at `sums[i]`: +F_s at a, −F_s at b when b is in range
+    /// (skipped otherwise), one spring after the other.
+    pub(crate) fn scatter_pass4(springs: Springs<'_>, y: &[SlotState], first_slot: usize, sums: &mut [Rec4])
+        = scatter_pass4_body;
+}
+
+#[inline(always)]
+fn scatter_pass4_body(springs: Springs<'_>, y: &[SlotState], first_slot: usize, sums: &mut [Rec4]) {
+    spring_blocks4(springs, y, &mut SlotSums { first_slot, sums });
+}
+
+/// F_s of spring s on padded records, scalar: the same bits as the blocked passes.
+#[inline]
+fn spring_force4(springs: &Springs<'_>, s: usize, y: &[SlotState]) -> Vec3 {
+    let [a, b] = springs.ends[s];
+    let (ya, yb) = (&y[a as usize], &y[b as usize]);
+    let d: Rec4 = std::array::from_fn(|c| yb.x[c] - ya.x[c]);
+    let w: Rec4 = std::array::from_fn(|c| yb.v[c] - ya.v[c]);
+    let pads = d[3] * d[3] + w[3] * w[3];
+    let q = spring_scale_padded(
+        d[0],
+        d[1],
+        d[2],
+        w[0],
+        w[1],
+        w[2],
+        pads,
+        springs.rest[s],
+        springs.stiffness[s],
+        springs.damping[s],
+    );
+    [q * d[0], q * d[1], q * d[2]]
+}
+
+/// Slot ranges per thread of the parallel spring sums: few, because each border costs the
+/// forces of the springs crossing it a second time (scalar, with cache misses).
+const RANGES_PER_THREAD: usize = 2;
+
+/// How [`SpringSystem::spring_sums4`] splits the work on several threads (made by
+/// [`SpringSystem::plan_sums`] from the spring ends, valid while they do not change): slot
+/// ranges `[s0, s1, p0, p1]` (slots s0..s1 and the springs p0..p1 of their first ends) and per
+/// range its cross springs, those whose second end lies in a later range (largest second end,
+/// spring ids in spring order). No ranges: one serial pass.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct SumPlan {
+    bounds: Vec<[usize; 4]>,
+    cross: Vec<(usize, Vec<u32>)>,
 }
 
 impl SpringSystem {
     /// Pass 1 on padded slot records (the RK4 stepper's layout).
     pub(crate) fn spring_forces4(&self, kernel: Kernel, y: &[SlotState], sf: &mut [Vec3], parallel: bool) {
         self.by_spring_chunks(sf, parallel, |springs, out| spring_pass4(kernel, springs, y, out));
+    }
+
+    /// Whether the springs are sorted by first end with a < b and the incidence lists are the
+    /// packed ones of [`SpringSystem::new`] (no mutator that touches the lists has run since):
+    /// then slot v's tails come before its heads in spring order, each list ascending, and
+    /// summing F_s in spring order gives the gather's bits, which lets the RK4 stepper add the
+    /// forces per slot in one pass over the springs (module docs, "Spring sums"). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let sorted = |ends: Vec<[u32; 2]>| {
+    ///     let n = ends.len();
+    ///     let sys = SpringSystem::new(ends, vec![1.0; n], vec![1.0; n], vec![0.0; n], vec![1.0; 3], &[false; 3], vec![0.0; 3], [0.0; 3]);
+    ///     sys.sorted_by_first_end()
+    /// };
+    /// assert!(sorted(vec![[0, 1], [0, 2], [1, 2]]));
+    /// assert!(!sorted(vec![[1, 2], [0, 1]])); // not by first end
+    /// assert!(!sorted(vec![[1, 0]])); // a > b
+    /// let mut sys = SpringSystem::new(vec![[0, 1]], vec![1.0], vec![1.0], vec![0.0], vec![1.0; 3], &[false; 3], vec![0.0; 3], [0.0; 3]);
+    /// sys.push_spring([0, 2], 1.0, 1.0, 0.0); // a mutator: the lists are no longer the packed ones
+    /// assert!(!sys.sorted_by_first_end());
+    /// ```
+    pub fn sorted_by_first_end(&self) -> bool {
+        self.inc.sorted
+    }
+
+    /// Plans [`SpringSystem::spring_sums4`] on the current thread pool (one range when not
+    /// `parallel` or small): two ranges of slots per thread, each at least one chunk (any split
+    /// gives the same bits). O(springs / threads + log springs) per range.
+    pub(crate) fn plan_sums(&self, parallel: bool, plan: &mut SumPlan) {
+        let n = self.slots();
+        let ranges = (RANGES_PER_THREAD * rayon::current_num_threads()).min(n / PARALLEL_CHUNK);
+        plan.bounds.clear();
+        if !parallel || ranges <= 1 {
+            return;
+        }
+        let slot_at = |r: usize| r * n / ranges;
+        let spring_at = |r: usize| self.ends.partition_point(|e| (e[0] as usize) < slot_at(r));
+        plan.bounds.extend((0..ranges).map(|r| [slot_at(r), slot_at(r + 1), spring_at(r), spring_at(r + 1)]));
+        plan.cross.resize_with(ranges, Default::default);
+        plan.cross.par_iter_mut().zip(&plan.bounds).for_each(|((reach, list), &[_, s1, p0, p1])| {
+            list.clear();
+            *reach = 0;
+            for (s, &[_, b]) in self.ends[p0..p1].iter().enumerate() {
+                if b as usize >= s1 {
+                    list.push((p0 + s) as u32);
+                    *reach = (*reach).max(b as usize);
+                }
+            }
+        });
+    }
+
+    /// The spring part of every slot's force, Σ −F_s (v = b) then +F_s (v = a) in spring order,
+    /// added into `sums` (all zero on entry, one per slot) straight from the springs: no
+    /// per-spring force array, no incidence lists. Bitwise equal to the gather for every kernel
+    /// and thread count. With a `plan` of several ranges (made by [`SpringSystem::plan_sums`]
+    /// for these ends), each range takes the springs of its first ends, but first adds the
+    /// forces of the earlier ranges' springs that end in it (computed there from the records),
+    /// which keeps the spring order per slot. Panics unless [`SpringSystem::sorted_by_first_end`].
+    /// O(springs + slots).
+    pub(crate) fn spring_sums4(&self, kernel: Kernel, y: &[SlotState], sums: &mut [Rec4], plan: &SumPlan) {
+        assert!(self.sorted_by_first_end() && sums.len() == self.slots(), "spring sums need a sorted system");
+        if plan.bounds.is_empty() {
+            scatter_pass4(kernel, self.spring_view(0..self.springs()), y, 0, sums);
+            return;
+        }
+        let mut parts = Vec::with_capacity(plan.bounds.len());
+        let mut rest = sums;
+        for &[s0, s1, _, _] in &plan.bounds {
+            let (part, tail) = rest.split_at_mut(s1 - s0);
+            parts.push(part);
+            rest = tail;
+        }
+        let all = self.spring_view(0..self.springs());
+        parts.into_par_iter().zip(&plan.bounds).enumerate().for_each(|(r, (part, &[s0, s1, p0, p1]))| {
+            let reaching = plan.cross[..r].iter().filter(|(reach, _)| *reach >= s0);
+            for &s in reaching.flat_map(|(_, list)| list) {
+                let b = self.ends[s as usize][1] as usize;
+                if (s0..s1).contains(&b) {
+                    let f = spring_force4(&all, s as usize, y);
+                    let t = &mut part[b - s0];
+                    *t = [t[0] - f[0], t[1] - f[1], t[2] - f[2], t[3]];
+                }
+            }
+            scatter_pass4(kernel, self.spring_view(p0..p1), y, s0, part);
+        });
     }
 }
 
@@ -928,6 +1137,9 @@ struct Incidence {
     adj: Vec<u32>,
     /// Entries of `adj` owned by no segment (abandoned by moves).
     garbage: usize,
+    /// Packed from springs sorted by first end, each with a < b, and unchanged since
+    /// ([`SpringSystem::sorted_by_first_end`]).
+    sorted: bool,
 }
 
 impl PartialEq for Incidence {
@@ -959,7 +1171,8 @@ impl Incidence {
                 fill[v][side] += 1;
             }
         }
-        Incidence { seg, adj, garbage: 0 }
+        let sorted = ends.iter().all(|&[a, b]| a < b) && ends.windows(2).all(|w| w[0][0] <= w[1][0]);
+        Incidence { seg, adj, garbage: 0, sorted }
     }
 
     /// (heads, tails) of slot v. O(1).
@@ -976,6 +1189,7 @@ impl Incidence {
 
     /// Adds spring s to v's head list (`head`) or tail list. O(degree) amortised.
     fn insert(&mut self, v: usize, head: bool, s: u32) {
+        self.sorted = false;
         if self.seg[v].len == self.seg[v].cap {
             self.grow(v);
         }
@@ -994,6 +1208,7 @@ impl Incidence {
 
     /// Removes spring s from v's head or tail list (panics if absent: a bug). O(degree).
     fn remove(&mut self, v: usize, head: bool, s: u32) {
+        self.sorted = false;
         let p = self.position(v, head, s);
         let g = &mut self.seg[v];
         let (last_head, last) = ((g.start + g.heads) as usize - 1, (g.start + g.len) as usize - 1);
@@ -1009,6 +1224,7 @@ impl Incidence {
 
     /// Renames spring `from` to `to` in v's head or tail list. O(degree).
     fn rename(&mut self, v: usize, head: bool, from: u32, to: u32) {
+        self.sorted = false;
         let p = self.position(v, head, from);
         self.adj[p] = to;
     }

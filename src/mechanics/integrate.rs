@@ -21,7 +21,7 @@ use std::str::FromStr;
 
 use rayon::prelude::*;
 
-use super::force::{Rec4, SlotState, SpringSystem, PARALLEL_CHUNK};
+use super::force::{Rec4, SlotState, SpringSystem, SumPlan, PARALLEL_CHUNK};
 use super::geom::{dot, norm, sub, Vec3};
 use super::simd::{multiversion, Kernel};
 
@@ -235,6 +235,12 @@ pub struct Stepper {
     acc: Vec<Vec3>,
     ax: Vec<Vec3>,
     av: Vec<Vec3>,
+    /// Per-slot spring force sums of the RK4 stages on a sorted system (zero between stages).
+    sums: Vec<Rec4>,
+    /// How the spring sums split across threads (remade every RK4 step).
+    plan: SumPlan,
+    /// Whether RK4 may sum spring forces per slot straight from the springs.
+    spring_sums: bool,
     /// (kinetic energy, non-finite probe) per chunk of slots, from the last RK4 stage.
     partials: Vec<Probe>,
     kernel: Kernel,
@@ -290,6 +296,9 @@ impl Stepper {
             acc: z(n),
             ax: z(n),
             av: z(n),
+            sums: vec![[0.0; 4]; n],
+            plan: SumPlan::default(),
+            spring_sums: true,
             partials: Vec::new(),
             kernel: Kernel::detect(),
             cg: CgBuffers::default(),
@@ -375,6 +384,34 @@ impl Stepper {
         self.kernel = kernel;
     }
 
+    /// Allows (`true`, the default) or forbids the one-pass spring sums of RK4 on a system sorted
+    /// by first end (`mechanics::force` module docs, "Spring sums"); forbidden, RK4 writes one force
+    /// per spring and gathers them per slot. Both give the same bits; the switch is for tests
+    /// and same-process benchmarks. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{FlatModel, Integrator, Material, StepConfig, Stepper};
+    ///
+    /// let (points, tets) = kuhn_cube(2);
+    /// let pinned: Vec<bool> = points.iter().map(|p| p[2] == 0.0).collect();
+    /// let flat = FlatModel::from_tets(&points, &tets, Material::default(), [0.0, 0.0, -9.81], &pinned).unwrap();
+    /// let run = |sums: bool| {
+    ///     let (mut x, mut v) = (flat.position.clone(), flat.velocity.clone());
+    ///     let mut stepper = Stepper::new(StepConfig::new(Integrator::Rk4, 1e-4), &flat.system, &x, &v).unwrap();
+    ///     stepper.set_spring_sums(sums);
+    ///     (0..5).for_each(|_| stepper.step(&flat.system, &mut x, &mut v).unwrap());
+    ///     x
+    /// };
+    /// assert_eq!(run(true), run(false)); // bit for bit
+    /// assert_ne!(run(true), flat.position); // and it moved
+    /// ```
+    pub fn set_spring_sums(&mut self, allowed: bool) {
+        self.spring_sums = allowed;
+    }
+
     /// Advances (x, v) by one step of the configured scheme, then checks for blow-up.
     /// O(slots + springs) (times the CG iterations for the implicit scheme).
     ///
@@ -445,11 +482,30 @@ impl Stepper {
         } else {
             self.ys.iter_mut().zip(x.iter().zip(v.iter())).for_each(copy);
         }
+        // A system sorted by first end sums its spring forces per slot in one pass over the
+        // springs (no force array, no incidence lists); any other uses the two-pass gather.
+        let sorted = self.spring_sums && sys.sorted_by_first_end();
+        self.sums.resize(x.len(), [0.0; 4]);
+        if sorted {
+            sys.plan_sums(par, &mut self.plan);
+        }
         for stage in stages {
-            sys.spring_forces4(kernel, &self.ys, &mut self.sf, par);
-            let sf: &[Vec3] = &self.sf;
-            let state = Rk4State { x: &mut *x, v: &mut *v, ys: &mut self.ys, ax: &mut self.ax, av: &mut self.av };
-            state.run(par, &mut self.partials, |first, chunk| rk4_stage(kernel, sys, sf, stage, first, chunk));
+            let forces = if sorted {
+                sys.spring_sums4(kernel, &self.ys, &mut self.sums, &self.plan);
+                None
+            } else {
+                sys.spring_forces4(kernel, &self.ys, &mut self.sf, par);
+                Some(&self.sf[..])
+            };
+            let state = Rk4State {
+                x: &mut *x,
+                v: &mut *v,
+                ys: &mut self.ys,
+                ax: &mut self.ax,
+                av: &mut self.av,
+                sums: &mut self.sums,
+            };
+            state.run(par, &mut self.partials, |first, chunk| rk4_stage(kernel, sys, forces, stage, first, chunk));
         }
     }
 
@@ -535,6 +591,7 @@ struct Rk4State<'a> {
     ys: &'a mut [SlotState],
     ax: &'a mut [Vec3],
     av: &'a mut [Vec3],
+    sums: &'a mut [Rec4],
 }
 
 impl Rk4State<'_> {
@@ -542,7 +599,7 @@ impl Rk4State<'_> {
     /// the probes go to `partials` in chunk order.
     fn run(self, par: bool, partials: &mut Vec<Probe>, pass: impl Fn(usize, Rk4State<'_>) -> Probe + Sync + Send) {
         let c = PARALLEL_CHUNK;
-        let Rk4State { x, v, ys, ax, av } = self;
+        let Rk4State { x, v, ys, ax, av, sums } = self;
         if par && x.len() > c {
             let chunks = (
                 x.par_chunks_mut(c),
@@ -550,38 +607,61 @@ impl Rk4State<'_> {
                 ys.par_chunks_mut(c),
                 ax.par_chunks_mut(c),
                 av.par_chunks_mut(c),
+                sums.par_chunks_mut(c),
             );
             chunks
                 .into_par_iter()
                 .enumerate()
-                .map(|(k, (x, v, ys, ax, av))| pass(k * c, Rk4State { x, v, ys, ax, av }))
+                .map(|(k, (x, v, ys, ax, av, sums))| pass(k * c, Rk4State { x, v, ys, ax, av, sums }))
                 .collect_into_vec(partials);
         } else {
             partials.clear();
             let chunks = x.chunks_mut(c).zip(v.chunks_mut(c)).zip(ys.chunks_mut(c)).zip(ax.chunks_mut(c));
             for (k, (((x, v), ys), ax)) in chunks.enumerate() {
-                let av = &mut av[k * c..k * c + x.len()];
-                partials.push(pass(k * c, Rk4State { x, v, ys, ax, av }));
+                let r = k * c..k * c + x.len();
+                let (av, sums) = (&mut av[r.clone()], &mut sums[r]);
+                partials.push(pass(k * c, Rk4State { x, v, ys, ax, av, sums }));
             }
         }
     }
 }
 
 multiversion! {
-    /// One RK4 stage over the slots `first..` of `s` (see [`Stage`]); spring forces in `sf`.
-    fn rk4_stage(sys: &SpringSystem, sf: &[Vec3], stage: Stage, first: usize, s: Rk4State<'_>) -> Probe = rk4_stage_body;
+    /// One RK4 stage over the slots `first..` of `s` (see [`Stage`]); the spring force sum of a
+    /// slot is the gather of the spring forces `sf` or, when `sf` is `None`, its entry of
+    /// `s.sums` (read, then reset to zero for the next stage).
+    fn rk4_stage(sys: &SpringSystem, sf: Option<&[Vec3]>, stage: Stage, first: usize, s: Rk4State<'_>) -> Probe
+        = rk4_stage_body;
 }
 
 #[inline(always)]
-fn rk4_stage_body(sys: &SpringSystem, sf: &[Vec3], stage: Stage, first: usize, s: Rk4State<'_>) -> Probe {
+fn rk4_stage_body(sys: &SpringSystem, sf: Option<&[Vec3]>, stage: Stage, first: usize, s: Rk4State<'_>) -> Probe {
+    match sf {
+        Some(sf) => stage_slots(sys, stage, first, s, |_, i, vi, _| sys.acceleration(i, vi, sf)),
+        None => stage_slots(sys, stage, first, s, |k, i, vi, sums| {
+            sys.acceleration_of_sum(i, unpad(std::mem::take(&mut sums[k])), vi)
+        }),
+    }
+}
+
+/// The stage's per-slot loop; `acceleration(k, first + k, v_k, sums)` gives slot k's acceleration.
+#[inline(always)]
+fn stage_slots(
+    sys: &SpringSystem,
+    stage: Stage,
+    first: usize,
+    s: Rk4State<'_>,
+    mut acceleration: impl FnMut(usize, usize, Vec3, &mut [Rec4]) -> Vec3,
+) -> Probe {
     let n = s.x.len();
     let (x, v, ys, ax, av) = (s.x, &mut s.v[..n], &mut s.ys[..n], &mut s.ax[..n], &mut s.av[..n]);
+    let sums = &mut s.sums[..n];
     let mut probe = Probe::default();
     match stage {
         Stage::First(c) => {
             for k in 0..n {
                 let (xi, vi) = (x[k], v[k]);
-                let a = sys.acceleration(first + k, vi, sf);
+                let a = acceleration(k, first + k, vi, sums);
                 ax[k] = vi;
                 av[k] = a;
                 ys[k] = SlotState { x: pad(madd(xi, c, vi)), v: pad(madd(vi, c, a)) };
@@ -590,7 +670,7 @@ fn rk4_stage_body(sys: &SpringSystem, sf: &[Vec3], stage: Stage, first: usize, s
         Stage::Middle(c) => {
             for k in 0..n {
                 let vi = unpad(ys[k].v);
-                let a = sys.acceleration(first + k, vi, sf);
+                let a = acceleration(k, first + k, vi, sums);
                 ax[k] = madd(ax[k], 2.0, vi);
                 av[k] = madd(av[k], 2.0, a);
                 ys[k] = SlotState { x: pad(madd(x[k], c, vi)), v: pad(madd(v[k], c, a)) };
@@ -599,7 +679,7 @@ fn rk4_stage_body(sys: &SpringSystem, sf: &[Vec3], stage: Stage, first: usize, s
         Stage::Last(c) => {
             for k in 0..n {
                 let vi = unpad(ys[k].v);
-                let a = sys.acceleration(first + k, vi, sf);
+                let a = acceleration(k, first + k, vi, sums);
                 x[k] = madd(x[k], c, add(ax[k], vi));
                 v[k] = madd(v[k], c, add(av[k], a));
                 probe.add(sys.mass[first + k], x[k], v[k]);

@@ -11,7 +11,7 @@
 
 use std::hash::{DefaultHasher, Hash, Hasher};
 
-use topomech::generate::{grid_triangles, kuhn_cube, SplitMix64};
+use topomech::generate::{disk_fan, grid_triangles, kuhn_cube, SplitMix64};
 use topomech::subdivide::{LeveledMap, TetMasses};
 use topomech::{CellId, GMap};
 
@@ -95,13 +95,7 @@ fn main() {
         let (p, t) = grid_triangles(n);
         run_2d(&format!("grid {n} levels {levels:?}"), p, &t, &levels, full);
     }
-    let mut pts = vec![[0.0; 3]];
-    let mut tris = Vec::new();
-    for k in 0..7u32 {
-        let a = std::f64::consts::TAU * k as f64 / 7.0;
-        pts.push([a.cos(), a.sin(), 0.0]);
-        tris.push([0, 1 + k, 1 + (k + 1) % 7]);
-    }
+    let (pts, tris) = disk_fan(7);
     run_2d("fan 7 levels [1, 2]", pts, &tris, &[1, 2], full);
     let (p, t) = grid_triangles(3);
     run_2d("grid 3 refused at level 0", p, &t, &[0], full);

@@ -172,13 +172,16 @@ pub fn witness_holds<const N: usize>(map: &GMap<N>, v: &InvariantViolation) -> b
                 && !map.cell_darts(dim, first).contains(&second)
         }
         CellIdOrphan { dim, id } => map.is_live_cell(dim, id) && map.darts().all(|d| map.cell_id(dim, d) != id),
+        TetLayout { dart, i, stored, built } => {
+            map.tets_as_built() && stored != built && (!map.contains(dart) || map.alpha_dyn(i, dart) == stored)
+        }
     }
 }
 
 /// The law `validate()` must name when several are broken: the first in the order of its table
 /// (a broken involution is the cause, not the quasi-manifold failure a neighbour then shows).
 fn first_in_table_order(broken: &[Law]) -> Option<Law> {
-    [Law::Involution, Law::QuasiManifold, Law::CellIdConstant, Law::CellIdUnique]
+    [Law::Involution, Law::QuasiManifold, Law::CellIdConstant, Law::CellIdUnique, Law::TetLayout]
         .into_iter()
         .find(|l| broken.contains(l))
 }

@@ -74,6 +74,31 @@ pub fn grid_triangles(n: usize) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
     (points, triangles)
 }
 
+/// A disk: n ≥ 3 triangles fanned around a centre (point 0) whose rim points 1..=n lie on the
+/// unit circle in the plane z = 0. V = n + 1, T = n, E = 2n, boundary edges = n: the one inner
+/// vertex of degree n. O(n).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate;
+///
+/// let (points, triangles) = generate::disk_fan(7);
+/// assert_eq!((points.len(), triangles.len()), (8, 7));
+/// assert!(triangles.iter().all(|t| t[0] == 0)); // every triangle has the centre
+/// assert!(points[1..].iter().all(|p| (p[0].hypot(p[1]) - 1.0).abs() < 1e-12));
+/// ```
+pub fn disk_fan(n: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    let mut points = vec![[0.0; 3]];
+    let mut triangles = Vec::with_capacity(n as usize);
+    for k in 0..n {
+        let a = std::f64::consts::TAU * k as f64 / n as f64;
+        points.push([a.cos(), a.sin(), 0.0]);
+        triangles.push([0, 1 + k, 1 + (k + 1) % n]);
+    }
+    (points, triangles)
+}
+
 /// A small deterministic pseudo-random generator (SplitMix64), so factories need no dependency.
 ///
 /// # Examples

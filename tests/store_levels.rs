@@ -330,6 +330,7 @@ fn violation_darts(v: &topomech::gmap::InvariantViolation) -> Vec<DartId> {
         CellIdDiffers { dart, other, .. } => vec![dart, other],
         CellIdShared { first, second, .. } => vec![first, second],
         CellIdOrphan { .. } => vec![],
+        TetLayout { dart, stored, built, .. } => vec![dart, stored, built],
     }
 }
 

@@ -13,7 +13,7 @@
 //! - refusals leave the map (and masses) unchanged.
 
 use proptest::prelude::*;
-use topomech::generate::{grid_triangles, kuhn_cube, SplitMix64};
+use topomech::generate::{disk_fan, grid_triangles, kuhn_cube, SplitMix64};
 use topomech::subdivide::{LeveledMap, Refinement, SubdivideError, TetMasses};
 use topomech::{DartId, GMap};
 
@@ -278,13 +278,7 @@ fn triangles_grids_and_disk_match_per_op() {
     let (p, t) = grid_triangles(2);
     compare_tris(tri_map(p, &t), 3);
     // A disk: a fan of 7 triangles around the centre.
-    let mut pts = vec![[0.0; 3]];
-    let mut tris = Vec::new();
-    for k in 0..7u32 {
-        let a = std::f64::consts::TAU * k as f64 / 7.0;
-        pts.push([a.cos(), a.sin(), 0.0]);
-        tris.push([0, 1 + k, 1 + (k + 1) % 7]);
-    }
+    let (pts, tris) = disk_fan(7);
     compare_tris(tri_map(pts, &tris), 2);
 }
 

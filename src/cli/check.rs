@@ -123,6 +123,7 @@ fn map_law_name(v: &InvariantViolation) -> &'static str {
         topomech::gmap::Law::QuasiManifold => "quasi_manifold",
         topomech::gmap::Law::CellIdConstant => "cell_id_constant",
         topomech::gmap::Law::CellIdUnique => "cell_id_unique",
+        topomech::gmap::Law::TetLayout => "tet_layout",
     }
 }
 
@@ -145,6 +146,7 @@ fn violation_darts(v: &InvariantViolation) -> Vec<u32> {
         CellIdNotLive { dart, .. } => vec![dart.0],
         CellIdShared { first, second, .. } => vec![first.0, second.0],
         CellIdOrphan { .. } => Vec::new(),
+        TetLayout { dart, .. } => vec![dart.0],
     }
 }
 

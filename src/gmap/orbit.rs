@@ -431,6 +431,33 @@ impl<const N: usize> GMap<N> {
     }
 }
 
+impl<const N: usize> GMap<N> {
+    /// Whether every live dart is known to lie in a closed tetrahedron as [`GMap::from_tets`]
+    /// built it: true from that builder until the first write that may change an αi link with
+    /// i < 3 or add a dart (α3 sews and unsews keep it). When true, every volume is a closed
+    /// tetrahedron whose darts 24t … 24t + 23 are linked by α0, α1, α2 in the builder's fixed
+    /// pattern, so those links need not be read nor checked. False proves nothing; always false for
+    /// n ≠ 3. A law of [`GMap::validate`] (`Law::TetLayout`). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let (mut map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+    /// assert!(map.tets_as_built());
+    /// let d = map.darts().find(|&d| !map.is_free(3, d)).unwrap();
+    /// map.unsew::<3>(d).unwrap(); // a face dissociation keeps every tet closed
+    /// assert!(map.tets_as_built());
+    /// map.unsew::<2>(d).unwrap(); // opens a tet
+    /// assert!(!map.tets_as_built());
+    /// ```
+    #[inline]
+    pub fn tets_as_built(&self) -> bool {
+        self.tets_as_built
+    }
+}
+
 impl GMap<3> {
     /// The distinct volume ids around the vertex of d, sorted: the vertex orbit ⟨α1, α2, α3⟩(d)
     /// walked as its corners ⟨α1, α2⟩ (each inside one volume, walked by [`GMap::for_each_dihedral`])
@@ -510,30 +537,6 @@ impl GMap<3> {
         let darts = [c, a1, a2, a21, a12, a121];
         let distinct = (0..6).all(|i| (i + 1..6).all(|j| darts[i] != darts[j]));
         (a121 == a212 && distinct).then_some(darts)
-    }
-
-    /// Whether every live dart is known to lie in a closed tetrahedron as [`GMap::from_tets`]
-    /// built it: true from that builder until the first write that may change an αi link with
-    /// i < 3 or add a dart (α3 sews and unsews keep it). When true, every volume is a closed
-    /// tetrahedron whose darts 24t … 24t + 23 are linked by α0, α1, α2 in the builder's fixed
-    /// pattern, so those links need not be read nor checked. False proves nothing. O(1).
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use topomech::GMap;
-    ///
-    /// let (mut map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
-    /// assert!(map.tets_as_built());
-    /// let d = map.darts().find(|&d| !map.is_free(3, d)).unwrap();
-    /// map.unsew::<3>(d).unwrap(); // a face dissociation keeps every tet closed
-    /// assert!(map.tets_as_built());
-    /// map.unsew::<2>(d).unwrap(); // opens a tet
-    /// assert!(!map.tets_as_built());
-    /// ```
-    #[inline]
-    pub fn tets_as_built(&self) -> bool {
-        self.tets_as_built
     }
 
     /// Sets the flag of [`GMap::tets_as_built`]: for the builder, whose tets are closed by

@@ -9,7 +9,7 @@
 //! α1(d0) to collect the other half of the fan.
 
 use crate::mechanics::geom::{cross, dot, sub};
-use crate::mechanics::model::triangle_vertices;
+use crate::mechanics::model::{closed_triangle_vertices, triangle_vertices};
 use crate::mechanics::{Body, Simulation, TouchedCells, Vec3};
 use crate::{CellId, DartId, GMap};
 
@@ -239,19 +239,18 @@ fn face_normal(body: &Body, d: DartId) -> Vec3 {
 /// [`face_normal`] for a dart `x` of the vertex being torn, reading the face's vertices off
 /// three darts instead of walking its orbit: when the face ⟨α0, α1⟩(x) closes after six darts
 /// (x, α0 x, α1 α0 x, α0 α1 α0 x = α1 α0 α1 x, α0 α1 x, α1 x) its vertices are those of x,
-/// α0 x and α0 α1 x; if they are distinct, that is [`triangle_vertices`]' sorted triple and the
-/// normal is the same bit for bit. Otherwise falls back to [`face_normal`]. O(1).
+/// α0 x and α0 α1 x ([`closed_triangle_vertices`]); if they are distinct, that is
+/// [`triangle_vertices`]' sorted triple and the normal is the same bit for bit. Otherwise falls
+/// back to [`face_normal`]. O(1).
 fn face_normal_at(body: &Body, x: DartId) -> Vec3 {
     let map = body.map();
     let (a, b) = (map.alpha_local(0, x), map.alpha_local(1, x));
     let c = map.alpha_local(0, b);
     let closed = a != x && b != x && c != b && map.alpha_local(0, map.alpha_local(1, a)) == map.alpha_local(1, c);
-    let mut ids = [map.vertex_id(x), map.vertex_id(a), map.vertex_id(c)];
-    ids.sort_unstable();
-    if !closed || ids[0] == ids[1] || ids[1] == ids[2] {
-        return face_normal(body, x);
+    match closed.then(|| closed_triangle_vertices(map, x)).flatten() {
+        Some(ids) => triangle_normal(body, ids),
+        None => face_normal(body, x),
     }
-    triangle_normal(body, ids)
 }
 
 /// The dart starting the fan of the vertex of `start`: among its inner darts, the one whose face

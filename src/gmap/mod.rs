@@ -304,8 +304,7 @@ impl<const N: usize> GMap<N> {
     #[inline(always)]
     pub(crate) fn alpha_local(&self, i: usize, d: DartId) -> DartId {
         if N == 3 && i < 3 && self.tets_as_built {
-            let k = d.0 % 24;
-            DartId(d.0 - k + crate::build::TET_LINKS[k as usize][i])
+            DartId(crate::build::built_tet_link(i, d.0))
         } else {
             self.alpha_dyn(i, d)
         }

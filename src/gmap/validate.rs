@@ -250,7 +250,7 @@ impl<const N: usize> GMap<N> {
             dart: DartId(d as u32),
             i,
             stored: DartId(self.alpha.get(d * row + i).copied().unwrap_or(d as u32)),
-            built: DartId((d - d % 24) as u32 + crate::build::TET_LINKS[d % 24][i]),
+            built: DartId(crate::build::built_tet_link(i, d as u32)),
         };
         if N != 3 || self.capacity() % 24 != 0 {
             return Err(violation(self.capacity(), 0));

@@ -850,12 +850,13 @@ pub(crate) fn triangle_vertices(map: &GMap<3>, d: DartId) -> Option<[CellId; 3]>
     Some(face)
 }
 
-/// [`triangle_vertices`] for a dart `d` of a closed tet ([`GMap::closed_tet_darts`]): its face
+/// [`triangle_vertices`] for a dart `d` whose face is known to close as a hexagon (as in a closed
+/// tet, [`GMap::closed_tet_darts`], or after the tear's six-dart check): its face
 /// ⟨α0, α1⟩(d) is then the closed hexagon d, α1 d, α0 d, α1 α0 d, α0 α1 d, α1 α0 α1 d, whose
 /// ⟨α1⟩ pairs share a vertex (α1 is in the vertex orbit), so its distinct vertex ids are those of
 /// d, α0 d and α0 α1 d: three loads of ids, the links computed for tets as built
 /// ([`GMap::alpha_local`]), else two loads; no walk. O(1).
-fn closed_triangle_vertices(map: &GMap<3>, d: DartId) -> Option<[CellId; 3]> {
+pub(crate) fn closed_triangle_vertices(map: &GMap<3>, d: DartId) -> Option<[CellId; 3]> {
     let mut face = [
         map.vertex_id(d),
         map.vertex_id(map.alpha_local(0, d)),

@@ -83,3 +83,36 @@ fn validate_names_the_broken_law_n3() {
         assert!(named.iter().any(|(l, c)| *l == law && *c > 0), "{law:?} never produced: {named:?}");
     }
 }
+
+/// Every single α3 link or unlink and every cell-id overwrite of small complexes of built tets:
+/// these edits keep [`GMap::tets_as_built`], so `validate()` takes its tet path (laws restated on
+/// tets), which must fail exactly when a law is broken and name the first broken law.
+#[test]
+fn validate_names_the_broken_law_on_built_tets() {
+    let complexes: [&[[u32; 4]]; 3] =
+        [&[[0, 1, 2, 3]], &[[0, 1, 2, 3], [0, 1, 2, 4]], &[[0, 1, 2, 3], [0, 1, 2, 4], [0, 1, 3, 4]]];
+    let mut named: Vec<(Law, usize)> = Vec::new();
+    for tets in complexes {
+        let (map, _) = GMap::<3>::from_tets(5, tets).unwrap();
+        let edits = all_edits(&map)
+            .into_iter()
+            .filter(|e| !matches!(e, RawEdit::Link { i, .. } | RawEdit::Unlink { i, .. } if *i < 3));
+        for edit in edits {
+            let mut broken = map.clone();
+            if !ops::raw_edit_unchecked(&mut broken, edit) {
+                continue;
+            }
+            assert!(broken.tets_as_built(), "{edit:?} cleared the flag");
+            check_validate_names_law(&broken).unwrap_or_else(|e| panic!("{tets:?} + {edit:?}: {e}"));
+            if let Err(v) = broken.validate() {
+                match named.iter_mut().find(|(l, _)| *l == v.law()) {
+                    Some((_, c)) => *c += 1,
+                    None => named.push((v.law(), 1)),
+                }
+            }
+        }
+    }
+    for law in [Law::Involution, Law::QuasiManifold, Law::CellIdConstant] {
+        assert!(named.iter().any(|(l, c)| *l == law && *c > 0), "{law:?} never produced: {named:?}");
+    }
+}

@@ -335,8 +335,13 @@ const fn tet_edge_index(u: usize, w: usize) -> usize {
     }
 }
 
-/// The local edge of each of the 24 darts of a tet.
-const TET_DART_EDGE: [u8; 24] = {
+/// The local corner (0..4) of each of the 24 darts of a tet: the corner's 6 darts are its
+/// ⟨α1, α2⟩ orbit in the tet.
+pub(crate) const TET_DART_CORNER: [u8; 24] = TET.vertex;
+
+/// The local edge (0..6, [`TET_EDGES`] order) of each of the 24 darts of a tet: the edge's 4
+/// darts are its ⟨α0, α2⟩ orbit in the tet.
+pub(crate) const TET_DART_EDGE: [u8; 24] = {
     let mut e = [0u8; 24];
     let mut k = 0;
     while k < 24 {

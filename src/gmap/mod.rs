@@ -28,6 +28,7 @@ mod mask;
 mod orbit;
 mod sew;
 mod validate;
+mod validate_tets;
 
 pub use cells::{CellCounts, MapSummary};
 pub use cmap::CombinatorialMap;

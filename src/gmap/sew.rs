@@ -633,6 +633,11 @@ impl<const N: usize> GMap<N> {
     /// smaller by the lockstep walk (a complete orbit) gets a fresh id. A piece that got a fresh
     /// id is complete, so its other endpoints are skipped. Endpoints that `links` proves still
     /// joined skip the walk (it would find them joined too: the outcome is the same).
+    /// An endpoint proven joined to an *earlier* endpoint is skipped before its id is even read:
+    /// it is in the same cell as that one through every relabelling (each relabels a whole cell),
+    /// so it would be skipped as complete, or be joined to the anchor of that cell, or lead to a
+    /// check that finds it joined — never to a change or a new anchor. Only the first endpoint of
+    /// each class is looked at (3 of the 12 per dimension for an inner face).
     /// `scratch` holds the (id, anchor endpoint index) list and the ids that got a fresh id (the
     /// complete pieces), reused across dimensions.
     fn split_cells(
@@ -647,8 +652,10 @@ impl<const N: usize> GMap<N> {
         let classes = links.classes(dim);
         anchors.clear();
         complete.clear();
-        for k in 0..2 * pairs.len() {
-            let z = endpoint(pairs, k);
+        for (k, z) in pairs.iter().flat_map(|&(x, y)| [x, y]).enumerate() {
+            if classes.has_earlier_member(k) {
+                continue;
+            }
             let id = self.cell_id(dim, z).0;
             if complete.contains(&id) {
                 continue;
@@ -665,7 +672,7 @@ impl<const N: usize> GMap<N> {
             let new = match links.split_of_whole_classes(&classes, dim, a, k) {
                 Some((side, is_z_side)) => {
                     let new = self.alloc_cell_id(dim);
-                    for w in (0..2 * pairs.len()).filter(|&w| classes.joined(w, side)) {
+                    for w in bits(classes.members(side)) {
                         self.set_cell_raw(dim, endpoint(pairs, w), new);
                     }
                     (new, is_z_side)
@@ -793,24 +800,68 @@ impl EndpointIndex {
     }
 }
 
-/// A partition of the endpoints into classes known to be joined in one cell dimension.
+/// A partition of the endpoints into classes known to be joined in one cell dimension: per
+/// endpoint p, the bit set of its class (bit q set iff q is proven joined to p; p's own bit
+/// included). All sets are empty when no proof was built. Endpoint indices are below
+/// 2 · [`QuickLinks::MAX_PAIRS`] = 32, so a class is one `u32`: `joined` is one shift, a class's
+/// size one popcount, and its members the set bits.
 struct Classes {
-    parent: [u8; 2 * QuickLinks::MAX_PAIRS],
-    len: usize,
+    class: [u32; 2 * QuickLinks::MAX_PAIRS],
 }
 
 impl Classes {
-    fn root(&self, mut p: usize) -> usize {
-        while self.parent[p] as usize != p {
-            p = self.parent[p] as usize;
+    /// The classes of the graph on `ends` endpoints whose edges are `links`: the connected
+    /// components, each found by a breadth-first closure over adjacency bit sets. O(ends + links).
+    fn of_links(ends: usize, links: impl Iterator<Item = (usize, usize)>) -> Self {
+        let mut adjacent = [0u32; 2 * QuickLinks::MAX_PAIRS];
+        for (p, q) in links {
+            adjacent[p] |= 1 << q;
+            adjacent[q] |= 1 << p;
         }
-        p
+        let mut class = [0u32; 2 * QuickLinks::MAX_PAIRS];
+        for p in 0..ends {
+            if class[p] != 0 {
+                continue;
+            }
+            let (mut members, mut todo) = (1u32 << p, 1u32 << p);
+            while todo != 0 {
+                let q = todo.trailing_zeros() as usize;
+                todo &= todo - 1;
+                let fresh = adjacent[q] & !members;
+                members |= fresh;
+                todo |= fresh;
+            }
+            for q in bits(members) {
+                class[q] = members;
+            }
+        }
+        Classes { class }
+    }
+
+    /// The members of p's class as a bit set (empty when no proof was built or p is past the
+    /// covered endpoints).
+    fn members(&self, p: usize) -> u32 {
+        self.class.get(p).copied().unwrap_or(0)
+    }
+
+    /// Whether endpoint p is proven joined to an endpoint q < p. O(1).
+    fn has_earlier_member(&self, p: usize) -> bool {
+        p < u32::BITS as usize && self.members(p) & ((1u32 << p) - 1) != 0
     }
 
     /// Whether endpoints p and q are proven joined (false when no proof was built).
     fn joined(&self, p: usize, q: usize) -> bool {
-        p < self.len && q < self.len && self.root(p) == self.root(q)
+        q < u32::BITS as usize && self.members(p) >> q & 1 != 0
     }
+}
+
+/// The indices of the set bits of `set`, lowest first.
+fn bits(mut set: u32) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        let q = set.trailing_zeros() as usize;
+        set &= set.checked_sub(1)?;
+        Some(q)
+    })
 }
 
 impl QuickLinks {
@@ -895,34 +946,18 @@ impl QuickLinks {
             return None;
         }
         let cell = self.gens & !(1 << dim);
-        let mut size = [0usize; 2];
-        for p in 0..self.ends {
-            let side = if classes.joined(p, a) {
-                0
-            } else if classes.joined(p, z) {
-                1
-            } else {
-                continue;
-            };
-            if self.direct[p] & cell != cell {
-                return None;
-            }
-            size[side] += 1;
+        let (side_a, side_z) = (classes.members(a), classes.members(z));
+        if bits(side_a | side_z).any(|p| self.direct[p] & cell != cell) {
+            return None;
         }
-        Some(if size[0] <= size[1] { (a, false) } else { (z, true) })
+        Some(if side_a.count_ones() <= side_z.count_ones() { (a, false) } else { (z, true) })
     }
 
-    /// The classes of endpoints proven joined in the cells of dimension `dim`.
+    /// The classes of endpoints proven joined in the cells of dimension `dim`. O(ends + links).
     fn classes(&self, dim: usize) -> Classes {
-        let mut c = Classes { parent: std::array::from_fn(|p| p as u8), len: self.ends };
         // αk is in the dim-cell orbit iff k ≠ dim; a ring also needs αi, and dim ≠ i here.
-        for &(p, q, _) in self.links[..self.len].iter().filter(|l| l.2 as usize != dim) {
-            let (rp, rq) = (c.root(p as usize), c.root(q as usize));
-            if rp != rq {
-                c.parent[rp.max(rq)] = rp.min(rq) as u8;
-            }
-        }
-        c
+        let links = self.links[..self.len].iter().filter(|l| l.2 as usize != dim);
+        Classes::of_links(self.ends, links.map(|&(p, q, _)| (p as usize, q as usize)))
     }
 }
 

@@ -819,11 +819,11 @@ impl Classes {
             adjacent[q] |= 1 << p;
         }
         let mut class = [0u32; 2 * QuickLinks::MAX_PAIRS];
-        for p in 0..ends {
-            if class[p] != 0 {
-                continue;
-            }
-            let (mut members, mut todo) = (1u32 << p, 1u32 << p);
+        // The endpoints not yet in a class; each round closes the class of the lowest one.
+        let mut rest = u32::MAX.checked_shr(u32::BITS - ends as u32).unwrap_or(0);
+        while rest != 0 {
+            let first = 1u32 << rest.trailing_zeros();
+            let (mut members, mut todo) = (first, first);
             while todo != 0 {
                 let q = todo.trailing_zeros() as usize;
                 todo &= todo - 1;
@@ -834,6 +834,7 @@ impl Classes {
             for q in bits(members) {
                 class[q] = members;
             }
+            rest &= !members;
         }
         Classes { class }
     }
@@ -888,13 +889,19 @@ impl QuickLinks {
         }
         out.ends = 2 * pairs.len();
         out.gens = ((1u16 << (N + 1)) - 1) as u8;
+        let mut ends = [DartId(0); 2 * Self::MAX_PAIRS];
+        for (e, &(x, y)) in ends.chunks_exact_mut(2).zip(pairs) {
+            e.copy_from_slice(&[x, y]);
+        }
+        let ends = &ends[..out.ends];
         let table = EndpointIndex::new(pairs);
         let index = |d: DartId| table.get(d);
-        let commuting = |k: usize, j: usize| k.abs_diff(i) >= 2 && k.abs_diff(j) >= 2;
-        for p in 0..out.ends {
-            let x = endpoint(pairs, p);
+        // The generators commuting with αk: those at index distance ≥ 2 from k.
+        let gens = u32::from(out.gens);
+        let commuting_with = |k: usize| gens & !(0b111 << k >> 1);
+        for (p, &x) in ends.iter().enumerate() {
             out.direct[p] |= 1 << i; // every endpoint is i-free now
-            for k in (0..=N).filter(|&k| k.abs_diff(i) >= 2) {
+            for k in bits(commuting_with(i)) {
                 let y = map.alpha_local(k, x);
                 if y == x {
                     out.direct[p] |= 1 << k;
@@ -906,19 +913,19 @@ impl QuickLinks {
             }
         }
         for j in [i.checked_sub(1), Some(i + 1).filter(|&j| j <= N)].into_iter().flatten() {
-            let mirrors = || (0..=N).filter(move |&k| commuting(k, j));
+            let mirrors = commuting_with(i) & commuting_with(j);
             // One walk per pair, none for a pair that is the αk image of a walked one.
-            let mut covered = [false; 2 * Self::MAX_PAIRS];
+            let mut covered = 0u32;
             let mut walks = RingWalks::new(i, j);
-            for m in 0..pairs.len() {
-                if covered[2 * m] {
+            for (m, &pair) in pairs.iter().enumerate() {
+                if covered >> (2 * m) & 1 != 0 {
                     continue;
                 }
-                walks.start(pairs[m], m);
+                walks.start(pair, m);
                 for p in [2 * m, 2 * m + 1] {
-                    covered[p] = true;
-                    for q in mirrors().filter_map(|k| index(map.alpha_local(k, endpoint(pairs, p)))) {
-                        covered[q] = true;
+                    covered |= 1 << p;
+                    for q in bits(mirrors).filter_map(|k| index(map.alpha_local(k, ends[p]))) {
+                        covered |= 1 << q;
                     }
                 }
             }
@@ -926,7 +933,7 @@ impl QuickLinks {
             for m in walks.joined() {
                 out.push(2 * m, 2 * m + 1, j);
                 let (x, y) = pairs[m];
-                for k in mirrors() {
+                for k in bits(mirrors) {
                     if let (Some(p), Some(q)) = (index(map.alpha_local(k, x)), index(map.alpha_local(k, y))) {
                         out.push(p, q, j);
                     }

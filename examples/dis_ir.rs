@@ -11,8 +11,9 @@
 //! ```
 
 //!
-//! `cargo run --release --example dis_ir [PASSES] [random | incision]` (default 2 passes over
-//! both face lists; `random` or `incision` for one of them).
+//! `cargo run --release --example dis_ir [PASSES] [random | incision] [inner | split]` (default
+//! 2 passes over both face lists; `random` or `incision` for one of them; `inner` for only its
+//! faces whose dissociation splits no vertex or edge, `split` for the others).
 
 use std::hash::{Hash, Hasher};
 use std::path::Path;
@@ -75,12 +76,22 @@ fn main() {
     let mut projection = Projection::build(&body, G);
     let (faces, _) = cut_select::faces_and_vertices(body.map());
     let incision = incision_faces(&body, &z.points);
-    let list: Vec<DartId> = match which.as_str() {
+    let mut list: Vec<DartId> = match which.as_str() {
         "random" => faces.clone(),
         "incision" => incision.clone(),
         _ => faces.iter().chain(&incision).copied().collect(),
     };
-    let mut calls = 0usize;
+    // Optionally only the faces whose dissociation splits no vertex or edge ("inner"), or only
+    // the others ("split"), found by one dissociation each, undone (not measured).
+    if let Some(kind) = std::env::args().nth(3) {
+        list.retain(|&d| {
+            let dis = cut::dissociate_face(&mut body, d).expect("inner face");
+            let inner = dis.vertices.is_empty() && dis.edges.is_empty();
+            undo(&mut body, &mut projection, &dis);
+            inner == (kind == "inner")
+        });
+    }
+    let (mut calls, mut inner) = (0usize, 0usize);
     // A digest of every outcome (ids of the faces, the split vertices and edges), to check that
     // two builds dissociate identically.
     let mut outcome = std::hash::DefaultHasher::new();
@@ -88,6 +99,7 @@ fn main() {
         for &d in &list {
             let dis = timed(&mut body, &mut projection, d);
             dis.faces.hash(&mut outcome);
+            inner += usize::from(dis.vertices.is_empty() && dis.edges.is_empty());
             for s in dis.vertices.iter().chain(&dis.edges) {
                 (s.kept, s.new, s.dart_kept, s.dart_new).hash(&mut outcome);
             }
@@ -96,7 +108,8 @@ fn main() {
         calls += list.len();
     }
     println!(
-        "dis_ir: {calls} dissociations ({} random faces, {} incision faces per pass), outcome digest {:016x}",
+        "dis_ir: {calls} dissociations ({} random faces, {} incision faces per pass; {inner} split no vertex or \
+         edge), outcome digest {:016x}",
         faces.len(),
         incision.len(),
         outcome.finish()

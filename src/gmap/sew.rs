@@ -611,7 +611,10 @@ impl<const N: usize> GMap<N> {
             self.unlink_raw(i, x);
         }
         let mut report = CellChanges { changes: Vec::new(), pairs, new_sides: SplitSides::default() };
-        let links = if quick { QuickLinks::find(self, i, &report.pairs) } else { QuickLinks::none() };
+        let mut links = QuickLinks::none();
+        if quick {
+            links.find(self, i, &report.pairs);
+        }
         // The per-dimension lists of `split_cells`, kept per thread between unsews (no
         // allocation in the steady state; they are cleared before use).
         let mut scratch = SPLIT_SCRATCH.take();
@@ -730,13 +733,14 @@ fn endpoint(pairs: &[(DartId, DartId)], k: usize) -> DartId {
 ///   (x, y) onto that of (αk(x), αk(y)), so that one is not walked (α0 in the example: the
 ///   other end of the edge).
 ///
-/// Built only for up to [`QuickLinks::MAX_PAIRS`] pairs (else no proof: every check walks);
-/// proofs beyond [`QuickLinks::MAX_LINKS`] are dropped (a dropped proof only costs a walk).
+/// Built only for up to [`QuickLinks::MAX_PAIRS`] pairs and maps of dimension below
+/// [`QuickLinks::MAX_GENS`] (else no proof: every check walks).
 struct QuickLinks {
-    /// (p, q, k): endpoints p and q joined through αk (direct) or through the ring ⟨αk, αi⟩;
-    /// either way the proof holds in the cells of every dimension other than k (and i).
-    links: [(u8, u8, u8); QuickLinks::MAX_LINKS],
-    len: usize,
+    /// Per generator k and endpoint p, the bit set of the endpoints q joined to p through αk
+    /// (direct) or through the ring ⟨αk, αi⟩; either way the proof holds in the cells of every
+    /// dimension other than k (and i). Kept per generator so that the classes of a dimension
+    /// are the closure of a few bit-set unions ([`QuickLinks::classes`]).
+    adjacent: [[u32; 2 * QuickLinks::MAX_PAIRS]; QuickLinks::MAX_GENS],
     /// Per endpoint, the bit set of the generators k with a direct link αk(p) = q or αk(p) = p.
     direct: [u8; 2 * QuickLinks::MAX_PAIRS],
     /// The bit set of the map's generators α0 … αn.
@@ -807,27 +811,27 @@ impl EndpointIndex {
 /// size one popcount, and its members the set bits.
 struct Classes {
     class: [u32; 2 * QuickLinks::MAX_PAIRS],
+    /// The endpoints joined to a lower-numbered one (every class member but its lowest).
+    followers: u32,
 }
 
 impl Classes {
-    /// The classes of the graph on `ends` endpoints whose edges are `links`: the connected
-    /// components, each found by a breadth-first closure over adjacency bit sets. O(ends + links).
-    fn of_links(ends: usize, links: impl Iterator<Item = (usize, usize)>) -> Self {
-        let mut adjacent = [0u32; 2 * QuickLinks::MAX_PAIRS];
-        for (p, q) in links {
-            adjacent[p] |= 1 << q;
-            adjacent[q] |= 1 << p;
-        }
+    /// The classes of the graph on `ends` endpoints where `adjacent(p)` is the bit set of p's
+    /// neighbours: the connected components, each found by a breadth-first closure over bit
+    /// sets. O(ends) calls of `adjacent`.
+    fn closure(ends: usize, adjacent: impl Fn(usize) -> u32) -> Self {
         let mut class = [0u32; 2 * QuickLinks::MAX_PAIRS];
         // The endpoints not yet in a class; each round closes the class of the lowest one.
         let mut rest = u32::MAX.checked_shr(u32::BITS - ends as u32).unwrap_or(0);
+        let mut followers = rest;
         while rest != 0 {
             let first = 1u32 << rest.trailing_zeros();
+            followers &= !first;
             let (mut members, mut todo) = (first, first);
             while todo != 0 {
                 let q = todo.trailing_zeros() as usize;
                 todo &= todo - 1;
-                let fresh = adjacent[q] & !members;
+                let fresh = adjacent(q) & !members;
                 members |= fresh;
                 todo |= fresh;
             }
@@ -836,7 +840,7 @@ impl Classes {
             }
             rest &= !members;
         }
-        Classes { class }
+        Classes { class, followers }
     }
 
     /// The members of p's class as a bit set (empty when no proof was built or p is past the
@@ -847,7 +851,7 @@ impl Classes {
 
     /// Whether endpoint p is proven joined to an endpoint q < p. O(1).
     fn has_earlier_member(&self, p: usize) -> bool {
-        p < u32::BITS as usize && self.members(p) & ((1u32 << p) - 1) != 0
+        self.followers.checked_shr(p as u32).is_some_and(|f| f & 1 != 0)
     }
 
     /// Whether endpoints p and q are proven joined (false when no proof was built).
@@ -867,25 +871,34 @@ fn bits(mut set: u32) -> impl Iterator<Item = usize> {
 
 impl QuickLinks {
     const MAX_PAIRS: usize = 16;
-    const MAX_LINKS: usize = 64;
+    /// Generators α0 … α3: proofs are built for maps of dimension ≤ 3.
+    const MAX_GENS: usize = 4;
     const RING_STEPS: usize = 64;
 
+    /// Records that endpoints p and q are joined through αk (or the ring ⟨αk, αi⟩).
     fn push(&mut self, p: usize, q: usize, k: usize) {
-        if p != q && self.len < Self::MAX_LINKS {
-            self.links[self.len] = (p as u8, q as u8, k as u8);
-            self.len += 1;
+        if p != q {
+            self.adjacent[k][p] |= 1 << q;
+            self.adjacent[k][q] |= 1 << p;
         }
     }
 
     /// No proof at all.
     fn none() -> Self {
-        QuickLinks { links: [(0, 0, 0); Self::MAX_LINKS], len: 0, direct: [0; 2 * Self::MAX_PAIRS], gens: 0, ends: 0 }
+        QuickLinks {
+            adjacent: [[0; 2 * Self::MAX_PAIRS]; Self::MAX_GENS],
+            direct: [0; 2 * Self::MAX_PAIRS],
+            gens: 0,
+            ends: 0,
+        }
     }
 
-    fn find<const N: usize>(map: &GMap<N>, i: usize, pairs: &[(DartId, DartId)]) -> Self {
-        let mut out = Self::none();
-        if pairs.len() > Self::MAX_PAIRS {
-            return out;
+    /// Fills `self` (no proof yet, [`QuickLinks::none`]; filled in place, as the struct is
+    /// half a kilobyte) with the proofs for the endpoints of `pairs`, just unlinked by αi.
+    fn find<const N: usize>(&mut self, map: &GMap<N>, i: usize, pairs: &[(DartId, DartId)]) {
+        let out = self;
+        if pairs.len() > Self::MAX_PAIRS || N >= Self::MAX_GENS {
+            return;
         }
         out.ends = 2 * pairs.len();
         out.gens = ((1u16 << (N + 1)) - 1) as u8;
@@ -940,7 +953,6 @@ impl QuickLinks {
                 }
             }
         }
-        out
     }
 
     /// When the classes of endpoints a and z (not joined) are each a whole dim-cell — every
@@ -960,11 +972,11 @@ impl QuickLinks {
         Some(if side_a.count_ones() <= side_z.count_ones() { (a, false) } else { (z, true) })
     }
 
-    /// The classes of endpoints proven joined in the cells of dimension `dim`. O(ends + links).
+    /// The classes of endpoints proven joined in the cells of dimension `dim`. O(ends).
     fn classes(&self, dim: usize) -> Classes {
         // αk is in the dim-cell orbit iff k ≠ dim; a ring also needs αi, and dim ≠ i here.
-        let links = self.links[..self.len].iter().filter(|l| l.2 as usize != dim);
-        Classes::of_links(self.ends, links.map(|&(p, q, _)| (p as usize, q as usize)))
+        let adjacent = |p: usize| (0..Self::MAX_GENS).filter(|&k| k != dim).fold(0, |a, k| a | self.adjacent[k][p]);
+        Classes::closure(self.ends, adjacent)
     }
 }
 

@@ -883,6 +883,15 @@ impl QuickLinks {
         }
     }
 
+    /// The endpoint that αk (k commuting with αi, its direct links found) maps endpoint p to:
+    /// p itself when p is k-free, `None` when the image is no endpoint. O(1).
+    fn image(&self, k: usize, p: usize) -> Option<usize> {
+        (self.direct[p] >> k & 1 != 0).then(|| match self.adjacent[k][p] {
+            0 => p,
+            q => q.trailing_zeros() as usize,
+        })
+    }
+
     /// No proof at all.
     fn none() -> Self {
         QuickLinks {
@@ -912,13 +921,16 @@ impl QuickLinks {
         // The generators commuting with αk: those at index distance ≥ 2 from k.
         let gens = u32::from(out.gens);
         let commuting_with = |k: usize| gens & !(0b111 << k >> 1);
-        for (p, &x) in ends.iter().enumerate() {
+        // Direct links, looked up for the first dart x of each pair only: αk commutes with αi,
+        // so αk maps the pair (x, αi x) onto the pair (αk x, αi αk x), endpoint q onto its
+        // partner q ^ 1 (the pairs are disjoint, each its two darts).
+        for (p, &x) in ends.iter().enumerate().step_by(2) {
             out.direct[p] |= 1 << i; // every endpoint is i-free now
+            out.direct[p + 1] |= 1 << i;
             for k in bits(commuting_with(i)) {
                 let y = map.alpha_local(k, x);
-                if y == x {
-                    out.direct[p] |= 1 << k;
-                } else if let Some(q) = index(y).filter(|&q| q > p) {
+                let Some(q) = (if y == x { Some(p) } else { index(y) }) else { continue };
+                for (p, q) in [(p, q), (p + 1, q ^ 1)] {
                     out.direct[p] |= 1 << k;
                     out.direct[q] |= 1 << k;
                     out.push(p, q, k);
@@ -937,7 +949,7 @@ impl QuickLinks {
                 walks.start(pair, m);
                 for p in [2 * m, 2 * m + 1] {
                     covered |= 1 << p;
-                    for q in bits(mirrors).filter_map(|k| index(map.alpha_local(k, ends[p]))) {
+                    for q in bits(mirrors).filter_map(|k| out.image(k, p)) {
                         covered |= 1 << q;
                     }
                 }
@@ -945,9 +957,8 @@ impl QuickLinks {
             walks.run(map, Self::RING_STEPS);
             for m in walks.joined() {
                 out.push(2 * m, 2 * m + 1, j);
-                let (x, y) = pairs[m];
                 for k in bits(mirrors) {
-                    if let (Some(p), Some(q)) = (index(map.alpha_local(k, x)), index(map.alpha_local(k, y))) {
+                    if let (Some(p), Some(q)) = (out.image(k, 2 * m), out.image(k, 2 * m + 1)) {
                         out.push(p, q, j);
                     }
                 }

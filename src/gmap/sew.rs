@@ -1121,6 +1121,51 @@ mod tests {
         assert!(sides > splits.iter().sum::<usize>(), "sides checked {sides}");
     }
 
+    /// The bit-set classes are the connected components of the link graph: on random graphs
+    /// (1 to 32 endpoints, sparse to dense, links of several generators, one generator left
+    /// out as a cell dimension would be), `joined`, `members` and `has_earlier_member` agree with
+    /// a plain union-find over the same links; past the covered endpoints nothing is joined.
+    #[test]
+    fn classes_are_the_connected_components() {
+        let mut rng = SplitMix64(23);
+        for round in 0..500 {
+            let ends = 1 + rng.below(2 * QuickLinks::MAX_PAIRS);
+            let mut links = QuickLinks::none();
+            links.ends = ends;
+            let mut edges = Vec::new();
+            for _ in 0..rng.below(1 + ends * (1 + round % 3)) {
+                let (p, q, k) = (rng.below(ends), rng.below(ends), rng.below(QuickLinks::MAX_GENS));
+                links.push(p, q, k);
+                edges.push((p, q, k));
+            }
+            let dim = rng.below(QuickLinks::MAX_GENS);
+            let classes = links.classes(dim);
+            let mut parent: Vec<usize> = (0..ends).collect();
+            fn root(parent: &mut [usize], mut p: usize) -> usize {
+                while parent[p] != p {
+                    p = parent[p];
+                }
+                p
+            }
+            for &(p, q, _) in edges.iter().filter(|e| e.2 != dim) {
+                let (rp, rq) = (root(&mut parent, p), root(&mut parent, q));
+                parent[rp] = rq;
+            }
+            for p in 0..ends {
+                let class: Vec<usize> = (0..ends).filter(|&q| root(&mut parent, q) == root(&mut parent, p)).collect();
+                assert_eq!(bits(classes.members(p)).collect::<Vec<_>>(), class, "round {round}, endpoint {p}");
+                for q in 0..ends {
+                    assert_eq!(classes.joined(p, q), class.contains(&q), "round {round}, {p} ~ {q}");
+                }
+                assert_eq!(classes.has_earlier_member(p), class[0] < p, "round {round}, endpoint {p}");
+            }
+            for p in ends..40 {
+                assert!(!classes.has_earlier_member(p) && !classes.joined(p, 0) && !classes.joined(0, p));
+            }
+        }
+        assert!(!QuickLinks::none().classes(0).joined(0, 0), "no proof, nothing joined");
+    }
+
     /// The hashed endpoint index answers as the linear scan it replaces, for endpoints and for
     /// other darts, on real unsew pair lists and on random ones (colliding slots included).
     #[test]

@@ -1,15 +1,18 @@
 //! An instruction-count probe of one face dissociation + projection update (issue 4), for
-//! callgrind: the random inner faces of `cut_probe` (same seed and selection) and the faces of
+//! callgrind: the random inner faces of `cut_probe` (same seed and selection) or the faces of
 //! the bench's mid-plane incision, each dissociated and undone, with nothing else in between.
-//! The timed part — `cut::dissociate_face` + `Projection::update` — is the one function
-//! [`timed`], so that callgrind's inclusive count of `dis_ir::timed` divided by its call count is
-//! the exact instruction cost of one dissociation with its update:
+//! The measured part — `cut::dissociate_face` + `Projection::update` — is the one function
+//! [`timed`], so that callgrind's inclusive count of `dis_ir::timed` divided by the number of
+//! dissociations printed is the exact instruction cost of one dissociation with its update:
 //!
 //! ```text
-//! valgrind --tool=callgrind --toggle-collect='dis_ir::timed' target/release/examples/dis_ir 2
-//! callgrind_annotate --inclusive=yes --tree=caller callgrind.out.<pid> | grep -B3 '\* .*dis_ir::timed'
+//! valgrind --tool=callgrind --toggle-collect='dis_ir::timed' --callgrind-out-file=OUT \
+//!     target/release/examples/dis_ir 5 random inner
+//! callgrind_annotate --inclusive=yes OUT | grep 'dis_ir::timed'
 //! ```
-
+//!
+//! It also prints a digest of every outcome (the face ids and the split vertices and edges of
+//! each dissociation), so that two builds can be checked to dissociate identically.
 //!
 //! `cargo run --release --example dis_ir [PASSES] [random | incision] [inner | split]` (default
 //! 2 passes over both face lists; `random` or `incision` for one of them; `inner` for only its

@@ -611,7 +611,10 @@ impl<const N: usize> GMap<N> {
             self.unlink_raw(i, x);
         }
         let mut report = CellChanges { changes: Vec::new(), pairs, new_sides: SplitSides::default() };
-        let links = if quick { QuickLinks::find(self, i, &report.pairs) } else { QuickLinks::none() };
+        let mut links = QuickLinks::none();
+        if quick {
+            links.find(self, i, &report.pairs);
+        }
         // The per-dimension lists of `split_cells`, kept per thread between unsews (no
         // allocation in the steady state; they are cleared before use).
         let mut scratch = SPLIT_SCRATCH.take();
@@ -633,6 +636,11 @@ impl<const N: usize> GMap<N> {
     /// smaller by the lockstep walk (a complete orbit) gets a fresh id. A piece that got a fresh
     /// id is complete, so its other endpoints are skipped. Endpoints that `links` proves still
     /// joined skip the walk (it would find them joined too: the outcome is the same).
+    /// An endpoint proven joined to an *earlier* endpoint is skipped before its id is even read:
+    /// it is in the same cell as that one through every relabelling (each relabels a whole cell),
+    /// so it would be skipped as complete, or be joined to the anchor of that cell, or lead to a
+    /// check that finds it joined — never to a change or a new anchor. Only the first endpoint of
+    /// each class is looked at (3 of the 12 per dimension for an inner face).
     /// `scratch` holds the (id, anchor endpoint index) list and the ids that got a fresh id (the
     /// complete pieces), reused across dimensions.
     fn split_cells(
@@ -647,8 +655,10 @@ impl<const N: usize> GMap<N> {
         let classes = links.classes(dim);
         anchors.clear();
         complete.clear();
-        for k in 0..2 * pairs.len() {
-            let z = endpoint(pairs, k);
+        for (k, z) in pairs.iter().flat_map(|&(x, y)| [x, y]).enumerate() {
+            if classes.has_earlier_member(k) {
+                continue;
+            }
             let id = self.cell_id(dim, z).0;
             if complete.contains(&id) {
                 continue;
@@ -665,7 +675,7 @@ impl<const N: usize> GMap<N> {
             let new = match links.split_of_whole_classes(&classes, dim, a, k) {
                 Some((side, is_z_side)) => {
                     let new = self.alloc_cell_id(dim);
-                    for w in (0..2 * pairs.len()).filter(|&w| classes.joined(w, side)) {
+                    for w in bits(classes.members(side)) {
                         self.set_cell_raw(dim, endpoint(pairs, w), new);
                     }
                     (new, is_z_side)
@@ -723,13 +733,14 @@ fn endpoint(pairs: &[(DartId, DartId)], k: usize) -> DartId {
 ///   (x, y) onto that of (αk(x), αk(y)), so that one is not walked (α0 in the example: the
 ///   other end of the edge).
 ///
-/// Built only for up to [`QuickLinks::MAX_PAIRS`] pairs (else no proof: every check walks);
-/// proofs beyond [`QuickLinks::MAX_LINKS`] are dropped (a dropped proof only costs a walk).
+/// Built only for up to [`QuickLinks::MAX_PAIRS`] pairs and maps of dimension below
+/// [`QuickLinks::MAX_GENS`] (else no proof: every check walks).
 struct QuickLinks {
-    /// (p, q, k): endpoints p and q joined through αk (direct) or through the ring ⟨αk, αi⟩;
-    /// either way the proof holds in the cells of every dimension other than k (and i).
-    links: [(u8, u8, u8); QuickLinks::MAX_LINKS],
-    len: usize,
+    /// Per generator k and endpoint p, the bit set of the endpoints q joined to p through αk
+    /// (direct) or through the ring ⟨αk, αi⟩; either way the proof holds in the cells of every
+    /// dimension other than k (and i). Kept per generator so that the classes of a dimension
+    /// are the closure of a few bit-set unions ([`QuickLinks::classes`]).
+    adjacent: [[u32; 2 * QuickLinks::MAX_PAIRS]; QuickLinks::MAX_GENS],
     /// Per endpoint, the bit set of the generators k with a direct link αk(p) = q or αk(p) = p.
     direct: [u8; 2 * QuickLinks::MAX_PAIRS],
     /// The bit set of the map's generators α0 … αn.
@@ -793,61 +804,133 @@ impl EndpointIndex {
     }
 }
 
-/// A partition of the endpoints into classes known to be joined in one cell dimension.
+/// A partition of the endpoints into classes known to be joined in one cell dimension: per
+/// endpoint p, the bit set of its class (bit q set iff q is proven joined to p; p's own bit
+/// included). All sets are empty when no proof was built. Endpoint indices are below
+/// 2 · [`QuickLinks::MAX_PAIRS`] = 32, so a class is one `u32`: `joined` is one shift, a class's
+/// size one popcount, and its members the set bits.
 struct Classes {
-    parent: [u8; 2 * QuickLinks::MAX_PAIRS],
-    len: usize,
+    class: [u32; 2 * QuickLinks::MAX_PAIRS],
+    /// The endpoints joined to a lower-numbered one (every class member but its lowest).
+    followers: u32,
 }
 
 impl Classes {
-    fn root(&self, mut p: usize) -> usize {
-        while self.parent[p] as usize != p {
-            p = self.parent[p] as usize;
+    /// The classes of the graph on `ends` endpoints where `adjacent(p)` is the bit set of p's
+    /// neighbours: the connected components, each found by a breadth-first closure over bit
+    /// sets. O(ends) calls of `adjacent`.
+    fn closure(ends: usize, adjacent: impl Fn(usize) -> u32) -> Self {
+        let mut class = [0u32; 2 * QuickLinks::MAX_PAIRS];
+        // The endpoints not yet in a class; each round closes the class of the lowest one.
+        let mut rest = u32::MAX.checked_shr(u32::BITS - ends as u32).unwrap_or(0);
+        let mut followers = rest;
+        while rest != 0 {
+            let first = 1u32 << rest.trailing_zeros();
+            followers &= !first;
+            let (mut members, mut todo) = (first, first);
+            while todo != 0 {
+                let q = todo.trailing_zeros() as usize;
+                todo &= todo - 1;
+                let fresh = adjacent(q) & !members;
+                members |= fresh;
+                todo |= fresh;
+            }
+            for q in bits(members) {
+                class[q] = members;
+            }
+            rest &= !members;
         }
-        p
+        Classes { class, followers }
+    }
+
+    /// The members of p's class as a bit set (empty when no proof was built or p is past the
+    /// covered endpoints).
+    fn members(&self, p: usize) -> u32 {
+        self.class.get(p).copied().unwrap_or(0)
+    }
+
+    /// Whether endpoint p is proven joined to an endpoint q < p. O(1).
+    fn has_earlier_member(&self, p: usize) -> bool {
+        self.followers.checked_shr(p as u32).is_some_and(|f| f & 1 != 0)
     }
 
     /// Whether endpoints p and q are proven joined (false when no proof was built).
     fn joined(&self, p: usize, q: usize) -> bool {
-        p < self.len && q < self.len && self.root(p) == self.root(q)
+        q < u32::BITS as usize && self.members(p) >> q & 1 != 0
     }
+}
+
+/// The indices of the set bits of `set`, lowest first.
+fn bits(mut set: u32) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        let q = set.trailing_zeros() as usize;
+        set &= set.checked_sub(1)?;
+        Some(q)
+    })
 }
 
 impl QuickLinks {
     const MAX_PAIRS: usize = 16;
-    const MAX_LINKS: usize = 64;
+    /// Generators α0 … α3: proofs are built for maps of dimension ≤ 3.
+    const MAX_GENS: usize = 4;
     const RING_STEPS: usize = 64;
 
+    /// Records that endpoints p and q are joined through αk (or the ring ⟨αk, αi⟩).
     fn push(&mut self, p: usize, q: usize, k: usize) {
-        if p != q && self.len < Self::MAX_LINKS {
-            self.links[self.len] = (p as u8, q as u8, k as u8);
-            self.len += 1;
+        if p != q {
+            self.adjacent[k][p] |= 1 << q;
+            self.adjacent[k][q] |= 1 << p;
         }
+    }
+
+    /// The endpoint that αk (k commuting with αi, its direct links found) maps endpoint p to:
+    /// p itself when p is k-free, `None` when the image is no endpoint. O(1).
+    fn image(&self, k: usize, p: usize) -> Option<usize> {
+        (self.direct[p] >> k & 1 != 0).then(|| match self.adjacent[k][p] {
+            0 => p,
+            q => q.trailing_zeros() as usize,
+        })
     }
 
     /// No proof at all.
     fn none() -> Self {
-        QuickLinks { links: [(0, 0, 0); Self::MAX_LINKS], len: 0, direct: [0; 2 * Self::MAX_PAIRS], gens: 0, ends: 0 }
+        QuickLinks {
+            adjacent: [[0; 2 * Self::MAX_PAIRS]; Self::MAX_GENS],
+            direct: [0; 2 * Self::MAX_PAIRS],
+            gens: 0,
+            ends: 0,
+        }
     }
 
-    fn find<const N: usize>(map: &GMap<N>, i: usize, pairs: &[(DartId, DartId)]) -> Self {
-        let mut out = Self::none();
-        if pairs.len() > Self::MAX_PAIRS {
-            return out;
+    /// Fills `self` (no proof yet, [`QuickLinks::none`]; filled in place, as the struct is
+    /// half a kilobyte) with the proofs for the endpoints of `pairs`, just unlinked by αi.
+    fn find<const N: usize>(&mut self, map: &GMap<N>, i: usize, pairs: &[(DartId, DartId)]) {
+        let out = self;
+        if pairs.len() > Self::MAX_PAIRS || N >= Self::MAX_GENS {
+            return;
         }
         out.ends = 2 * pairs.len();
         out.gens = ((1u16 << (N + 1)) - 1) as u8;
+        let mut ends = [DartId(0); 2 * Self::MAX_PAIRS];
+        for (e, &(x, y)) in ends.chunks_exact_mut(2).zip(pairs) {
+            e.copy_from_slice(&[x, y]);
+        }
+        let ends = &ends[..out.ends];
         let table = EndpointIndex::new(pairs);
         let index = |d: DartId| table.get(d);
-        let commuting = |k: usize, j: usize| k.abs_diff(i) >= 2 && k.abs_diff(j) >= 2;
-        for p in 0..out.ends {
-            let x = endpoint(pairs, p);
+        // The generators commuting with αk: those at index distance ≥ 2 from k.
+        let gens = u32::from(out.gens);
+        let commuting_with = |k: usize| gens & !(0b111 << k >> 1);
+        // Direct links, looked up for the first dart x of each pair only: αk commutes with αi,
+        // so αk maps the pair (x, αi x) onto the pair (αk x, αi αk x), endpoint q onto its
+        // partner q ^ 1 (the pairs are disjoint, each its two darts).
+        for (p, &x) in ends.iter().enumerate().step_by(2) {
             out.direct[p] |= 1 << i; // every endpoint is i-free now
-            for k in (0..=N).filter(|&k| k.abs_diff(i) >= 2) {
+            out.direct[p + 1] |= 1 << i;
+            for k in bits(commuting_with(i)) {
                 let y = map.alpha_local(k, x);
-                if y == x {
-                    out.direct[p] |= 1 << k;
-                } else if let Some(q) = index(y).filter(|&q| q > p) {
+                let Some(q) = (if y == x { Some(p) } else { index(y) }) else { continue };
+                for (p, q) in [(p, q), (p + 1, q ^ 1)] {
                     out.direct[p] |= 1 << k;
                     out.direct[q] |= 1 << k;
                     out.push(p, q, k);
@@ -855,34 +938,32 @@ impl QuickLinks {
             }
         }
         for j in [i.checked_sub(1), Some(i + 1).filter(|&j| j <= N)].into_iter().flatten() {
-            let mirrors = || (0..=N).filter(move |&k| commuting(k, j));
+            let mirrors = commuting_with(i) & commuting_with(j);
             // One walk per pair, none for a pair that is the αk image of a walked one.
-            let mut covered = [false; 2 * Self::MAX_PAIRS];
+            let mut covered = 0u32;
             let mut walks = RingWalks::new(i, j);
-            for m in 0..pairs.len() {
-                if covered[2 * m] {
+            for (m, &pair) in pairs.iter().enumerate() {
+                if covered >> (2 * m) & 1 != 0 {
                     continue;
                 }
-                walks.start(pairs[m], m);
+                walks.start(pair, m);
                 for p in [2 * m, 2 * m + 1] {
-                    covered[p] = true;
-                    for q in mirrors().filter_map(|k| index(map.alpha_local(k, endpoint(pairs, p)))) {
-                        covered[q] = true;
+                    covered |= 1 << p;
+                    for q in bits(mirrors).filter_map(|k| out.image(k, p)) {
+                        covered |= 1 << q;
                     }
                 }
             }
             walks.run(map, Self::RING_STEPS);
             for m in walks.joined() {
                 out.push(2 * m, 2 * m + 1, j);
-                let (x, y) = pairs[m];
-                for k in mirrors() {
-                    if let (Some(p), Some(q)) = (index(map.alpha_local(k, x)), index(map.alpha_local(k, y))) {
+                for k in bits(mirrors) {
+                    if let (Some(p), Some(q)) = (out.image(k, 2 * m), out.image(k, 2 * m + 1)) {
                         out.push(p, q, j);
                     }
                 }
             }
         }
-        out
     }
 
     /// When the classes of endpoints a and z (not joined) are each a whole dim-cell — every
@@ -895,34 +976,18 @@ impl QuickLinks {
             return None;
         }
         let cell = self.gens & !(1 << dim);
-        let mut size = [0usize; 2];
-        for p in 0..self.ends {
-            let side = if classes.joined(p, a) {
-                0
-            } else if classes.joined(p, z) {
-                1
-            } else {
-                continue;
-            };
-            if self.direct[p] & cell != cell {
-                return None;
-            }
-            size[side] += 1;
+        let (side_a, side_z) = (classes.members(a), classes.members(z));
+        if bits(side_a | side_z).any(|p| self.direct[p] & cell != cell) {
+            return None;
         }
-        Some(if size[0] <= size[1] { (a, false) } else { (z, true) })
+        Some(if side_a.count_ones() <= side_z.count_ones() { (a, false) } else { (z, true) })
     }
 
-    /// The classes of endpoints proven joined in the cells of dimension `dim`.
+    /// The classes of endpoints proven joined in the cells of dimension `dim`. O(ends).
     fn classes(&self, dim: usize) -> Classes {
-        let mut c = Classes { parent: std::array::from_fn(|p| p as u8), len: self.ends };
         // αk is in the dim-cell orbit iff k ≠ dim; a ring also needs αi, and dim ≠ i here.
-        for &(p, q, _) in self.links[..self.len].iter().filter(|l| l.2 as usize != dim) {
-            let (rp, rq) = (c.root(p as usize), c.root(q as usize));
-            if rp != rq {
-                c.parent[rp.max(rq)] = rp.min(rq) as u8;
-            }
-        }
-        c
+        let adjacent = |p: usize| (0..Self::MAX_GENS).filter(|&k| k != dim).fold(0, |a, k| a | self.adjacent[k][p]);
+        Classes::closure(self.ends, adjacent)
     }
 }
 
@@ -1054,6 +1119,51 @@ mod tests {
         }
         assert!(splits.iter().all(|&n| n > 0), "splits per dimension {splits:?}");
         assert!(sides > splits.iter().sum::<usize>(), "sides checked {sides}");
+    }
+
+    /// The bit-set classes are the connected components of the link graph: on random graphs
+    /// (1 to 32 endpoints, sparse to dense, links of several generators, one generator left
+    /// out as a cell dimension would be), `joined`, `members` and `has_earlier_member` agree with
+    /// a plain union-find over the same links; past the covered endpoints nothing is joined.
+    #[test]
+    fn classes_are_the_connected_components() {
+        let mut rng = SplitMix64(23);
+        for round in 0..500 {
+            let ends = 1 + rng.below(2 * QuickLinks::MAX_PAIRS);
+            let mut links = QuickLinks::none();
+            links.ends = ends;
+            let mut edges = Vec::new();
+            for _ in 0..rng.below(1 + ends * (1 + round % 3)) {
+                let (p, q, k) = (rng.below(ends), rng.below(ends), rng.below(QuickLinks::MAX_GENS));
+                links.push(p, q, k);
+                edges.push((p, q, k));
+            }
+            let dim = rng.below(QuickLinks::MAX_GENS);
+            let classes = links.classes(dim);
+            let mut parent: Vec<usize> = (0..ends).collect();
+            fn root(parent: &mut [usize], mut p: usize) -> usize {
+                while parent[p] != p {
+                    p = parent[p];
+                }
+                p
+            }
+            for &(p, q, _) in edges.iter().filter(|e| e.2 != dim) {
+                let (rp, rq) = (root(&mut parent, p), root(&mut parent, q));
+                parent[rp] = rq;
+            }
+            for p in 0..ends {
+                let class: Vec<usize> = (0..ends).filter(|&q| root(&mut parent, q) == root(&mut parent, p)).collect();
+                assert_eq!(bits(classes.members(p)).collect::<Vec<_>>(), class, "round {round}, endpoint {p}");
+                for q in 0..ends {
+                    assert_eq!(classes.joined(p, q), class.contains(&q), "round {round}, {p} ~ {q}");
+                }
+                assert_eq!(classes.has_earlier_member(p), class[0] < p, "round {round}, endpoint {p}");
+            }
+            for p in ends..40 {
+                assert!(!classes.has_earlier_member(p) && !classes.joined(p, 0) && !classes.joined(0, p));
+            }
+        }
+        assert!(!QuickLinks::none().classes(0).joined(0, 0), "no proof, nothing joined");
     }
 
     /// The hashed endpoint index answers as the linear scan it replaces, for endpoints and for

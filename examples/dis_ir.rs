@@ -1,0 +1,120 @@
+//! An instruction-count probe of one face dissociation + projection update (issue 4), for
+//! callgrind: the random inner faces of `cut_probe` (same seed and selection) or the faces of
+//! the bench's mid-plane incision, each dissociated and undone, with nothing else in between.
+//! The measured part — `cut::dissociate_face` + `Projection::update` — is the one function
+//! [`timed`], so that callgrind's inclusive count of `dis_ir::timed` divided by the number of
+//! dissociations printed is the exact instruction cost of one dissociation with its update:
+//!
+//! ```text
+//! valgrind --tool=callgrind --toggle-collect='dis_ir::timed' --callgrind-out-file=OUT \
+//!     target/release/examples/dis_ir 5 random inner
+//! callgrind_annotate --inclusive=yes OUT | grep 'dis_ir::timed'
+//! ```
+//!
+//! It also prints a digest of every outcome (the face ids and the split vertices and edges of
+//! each dissociation), so that two builds can be checked to dissociate identically.
+//!
+//! `cargo run --release --example dis_ir [PASSES] [random | incision] [inner | split]` (default
+//! 2 passes over both face lists; `random` or `incision` for one of them; `inner` for only its
+//! faces whose dissociation splits no vertex or edge, `split` for the others).
+
+use std::hash::{Hash, Hasher};
+use std::path::Path;
+
+#[path = "../benches/common/cut_select.rs"]
+mod cut_select;
+
+use topomech::cut;
+use topomech::mechanics::{Body, Material, Projection, TouchedCells, Vec3};
+use topomech::DartId;
+
+const G: Vec3 = [0.0, 0.0, -9.81];
+
+/// The measured operation: one dissociation and its projection update.
+#[inline(never)]
+fn timed(body: &mut Body, projection: &mut Projection, d: DartId) -> cut::Dissociation {
+    let dis = cut::dissociate_face(body, d).expect("inner face");
+    projection.update(body, &dis.touched);
+    dis
+}
+
+/// Sews the face back and lets the projection follow (not measured).
+#[inline(never)]
+fn undo(body: &mut Body, projection: &mut Projection, dis: &cut::Dissociation) {
+    let mut touched = TouchedCells::default();
+    let changes = body.sew3(dis.dart, dis.opposite).expect("sew back");
+    touched.record(body.map(), &changes);
+    projection.update(body, &touched);
+}
+
+/// The inner faces the plane through the bounding box's centre, normal (1, 0.3, 0.2), separates
+/// (the bench's incision faces).
+fn incision_faces(body: &Body, points: &[Vec3]) -> Vec<DartId> {
+    let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
+    for p in points {
+        for c in 0..3 {
+            lo[c] = lo[c].min(p[c]);
+            hi[c] = hi[c].max(p[c]);
+        }
+    }
+    let plane = cut::Plane { point: std::array::from_fn(|c| (lo[c] + hi[c]) / 2.0), normal: [1.0, 0.3, 0.2] };
+    let side = cut::tet_sides(body, &plane);
+    let map = body.map();
+    map.one_dart_per_cell(2)
+        .into_iter()
+        .filter(|&d| {
+            let other = map.alpha::<3>(d);
+            other != d && side[map.cell_id(3, d).index()] != side[map.cell_id(3, other).index()]
+        })
+        .collect()
+}
+
+fn main() {
+    let passes: usize = std::env::args().nth(1).and_then(|a| a.parse().ok()).unwrap_or(2);
+    let which = std::env::args().nth(2).unwrap_or_default();
+    let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes/liver_547.msh"));
+    let mesh = topomech::io::read_mesh(path).expect("liver_547.msh");
+    let (z, _) = mesh.spatially_ordered();
+    let (mut body, _) = Body::from_tets(&z.points, &z.tets, Material::default()).expect("mesh");
+    let mut projection = Projection::build(&body, G);
+    let (faces, _) = cut_select::faces_and_vertices(body.map());
+    let incision = incision_faces(&body, &z.points);
+    let mut list: Vec<DartId> = match which.as_str() {
+        "random" => faces.clone(),
+        "incision" => incision.clone(),
+        _ => faces.iter().chain(&incision).copied().collect(),
+    };
+    // Optionally only the faces whose dissociation splits no vertex or edge ("inner"), or only
+    // the others ("split"), found by one dissociation each, undone (not measured).
+    if let Some(kind) = std::env::args().nth(3) {
+        list.retain(|&d| {
+            let dis = cut::dissociate_face(&mut body, d).expect("inner face");
+            let inner = dis.vertices.is_empty() && dis.edges.is_empty();
+            undo(&mut body, &mut projection, &dis);
+            inner == (kind == "inner")
+        });
+    }
+    let (mut calls, mut inner) = (0usize, 0usize);
+    // A digest of every outcome (ids of the faces, the split vertices and edges), to check that
+    // two builds dissociate identically.
+    let mut outcome = std::hash::DefaultHasher::new();
+    for _ in 0..passes {
+        for &d in &list {
+            let dis = timed(&mut body, &mut projection, d);
+            dis.faces.hash(&mut outcome);
+            inner += usize::from(dis.vertices.is_empty() && dis.edges.is_empty());
+            for s in dis.vertices.iter().chain(&dis.edges) {
+                (s.kept, s.new, s.dart_kept, s.dart_new).hash(&mut outcome);
+            }
+            undo(&mut body, &mut projection, &dis);
+        }
+        calls += list.len();
+    }
+    println!(
+        "dis_ir: {calls} dissociations ({} random faces, {} incision faces per pass; {inner} split no vertex or \
+         edge), outcome digest {:016x}",
+        faces.len(),
+        incision.len(),
+        outcome.finish()
+    );
+}

@@ -14,12 +14,13 @@
 //! It also prints a digest of every outcome (the face ids and the split vertices and edges of
 //! each dissociation), so that two builds can be checked to dissociate identically.
 //!
-//! `cargo run --release --example dis_ir [PASSES] [random | incision] [inner | split]` (default
-//! 2 passes over both face lists; `random` or `incision` for one of them; `inner` for only its
-//! faces whose dissociation splits no vertex or edge, `split` for the others).
+//! `cargo run --release --example dis_ir [--mesh MESH] [PASSES] [random | incision] [inner | split]`
+//! (default liver_547, 2 passes over both face lists; `random` or `incision` for one of them;
+//! `inner` for only its faces whose dissociation splits no vertex or edge, `split` for the
+//! others). With `--mesh`, the same selections on another mesh (liver_1M: is the instruction
+//! count per dissociation independent of the mesh size?).
 
 use std::hash::{Hash, Hasher};
-use std::path::Path;
 
 #[path = "../benches/common/cut_select.rs"]
 mod cut_select;
@@ -70,10 +71,15 @@ fn incision_faces(body: &Body, points: &[Vec3]) -> Vec<DartId> {
 }
 
 fn main() {
-    let passes: usize = std::env::args().nth(1).and_then(|a| a.parse().ok()).unwrap_or(2);
-    let which = std::env::args().nth(2).unwrap_or_default();
-    let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes/liver_547.msh"));
-    let mesh = topomech::io::read_mesh(path).expect("liver_547.msh");
+    let mut args: Vec<String> = std::env::args().collect();
+    let path = match args.iter().position(|a| a == "--mesh") {
+        Some(i) if i + 1 < args.len() => args.drain(i..i + 2).nth(1).map(std::path::PathBuf::from),
+        _ => None,
+    };
+    let path = path.unwrap_or_else(|| concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes/liver_547.msh").into());
+    let passes: usize = args.get(1).and_then(|a| a.parse().ok()).unwrap_or(2);
+    let which = args.get(2).cloned().unwrap_or_default();
+    let mesh = topomech::io::read_mesh(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let (z, _) = mesh.spatially_ordered();
     let (mut body, _) = Body::from_tets(&z.points, &z.tets, Material::default()).expect("mesh");
     let mut projection = Projection::build(&body, G);
@@ -86,7 +92,7 @@ fn main() {
     };
     // Optionally only the faces whose dissociation splits no vertex or edge ("inner"), or only
     // the others ("split"), found by one dissociation each, undone (not measured).
-    if let Some(kind) = std::env::args().nth(3) {
+    if let Some(kind) = args.get(3) {
         list.retain(|&d| {
             let dis = cut::dissociate_face(&mut body, d).expect("inner face");
             let inner = dis.vertices.is_empty() && dis.edges.is_empty();

@@ -93,14 +93,20 @@ fn join(forest: &mut [u32], a: u32, b: u32) -> bool {
     true
 }
 
-/// Per cell dimension: the distinct live-checked ids of the pieces, and the orbit count pieces
-/// give.
+/// What the tet sweep counts, per cell dimension: the distinct ids of the pieces, and what
+/// gives the number of cells (faces counted directly, vertices and edges by union-find).
 struct PieceCensus {
+    /// The ids seen so far, one set per dimension.
     used: Vec<VisitBits>,
+    /// The number of distinct ids seen, per dimension.
     distinct: [usize; 4],
+    /// Face pieces that are free or glued to a face piece numbered no lower: one per face.
     glued_or_free_faces: usize,
+    /// Union-find forest over the 4 corner pieces of every tet.
     vertex_forest: Vec<u32>,
+    /// Union-find forest over the 6 edge pieces of every tet.
     edge_forest: Vec<u32>,
+    /// Successful joins in the vertex and the edge forest.
     joins: [usize; 2],
 }
 

@@ -113,3 +113,68 @@ fn validate_names_any_single_corruption() {
         }
     });
 }
+
+/// The darts of face `f` of tet `t` (built layout: 24t + 6f + j) in the order φ(j) of the flag
+/// bijection onto itself that commutes with α0 and α1 and sends flag 0 to flag `r`: the α0/α1
+/// words from flag 0, applied to flag r instead. A gluing along it satisfies the quasi-manifold
+/// laws with α0 and α1, so only the ids (or a partner left behind) can break a law.
+fn face_flags_from(map: &GMap<3>, t: u32, f: u32, r: u32) -> [DartId; 6] {
+    let first = 24 * t + 6 * f;
+    let (mut from_zero, mut from_r) = (vec![DartId(first)], vec![DartId(first + r)]);
+    let mut head = 0;
+    while head < from_zero.len() {
+        for i in 0..2 {
+            let next = map.alpha_dyn(i, from_zero[head]);
+            if !from_zero.contains(&next) {
+                from_zero.push(next);
+                from_r.push(map.alpha_dyn(i, from_r[head]));
+            }
+        }
+        head += 1;
+    }
+    let mut out = [DartId(first); 6];
+    for (x, y) in from_zero.iter().zip(&from_r) {
+        out[(x.0 - first) as usize] = *y;
+    }
+    out
+}
+
+/// After any two raw edits that keep the tets-as-built flag — α3 links and unlinks, cell-id
+/// overwrites, and whole-face gluings along a flag bijection that commutes with α0 and α1 — of
+/// two built tets sharing a face, validate() (which then takes its tet path) fails iff a law is
+/// broken and names the first broken law with a true witness.
+#[cfg_attr(kani, kani::proof)]
+#[cfg_attr(kani, kani::unwind(50))]
+#[cfg_attr(not(kani), test)]
+fn validate_tet_path_names_any_double_corruption() {
+    let (built, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+    cases(3000, || {
+        let mut map = built.clone();
+        let cap = map.capacity() as u32;
+        for _ in 0..2 {
+            let (kind, a, b, dim, id) =
+                (any::<u8>() % 4, any::<u32>() % cap, any::<u32>() % cap, any::<u8>() % 4, any::<u8>());
+            let edits: Vec<RawEdit> = match kind {
+                0 => vec![RawEdit::Link { i: 3, a: DartId(a), b: DartId(b) }],
+                1 => vec![RawEdit::Unlink { i: 3, a: DartId(a) }],
+                2 => vec![RawEdit::SetCell { dim: usize::from(dim), d: DartId(a), id: u32::from(id % 12) }],
+                _ => {
+                    let (from, onto) = (
+                        face_flags_from(&map, a / 24, a % 24 / 6, 0),
+                        face_flags_from(&map, b / 24, b % 24 / 6, u32::from(id % 6)),
+                    );
+                    from.iter().zip(&onto).map(|(&a, &b)| RawEdit::Link { i: 3, a, b }).collect()
+                }
+            };
+            for edit in edits {
+                if !assume(ops::raw_edit_unchecked(&mut map, edit)) {
+                    return;
+                }
+            }
+        }
+        assert!(map.tets_as_built(), "the edits keep the flag");
+        if let Err(e) = check_validate_names_law(&map) {
+            panic!("{e}");
+        }
+    });
+}

@@ -6,7 +6,9 @@
 //!   equal a labelling by orbits and agree with the reported changes. Also `is_isomorphic`
 //!   against brute force over all relabellings.
 //! * [`invalid`]: every single raw corruption of small valid maps; `validate()` must fail iff
-//!   some law is broken, and must name a law that is broken, with a true witness.
+//!   some law is broken, and must name a law that is broken, with a true witness. Also every
+//!   single α3 or cell-id edit of 1-, 2- and 3-tet complexes built by `from_tets`, which keeps
+//!   `tets_as_built` and so exercises `validate()`'s tet path.
 //! * [`cut_dissociation`]: every order of dissociating every subset of inner faces (and removing
 //!   tets) on two tets, a closed fan of three and the Kuhn cube k = 1, every cut law checked.
 //! * [`subdivision`]: every sequence of a few edge splits, triangle 1→4 and tet 1→8 (one dart per

@@ -3,6 +3,7 @@
 //!
 //!     cargo run --release --example bench_kernel -- 40            # Kuhn cube, k = 40
 //!     cargo run --release --example bench_kernel -- --mesh FILE   # any mesh `read_mesh` reads
+//!     cargo run --release --example bench_kernel -- --mesh FILE --z-order   # the same, points and tets Z-ordered first (untimed)
 //!
 //! Every phase is run `--reps` times (default 3) and the median is reported. Times are the
 //! thread's CPU time (as in CGAL's benchmark, which also uses thread CPU time because the host is
@@ -76,14 +77,17 @@ struct Args {
     k: usize,
     mesh: Option<PathBuf>,
     reps: usize,
+    /// Points and tets of the mesh file in Z-order (`TetMesh::spatially_ordered`, untimed).
+    z_order: bool,
 }
 
 fn parse_args() -> Result<Args, String> {
-    let mut args = Args { k: 40, mesh: None, reps: 3 };
+    let mut args = Args { k: 40, mesh: None, reps: 3, z_order: false };
     let mut it = std::env::args().skip(1);
     while let Some(a) = it.next() {
         match a.as_str() {
             "--mesh" => args.mesh = Some(it.next().ok_or("--mesh needs a path")?.into()),
+            "--z-order" => args.z_order = true,
             "--reps" => args.reps = it.next().and_then(|r| r.parse().ok()).ok_or("--reps needs a number")?,
             k => args.k = k.parse().map_err(|_| format!("unknown argument {k}"))?,
         }
@@ -110,13 +114,17 @@ fn main() {
     let args = match parse_args() {
         Ok(a) => a,
         Err(e) => {
-            eprintln!("bench_kernel: {e}\nusage: bench_kernel [k] [--mesh FILE] [--reps R]");
+            eprintln!("bench_kernel: {e}\nusage: bench_kernel [k] [--mesh FILE [--z-order]] [--reps R]");
             std::process::exit(2);
         }
     };
     let read_start = (thread_cpu_seconds(), Instant::now());
     let (label, points, tets) = match &args.mesh {
         Some(path) => match topomech::io::read_mesh(path) {
+            Ok(m) if args.z_order => {
+                let z = m.spatially_ordered().0;
+                (format!("{} (Z-order)", path.display()), z.points, z.tets)
+            }
             Ok(m) => (path.display().to_string(), m.points, m.tets),
             Err(e) => {
                 eprintln!("bench_kernel: {e}");

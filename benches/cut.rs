@@ -83,31 +83,9 @@ fn fixture_of(name: &str, mesh: &topomech::mesh::TetMesh) -> Fixture {
     fixture(name, &z.points, &z.tets)
 }
 
-/// The inner faces that the plane through the bounding box's centre with normal (1, 0.3, 0.2)
-/// separates, in `incise_plane`'s order (its own selection rule, on the fixture's map).
-fn incision_faces(body: &Body, points: &[Vec3]) -> Vec<DartId> {
-    let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
-    for p in points {
-        for c in 0..3 {
-            lo[c] = lo[c].min(p[c]);
-            hi[c] = hi[c].max(p[c]);
-        }
-    }
-    let plane = cut::Plane { point: std::array::from_fn(|c| (lo[c] + hi[c]) / 2.0), normal: [1.0, 0.3, 0.2] };
-    let side = cut::tet_sides(body, &plane);
-    let map = body.map();
-    map.one_dart_per_cell(2)
-        .into_iter()
-        .filter(|&d| {
-            let other = map.alpha::<3>(d);
-            other != d && side[map.cell_id(3, d).index()] != side[map.cell_id(3, other).index()]
-        })
-        .collect()
-}
-
 fn fixture(name: &str, points: &[Vec3], tets: &[[u32; 4]]) -> Fixture {
     let (body, _) = Body::from_tets(points, tets, Material::default()).expect("mesh");
-    let incision = incision_faces(&body, points);
+    let incision = cut_select::incision_faces(&body, points);
     let projection = Projection::build(&body, G);
     let map = body.map();
     let (faces, vertices) = cut_select::faces_and_vertices(map);

@@ -48,28 +48,6 @@ fn undo(body: &mut Body, projection: &mut Projection, dis: &cut::Dissociation) {
     projection.update(body, &touched);
 }
 
-/// The inner faces the plane through the bounding box's centre, normal (1, 0.3, 0.2), separates
-/// (the bench's incision faces).
-fn incision_faces(body: &Body, points: &[Vec3]) -> Vec<DartId> {
-    let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
-    for p in points {
-        for c in 0..3 {
-            lo[c] = lo[c].min(p[c]);
-            hi[c] = hi[c].max(p[c]);
-        }
-    }
-    let plane = cut::Plane { point: std::array::from_fn(|c| (lo[c] + hi[c]) / 2.0), normal: [1.0, 0.3, 0.2] };
-    let side = cut::tet_sides(body, &plane);
-    let map = body.map();
-    map.one_dart_per_cell(2)
-        .into_iter()
-        .filter(|&d| {
-            let other = map.alpha::<3>(d);
-            other != d && side[map.cell_id(3, d).index()] != side[map.cell_id(3, other).index()]
-        })
-        .collect()
-}
-
 fn main() {
     let mut args: Vec<String> = std::env::args().collect();
     let path = match args.iter().position(|a| a == "--mesh") {
@@ -84,7 +62,7 @@ fn main() {
     let (mut body, _) = Body::from_tets(&z.points, &z.tets, Material::default()).expect("mesh");
     let mut projection = Projection::build(&body, G);
     let (faces, _) = cut_select::faces_and_vertices(body.map());
-    let incision = incision_faces(&body, &z.points);
+    let incision = cut_select::incision_faces(&body, &z.points);
     let mut list: Vec<DartId> = match which.as_str() {
         "random" => faces.clone(),
         "incision" => incision.clone(),

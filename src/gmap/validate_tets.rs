@@ -226,7 +226,7 @@ impl<const N: usize> GMap<N> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::generate::kuhn_cube;
+    use crate::generate::{kuhn_cube, SplitMix64};
     use crate::{CellId, DartId};
 
     /// The two fast paths' verdicts on a map flagged as built tets whose layout law holds.
@@ -236,23 +236,11 @@ mod tests {
         (map.built_tet_laws_hold(&dead, &live), map.all_laws_hold(&dead, &live))
     }
 
-    /// A small xorshift generator: the tests stay deterministic with no dev-dependency.
-    struct Rng(u64);
-
-    impl Rng {
-        fn below(&mut self, n: usize) -> usize {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            (self.0 % n as u64) as usize
-        }
-    }
-
     /// A random edit that keeps the tets-as-built flag: an α3 link or unlink, or a new cell id
     /// in 0..=bound (one past the allocator: not live; some maps have freed ids below it) at one
     /// dart, at the darts of its piece (constant inside the tet, so only α3 sees it) or at its
     /// whole cell (constant everywhere, so only liveness or uniqueness can fail).
-    fn random_edit(map: &mut GMap<3>, rng: &mut Rng) {
+    fn random_edit(map: &mut GMap<3>, rng: &mut SplitMix64) {
         let cap = map.capacity();
         let (a, b) = (DartId(rng.below(cap) as u32), DartId(rng.below(cap) as u32));
         let dim = rng.below(4);
@@ -302,11 +290,13 @@ mod tests {
 
     #[test]
     fn the_tet_path_agrees_with_the_generic_path_on_random_corruptions() {
-        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+        // Corruptions that break only α1α3 (the other checks and the counts catch the rest) are
+        // rare: about one seed in two meets one in this many cases; seed 547 does.
+        let mut rng = SplitMix64(547);
         let mut verdicts = [0usize; 2];
         for map in built_maps() {
             assert_eq!(both_paths(&map), (true, true));
-            for case in 0..3000 {
+            for case in 0..20000 {
                 let mut broken = map.clone();
                 for _ in 0..1 + case % 3 {
                     random_edit(&mut broken, &mut rng);

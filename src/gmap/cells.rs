@@ -94,6 +94,11 @@ impl<const N: usize> GMap<N> {
     /// the forests' roots (the smallest dart of each orbit) stay in cache, unlike the random row
     /// reads of a flood.
     ///
+    /// On a map whose tets are as built ([`Self::tets_as_built`], layout law checked in the same
+    /// call) the union-find runs over the corners, edges and faces of the tets instead of darts,
+    /// joined across α3 (15 nodes per tet instead of 24 per forest; same counts, tested against
+    /// the dart sweep). O(darts · α(tets)) then.
+    ///
     /// # Examples
     ///
     /// ```
@@ -106,6 +111,9 @@ impl<const N: usize> GMap<N> {
     /// assert_eq!(map.count_cells_by_traversal(), map.count_cells()); // ids and orbits agree
     /// ```
     pub fn count_cells_by_traversal(&self) -> CellCounts {
+        if let Some(counts) = self.count_built_tet_orbits() {
+            return CellCounts(counts[..4].to_vec());
+        }
         let masks: Vec<AlphaMask> = (0..=N).map(|i| AlphaMask::cell(N, i)).collect();
         CellCounts(self.count_orbits_in_one_sweep(&masks))
     }
@@ -115,7 +123,7 @@ impl<const N: usize> GMap<N> {
     /// O(darts · n² · α(darts)).
     ///
     /// Same sweep as [`Self::count_cells_by_traversal`] with one more union-find forest, over
-    /// all n + 1 involutions, for the components.
+    /// all n + 1 involutions, for the components (over tets joined by α3 on the tet path).
     ///
     /// # Examples
     ///
@@ -129,6 +137,9 @@ impl<const N: usize> GMap<N> {
     /// assert_eq!((cells, components), (map.count_cells_by_traversal(), map.components().len()));
     /// ```
     pub fn count_all_cells_by_traversal(&self) -> (CellCounts, usize) {
+        if let Some(counts) = self.count_built_tet_orbits() {
+            return (CellCounts(counts[..4].to_vec()), counts[4]);
+        }
         let mut masks: Vec<AlphaMask> = (0..=N).map(|i| AlphaMask::cell(N, i)).collect();
         masks.push(AlphaMask::all(N));
         let mut counts = self.count_orbits_in_one_sweep(&masks);

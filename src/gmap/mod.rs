@@ -20,6 +20,7 @@
 //! darts it touched; with the `expensive-checks` feature the full [`GMap::validate`] runs.
 
 mod cells;
+mod cells_tets;
 mod cmap;
 mod dart;
 mod iso;

@@ -250,7 +250,7 @@ impl<const N: usize> GMap<N> {
     fn laws_hold(&self) -> bool {
         let (dead, live) = self.id_liveness();
         if self.tets_as_built {
-            return self.check_tet_layout().is_ok() && self.built_tet_laws_hold(&dead, &live);
+            return self.built_tet_laws_hold(&dead, &live);
         }
         self.all_laws_hold(&dead, &live)
     }
@@ -608,5 +608,22 @@ mod tests {
         assert_eq!(map.alpha_dyn(i, dart), stored);
         map.tets_as_built = false;
         assert_eq!(map.validate(), Ok(()));
+    }
+
+    /// α1 rewired inside a lone tet (still an involution, every piece of the pattern keeps one
+    /// id, nothing sewn by α3): the tet path's other checks all read the pattern, so only its
+    /// layout check can see that the actual vertex orbits no longer carry one id.
+    #[test]
+    fn a_tet_rewired_inside_breaks_only_the_layout_law() {
+        let (mut map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+        let (a, b) = (DartId(0), DartId(6));
+        let (a1, b1) = (map.alpha_dyn(1, a), map.alpha_dyn(1, b));
+        map.link_raw(1, a, b);
+        map.link_raw(1, a1, b1);
+        map.tets_as_built = true;
+        assert!(!map.laws_hold(), "the fast path missed the rewiring");
+        assert_eq!(map.validate().map_err(|e| e.law()), Err(Law::CellIdConstant)); // first in table order
+        map.tets_as_built = false;
+        assert_eq!(map.validate().map_err(|e| e.law()), Err(Law::CellIdConstant));
     }
 }

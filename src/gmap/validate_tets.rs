@@ -26,10 +26,10 @@ use super::GMap;
 use crate::build::{built_tet_link, TET_DART_CORNER, TET_DART_EDGE, TET_LINKS};
 
 /// The number of pieces of one tet per cell dimension: corners, edges, faces, the tet.
-const PIECES: [usize; 4] = [4, 6, 4, 1];
+pub(super) const PIECES: [usize; 4] = [4, 6, 4, 1];
 
 /// Per dart offset k in a tet and cell dimension: the index of k's piece in its tet.
-const PIECE: [[u8; 4]; 24] = {
+pub(super) const PIECE: [[u8; 4]; 24] = {
     let mut piece = [[0u8; 4]; 24];
     let mut k = 0;
     while k < 24 {
@@ -76,14 +76,14 @@ const FACE_JOINERS: [usize; 3] = [0, 2, 4];
 /// The global index of dart x's piece of dimension dim (pieces of tet t numbered after those of
 /// the tets before it).
 #[inline(always)]
-fn piece_of(dim: usize, x: u32) -> u32 {
+pub(super) fn piece_of(dim: usize, x: u32) -> u32 {
     (x / 24) * PIECES[dim] as u32 + u32::from(PIECE[(x % 24) as usize][dim])
 }
 
 /// Joins the trees of a and b in a union-find forest whose roots are the smallest elements of
 /// their trees; whether they were apart. O(α(len)).
 #[inline(always)]
-fn join(forest: &mut [u32], a: u32, b: u32) -> bool {
+pub(super) fn join(forest: &mut [u32], a: u32, b: u32) -> bool {
     let (ra, rb) = (find_root(forest, a), find_root(forest, b));
     if ra == rb {
         return false;
@@ -111,12 +111,12 @@ struct PieceCensus {
 }
 
 impl<const N: usize> GMap<N> {
-    /// Whether every law holds, for a 3-map whose tet layout law holds (precondition:
-    /// `check_tet_layout()` is `Ok` with the flag set; any other map gets `false`). Same verdict
-    /// as the generic fast path. `dead[dim]`: the freed ids (`None` if none); `live[dim]`: the
+    /// Whether every law holds, for a 3-map flagged [`GMap::tets_as_built`], the tet layout law
+    /// included (checked here, block by block, in the same pass: any other map gets `false`).
+    /// Where the layout law holds, same verdict as the generic fast path. `dead[dim]`: the freed ids (`None` if none); `live[dim]`: the
     /// number of live ids. O(darts + tets · α(tets)).
     pub(super) fn built_tet_laws_hold(&self, dead: &[Option<VisitBits>], live: &[usize]) -> bool {
-        if N != 3 || self.capacity() % 24 != 0 {
+        if N != 3 || self.capacity() % 24 != 0 || self.dart_count() != self.capacity() {
             return false;
         }
         let tets = self.capacity() / 24;
@@ -144,8 +144,9 @@ impl<const N: usize> GMap<N> {
             .all(|((&distinct, &live), orbits)| distinct == live && distinct == orbits)
     }
 
-    /// The per-dart laws left at the 24 darts of tet t: α3 is an involution and commutes with α0
-    /// and α1, vertex, edge and face ids agree across α3, and every id is its piece's. O(1).
+    /// The per-dart laws left at the 24 darts of tet t: α0, α1, α2 are the layout's, α3 is an
+    /// involution and commutes with α0 and α1, vertex, edge and face ids agree across α3, and
+    /// every id is its piece's. O(1).
     ///
     /// The α3 images' rows (the only reads outside the tet's block, often cache misses) are
     /// gathered first in a loop of independent loads, so that their misses overlap.
@@ -167,7 +168,8 @@ impl<const N: usize> GMap<N> {
         for k in 0..24 {
             let e = alpha[k * w + 3];
             bad |= far_alpha3[k] != (base + k) as u32;
-            let [l0, l1, _] = TET_LINKS[k];
+            let [l0, l1, l2] = TET_LINKS[k];
+            bad |= alpha[k * w..k * w + 3] != [base as u32 + l0, base as u32 + l1, base as u32 + l2];
             bad |= built_tet_link(0, e) != alpha[l0 as usize * w + 3];
             bad |= built_tet_link(1, e) != alpha[l1 as usize * w + 3];
             let own = &cells[k * w..k * w + w];

@@ -105,12 +105,7 @@ mod tests {
     /// the tet path must refuse and the dart sweep answer.
     #[test]
     fn a_tet_rewired_inside_is_left_to_the_dart_sweep() {
-        let (mut map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
-        let (a, b) = (DartId(0), DartId(6));
-        let (a1, b1) = (map.alpha_dyn(1, a), map.alpha_dyn(1, b));
-        map.link_raw(1, a, b);
-        map.link_raw(1, a1, b1);
-        map.tets_as_built = true;
+        let map = super::super::validate::tet_rewired_inside();
         assert_eq!(map.count_built_tet_orbits(), None);
         let (cells, components) = map.count_all_cells_by_traversal();
         assert_eq!([cells.0.clone(), vec![components]].concat(), generic_counts(&map));

@@ -552,6 +552,21 @@ impl<const N: usize> GMap<N> {
     }
 }
 
+/// A lone tet as built whose α1 is rewired inside (darts 0 and 6 swap partners: still an
+/// involution, every piece of the pattern keeps one id, nothing sewn by α3), with the
+/// tets-as-built flag forced on: only the layout law can tell that the actual vertex orbits are no
+/// longer the pattern's corners. For the tests of the tet paths.
+#[cfg(test)]
+pub(super) fn tet_rewired_inside() -> GMap<3> {
+    let (mut map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    let (a, b) = (DartId(0), DartId(6));
+    let (a1, b1) = (map.alpha_dyn(1, a), map.alpha_dyn(1, b));
+    map.link_raw(1, a, b);
+    map.link_raw(1, a1, b1);
+    map.tets_as_built = true;
+    map
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -610,17 +625,11 @@ mod tests {
         assert_eq!(map.validate(), Ok(()));
     }
 
-    /// α1 rewired inside a lone tet (still an involution, every piece of the pattern keeps one
-    /// id, nothing sewn by α3): the tet path's other checks all read the pattern, so only its
+    /// [`tet_rewired_inside`]: the tet path's other checks all read the pattern, so only its
     /// layout check can see that the actual vertex orbits no longer carry one id.
     #[test]
     fn a_tet_rewired_inside_breaks_only_the_layout_law() {
-        let (mut map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
-        let (a, b) = (DartId(0), DartId(6));
-        let (a1, b1) = (map.alpha_dyn(1, a), map.alpha_dyn(1, b));
-        map.link_raw(1, a, b);
-        map.link_raw(1, a1, b1);
-        map.tets_as_built = true;
+        let mut map = tet_rewired_inside();
         assert!(!map.laws_hold(), "the fast path missed the rewiring");
         assert_eq!(map.validate().map_err(|e| e.law()), Err(Law::CellIdConstant)); // first in table order
         map.tets_as_built = false;

@@ -70,8 +70,8 @@ mod tests {
     }
 
     /// Random α3 rewirings that keep α3 an involution (unlink two darts, then link them or leave
-    /// them free; or free a whole tet): most of them break the quasi-manifold law, none the layout law, so the tet
-    /// path must count exactly what the generic sweep counts on every one of them.
+    /// them free; or free a whole tet): most of them break the quasi-manifold law, none the
+    /// layout law, so the tet path must count exactly what the generic sweep counts on every one.
     #[test]
     fn the_tet_path_counts_the_generic_sweeps_orbits_under_any_involutive_alpha3() {
         let mut rng = SplitMix64(2026);

@@ -554,8 +554,9 @@ impl<const N: usize> GMap<N> {
 
 /// A lone tet as built whose α1 is rewired inside (darts 0 and 6 swap partners: still an
 /// involution, every piece of the pattern keeps one id, nothing sewn by α3), with the
-/// tets-as-built flag forced on: only the layout law can tell that the actual vertex orbits are no
-/// longer the pattern's corners. For the tests of the tet paths.
+/// tets-as-built flag forced on. Its actual vertex orbits are no longer the pattern's corners
+/// (the generic laws see vertex ids that are not constant), but every check of the tet paths that
+/// reads the pattern passes: only their layout check can tell. For the tests of the tet paths.
 #[cfg(test)]
 pub(super) fn tet_rewired_inside() -> GMap<3> {
     let (mut map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
@@ -625,10 +626,10 @@ mod tests {
         assert_eq!(map.validate(), Ok(()));
     }
 
-    /// [`tet_rewired_inside`]: the tet path's other checks all read the pattern, so only its
-    /// layout check can see that the actual vertex orbits no longer carry one id.
+    /// [`tet_rewired_inside`]: validate's tet path must refuse it through its layout check, and
+    /// the detailed pass names the first law broken in table order.
     #[test]
-    fn a_tet_rewired_inside_breaks_only_the_layout_law() {
+    fn a_tet_rewired_inside_is_refused_by_the_tet_path() {
         let mut map = tet_rewired_inside();
         assert!(!map.laws_hold(), "the fast path missed the rewiring");
         assert_eq!(map.validate().map_err(|e| e.law()), Err(Law::CellIdConstant)); // first in table order

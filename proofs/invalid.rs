@@ -116,3 +116,39 @@ fn validate_names_the_broken_law_on_built_tets() {
         assert!(named.iter().any(|(l, c)| *l == law && *c > 0), "{law:?} never produced: {named:?}");
     }
 }
+
+/// Every α3 rewiring (unlink a and b, then link them, or leave them free when a = b) of small
+/// complexes of built tets keeps α3 an involution and the tets-as-built flag, so the cell and
+/// component counts take their tet path (a union-find over tet corners, edges, faces and tets):
+/// they must equal the orbit walks of `one_dart_per_cell_by_traversal` and `components`, which
+/// read no id and share no code with it.
+#[test]
+fn cell_counts_on_built_tets_equal_orbit_walks_after_every_alpha3_rewiring() {
+    let complexes: [&[[u32; 4]]; 3] =
+        [&[[0, 1, 2, 3]], &[[0, 1, 2, 3], [0, 1, 2, 4]], &[[0, 1, 2, 3], [0, 1, 2, 4], [0, 1, 3, 4]]];
+    let mut distinct = std::collections::HashSet::new();
+    for tets in complexes {
+        let (map, _) = GMap::<3>::from_tets(5, tets).unwrap();
+        let cap = map.capacity() as u32;
+        for a in 0..cap {
+            for b in a..cap {
+                let mut rewired = map.clone();
+                for edit in [
+                    RawEdit::Unlink { i: 3, a: DartId(a) },
+                    RawEdit::Unlink { i: 3, a: DartId(b) },
+                    RawEdit::Link { i: 3, a: DartId(a), b: DartId(b) },
+                ] {
+                    assert!(ops::raw_edit_unchecked(&mut rewired, edit), "{edit:?} refused");
+                }
+                assert!(rewired.tets_as_built(), "an α3 edit cleared the flag");
+                let walked: Vec<usize> = (0..=3).map(|dim| rewired.one_dart_per_cell_by_traversal(dim).len()).collect();
+                let (cells, components) = rewired.count_all_cells_by_traversal();
+                assert_eq!(cells.0, walked, "{tets:?}: α3 rewired at {a}, {b}");
+                assert_eq!(components, rewired.components().len(), "{tets:?}: α3 rewired at {a}, {b}");
+                assert_eq!(rewired.count_cells_by_traversal(), cells);
+                distinct.insert((cells.0, components));
+            }
+        }
+    }
+    assert!(distinct.len() > 20, "too few distinct outcomes: {}", distinct.len());
+}

@@ -10,9 +10,9 @@
 //!   i-cell id is constant under those αj iff it is constant on every piece, an i-cell is a class
 //!   of pieces joined by α3, and a volume is exactly one tet.
 //!
-//! What is left reads each dart's own block and the row of its α3 image: α3 is an involution,
-//! commutes with α0 and α1, and carries the vertex, edge and face ids across; every piece's id is
-//! live. Uniqueness is then counted on pieces: #volumes = #tets; a face is one piece or two glued
+//! The layout law itself is checked in the same pass, block by block. What is left reads each
+//! dart's own block and the row of its α3 image: α3 is an involution, commutes with α0 and α1,
+//! and carries the vertex, edge and face ids across; every piece's id is live. Uniqueness is then counted on pieces: #volumes = #tets; a face is one piece or two glued
 //! by α3; vertices and edges are the classes of a union-find over the 4 and 6 pieces of every
 //! tet, joined across each glued face at three of its darts (the other three are their α0 or α1
 //! images, which α3 commutes with and which stay in the same corner and edge).
@@ -29,7 +29,7 @@ use crate::build::{built_tet_link, TET_DART_CORNER, TET_DART_EDGE, TET_LINKS};
 pub(super) const PIECES: [usize; 4] = [4, 6, 4, 1];
 
 /// Per dart offset k in a tet and cell dimension: the index of k's piece in its tet.
-pub(super) const PIECE: [[u8; 4]; 24] = {
+const PIECE: [[u8; 4]; 24] = {
     let mut piece = [[0u8; 4]; 24];
     let mut k = 0;
     while k < 24 {
@@ -113,8 +113,8 @@ struct PieceCensus {
 impl<const N: usize> GMap<N> {
     /// Whether every law holds, for a 3-map flagged [`GMap::tets_as_built`], the tet layout law
     /// included (checked here, block by block, in the same pass: any other map gets `false`).
-    /// Where the layout law holds, same verdict as the generic fast path. `dead[dim]`: the freed ids (`None` if none); `live[dim]`: the
-    /// number of live ids. O(darts + tets · α(tets)).
+    /// Where the layout law holds, same verdict as the generic fast path. `dead[dim]`: the freed
+    /// ids (`None` if none); `live[dim]`: the number of live ids. O(darts + tets · α(tets)).
     pub(super) fn built_tet_laws_hold(&self, dead: &[Option<VisitBits>], live: &[usize]) -> bool {
         if N != 3 || self.capacity() % 24 != 0 || self.dart_count() != self.capacity() {
             return false;

@@ -364,11 +364,19 @@ pub(crate) const TET_LINKS: [[u32; 3]; 24] = {
 };
 
 /// αi(d) (i < 3) of dart d of a tet as [`GMap::from_tets`] lays it out: dart 24t + k is linked to
-/// 24t + `TET_LINKS[k][i]`. The one place the pattern is applied to a dart id. O(1).
+/// 24t + `TET_LINKS[k][i]`. With [`built_tet_links`], the one place the pattern is applied to a
+/// dart id. O(1).
 #[inline(always)]
 pub(crate) fn built_tet_link(i: usize, d: u32) -> u32 {
     let k = d % 24;
     d - k + TET_LINKS[k as usize][i]
+}
+
+/// [α0(d), α1(d), α2(d)] of dart d of a tet as built (see [`built_tet_link`]). O(1).
+#[inline(always)]
+pub(crate) fn built_tet_links(d: u32) -> [u32; 3] {
+    let k = d % 24;
+    TET_LINKS[k as usize].map(|offset| d - k + offset)
 }
 
 /// The `count` local items (corners or edges) of a tet sorted by the smallest dart that carries

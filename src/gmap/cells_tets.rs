@@ -15,17 +15,15 @@
 
 use super::validate_tets::{join, piece_of, PIECES};
 use super::GMap;
-use crate::build::TET_LINKS;
+use crate::build::built_tet_links;
 
 impl<const N: usize> GMap<N> {
     /// `[vertices, edges, faces, volumes, components]` of a 3-map flagged as built tets whose
     /// layout law holds (checked in the same pass); `None` for any other map, and when an α3
     /// image is out of range (the generic sweep then answers). O(darts · α(tets)).
     pub(super) fn count_built_tet_orbits(&self) -> Option<[usize; 5]> {
-        if N != 3 || !self.tets_as_built() || self.capacity() % 24 != 0 || self.dart_count() != self.capacity() {
-            return None;
-        }
-        let (w, capacity, tets) = (N + 1, self.capacity() as u32, self.capacity() / 24);
+        let tets = self.live_tet_blocks().filter(|_| self.tets_as_built())?;
+        let (w, capacity) = (N + 1, self.capacity() as u32);
         // Union-find forests over the corner, edge and face pieces, and over the tets.
         let mut forests: [Vec<u32>; 4] = std::array::from_fn(|dim| {
             let per_tet = if dim < 3 { PIECES[dim] } else { 1 };
@@ -33,12 +31,11 @@ impl<const N: usize> GMap<N> {
         });
         let mut joins = [0usize; 4];
         for (t, rows) in self.alpha.chunks_exact(24 * w).enumerate() {
-            let base = 24 * t as u32;
-            for (k, (row, links)) in rows.chunks_exact(w).zip(&TET_LINKS).enumerate() {
-                if row[..3] != [base + links[0], base + links[1], base + links[2]] {
+            for (k, row) in rows.chunks_exact(w).enumerate() {
+                let (d, e) = ((24 * t + k) as u32, row[3]);
+                if row[..3] != built_tet_links(d) {
                     return None; // the layout law fails
                 }
-                let (d, e) = (base + k as u32, row[3]);
                 if e <= d {
                     continue; // free, or met from e
                 }

@@ -289,12 +289,10 @@ impl<const N: usize> GMap<N> {
         if let Some(d) = (0..self.capacity()).find(|&d| !self.contains(DartId(d as u32))) {
             return Err(violation(d, 0));
         }
-        for (t, rows) in self.alpha.chunks_exact(24 * row).enumerate() {
-            let base = 24 * t as u32;
-            for (k, links) in crate::build::TET_LINKS.iter().enumerate() {
-                if let Some(i) = (0..3).find(|&i| rows[k * row + i] != base + links[i]) {
-                    return Err(violation(24 * t + k, i));
-                }
+        for (d, links) in self.alpha.chunks_exact(row).enumerate() {
+            let built = crate::build::built_tet_links(d as u32);
+            if let Some(i) = (0..3).find(|&i| links[i] != built[i]) {
+                return Err(violation(d, i));
             }
         }
         Ok(())

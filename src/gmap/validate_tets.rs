@@ -12,10 +12,11 @@
 //!
 //! The layout law itself is checked in the same pass, block by block. What is left reads each
 //! dart's own block and the row of its α3 image: α3 is an involution, commutes with α0 and α1,
-//! and carries the vertex, edge and face ids across; every piece's id is live. Uniqueness is then counted on pieces: #volumes = #tets; a face is one piece or two glued
-//! by α3; vertices and edges are the classes of a union-find over the 4 and 6 pieces of every
-//! tet, joined across each glued face at three of its darts (the other three are their α0 or α1
-//! images, which α3 commutes with and which stay in the same corner and edge).
+//! and carries the vertex, edge and face ids across; every piece's id is live. Uniqueness is
+//! then counted on pieces: #volumes = #tets; a face is one piece or two glued by α3; vertices
+//! and edges are the classes of a union-find over the 4 and 6 pieces of every tet, joined across
+//! each glued face at three of its darts (the other three are their α0 or α1 images, which α3
+//! commutes with and which stay in the same corner and edge).
 //!
 //! Cost: one sequential pass over the rows, reading one α3 image per dart, plus O(tets · α(tets))
 //! union-find; the generic path reads the rows of all n + 1 neighbours of every dart and unions
@@ -23,7 +24,7 @@
 
 use super::orbit::{find_root, VisitBits};
 use super::GMap;
-use crate::build::{built_tet_link, TET_DART_CORNER, TET_DART_EDGE, TET_LINKS};
+use crate::build::{built_tet_link, built_tet_links, TET_DART_CORNER, TET_DART_EDGE, TET_LINKS};
 
 /// The number of pieces of one tet per cell dimension: corners, edges, faces, the tet.
 pub(super) const PIECES: [usize; 4] = [4, 6, 4, 1];
@@ -111,15 +112,20 @@ struct PieceCensus {
 }
 
 impl<const N: usize> GMap<N> {
+    /// The number of tets when n = 3, the dart slots are whole blocks of 24 and every slot is
+    /// live (what the tet paths need before reading blocks); `None` otherwise. O(1).
+    pub(super) fn live_tet_blocks(&self) -> Option<usize> {
+        (N == 3 && self.capacity() % 24 == 0 && self.dart_count() == self.capacity()).then(|| self.capacity() / 24)
+    }
+
     /// Whether every law holds, for a 3-map flagged [`GMap::tets_as_built`], the tet layout law
     /// included (checked here, block by block, in the same pass: any other map gets `false`).
     /// Where the layout law holds, same verdict as the generic fast path. `dead[dim]`: the freed
     /// ids (`None` if none); `live[dim]`: the number of live ids. O(darts + tets · α(tets)).
     pub(super) fn built_tet_laws_hold(&self, dead: &[Option<VisitBits>], live: &[usize]) -> bool {
-        if N != 3 || self.capacity() % 24 != 0 || self.dart_count() != self.capacity() {
+        let Some(tets) = self.live_tet_blocks() else {
             return false;
-        }
-        let tets = self.capacity() / 24;
+        };
         let mut census = PieceCensus {
             used: self.ids.iter().map(|a| VisitBits::new(a.next as usize)).collect(),
             distinct: [0; 4],
@@ -168,8 +174,8 @@ impl<const N: usize> GMap<N> {
         for k in 0..24 {
             let e = alpha[k * w + 3];
             bad |= far_alpha3[k] != (base + k) as u32;
-            let [l0, l1, l2] = TET_LINKS[k];
-            bad |= alpha[k * w..k * w + 3] != [base as u32 + l0, base as u32 + l1, base as u32 + l2];
+            let [l0, l1, _] = TET_LINKS[k];
+            bad |= alpha[k * w..k * w + 3] != built_tet_links((base + k) as u32);
             bad |= built_tet_link(0, e) != alpha[l0 as usize * w + 3];
             bad |= built_tet_link(1, e) != alpha[l1 as usize * w + 3];
             let own = &cells[k * w..k * w + w];

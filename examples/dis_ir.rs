@@ -19,6 +19,11 @@
 //! `inner` for only its faces whose dissociation splits no vertex or edge, `split` for the
 //! others). With `--mesh`, the same selections on another mesh (liver_1M: is the instruction
 //! count per dissociation independent of the mesh size?).
+//!
+//! `dis_ir [PASSES] tear` measures one fan tear + projection update instead (`cut_probe`'s
+//! interior vertices and direction, each torn and sewn back), in the one function [`timed_tear`]
+//! (`--toggle-collect='dis_ir::timed_tear'`); its digest covers every tear's fan, the split
+//! vertices and edges of each of its dissociations, and the masses of the torn vertex's sides.
 
 use std::hash::{Hash, Hasher};
 
@@ -37,6 +42,46 @@ fn timed(body: &mut Body, projection: &mut Projection, d: DartId) -> cut::Dissoc
     let dis = cut::dissociate_face(body, d).expect("inner face");
     projection.update(body, &dis.touched);
     dis
+}
+
+/// The measured operation of `tear`: one fan tear and its projection update.
+#[inline(never)]
+fn timed_tear(body: &mut Body, projection: &mut Projection, d: DartId) -> cut::Tear {
+    let v = body.map().vertex_id(d);
+    let tear = cut::tear_vertex(body, v, [1.0, 0.3, 0.2], Some(d)).expect("vertex");
+    projection.update(body, &tear.touched);
+    tear
+}
+
+/// Tears every vertex of `vertices` `passes` times, each sewn back (not measured); returns the
+/// number of tears and the outcome digest.
+fn tears(body: &mut Body, projection: &mut Projection, vertices: &[DartId], passes: usize) -> (usize, u64) {
+    let mut outcome = std::hash::DefaultHasher::new();
+    for _ in 0..passes {
+        for &d in vertices {
+            let tear = timed_tear(body, projection, d);
+            (&tear.fan, tear.split).hash(&mut outcome);
+            for dis in &tear.dissociations {
+                dis.faces.hash(&mut outcome);
+                for s in dis.vertices.iter().chain(&dis.edges) {
+                    (s.kept, s.new, s.dart_kept, s.dart_new).hash(&mut outcome);
+                }
+            }
+            for dis in tear.dissociations.iter().filter(|dis| !dis.vertices.is_empty()) {
+                for s in &dis.vertices {
+                    let mass = |x: DartId| body.attrs().vertex_mass(body.map().vertex_id(x)).to_bits();
+                    (mass(s.dart_kept), mass(s.dart_new)).hash(&mut outcome);
+                }
+            }
+            let mut touched = TouchedCells::default();
+            for dis in tear.dissociations.iter().rev() {
+                let changes = body.sew3(dis.dart, dis.opposite).expect("sew back");
+                touched.record(body.map(), &changes);
+            }
+            projection.update(body, &touched);
+        }
+    }
+    (passes * vertices.len(), outcome.finish())
 }
 
 /// Sews the face back and lets the projection follow (not measured).
@@ -61,7 +106,12 @@ fn main() {
     let (z, _) = mesh.spatially_ordered();
     let (mut body, _) = Body::from_tets(&z.points, &z.tets, Material::default()).expect("mesh");
     let mut projection = Projection::build(&body, G);
-    let (faces, _) = cut_select::faces_and_vertices(body.map());
+    let (faces, vertices) = cut_select::faces_and_vertices(body.map());
+    if which == "tear" {
+        let (calls, digest) = tears(&mut body, &mut projection, &vertices, passes);
+        println!("dis_ir: {calls} tears ({} interior vertices per pass), outcome digest {digest:016x}", vertices.len());
+        return;
+    }
     let incision = cut_select::incision_faces(&body, &z.points);
     let mut list: Vec<DartId> = match which.as_str() {
         "random" => faces.clone(),

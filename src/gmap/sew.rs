@@ -15,11 +15,14 @@
 //! unless a cheap proof settles it first (`QuickLinks`: direct αk links between the unsewn darts,
 //! and the rings ⟨αi±1, αi⟩ walked from both darts of each pair). For the α3-unsew of an inner
 //! triangle that proof covers all three vertices and edges (three rings of tets around its edges)
-//! and the face itself, so nothing is walked beyond the rings.
+//! and the face itself, so nothing is walked beyond the rings. What the proof leaves (a cell that
+//! really split, as on every face of a tear's fan) is walked by a `Shortcut` where the cell's
+//! orbit allows it — the edge as two paths of tets, the vertex corner by corner — with the
+//! lockstep walk's answer.
 
 use rustc_hash::FxHashMap;
 
-use super::orbit::generators;
+use super::orbit::{generators, with_stamps, Stamps};
 use super::{AlphaMask, CellId, DartId, GMap};
 
 /// Why a sew or unsew was refused. The map is unchanged when one is returned.
@@ -610,7 +613,7 @@ impl<const N: usize> GMap<N> {
             std::hint::black_box((self.cell_row(x.0)[0], self.cell_row(y.0)[0]));
             self.unlink_raw(i, x);
         }
-        let mut report = CellChanges { changes: Vec::new(), pairs, new_sides: SplitSides::default() };
+        let mut report = CellChanges { changes: Vec::with_capacity(8), pairs, new_sides: SplitSides::default() };
         let mut links = QuickLinks::none();
         if quick {
             links.find(self, i, &report.pairs);
@@ -620,7 +623,7 @@ impl<const N: usize> GMap<N> {
         let mut scratch = SPLIT_SCRATCH.take();
         for dim in (0..=N).filter(|&dim| dim != i) {
             let CellChanges { changes, pairs, new_sides } = &mut report;
-            self.split_cells(dim, pairs, &links, &mut scratch, (changes, new_sides));
+            self.split_cells((i, dim, quick), pairs, &links, &mut scratch, (changes, new_sides));
         }
         SPLIT_SCRATCH.set(scratch);
         #[cfg(debug_assertions)]
@@ -633,7 +636,9 @@ impl<const N: usize> GMap<N> {
     /// After unlinking, makes the dim-cell ids exact again. Every piece of a cell that fell apart
     /// holds an endpoint of an unlinked pair, so it suffices to check each endpoint against an
     /// *anchor* endpoint of its current id: if they are no longer in one orbit, the piece found
-    /// smaller by the lockstep walk (a complete orbit) gets a fresh id. A piece that got a fresh
+    /// smaller by the lockstep walk (a complete orbit; on `quick` unsews, where the cell's orbit
+    /// allows it, a [`Shortcut`] finds the same piece by paths or by corners) gets a fresh id.
+    /// A piece that got a fresh
     /// id is complete, so its other endpoints are skipped. Endpoints that `links` proves still
     /// joined skip the walk (it would find them joined too: the outcome is the same).
     /// An endpoint proven joined to an *earlier* endpoint is skipped before its id is even read:
@@ -645,7 +650,7 @@ impl<const N: usize> GMap<N> {
     /// complete pieces), reused across dimensions.
     fn split_cells(
         &mut self,
-        dim: usize,
+        (i, dim, quick): (usize, usize, bool),
         pairs: &[(DartId, DartId)],
         links: &QuickLinks,
         (anchors, complete): &mut SplitScratch,
@@ -681,7 +686,12 @@ impl<const N: usize> GMap<N> {
                     (new, is_z_side)
                 }
                 None => {
-                    let Some((side, is_z_side)) = self.split_side(anchor, z, mask) else { continue };
+                    let walked = match Shortcut::of(N, i, dim).filter(|_| quick) {
+                        Some(Shortcut::Ring(ring)) => ring.split_side(self, anchor, z),
+                        Some(Shortcut::Corners(corners)) => corners.split_side(self, anchor, z),
+                        None => self.split_side(anchor, z, mask),
+                    };
+                    let Some((side, is_z_side)) = walked else { continue };
                     let new = self.alloc_cell_id(dim);
                     for &w in &side {
                         self.set_cell_raw(dim, w, new);
@@ -704,6 +714,206 @@ type SplitScratch = (Vec<(u32, usize)>, Vec<u32>);
 thread_local! {
     /// The (id, anchor) and complete-id lists of [`GMap::split_cells`], reused across unsews.
     static SPLIT_SCRATCH: std::cell::Cell<SplitScratch> = const { std::cell::Cell::new((Vec::new(), Vec::new())) };
+}
+
+/// A faster way than [`GMap::split_side`]'s dart-by-dart walk to the same answer, for one cell
+/// dimension after an αi-unsew: by paths ([`RingCell`]) or by corners ([`CornerCell`]).
+#[derive(Clone, Copy, Debug)]
+enum Shortcut {
+    Ring(RingCell),
+    Corners(CornerCell),
+}
+
+impl Shortcut {
+    /// The shortcut for the dim-cells of an n-map after an αi-unsew, if there is one: paths where
+    /// the cell has a ring form, else corners in a 3-map. O(n).
+    fn of(n: usize, i: usize, dim: usize) -> Option<Shortcut> {
+        RingCell::of(n, i, dim).map(Shortcut::Ring).or_else(|| CornerCell::of(n, i, dim).map(Shortcut::Corners))
+    }
+}
+
+/// A cell of a 3-map after an αi-unsew walked corner by corner: its orbit ⟨αi, αh, αl⟩ is the
+/// union of the two-generator orbits ⟨αh, αl⟩ (the corners: for a vertex after an α3-unsew, the
+/// six darts of the vertex in one tet) joined by αi links. [`CornerCell::split_side`] runs the
+/// lockstep walk of [`GMap::split_side`] over corners instead of darts — a corner is read with no
+/// visited set, and only its darts' αi images are looked up — and gives the same answer: `None`
+/// iff the two darts are one cell (a side that ends without meeting the other is its whole
+/// cell, which then does not hold the other dart), else the side the dart walk would exhaust
+/// first, that is the anchor's iff it has no more darts than the other (the anchor moves first
+/// in each round). The corner walk keeps counting the other side until that comparison is
+/// decided. The darts come in another order (not part of the answer). O(darts walked).
+/// Unit test `corner_split_is_split_side`.
+#[derive(Clone, Copy, Debug)]
+struct CornerCell {
+    i: usize,
+    h: usize,
+    l: usize,
+}
+
+impl CornerCell {
+    /// The corner form of the dim-cells of an n-map after an αi-unsew: for n = 3, every dim ≠ i.
+    fn of(n: usize, i: usize, dim: usize) -> Option<CornerCell> {
+        if n != 3 || dim == i || dim > 3 || i > 3 {
+            return None;
+        }
+        let mut hl = (0..=3).filter(|&g| g != dim && g != i);
+        Some(CornerCell { i, h: hl.next()?, l: hl.next()? })
+    }
+
+    /// See the type's documentation.
+    fn split_side<const N: usize>(&self, map: &GMap<N>, a: DartId, z: DartId) -> Option<(Vec<DartId>, bool)> {
+        if a == z {
+            return None;
+        }
+        with_stamps(|stamps| {
+            let tag = stamps.fresh(map.capacity(), 2);
+            // Per side: its darts (corner after corner, so also the queue of corners to expand:
+            // `next` is the first dart not yet looked across αi) and whether it is complete.
+            let mut darts: [Vec<DartId>; 2] = [Vec::with_capacity(64), Vec::with_capacity(64)];
+            let mut next = [0usize; 2];
+            self.enter(map, a, stamps, tag, &mut darts[0]);
+            if stamps.has(z.0, tag) {
+                return None; // one corner
+            }
+            self.enter(map, z, stamps, tag + 1, &mut darts[1]);
+            let mut done = [false; 2];
+            loop {
+                for side in 0..2 {
+                    if done[side] {
+                        continue;
+                    }
+                    let (own, other) = (tag + side as u32, tag + 1 - side as u32);
+                    match self.expand(map, stamps, (own, other), &mut darts[side], &mut next[side]) {
+                        Expand::Met => return None,
+                        Expand::Grew => {}
+                        Expand::Complete => done[side] = true,
+                    }
+                }
+                let (sa, sz) = (darts[0].len(), darts[1].len());
+                // A complete side is a whole cell; the other side has at least its darts so far.
+                let decided = match done {
+                    [true, true] => Some(sa > sz),
+                    [true, false] if sz >= sa => Some(false),
+                    [false, true] if sa > sz => Some(true),
+                    _ => None,
+                };
+                if let Some(z_side) = decided {
+                    return Some((std::mem::take(&mut darts[usize::from(z_side)]), z_side));
+                }
+            }
+        })
+    }
+
+    /// Appends the corner ⟨αh, αl⟩ of `c` to `darts`, stamping each with `own`.
+    fn enter<const N: usize>(&self, map: &GMap<N>, c: DartId, stamps: &mut Stamps, own: u32, darts: &mut Vec<DartId>) {
+        map.for_each_dihedral(c, self.h, self.l, |x| {
+            stamps.mark(x.0, own);
+            darts.push(x);
+        });
+    }
+
+    /// Looks across αi from the side's darts `next..` until a corner not yet found is entered
+    /// (or the other side's is met). O(corner).
+    fn expand<const N: usize>(
+        &self,
+        map: &GMap<N>,
+        stamps: &mut Stamps,
+        (own, other): (u32, u32),
+        darts: &mut Vec<DartId>,
+        next: &mut usize,
+    ) -> Expand {
+        while *next < darts.len() {
+            let x = darts[*next];
+            *next += 1;
+            let y = map.alpha_dyn(self.i, x);
+            if y == x || stamps.has(y.0, own) {
+                continue;
+            }
+            if stamps.has(y.0, other) {
+                return Expand::Met;
+            }
+            self.enter(map, y, stamps, own, darts);
+            return Expand::Grew;
+        }
+        Expand::Complete
+    }
+}
+
+/// What one step of a [`CornerCell`] walk did.
+enum Expand {
+    /// It reached a dart of the other side: one cell.
+    Met,
+    /// It entered a new corner.
+    Grew,
+    /// The side has no dart left to look across: it is a whole cell.
+    Complete,
+}
+
+/// A cell dimension whose orbit, after an αi-unsew, is read off one two-generator path: the
+/// cell's generators are αi, αj and at most one αk that commutes with both (|k − i| ≥ 2 and
+/// |k − j| ≥ 2). Then ⟨αi, αj, αk⟩ = ⟨αj, αi⟩ ∪ αk ⟨αj, αi⟩, so the cell of an unlinked endpoint x
+/// (i-free) is the path ⟨αj, αi⟩(x) plus its αk image, which is that path itself or disjoint from
+/// it. In a 3-map unsewn by α3 this is the edge (α0, α2, α3): the chain of tets around it on one
+/// side of the cut, both ends; in a 2-map unsewn by α2, the vertex (α1, α2).
+///
+/// [`RingCell::split_side`] gives [`GMap::split_side`]'s answer without its visited sets: the
+/// same side (the lockstep walk exhausts the anchor's side first iff it is not larger, as the
+/// anchor moves first in each round), with its darts in another order (the order is not part of
+/// the answer: [`CellChanges::new_side`]). Requires a map whose α links commute as validity says
+/// (true after every public operation). Unit test `ring_split_is_split_side`.
+#[derive(Clone, Copy, Debug)]
+struct RingCell {
+    i: usize,
+    j: usize,
+    k: Option<usize>,
+}
+
+impl RingCell {
+    /// The ring form of the dim-cells of an n-map after an αi-unsew, if they have one. O(n).
+    fn of(n: usize, i: usize, dim: usize) -> Option<RingCell> {
+        let (mut others, mut len) = ([0; 2], 0);
+        for g in (0..=n).filter(|&g| g != dim && g != i) {
+            if len == 2 {
+                return None; // four generators or more: not a ring
+            }
+            others[len] = g;
+            len += 1;
+        }
+        let commutes = |a: usize, b: usize| a.abs_diff(b) >= 2;
+        match others[..len] {
+            [j] => Some(RingCell { i, j, k: None }),
+            [a, b] if commutes(b, i) && commutes(b, a) => Some(RingCell { i, j: a, k: Some(b) }),
+            [a, b] if commutes(a, i) && commutes(a, b) => Some(RingCell { i, j: b, k: Some(a) }),
+            _ => None,
+        }
+    }
+
+    /// The darts of the cell of the i-free dart `x`: the path ⟨αj, αi⟩(x), then its αk image
+    /// when that is another path. O(cell).
+    fn cell<const N: usize>(&self, map: &GMap<N>, x: DartId) -> Vec<DartId> {
+        let mut side = Vec::with_capacity(32);
+        map.for_each_dihedral(x, self.j, self.i, |y| side.push(y));
+        if let Some(k) = self.k {
+            let path = side.len();
+            if !side.contains(&map.alpha_local(k, x)) {
+                for p in 0..path {
+                    side.push(map.alpha_local(k, side[p]));
+                }
+            }
+        }
+        side
+    }
+
+    /// [`GMap::split_side`] of the i-free darts `a` (the anchor) and `z`: `None` if they are one
+    /// cell, else the smaller side (a's on a tie) and whether it is z's. O(cells of a and z).
+    fn split_side<const N: usize>(&self, map: &GMap<N>, a: DartId, z: DartId) -> Option<(Vec<DartId>, bool)> {
+        let side_a = self.cell(map, a);
+        if side_a.contains(&z) {
+            return None;
+        }
+        let side_z = self.cell(map, z);
+        Some(if side_a.len() <= side_z.len() { (side_a, false) } else { (side_z, true) })
+    }
 }
 
 /// Endpoint k of the unlinked pairs: pair k / 2, first or second dart.
@@ -1188,6 +1398,90 @@ mod tests {
                 assert_eq!(table.get(d), scan(d), "pairs {pairs:?}, dart {d}");
             }
         }
+    }
+
+    /// A copy of `map` with about one in `one_in` of its i-sewn darts unsewn (seeded).
+    fn cut_at_random<const N: usize>(map: &GMap<N>, i: usize, seed: u64, one_in: usize) -> GMap<N> {
+        let mut cut = map.clone();
+        let mut rng = SplitMix64(seed);
+        for d in map.darts() {
+            if rng.below(one_in) == 0 && !cut.is_free(i, d) {
+                cut.unsew_with(i, d, false).unwrap();
+            }
+        }
+        cut
+    }
+
+    /// A split walk's answer with the side sorted (the order is not part of the answer).
+    fn as_set(answer: Option<(Vec<DartId>, bool)>) -> Option<(Vec<DartId>, bool)> {
+        answer.map(|(mut side, flag)| {
+            side.sort_unstable();
+            (side, flag)
+        })
+    }
+
+    /// [`CornerCell::split_side`] is [`GMap::split_side`] (the same side as a set, the same
+    /// flag) on pairs of i-free darts of a cut 3-map, for every i and every cell dimension ≠ i,
+    /// pairs of one corner included.
+    #[test]
+    fn corner_split_is_split_side() {
+        let (points, tets) = kuhn_cube(2);
+        let (cube, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+        let mut seen = [0; 3]; // joined, split on a's side, split on z's side
+        for i in 0..=3 {
+            let map = cut_at_random(&cube, i, 17 + i as u64, 3);
+            for dim in (0..=3).filter(|&dim| dim != i) {
+                let corners = CornerCell::of(3, i, dim).unwrap();
+                let free: Vec<DartId> = map.darts().filter(|&d| map.is_free(i, d)).collect();
+                for (n, &a) in free.iter().enumerate().step_by(2) {
+                    let near = [map.alpha_local(corners.h, a), map.alpha_local(corners.l, a)];
+                    for z in free.iter().copied().skip(n % 7).step_by(7).chain(near) {
+                        let want = as_set(map.split_side(a, z, AlphaMask::cell(3, dim)));
+                        assert_eq!(as_set(corners.split_side(&map, a, z)), want, "alpha{i} dim {dim}: {a:?} {z:?}");
+                        seen[want.map_or(0, |w| 1 + usize::from(w.1))] += 1;
+                    }
+                }
+            }
+        }
+        assert!(seen.iter().all(|&n| n > 20), "joined / a's side / z's side: {seen:?}");
+        assert!(CornerCell::of(2, 2, 0).is_none() && CornerCell::of(3, 3, 3).is_none());
+    }
+
+    /// [`RingCell::split_side`] is [`GMap::split_side`] (the same side as a set, the same flag)
+    /// on every pair of i-free darts of a map with boundaries and cuts, in every cell dimension
+    /// that has a ring form, for 3-maps unsewn by α3 (edges), α2 or α1 and 2-maps unsewn by α2
+    /// (vertices and edges) or α1. The pairs include joined ones, split ones of equal and of
+    /// different sizes, and darts of one cell.
+    #[test]
+    fn ring_split_is_split_side() {
+        fn check<const N: usize>(map: &GMap<N>, i: usize) -> [usize; 3] {
+            let mut seen = [0; 3]; // joined, split on a's side, split on z's side
+            for dim in (0..=N).filter(|&dim| dim != i) {
+                let Some(ring) = RingCell::of(N, i, dim) else { continue };
+                let free: Vec<DartId> = map.darts().filter(|&d| map.is_free(i, d)).collect();
+                for (n, &a) in free.iter().enumerate() {
+                    for &z in free.iter().skip(n % 5).step_by(5) {
+                        let want = as_set(map.split_side(a, z, AlphaMask::cell(N, dim)));
+                        assert_eq!(as_set(ring.split_side(map, a, z)), want, "alpha{i} dim {dim}: {a:?} {z:?}");
+                        seen[want.map_or(0, |w| 1 + usize::from(w.1))] += 1;
+                    }
+                }
+            }
+            seen
+        }
+        let mut totals = [0; 3];
+        let mut add = |seen: [usize; 3]| totals.iter_mut().zip(seen).for_each(|(t, s)| *t += s);
+        let (points, tets) = kuhn_cube(2);
+        let (cube, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+        for i in 1..=3 {
+            add(check(&cut_at_random(&cube, i, 3 + i as u64, 4), i));
+        }
+        let (points, triangles) = crate::generate::grid_triangles(4);
+        let (grid, _) = GMap::<2>::from_triangles(points.len(), &triangles).unwrap();
+        for i in 1..=2 {
+            add(check(&cut_at_random(&grid, i, 5 + i as u64, 3), i));
+        }
+        assert!(totals.iter().all(|&n| n > 20), "joined / a's side / z's side: {totals:?}");
     }
 
     /// The same on a 2-map (rings ⟨α1, α2⟩ and ⟨α0, α1⟩, ⟨α2, α1⟩), cut edge by edge.

@@ -637,11 +637,10 @@ impl<const N: usize> GMap<N> {
     /// holds an endpoint of an unlinked pair, so it suffices to check each endpoint against an
     /// *anchor* endpoint of its current id: if they are no longer in one orbit, the piece found
     /// smaller by the lockstep walk (a complete orbit; on `quick` unsews, where the cell's orbit
-    /// allows it, a [`Shortcut`] finds the same piece by paths or by corners) gets a fresh id.
-    /// A piece that got a fresh
-    /// id is complete, so its other endpoints are skipped. Endpoints that `links` proves still
-    /// joined skip the walk (it would find them joined too: the outcome is the same).
-    /// An endpoint proven joined to an *earlier* endpoint is skipped before its id is even read:
+    /// allows it, a [`Shortcut`] finds the same piece by paths or by corners) gets a fresh id. A
+    /// piece that got a fresh id is complete, so its other endpoints are skipped. Endpoints that
+    /// `links` proves still joined skip the walk (it would find them joined too: the outcome is
+    /// the same). An endpoint proven joined to an *earlier* endpoint is skipped before its id is even read:
     /// it is in the same cell as that one through every relabelling (each relabels a whole cell),
     /// so it would be skipped as complete, or be joined to the anchor of that cell, or lead to a
     /// check that finds it joined — never to a change or a new anchor. Only the first endpoint of

@@ -218,10 +218,9 @@ impl<const N: usize> GMap<N> {
         }
         let (gens, len) = generators(N, mask);
         let gens = &gens[..len];
-        let mut walk =
-            Lockstep { queue: [Vec::with_capacity(16), Vec::with_capacity(16)], head: [0, 0], filter: [[0; 4]; 2] };
-        walk.push(0, a);
-        walk.push(1, b);
+        let mut walk = Lockstep { queue: [Vec::with_capacity(16), Vec::with_capacity(16)], head: [0, 0] };
+        walk.queue[0].push(a);
+        walk.queue[1].push(b);
         loop {
             if walk.queue[0].len() + walk.queue[1].len() > LINEAR_LIMIT {
                 return with_stamps(|stamps| walk.finish_stamped(self, gens, stamps));
@@ -234,11 +233,11 @@ impl<const N: usize> GMap<N> {
                     if y == x {
                         continue;
                     }
-                    if walk.holds(1 - side, y) {
+                    if walk.queue[1 - side].contains(&y) {
                         return None;
                     }
-                    if !walk.holds(side, y) {
-                        walk.push(side, y);
+                    if !walk.queue[side].contains(&y) {
+                        walk.queue[side].push(y);
                     }
                 }
             }
@@ -608,41 +607,12 @@ impl TetWords {
 
 /// The state of [`GMap::split_side`]: two breadth-first walks, each queue holding every dart its
 /// side has found (so the queues are also the visited sets while they are small).
-///
-/// While the queues are small (the linear phase), membership is a scan of the queue behind a
-/// 256-bit filter per side: a dart whose bit is clear is certainly absent, so most scans are
-/// skipped (a bit set by another dart only costs the scan that was always made before). The
-/// filter never changes an answer, only how fast it is found. The stamped phase does not use it.
 struct Lockstep {
     queue: [Vec<DartId>; 2],
     head: [usize; 2],
-    filter: [[u64; 4]; 2],
 }
 
 impl Lockstep {
-    /// The filter word and bit of dart `y`: 8 bits of a multiplicative hash, so that the darts
-    /// of one tet (consecutive ids) spread over the filter. O(1).
-    #[inline(always)]
-    fn filter_bit(y: DartId) -> (usize, u64) {
-        let h = y.0.wrapping_mul(0x9E37_79B1) >> 24;
-        ((h >> 6) as usize, 1u64 << (h & 63))
-    }
-
-    /// Appends `y` to `side`'s queue and sets its filter bit (linear phase). O(1).
-    #[inline(always)]
-    fn push(&mut self, side: usize, y: DartId) {
-        let (w, bit) = Self::filter_bit(y);
-        self.filter[side][w] |= bit;
-        self.queue[side].push(y);
-    }
-
-    /// Whether `side` has found `y` (linear phase). O(1) when the filter says no, else O(queue).
-    #[inline(always)]
-    fn holds(&self, side: usize, y: DartId) -> bool {
-        let (w, bit) = Self::filter_bit(y);
-        self.filter[side][w] & bit != 0 && self.queue[side].contains(&y)
-    }
-
     /// The next dart of `side` to expand, or `None` if that side is exhausted.
     #[inline]
     fn next(&mut self, side: usize) -> Option<DartId> {

@@ -67,18 +67,13 @@ fn tears(body: &mut Body, projection: &mut Projection, vertices: &[DartId], pass
                     (s.kept, s.new, s.dart_kept, s.dart_new).hash(&mut outcome);
                 }
             }
-            for dis in tear.dissociations.iter().filter(|dis| !dis.vertices.is_empty()) {
-                for s in &dis.vertices {
-                    let mass = |x: DartId| body.attrs().vertex_mass(body.map().vertex_id(x)).to_bits();
-                    (mass(s.dart_kept), mass(s.dart_new)).hash(&mut outcome);
-                }
+            for s in tear.dissociations.iter().flat_map(|dis| &dis.vertices) {
+                let mass = |x: DartId| body.attrs().vertex_mass(body.map().vertex_id(x)).to_bits();
+                (mass(s.dart_kept), mass(s.dart_new)).hash(&mut outcome);
             }
-            let mut touched = TouchedCells::default();
             for dis in tear.dissociations.iter().rev() {
-                let changes = body.sew3(dis.dart, dis.opposite).expect("sew back");
-                touched.record(body.map(), &changes);
+                undo(body, projection, dis);
             }
-            projection.update(body, &touched);
         }
     }
     (passes * vertices.len(), outcome.finish())

@@ -244,11 +244,12 @@ fn face_normal(body: &Body, d: DartId) -> Vec3 {
 /// back to [`face_normal`]. O(1).
 fn face_normal_at(body: &Body, x: DartId) -> Vec3 {
     let map = body.map();
-    let (a, b) = (map.alpha_local(0, x), map.alpha_local(1, x));
-    let c = map.alpha_local(0, b);
     // A face of a tet as built is a closed hexagon (the layout law), so the test is skipped then.
-    let closed = map.tets_as_built()
-        || a != x && b != x && c != b && map.alpha_local(0, map.alpha_local(1, a)) == map.alpha_local(1, c);
+    let closed = map.tets_as_built() || {
+        let (a, b) = (map.alpha_local(0, x), map.alpha_local(1, x));
+        let c = map.alpha_local(0, b);
+        a != x && b != x && c != b && map.alpha_local(0, map.alpha_local(1, a)) == map.alpha_local(1, c)
+    };
     match closed.then(|| closed_triangle_vertices(map, x)).flatten() {
         Some(ids) => triangle_normal(body, ids),
         None => face_normal(body, x),

@@ -24,6 +24,14 @@
 //! the mean edge length) in file order and in Z-order. `TOPOMECH_CUT_ORDER=file` builds in file
 //! order instead (for A/B runs against older bench binaries, which built in file order).
 //!
+//! The large / small ratio of the criterion groups compares two measurements taken seconds
+//! apart, on a host whose speed drifts between processes and within one: it swings. After the
+//! criterion groups, every operation is therefore also measured **interleaved**: blocks of
+//! [`BLOCK`] operations on the small mesh and on the large one, alternated [`BLOCKS`] times,
+//! so that both meshes see the same host states; p50 and ratio are printed as `CUT-PAIRED`
+//! lines. (The first operations of a block run with the caches the other mesh left: they land in
+//! the tail, not at the median.)
+//!
 //! `cargo bench --bench cut` (release, without `expensive-checks`). `TOPOMECH_CUT_LARGE=kuhn`
 //! forces the Kuhn cube.
 
@@ -120,6 +128,13 @@ fn undo(f: &mut Fixture, dissociations: &[cut::Dissociation]) {
     f.projection.update(&f.body, &touched);
 }
 
+/// Undoes the incision faces still dissociated (untimed), so that the next operation starts from
+/// the intact body.
+fn reset(f: &mut Fixture) {
+    let done = std::mem::take(&mut f.done);
+    undo(f, &done);
+}
+
 /// One dissociation of a random face + projection update, timed; undone untimed.
 fn dissociate_once(f: &mut Fixture, i: usize) -> Duration {
     let d = f.faces[i % f.faces.len()];
@@ -209,6 +224,29 @@ fn measure(c: &mut Criterion, group: &str, f: &mut Fixture, op: Op) -> (f64, f64
     (percentile(&mut s, 0.5), percentile(&mut s, 0.9))
 }
 
+/// Operations per block of [`interleaved`].
+const BLOCK: usize = 64;
+/// Blocks per mesh of [`interleaved`].
+const BLOCKS: usize = 64;
+
+/// `op` on `small` and on `large` in alternated blocks of [`BLOCK`] operations, [`BLOCKS`]
+/// blocks each, every single operation timed; returns the (p50 small, p50 large) in µs.
+fn interleaved(small: &mut Fixture, large: &mut Fixture, op: Op) -> (f64, f64) {
+    let (mut s, mut l) = (Vec::with_capacity(BLOCK * BLOCKS), Vec::with_capacity(BLOCK * BLOCKS));
+    let (mut cs, mut cl) = (0usize, 0usize);
+    for _ in 0..BLOCKS {
+        for _ in 0..BLOCK {
+            s.push(op(small, cs));
+            cs += 1;
+        }
+        for _ in 0..BLOCK {
+            l.push(op(large, cl));
+            cl += 1;
+        }
+    }
+    (percentile(&mut s, 0.5), percentile(&mut l, 0.5))
+}
+
 fn cut_bench(c: &mut Criterion) {
     let Some(mut small) = small() else {
         eprintln!("liver_547.msh absent: cut bench skipped");
@@ -225,12 +263,16 @@ fn cut_bench(c: &mut Criterion) {
         large.incision.len(),
         large.name
     );
-    for (group, op) in [
+    let ops = [
         ("dissociate_face+projection_random_cold", dissociate_once as Op),
         ("dissociate_face+projection_incision_faces_undone", incision_face_once as Op),
         ("dissociate_face+projection_incision_order", incise_once as Op),
         ("tear_fan+projection", tear_once as Op),
-    ] {
+    ];
+    for (group, op) in ops {
+        // Each group starts from the intact bodies (the incision order leaves a cut half done).
+        reset(&mut small);
+        reset(&mut large);
         let (s50, s90) = measure(c, group, &mut small, op);
         let (l50, l90) = measure(c, group, &mut large, op);
         report.push(format!(
@@ -242,6 +284,18 @@ fn cut_bench(c: &mut Criterion) {
     }
     for line in report {
         println!("CUT {line}");
+    }
+    for (group, op) in ops {
+        reset(&mut small);
+        reset(&mut large);
+        let (s50, l50) = interleaved(&mut small, &mut large, op);
+        println!(
+            "CUT-PAIRED {group}: {} p50 {s50:.2} µs | {} p50 {l50:.2} µs | ratio p50 {:.2} ({BLOCKS} alternated \
+             blocks of {BLOCK} per mesh)",
+            small.name,
+            large.name,
+            l50 / s50
+        );
     }
 }
 

@@ -200,19 +200,44 @@ pub struct CellChanges {
 /// ```
 #[derive(Debug, Clone, Default)]
 pub struct SplitSides {
-    /// (index of the split in `changes`, every dart of its new side).
-    entries: Vec<(u32, Vec<DartId>)>,
+    /// Per recorded side: (index of the split in `changes`, end of its darts in `darts`); a
+    /// side starts where the previous one ends.
+    ends: Vec<(u32, u32)>,
+    /// The darts of every recorded side, one side after the other (one buffer for all sides,
+    /// so that an unsew allocates for its sides at most twice).
+    darts: Vec<DartId>,
 }
 
 impl SplitSides {
-    /// Records `side` as the new side of change k.
-    pub(crate) fn push(&mut self, k: usize, side: Vec<DartId>) {
-        self.entries.push((k as u32, side));
+    /// Where the darts of the next side go: a side is appended to this buffer, then
+    /// [`SplitSides::close`]d (darts appended and not closed belong to no side: truncate them).
+    fn open(&mut self) -> &mut Vec<DartId> {
+        if self.darts.capacity() == 0 {
+            // Room for both sides of the cells of a face (a walked split reads both sides):
+            // the buffer is allocated once per unsew, not grown dart by dart.
+            self.darts.reserve(Self::FIRST_CAPACITY);
+        }
+        &mut self.darts
     }
 
-    /// The darts of change k's new side; empty if none was recorded. O(entries).
+    /// Darts reserved at the first side.
+    const FIRST_CAPACITY: usize = 128;
+
+    /// The darts of the side being appended (those past the last closed side).
+    fn pending(&self) -> &[DartId] {
+        &self.darts[self.ends.last().map_or(0, |e| e.1 as usize)..]
+    }
+
+    /// Closes the appended darts as the new side of change k.
+    fn close(&mut self, k: usize) {
+        self.ends.push((k as u32, self.darts.len() as u32));
+    }
+
+    /// The darts of change k's new side; empty if none was recorded. O(recorded sides).
     fn get(&self, k: usize) -> &[DartId] {
-        self.entries.iter().find(|e| e.0 as usize == k).map_or(&[], |e| &e.1)
+        let Some(e) = self.ends.iter().position(|e| e.0 as usize == k) else { return &[] };
+        let start = if e == 0 { 0 } else { self.ends[e - 1].1 as usize };
+        &self.darts[start..self.ends[e].1 as usize]
     }
 }
 
@@ -514,7 +539,7 @@ impl<const N: usize> GMap<N> {
             self.link_raw(i, x, y);
         }
         let keep: Vec<u32> = (0..=N).map(|dim| self.cell_id(dim, d1).0).collect();
-        let mut report = CellChanges { changes: Vec::new(), pairs, new_sides: SplitSides::default() };
+        let mut report = CellChanges { changes: Vec::with_capacity(8), pairs, new_sides: SplitSides::default() };
         for k in 0..report.pairs.len() {
             let (x, y) = report.pairs[k];
             for dim in (0..=N).filter(|&dim| dim != i) {
@@ -685,17 +710,21 @@ impl<const N: usize> GMap<N> {
                     (new, is_z_side)
                 }
                 None => {
+                    let out = sides.open();
                     let walked = match Shortcut::of(N, i, dim).filter(|_| quick) {
-                        Some(Shortcut::Ring(ring)) => ring.split_side(self, anchor, z),
-                        Some(Shortcut::Corners(corners)) => corners.split_side(self, anchor, z),
-                        None => self.split_side(anchor, z, mask),
+                        Some(Shortcut::Ring(ring)) => ring.split_side(self, anchor, z, out),
+                        Some(Shortcut::Corners(corners)) => corners.split_side(self, anchor, z, out),
+                        None => self.split_side(anchor, z, mask).map(|(side, is_z_side)| {
+                            out.extend(side);
+                            is_z_side
+                        }),
                     };
-                    let Some((side, is_z_side)) = walked else { continue };
+                    let Some(is_z_side) = walked else { continue };
                     let new = self.alloc_cell_id(dim);
-                    for &w in &side {
+                    for &w in sides.pending() {
                         self.set_cell_raw(dim, w, new);
                     }
-                    sides.push(changes.len(), side);
+                    sides.close(changes.len());
                     (new, is_z_side)
                 }
             };
@@ -713,6 +742,8 @@ type SplitScratch = (Vec<(u32, usize)>, Vec<u32>);
 thread_local! {
     /// The (id, anchor) and complete-id lists of [`GMap::split_cells`], reused across unsews.
     static SPLIT_SCRATCH: std::cell::Cell<SplitScratch> = const { std::cell::Cell::new((Vec::new(), Vec::new())) };
+    /// The two sides' dart lists of [`CornerCell::split_side`], reused across walks.
+    static CORNER_SCRATCH: std::cell::Cell<[Vec<DartId>; 2]> = const { std::cell::Cell::new([Vec::new(), Vec::new()]) };
 }
 
 /// A faster way than [`GMap::split_side`]'s dart-by-dart walk to the same answer, for one cell
@@ -759,48 +790,67 @@ impl CornerCell {
         Some(CornerCell { i, h: hl.next()?, l: hl.next()? })
     }
 
-    /// See the type's documentation.
-    fn split_side<const N: usize>(&self, map: &GMap<N>, a: DartId, z: DartId) -> Option<(Vec<DartId>, bool)> {
+    /// See the type's documentation: the side is appended to `out`, and whether it is z's
+    /// returned (`out` unchanged when `None`).
+    fn split_side<const N: usize>(&self, map: &GMap<N>, a: DartId, z: DartId, out: &mut Vec<DartId>) -> Option<bool> {
         if a == z {
             return None;
         }
-        with_stamps(|stamps| {
-            let tag = stamps.fresh(map.capacity(), 2);
-            // Per side: its darts (corner after corner, so also the queue of corners to expand:
-            // `next` is the first dart not yet looked across αi) and whether it is complete.
-            let mut darts: [Vec<DartId>; 2] = [Vec::with_capacity(64), Vec::with_capacity(64)];
-            let mut next = [0usize; 2];
-            self.enter(map, a, stamps, tag, &mut darts[0]);
-            if stamps.has(z.0, tag) {
-                return None; // one corner
-            }
-            self.enter(map, z, stamps, tag + 1, &mut darts[1]);
-            let mut done = [false; 2];
-            loop {
-                for side in 0..2 {
-                    if done[side] {
-                        continue;
-                    }
-                    let (own, other) = (tag + side as u32, tag + 1 - side as u32);
-                    match self.expand(map, stamps, (own, other), &mut darts[side], &mut next[side]) {
-                        Expand::Met => return None,
-                        Expand::Grew => {}
-                        Expand::Complete => done[side] = true,
-                    }
+        // Per side: its darts (corner after corner, so also the queue of corners to expand:
+        // `next` is the first dart not yet looked across αi) and whether it is complete. The
+        // two lists are kept per thread between walks (cleared first: no allocation in the
+        // steady state).
+        let mut darts = CORNER_SCRATCH.take();
+        darts.iter_mut().for_each(Vec::clear);
+        let answer = with_stamps(|stamps| self.walk(map, (a, z), stamps, &mut darts));
+        if let Some(z_side) = answer {
+            out.extend_from_slice(&darts[usize::from(z_side)]);
+        }
+        CORNER_SCRATCH.set(darts);
+        answer
+    }
+
+    /// The lockstep corner walk of [`CornerCell::split_side`] from `a` and `z`, filling `darts`
+    /// (empty on entry) with the darts found on each side; returns whether z's side is the answer.
+    fn walk<const N: usize>(
+        &self,
+        map: &GMap<N>,
+        (a, z): (DartId, DartId),
+        stamps: &mut Stamps,
+        darts: &mut [Vec<DartId>; 2],
+    ) -> Option<bool> {
+        let tag = stamps.fresh(map.capacity(), 2);
+        let mut next = [0usize; 2];
+        self.enter(map, a, stamps, tag, &mut darts[0]);
+        if stamps.has(z.0, tag) {
+            return None; // one corner
+        }
+        self.enter(map, z, stamps, tag + 1, &mut darts[1]);
+        let mut done = [false; 2];
+        loop {
+            for side in 0..2 {
+                if done[side] {
+                    continue;
                 }
-                let (sa, sz) = (darts[0].len(), darts[1].len());
-                // A complete side is a whole cell; the other side has at least its darts so far.
-                let decided = match done {
-                    [true, true] => Some(sa > sz),
-                    [true, false] if sz >= sa => Some(false),
-                    [false, true] if sa > sz => Some(true),
-                    _ => None,
-                };
-                if let Some(z_side) = decided {
-                    return Some((std::mem::take(&mut darts[usize::from(z_side)]), z_side));
+                let (own, other) = (tag + side as u32, tag + 1 - side as u32);
+                match self.expand(map, stamps, (own, other), &mut darts[side], &mut next[side]) {
+                    Expand::Met => return None,
+                    Expand::Grew => {}
+                    Expand::Complete => done[side] = true,
                 }
             }
-        })
+            let (sa, sz) = (darts[0].len(), darts[1].len());
+            // A complete side is a whole cell; the other side has at least its darts so far.
+            let decided = match done {
+                [true, true] => Some(sa > sz),
+                [true, false] if sz >= sa => Some(false),
+                [false, true] if sa > sz => Some(true),
+                _ => None,
+            };
+            if decided.is_some() {
+                return decided;
+            }
+        }
     }
 
     /// Appends the corner ⟨αh, αl⟩ of `c` to `darts`, stamping each with `own`.
@@ -887,31 +937,42 @@ impl RingCell {
         }
     }
 
-    /// The darts of the cell of the i-free dart `x`: the path ⟨αj, αi⟩(x), then its αk image
-    /// when that is another path. O(cell).
-    fn cell<const N: usize>(&self, map: &GMap<N>, x: DartId) -> Vec<DartId> {
-        let mut side = Vec::with_capacity(32);
-        map.for_each_dihedral(x, self.j, self.i, |y| side.push(y));
+    /// Appends the darts of the cell of the i-free dart `x` to `out`: the path ⟨αj, αi⟩(x),
+    /// then its αk image when that is another path. O(cell).
+    fn append_cell<const N: usize>(&self, map: &GMap<N>, x: DartId, out: &mut Vec<DartId>) {
+        let start = out.len();
+        map.for_each_dihedral(x, self.j, self.i, |y| out.push(y));
         if let Some(k) = self.k {
-            let path = side.len();
-            if !side.contains(&map.alpha_local(k, x)) {
-                for p in 0..path {
-                    side.push(map.alpha_local(k, side[p]));
+            let end = out.len();
+            if !out[start..].contains(&map.alpha_local(k, x)) {
+                for p in start..end {
+                    out.push(map.alpha_local(k, out[p]));
                 }
             }
         }
-        side
     }
 
     /// [`GMap::split_side`] of the i-free darts `a` (the anchor) and `z`: `None` if they are one
-    /// cell, else the smaller side (a's on a tie) and whether it is z's. O(cells of a and z).
-    fn split_side<const N: usize>(&self, map: &GMap<N>, a: DartId, z: DartId) -> Option<(Vec<DartId>, bool)> {
-        let side_a = self.cell(map, a);
-        if side_a.contains(&z) {
+    /// cell (`out` unchanged), else the smaller side (a's on a tie) appended to `out` and whether
+    /// it is z's. Both cells are read into `out`, the larger then dropped: no list of its own.
+    /// O(cells of a and z).
+    fn split_side<const N: usize>(&self, map: &GMap<N>, a: DartId, z: DartId, out: &mut Vec<DartId>) -> Option<bool> {
+        let start = out.len();
+        self.append_cell(map, a, out);
+        if out[start..].contains(&z) {
+            out.truncate(start);
             return None;
         }
-        let side_z = self.cell(map, z);
-        Some(if side_a.len() <= side_z.len() { (side_a, false) } else { (side_z, true) })
+        let mid = out.len();
+        self.append_cell(map, z, out);
+        let (len_a, len_z) = (mid - start, out.len() - mid);
+        if len_a <= len_z {
+            out.truncate(mid);
+            return Some(false);
+        }
+        out.copy_within(mid.., start);
+        out.truncate(start + len_z);
+        Some(true)
     }
 }
 
@@ -1419,6 +1480,19 @@ mod tests {
         })
     }
 
+    /// The answer of a shortcut's `split_side` that appends to a list, run on a list that
+    /// already holds other darts: they must be left as they were, and nothing appended on
+    /// `None`. Returns the appended side (sorted) and the flag.
+    fn appended(split_side: impl FnOnce(&mut Vec<DartId>) -> Option<bool>) -> Option<(Vec<DartId>, bool)> {
+        let before = [DartId(7), DartId(3), DartId(7)];
+        let mut out = before.to_vec();
+        let flag = split_side(&mut out);
+        assert_eq!(out[..before.len()], before, "the darts already in the list changed");
+        let side = out.split_off(before.len());
+        assert!(flag.is_some() || side.is_empty(), "darts appended without a split: {side:?}");
+        as_set(flag.map(|flag| (side, flag)))
+    }
+
     /// [`CornerCell::split_side`] is [`GMap::split_side`] (the same side as a set, the same
     /// flag) on pairs of i-free darts of a cut 3-map, for every i and every cell dimension ≠ i,
     /// pairs of one corner included.
@@ -1436,7 +1510,11 @@ mod tests {
                     let near = [map.alpha_local(corners.h, a), map.alpha_local(corners.l, a)];
                     for z in free.iter().copied().skip(n % 7).step_by(7).chain(near) {
                         let want = as_set(map.split_side(a, z, AlphaMask::cell(3, dim)));
-                        assert_eq!(as_set(corners.split_side(&map, a, z)), want, "alpha{i} dim {dim}: {a:?} {z:?}");
+                        assert_eq!(
+                            appended(|out| corners.split_side(&map, a, z, out)),
+                            want,
+                            "alpha{i} dim {dim}: {a:?} {z:?}"
+                        );
                         seen[want.map_or(0, |w| 1 + usize::from(w.1))] += 1;
                     }
                 }
@@ -1461,7 +1539,11 @@ mod tests {
                 for (n, &a) in free.iter().enumerate() {
                     for &z in free.iter().skip(n % 5).step_by(5) {
                         let want = as_set(map.split_side(a, z, AlphaMask::cell(N, dim)));
-                        assert_eq!(as_set(ring.split_side(map, a, z)), want, "alpha{i} dim {dim}: {a:?} {z:?}");
+                        assert_eq!(
+                            appended(|out| ring.split_side(map, a, z, out)),
+                            want,
+                            "alpha{i} dim {dim}: {a:?} {z:?}"
+                        );
                         seen[want.map_or(0, |w| 1 + usize::from(w.1))] += 1;
                     }
                 }

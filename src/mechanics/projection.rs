@@ -65,6 +65,8 @@ pub struct Projection {
     edge_spring: Vec<u32>,
     vertex_dart: Vec<Option<DartId>>,
     version: u64,
+    /// The lists of [`Resolved::of`], kept between updates.
+    scratch: Resolved,
 }
 
 impl Projection {
@@ -109,7 +111,15 @@ impl Projection {
             edge_spring[e.index()] = s as u32;
         }
         let system = system_of(mech, &springs, &spring_edge, &vertex_dart, gravity);
-        Projection { system, spring_edge, spring_dart, edge_spring, vertex_dart, version: body.version() }
+        Projection {
+            system,
+            spring_edge,
+            spring_dart,
+            edge_spring,
+            vertex_dart,
+            version: body.version(),
+            scratch: Resolved::default(),
+        }
     }
 
     /// Rebuilds from scratch after topological changes (keeps the gravity). O(darts + E log E).
@@ -208,18 +218,20 @@ impl Projection {
         if self.edge_spring.len() < map.cell_id_bound(1) {
             self.edge_spring.resize(map.cell_id_bound(1), u32::MAX);
         }
-        for (v, d) in resolve(map, 0, &touched.vertices) {
+        let mut resolved = std::mem::take(&mut self.scratch);
+        for &(v, d) in resolved.of(map, 0, &touched.vertices) {
             self.vertex_dart[v.index()] = d;
             let (m, g) = if d.is_some() { (mech.vertex_mass(v), mech.vertex_viscosity(v)) } else { (0.0, 0.0) };
             let fixed = d.is_none() || mech.pinned[v];
             self.system.set_slot(v.index(), m, fixed, g);
         }
-        for (e, d) in resolve(map, 1, &touched.edges) {
+        for &(e, d) in resolved.of(map, 1, &touched.edges) {
             match d {
                 Some(d) => self.set_spring(map, mech, e, d),
                 None => self.remove_spring(e),
             }
         }
+        self.scratch = resolved;
         self.version = body.version();
     }
 
@@ -502,14 +514,12 @@ impl TouchedCells {
         mut star: impl FnMut(&mut Self, DartId, Option<&[DartId]>),
     ) {
         for (k, (kept, new, dk, dn)) in changes.splits_with_index(0) {
-            self.vertices.push((kept, Some(dk)));
-            self.vertices.push((new, Some(dn)));
+            push_pair(&mut self.vertices, [(kept, Some(dk)), (new, Some(dn))]);
             let side = changes.new_side(k);
             star(self, dn, (!side.is_empty()).then_some(side));
         }
         for (kept, new, dk, dn) in changes.splits(1) {
-            self.edges.push((kept, Some(dk)));
-            self.edges.push((new, Some(dn)));
+            push_pair(&mut self.edges, [(kept, Some(dk)), (new, Some(dn))]);
         }
         let darts = || changes.pairs.iter().flat_map(|&(a, b)| [a, b]);
         for (kept, absorbed) in changes.merges(0) {
@@ -533,6 +543,7 @@ impl TouchedCells {
     /// [`TouchedCells::STAR_EDGES`] distinct edges the rest are pushed per dart (duplicates are
     /// harmless). O(vertex orbit · star edges), no allocation beyond the records.
     fn edges_around(&mut self, map: &GMap<3>, darts: impl IntoIterator<Item = DartId>) {
+        self.edges.reserve(Self::STAR_RESERVE);
         let start = self.edges.len();
         let mut ids = [u32::MAX; Self::STAR_EDGES];
         let mut len = 0;
@@ -552,6 +563,10 @@ impl TouchedCells {
 
     /// Distinct edges of a star deduplicated by [`TouchedCells::record`].
     const STAR_EDGES: usize = 64;
+
+    /// Edge records reserved per star (a typical star in a tet mesh has about 20 edges; a
+    /// larger one only grows the list).
+    const STAR_RESERVE: usize = 24;
 
     /// Appends the records of `other` (a later operation of the same batch). O(|other|).
     ///
@@ -598,33 +613,59 @@ impl TouchedCells {
     }
 }
 
-/// Per id, the latest record whose dart still carries the id in dimension `dim`, or `None`.
-/// Sorted by id. O(r log r) for r records: the records sorted by (id, latest first), then one
-/// pass (no hash map), reading the map only until each id has a valid dart.
-fn resolve(map: &GMap<3>, dim: usize, records: &[(CellId, Option<DartId>)]) -> Vec<(CellId, Option<DartId>)> {
-    let mut order: Vec<(u32, u32)> =
-        records.iter().enumerate().map(|(k, r)| (r.0 .0, (records.len() - 1 - k) as u32)).collect();
-    order.sort_unstable();
-    let mut out: Vec<(CellId, Option<DartId>)> = Vec::with_capacity(order.len());
-    for (id, rev) in order {
-        // Only until an id has its dart: the map is read for no record older than that one.
-        let valid = || {
-            let d = records[records.len() - 1 - rev as usize].1;
-            d.filter(|&d| map.contains(d) && map.cell_id(dim, d).0 == id)
-        };
-        match out.last_mut() {
-            Some(last) if last.0 .0 == id => {
-                if last.1.is_none() {
-                    last.1 = valid();
-                }
-            }
-            _ => out.push((CellId(id), valid())),
-        }
+/// Appends two records, making room for a triangle's worth (3 pairs) at the first push: one
+/// allocation for a face's splits rather than a growth at the third pair.
+fn push_pair(list: &mut Vec<(CellId, Option<DartId>)>, pair: [(CellId, Option<DartId>); 2]) {
+    if list.capacity() == 0 {
+        list.reserve(6);
     }
-    out
+    list.extend(pair);
 }
 
-/// [`resolve`] as it was written first (a hash map filled from the latest record back): the
+/// [`Resolved::of`] into fresh lists (for the unit tests).
+#[cfg(test)]
+fn resolve(map: &GMap<3>, dim: usize, records: &[(CellId, Option<DartId>)]) -> Vec<(CellId, Option<DartId>)> {
+    Resolved::default().of(map, dim, records).to_vec()
+}
+
+/// The lists of [`Resolved::of`]: the records' order and the answer, kept by
+/// [`Projection::update`] from one update to the next (no allocation in the steady state).
+#[derive(Clone, Debug, Default)]
+struct Resolved {
+    order: Vec<(u32, u32)>,
+    out: Vec<(CellId, Option<DartId>)>,
+}
+
+impl Resolved {
+    /// Per id, the latest record whose dart still carries the id in dimension `dim`, or `None`.
+    /// Sorted by id. O(r log r) for r records: the records sorted by (id, latest first), then
+    /// one pass (no hash map), reading the map only until each id has a valid dart.
+    fn of(&mut self, map: &GMap<3>, dim: usize, records: &[(CellId, Option<DartId>)]) -> &[(CellId, Option<DartId>)] {
+        let Resolved { order, out } = self;
+        order.clear();
+        out.clear();
+        order.extend(records.iter().enumerate().map(|(k, r)| (r.0 .0, (records.len() - 1 - k) as u32)));
+        order.sort_unstable();
+        for &(id, rev) in order.iter() {
+            // Only until an id has its dart: the map is read for no record older than that one.
+            let valid = || {
+                let d = records[records.len() - 1 - rev as usize].1;
+                d.filter(|&d| map.contains(d) && map.cell_id(dim, d).0 == id)
+            };
+            match out.last_mut() {
+                Some(last) if last.0 .0 == id => {
+                    if last.1.is_none() {
+                        last.1 = valid();
+                    }
+                }
+                _ => out.push((CellId(id), valid())),
+            }
+        }
+        out
+    }
+}
+
+/// [`Resolved::of`] as it was written first (a hash map filled from the latest record back): the
 /// reference of the unit test.
 #[cfg(test)]
 fn resolve_by_hash(map: &GMap<3>, dim: usize, records: &[(CellId, Option<DartId>)]) -> Vec<(CellId, Option<DartId>)> {

@@ -203,8 +203,8 @@ pub struct SplitSides {
     /// Per recorded side: (index of the split in `changes`, end of its darts in `darts`); a
     /// side starts where the previous one ends.
     ends: Vec<(u32, u32)>,
-    /// The darts of every recorded side, one side after the other (one buffer for all sides,
-    /// so that an unsew allocates for its sides at most twice).
+    /// The darts of every recorded side, one side after the other (one buffer for all sides:
+    /// an unsew allocates two lists for its sides, not one per side).
     darts: Vec<DartId>,
 }
 
@@ -539,7 +539,7 @@ impl<const N: usize> GMap<N> {
             self.link_raw(i, x, y);
         }
         let keep: Vec<u32> = (0..=N).map(|dim| self.cell_id(dim, d1).0).collect();
-        let mut report = CellChanges { changes: Vec::with_capacity(8), pairs, new_sides: SplitSides::default() };
+        let mut report = CellChanges { changes: Vec::new(), pairs, new_sides: SplitSides::default() };
         for k in 0..report.pairs.len() {
             let (x, y) = report.pairs[k];
             for dim in (0..=N).filter(|&dim| dim != i) {

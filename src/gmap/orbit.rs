@@ -411,8 +411,10 @@ impl<const N: usize> GMap<N> {
 impl<const N: usize> GMap<N> {
     /// Calls `f` once on every dart of the two-generator orbit ⟨αj, αk⟩(d), d first, with no
     /// visited set: such an orbit is a cycle or a path of alternating αj, αk links, walked from d
-    /// one way (αj first) until it closes or ends, then the other way. O(orbit).
-    pub(crate) fn for_each_dihedral(&self, d: DartId, j: usize, k: usize, mut f: impl FnMut(DartId)) {
+    /// one way (αj first) until it closes or ends, then the other way. Returns whether it closed:
+    /// then the darts came in cycle order, the t-th and the next one (the last and d) linked by
+    /// αj for even t, by αk for odd t. O(orbit).
+    pub(crate) fn for_each_dihedral(&self, d: DartId, j: usize, k: usize, mut f: impl FnMut(DartId)) -> bool {
         f(d);
         for gens in [[j, k], [k, j]] {
             let mut x = d;
@@ -422,12 +424,13 @@ impl<const N: usize> GMap<N> {
                     break; // an end of the path: walk the other way from d
                 }
                 if y == d {
-                    return; // the cycle closed: every dart was visited
+                    return true; // the cycle closed: every dart was visited
                 }
                 f(y);
                 x = y;
             }
         }
+        false
     }
 }
 
@@ -494,7 +497,7 @@ impl GMap<3> {
                 let six = self.hexagon(c);
                 match six {
                     Some(darts) => darts.iter().for_each(|x| stamps.mark(x.0, tag)),
-                    None => self.for_each_dihedral(c, 1, 2, |x| stamps.mark(x.0, tag)),
+                    None => _ = self.for_each_dihedral(c, 1, 2, |x| stamps.mark(x.0, tag)),
                 }
                 (c, six)
             };
@@ -516,7 +519,7 @@ impl GMap<3> {
                 };
                 match six {
                     Some(darts) => darts.into_iter().for_each(&mut step),
-                    None => self.for_each_dihedral(c, 1, 2, step),
+                    None => _ = self.for_each_dihedral(c, 1, 2, step),
                 }
                 next = spill.pop().or_else(|| {
                     len = len.checked_sub(1)?;

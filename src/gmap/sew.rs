@@ -613,24 +613,7 @@ impl<const N: usize> GMap<N> {
         if self.is_free(i, d) {
             return Err(SewError::AlreadyFree { dart: d, i });
         }
-        // Each pair {x, αi(x)} once. The orbit usually holds only one side of a pair (αi(x) is
-        // in it only for twisted orbits), so the pair is normalised rather than filtered on x < y.
-        // A two-generator orbit (the face ⟨α0, α1⟩ of an α3-unsew) is walked with no visited set
-        // and no list of its own: the same darts, and the pairs are sorted below anyway.
-        let mask = AlphaMask::commuting_with(N, i);
-        let (gens, len) = generators(N, mask);
-        let mut pairs: Vec<(DartId, DartId)> = Vec::with_capacity(8);
-        let pair_of = |x: DartId| {
-            let y = self.alpha_dyn(i, x);
-            pairs.push((x.min(y), x.max(y)));
-        };
-        if len == 2 {
-            self.for_each_dihedral(d, gens[0], gens[1], pair_of);
-        } else {
-            self.orbit(d, mask).into_iter().for_each(pair_of);
-        }
-        pairs.sort_unstable();
-        pairs.dedup();
+        let (pairs, cycle) = self.unsewn_pairs(i, d);
         for &(x, y) in &pairs {
             // Bring the endpoints' cell rows in now (`split_cells` reads and writes them after
             // the ring walks): their cache misses overlap with each other and with the walks
@@ -641,7 +624,7 @@ impl<const N: usize> GMap<N> {
         let mut report = CellChanges { changes: Vec::with_capacity(8), pairs, new_sides: SplitSides::default() };
         let mut links = QuickLinks::none();
         if quick {
-            links.find(self, i, &report.pairs);
+            links.find(self, i, &report.pairs, cycle.endpoints(report.pairs.len()).as_ref());
         }
         // The per-dimension lists of `split_cells`, kept per thread between unsews (no
         // allocation in the steady state; they are cleared before use).
@@ -656,6 +639,34 @@ impl<const N: usize> GMap<N> {
         #[cfg(not(debug_assertions))]
         self.after_mutation(&[]);
         Ok(report)
+    }
+
+    /// The pairs {x, αi(x)} that an αi-unsew of d unlinks, each once, sorted: x over the orbit
+    /// of d under the generators commuting with αi. The orbit usually holds only one side of a
+    /// pair (αi(x) is in it only for twisted orbits), so the pair is normalised rather than
+    /// filtered on x < y. A two-generator orbit (the face ⟨α0, α1⟩ of an α3-unsew) is walked
+    /// with no visited set and no list of its own, and also returned as a [`Cycle`] (closed or
+    /// not). O(orbit · log orbit).
+    fn unsewn_pairs(&self, i: usize, d: DartId) -> (Vec<(DartId, DartId)>, Cycle) {
+        let mask = AlphaMask::commuting_with(N, i);
+        let (gens, len) = generators(N, mask);
+        let mut pairs: Vec<(DartId, DartId)> = Vec::with_capacity(8);
+        let mut cycle = Cycle::new([gens[0], gens[1]]);
+        let pair_of = |x: DartId| {
+            let y = self.alpha_dyn(i, x);
+            pairs.push((x.min(y), x.max(y)));
+            cycle.push(x, x.min(y));
+        };
+        let closed = if len == 2 {
+            self.for_each_dihedral(d, gens[0], gens[1], pair_of)
+        } else {
+            self.orbit(d, mask).into_iter().for_each(pair_of);
+            false
+        };
+        cycle.closed = closed;
+        pairs.sort_unstable();
+        pairs.dedup();
+        (pairs, cycle)
     }
 
     /// After unlinking, makes the dim-cell ids exact again. Every piece of a cell that fell apart
@@ -987,6 +998,59 @@ fn endpoint(pairs: &[(DartId, DartId)], k: usize) -> DartId {
     }
 }
 
+/// The orbit of an unsew's dart under its two commuting generators ⟨αj, αk⟩ when that orbit is a
+/// closed cycle, as [`GMap::for_each_dihedral`] walked it (for an α3-unsew in a 3-map: the six
+/// darts of a closed triangle on one side of the face, alternately α0- and α1-linked). The links
+/// between its darts are then known from the walk, so [`QuickLinks::find`] takes its direct
+/// links from here instead of looking up αj and αk of every endpoint in a dart → endpoint table.
+struct Cycle {
+    gens: [usize; 2],
+    /// Per dart in walk order: the dart, and the smaller dart of its unsewn pair.
+    darts: [(DartId, DartId); QuickLinks::MAX_PAIRS],
+    /// Darts walked (may exceed the array: then no hint).
+    len: usize,
+    closed: bool,
+}
+
+impl Cycle {
+    fn new(gens: [usize; 2]) -> Self {
+        Cycle { gens, darts: [(DartId(0), DartId(0)); QuickLinks::MAX_PAIRS], len: 0, closed: false }
+    }
+
+    fn push(&mut self, x: DartId, pair_min: DartId) {
+        if let Some(slot) = self.darts.get_mut(self.len) {
+            *slot = (x, pair_min);
+        }
+        self.len += 1;
+    }
+
+    /// The endpoint index of each walked dart, in walk order, if the walk closed and each of its
+    /// darts is in its own unlinked pair (`pairs` distinct pairs, as many as darts: no pair has
+    /// both darts in the cycle). The pairs are sorted by their smaller dart, all distinct, so
+    /// the pair of a dart is the rank of its pair's smaller dart: endpoint 2 · rank, plus one
+    /// when the dart is the larger of its pair. O(len²), len ≤ [`QuickLinks::MAX_PAIRS`].
+    fn endpoints(&self, pairs: usize) -> Option<CycleEnds> {
+        if !self.closed || self.len != pairs || self.len > QuickLinks::MAX_PAIRS {
+            return None;
+        }
+        let walked = &self.darts[..self.len];
+        let mut ends = [0u8; QuickLinks::MAX_PAIRS];
+        for (e, &(x, low)) in ends.iter_mut().zip(walked) {
+            let rank = walked.iter().filter(|w| w.1 < low).count();
+            *e = (2 * rank + usize::from(x != low)) as u8;
+        }
+        Some(CycleEnds { gens: self.gens, ends, len: self.len })
+    }
+}
+
+/// A closed [`Cycle`] by endpoint index: the t-th and the next walked dart (the last and the
+/// first) are linked by `gens[t % 2]`.
+struct CycleEnds {
+    gens: [usize; 2],
+    ends: [u8; QuickLinks::MAX_PAIRS],
+    len: usize,
+}
+
 /// Connections between the endpoints of an unsew that are cheap to prove, so that the exact
 /// lockstep walk runs only where a cell may really have split.
 ///
@@ -1174,7 +1238,9 @@ impl QuickLinks {
 
     /// Fills `self` (no proof yet, [`QuickLinks::none`]; filled in place, as the struct is
     /// half a kilobyte) with the proofs for the endpoints of `pairs`, just unlinked by αi.
-    fn find<const N: usize>(&mut self, map: &GMap<N>, i: usize, pairs: &[(DartId, DartId)]) {
+    /// `cycle`, when the unsewn orbit was a closed cycle, gives the direct links without a
+    /// lookup (the same links: unit test `cycle_links_are_the_looked_up_links`).
+    fn find<const N: usize>(&mut self, map: &GMap<N>, i: usize, pairs: &[(DartId, DartId)], cycle: Option<&CycleEnds>) {
         let out = self;
         if pairs.len() > Self::MAX_PAIRS || N >= Self::MAX_GENS {
             return;
@@ -1186,26 +1252,12 @@ impl QuickLinks {
             e.copy_from_slice(&[x, y]);
         }
         let ends = &ends[..out.ends];
-        let table = EndpointIndex::new(pairs);
-        let index = |d: DartId| table.get(d);
         // The generators commuting with αk: those at index distance ≥ 2 from k.
         let gens = u32::from(out.gens);
         let commuting_with = |k: usize| gens & !(0b111 << k >> 1);
-        // Direct links, looked up for the first dart x of each pair only: αk commutes with αi,
-        // so αk maps the pair (x, αi x) onto the pair (αk x, αi αk x), endpoint q onto its
-        // partner q ^ 1 (the pairs are disjoint, each its two darts).
-        for (p, &x) in ends.iter().enumerate().step_by(2) {
-            out.direct[p] |= 1 << i; // every endpoint is i-free now
-            out.direct[p + 1] |= 1 << i;
-            for k in bits(commuting_with(i)) {
-                let y = map.alpha_local(k, x);
-                let Some(q) = (if y == x { Some(p) } else { index(y) }) else { continue };
-                for (p, q) in [(p, q), (p + 1, q ^ 1)] {
-                    out.direct[p] |= 1 << k;
-                    out.direct[q] |= 1 << k;
-                    out.push(p, q, k);
-                }
-            }
+        match cycle {
+            Some(cycle) => out.cycle_links(i, cycle),
+            None => out.looked_up_links(map, i, ends, pairs, commuting_with(i)),
         }
         for j in [i.checked_sub(1), Some(i + 1).filter(|&j| j <= N)].into_iter().flatten() {
             let mirrors = commuting_with(i) & commuting_with(j);
@@ -1233,6 +1285,54 @@ impl QuickLinks {
                     }
                 }
             }
+        }
+    }
+
+    /// The direct links, looked up for the first dart x of each pair only: αk (each k of
+    /// `commuting`, the generators commuting with αi) maps the pair (x, αi x) onto the pair
+    /// (αk x, αi αk x), endpoint q onto its partner q ^ 1 (the pairs are disjoint, each its two
+    /// darts). O(pairs · generators).
+    fn looked_up_links<const N: usize>(
+        &mut self,
+        map: &GMap<N>,
+        i: usize,
+        ends: &[DartId],
+        pairs: &[(DartId, DartId)],
+        commuting: u32,
+    ) {
+        let table = EndpointIndex::new(pairs);
+        for (p, &x) in ends.iter().enumerate().step_by(2) {
+            self.direct[p] |= 1 << i; // every endpoint is i-free now
+            self.direct[p + 1] |= 1 << i;
+            for k in bits(commuting) {
+                let y = map.alpha_local(k, x);
+                let Some(q) = (if y == x { Some(p) } else { table.get(y) }) else { continue };
+                self.direct_link(p, q, k);
+            }
+        }
+    }
+
+    /// The same links as [`QuickLinks::looked_up_links`] when the unsewn orbit is the closed
+    /// `cycle`: each of its links joins two of its darts' endpoints, and their partners. O(pairs).
+    fn cycle_links(&mut self, i: usize, cycle: &CycleEnds) {
+        let ends = &cycle.ends[..cycle.len];
+        for (t, &p) in ends.iter().enumerate() {
+            let p = usize::from(p);
+            self.direct[p] |= 1 << i; // every endpoint is i-free now
+            self.direct[p ^ 1] |= 1 << i;
+            let q = usize::from(if t + 1 < ends.len() { ends[t + 1] } else { ends[0] });
+            self.direct_link(p, q, cycle.gens[t % 2]);
+        }
+    }
+
+    /// Records the direct link αk(p) = q (q = p when p is k-free) and its image by αi, the link
+    /// between the partners p ^ 1 and q ^ 1.
+    #[inline]
+    fn direct_link(&mut self, p: usize, q: usize, k: usize) {
+        for (p, q) in [(p, q), (p ^ 1, q ^ 1)] {
+            self.direct[p] |= 1 << k;
+            self.direct[q] |= 1 << k;
+            self.push(p, q, k);
         }
     }
 
@@ -1434,6 +1534,65 @@ mod tests {
             }
         }
         assert!(!QuickLinks::none().classes(0).joined(0, 0), "no proof, nothing joined");
+    }
+
+    /// The direct links read off a closed unsewn cycle are those looked up dart by dart: the same
+    /// bit sets, for α3-unsews (closed triangles) and α0-unsews (closed edge rings) of a 3-map,
+    /// with the tets as built (links computed) and after α2-cuts (links read), at every dart.
+    #[test]
+    fn cycle_links_are_the_looked_up_links() {
+        let (points, tets) = kuhn_cube(2);
+        let (cube, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+        let mut cycles = [0usize; 4];
+        let maps = [cube.clone(), cut_at_random(&cube, 3, 5, 4), cut_at_random(&cube, 2, 7, 9)];
+        for (m, map) in maps.iter().enumerate() {
+            assert_eq!(map.tets_as_built(), m < 2);
+            for (i, cycles) in cycles.iter_mut().enumerate() {
+                for d in map.darts().filter(|&d| !map.is_free(i, d)) {
+                    let (pairs, cycle) = map.unsewn_pairs(i, d);
+                    let Some(ends) = cycle.endpoints(pairs.len()) else { continue };
+                    let mut unlinked = map.clone();
+                    for &(x, _) in &pairs {
+                        unlinked.unlink_raw(i, x);
+                    }
+                    let (mut looked_up, mut read) = (QuickLinks::none(), QuickLinks::none());
+                    looked_up.find(&unlinked, i, &pairs, None);
+                    read.find(&unlinked, i, &pairs, Some(&ends));
+                    assert!(looked_up.ends > 0, "alpha{i} unsew of {d}: no proof built");
+                    assert_eq!(looked_up.adjacent, read.adjacent, "alpha{i} unsew of {d}");
+                    assert_eq!(looked_up.direct, read.direct, "alpha{i} unsew of {d}");
+                    *cycles += 1;
+                }
+            }
+        }
+        assert!(cycles[0] > 0 && cycles[3] > 0 && cycles[1] == 0 && cycles[2] == 0, "cycles per i {cycles:?}");
+    }
+
+    /// A face α3-sewn to itself (six darts, three pairs: the orbit holds both darts of each
+    /// pair) gives no cycle hint, and its unsew comes out the same with and without the quick
+    /// proofs.
+    #[test]
+    fn self_glued_faces_give_no_cycle_hint() {
+        let (tet, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+        let mut glued = 0;
+        for (d, e) in tet.darts().flat_map(|d| tet.darts().map(move |e| (d, e))) {
+            if !tet.is_sewable::<3>(d, e) {
+                continue;
+            }
+            let mut fast = tet.clone();
+            fast.sew::<3>(d, e).unwrap();
+            let (pairs, cycle) = fast.unsewn_pairs(3, d);
+            if pairs.len() == 6 {
+                continue; // glued to another face
+            }
+            assert!(cycle.closed && cycle.len == 6 && pairs.len() == 3, "{d} ~ {e}");
+            assert!(cycle.endpoints(pairs.len()).is_none(), "{d} ~ {e}: a hint for a self-glued face");
+            let mut slow = fast.clone();
+            assert_eq!(fast.unsew_with(3, d, true).unwrap(), slow.unsew_with(3, d, false).unwrap(), "{d} ~ {e}");
+            assert!(same_state(&fast, &slow) && fast.validate().is_ok(), "{d} ~ {e}");
+            glued += 1;
+        }
+        assert!(glued > 0, "no face could be glued to itself");
     }
 
     /// The hashed endpoint index answers as the linear scan it replaces, for endpoints and for

@@ -571,10 +571,15 @@ impl GMap<3> {
 }
 
 /// The 24 flags of a tetrahedron as words in α0, α1, α2 from one of them: a breadth-first
-/// spanning tree of the flag graph of a lone tet built by [`GMap::from_tets`] (`tree[k]` =
+/// spanning tree of the flag graph of a tet as [`GMap::from_tets`] lays it out (`tree[k]` =
 /// (parent, generator), `tree[0]` the root) and its 13 other links (`extra`: (a, g, b) with
 /// αg(flag a) = flag b). A set of darts w(d) closed under these links is closed under α0, α1,
 /// α2: every (flag, generator) is a tree link or an extra link, both ways.
+///
+/// Built from the builder's link pattern itself ([`crate::build::built_tet_link`]), not from a
+/// built map: building a map checks its tets with these words in debug builds, so building one
+/// here would re-enter the initialisation of the words (a deadlock of the `OnceLock`, which hung
+/// every debug build's first `from_tets`; test `tet_words_build_in_debug_builds`).
 struct TetWords {
     tree: [(u8, u8); 24],
     extra: Vec<(u8, u8, u8)>,
@@ -587,8 +592,8 @@ impl TetWords {
     }
 
     fn build() -> TetWords {
-        let (tet, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).expect("a lone tet builds");
-        let mut index = vec![u8::MAX; tet.capacity()];
+        let link = |g: usize, x: DartId| DartId(crate::build::built_tet_link(g, x.0));
+        let mut index = [u8::MAX; 24];
         let mut order = vec![DartId(0)];
         let mut tree = [(0u8, 0u8); 24];
         index[0] = 0;
@@ -597,7 +602,7 @@ impl TetWords {
         while head < order.len() {
             let x = order[head];
             for g in 0..3 {
-                let y = tet.alpha_dyn(g, x);
+                let y = link(g, x);
                 if index[y.index()] == u8::MAX {
                     index[y.index()] = order.len() as u8;
                     tree[order.len()] = (head as u8, g as u8);
@@ -715,6 +720,35 @@ pub(crate) fn join_with_smaller(forest: &mut [u32], d: u32, row: &[u32], gens: &
 #[cfg(test)]
 mod tests {
     use std::collections::HashSet;
+
+    /// The tet words, built from the layout pattern with no map, are those of a breadth-first
+    /// walk over a built lone tet's α0, α1, α2; and building them builds no map (that re-entered
+    /// their own initialisation from `from_tets`' debug check: every debug build hung). Run with
+    /// debug assertions (`cargo test --lib`, as `.ci/run` does) the first `from_tets` below is
+    /// the one that used to hang; it runs in a thread, so a regression fails instead of hanging.
+    #[test]
+    fn tet_words_build_in_debug_builds() {
+        let (sent, got) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let built = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).map(|(tet, _)| tet);
+            let _ = sent.send(built);
+        });
+        let tet = got
+            .recv_timeout(std::time::Duration::from_secs(120))
+            .expect("from_tets did not return in 120 s (the tet words' initialisation re-entered?)")
+            .unwrap();
+        let words = super::TetWords::build();
+        let mut darts = [DartId(0); 24];
+        for (k, &(parent, g)) in words.tree.iter().enumerate().skip(1) {
+            darts[k] = tet.alpha_dyn(usize::from(g), darts[usize::from(parent)]);
+        }
+        let distinct: HashSet<DartId> = darts.iter().copied().collect();
+        assert_eq!(distinct.len(), 24, "the tree reaches every flag of the tet once");
+        for &(a, g, b) in &words.extra {
+            assert_eq!(tet.alpha_dyn(usize::from(g), darts[usize::from(a)]), darts[usize::from(b)]);
+        }
+        assert_eq!(words.extra.len(), 13);
+    }
 
     use super::*;
     use crate::generate::kuhn_cube;

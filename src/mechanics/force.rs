@@ -1211,8 +1211,11 @@ impl Incidence {
         self.sorted = false;
         let p = self.position(v, head, s);
         let g = &mut self.seg[v];
-        let (last_head, last) = ((g.start + g.heads) as usize - 1, (g.start + g.len) as usize - 1);
+        // s was found in the list, so that list is not empty: neither index underflows. (The
+        // last head is computed only for a head: with no heads at slot 0 it would underflow.)
+        let last = (g.start + g.len) as usize - 1;
         if head {
+            let last_head = (g.start + g.heads) as usize - 1;
             self.adj[p] = self.adj[last_head];
             self.adj[last_head] = self.adj[last];
             g.heads -= 1;

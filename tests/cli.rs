@@ -280,6 +280,37 @@ fn a_bad_command_line_is_a_usage_error_not_a_panic() {
     assert!(!stderr(&out).contains("panicked"));
 }
 
+/// Numbers that parse but make no sense are refused with a message, not run silently: a NaN
+/// tear threshold (no vertex compares above NaN, so nothing would ever tear) and a negative
+/// removal radius (an empty ball).
+#[test]
+fn non_finite_and_out_of_range_numbers_are_refused_with_a_message() {
+    let liver = concat!(env!("CARGO_MANIFEST_DIR"), "/data/liver_547_v22.msh");
+    for (args, needle) in [
+        (vec!["tear", liver, "--threshold", "NaN", "--steps", "1"], "threshold NaN"),
+        (vec!["tear", liver, "--threshold", "inf", "--steps", "1"], "threshold inf"),
+        (vec!["remove", liver, "--sphere", "0,0,0,-1"], "radius"),
+    ] {
+        let out = run(&args);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains(needle), "{args:?}: {}", stderr(&out));
+        assert!(!stderr(&out).contains("panicked"));
+    }
+    // Non-finite numbers in vector and plane arguments are usage errors (exit 2) naming the
+    // value, not a run that blows up at step 0 or pins nothing.
+    for (args, needle) in [
+        (vec!["simulate", liver, "--steps", "1", "--gravity", "nan,0,0"], "not finite"),
+        (vec!["simulate", liver, "--steps", "1", "--pin-below", "z=nan"], "not finite"),
+        (vec!["remove", liver, "--sphere", "nan,0,0,1"], "not finite"),
+        (vec!["cut", liver, "--plane", "0,0,0,inf,0,0"], "not finite"),
+    ] {
+        let out = run(&args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains(needle), "{args:?}: {}", stderr(&out));
+        assert!(!stderr(&out).contains("panicked"));
+    }
+}
+
 #[test]
 fn ambiguity_subdivide_reports_the_mixed_campaign_and_rejects_a_bad_probability() {
     let o = run(&["ambiguity", "kuhn:1", "--cuts", "2", "--sequences", "3", "--subdivide", "0.5", "--json"]);

@@ -12,7 +12,8 @@ use std::process::Command;
 
 use proptest::prelude::*;
 use topomech::generate::kuhn_cube;
-use topomech::subdivide::{tet_distance, LeveledMap, SubdivideError, TetMasses};
+use topomech::mechanics::Material;
+use topomech::subdivide::{tet_distance, CouplingError, LeveledMap, LeveledMechanics, SubdivideError, TetMasses};
 use topomech::GMap;
 
 const RHO: f64 = 3.0;
@@ -97,6 +98,72 @@ fn refinement_continues_from_the_current_level_and_refuses_going_back() {
     assert_eq!(m.map().dart_count(), before, "a refused refinement changes nothing");
     let err = m.refine_around([0.5, 0.5, 0.5], 1.0, 251, &mut masses).unwrap_err();
     assert!(matches!(err, SubdivideError::LevelTooHigh(251)), "{err:?}");
+    // A ball no tet can be compared with: refused, not an empty refinement.
+    for (center, radius) in
+        [([f64::NAN, 0.5, 0.5], 1.0), ([0.5; 3], f64::NAN), ([0.5; 3], -0.1), ([0.5; 3], f64::INFINITY)]
+    {
+        let err = m.refine_around(center, radius, 3, &mut masses).unwrap_err();
+        assert!(matches!(err, SubdivideError::BadBall { .. }), "{center:?} {radius}: {err:?}");
+        let err = m.refine_around_per_op(center, radius, 3, &mut masses).unwrap_err();
+        assert!(matches!(err, SubdivideError::BadBall { .. }), "{center:?} {radius}: {err:?}");
+    }
+    assert_eq!((m.map().dart_count(), m.max_level()), (before, 2), "a refused refinement changes nothing");
+}
+
+/// The dart limit refuses a level before it starts, on the bulk path (the ball holds the whole
+/// cube), on the per-op path (a corner zone), through the spring coupling and for 2D uniform
+/// refinement; the levels done before are kept and valid, and a limit just large enough lets
+/// the same refinement through.
+#[test]
+fn the_dart_limit_refuses_a_level_before_it_starts_and_keeps_the_levels_before() {
+    let refused = |e: &SubdivideError, level: u8| match *e {
+        SubdivideError::DartLimit { level: l, darts, estimate, limit, .. } => {
+            l == level && estimate > limit && darts <= limit
+        }
+        _ => false,
+    };
+    // Bulk: the Kuhn cube k = 1 (6 tets, 144 darts) to level 2 = 384 tets, 9 216 darts.
+    for (limit, done) in [(1_000, 0u8), (9_215, 1), (9_216, 2)] {
+        let mut m = cube(1);
+        let mut masses = TetMasses::from_density(&m, RHO).unwrap();
+        let mass0 = masses.total(&m);
+        m.set_max_darts(limit);
+        match m.refine_around([0.5; 3], 10.0, 2, &mut masses) {
+            Ok(_) => assert_eq!(done, 2, "limit {limit} accepted level 2"),
+            Err(e) => assert!(refused(&e, done + 1), "limit {limit}: {e:?}"),
+        }
+        assert_eq!(m.max_level(), done, "limit {limit}");
+        assert_eq!(m.map().dart_count(), 144 * 8usize.pow(u32::from(done)), "limit {limit}");
+        check_laws(&m, &masses, [0.5; 3], if done == 0 { -1.0 } else { 10.0 }, done, mass0);
+    }
+    // Per op: a corner zone of the cube k = 2, estimated per tet of the zone.
+    let mut m = cube(2);
+    let mut masses = TetMasses::from_density(&m, RHO).unwrap();
+    m.set_max_darts(m.map().dart_count() + 10);
+    let before = m.map().dart_count();
+    let e = m.refine_around([0.0; 3], 0.3, 1, &mut masses).unwrap_err();
+    assert!(refused(&e, 1), "{e:?}");
+    assert!(e.to_string().contains("--max-darts"), "{e}");
+    assert_eq!((m.max_level(), m.map().dart_count()), (0, before));
+    let e = m.refine_around_per_op([0.0; 3], 10.0, 1, &mut masses).unwrap_err();
+    assert!(refused(&e, 1), "{e:?}");
+    m.set_max_darts(usize::MAX);
+    m.refine_around([0.0; 3], 0.3, 1, &mut masses).unwrap();
+    // The spring coupling's own zone loop.
+    let mut m = cube(2);
+    let mut mech = LeveledMechanics::new(&m, Material::default()).unwrap();
+    m.set_max_darts(m.map().dart_count() + 10);
+    let e = mech.refine_around(&mut m, [0.0; 3], 0.3, 1).unwrap_err();
+    assert!(matches!(&e, CouplingError::Subdivide(s) if refused(s, 1)), "{e:?}");
+    assert_eq!(m.max_level(), 0);
+    // 2D uniform refinement: every triangle becomes four.
+    let (map, _) = GMap::<2>::from_triangles(4, &[[0, 1, 2], [0, 2, 3]]).unwrap();
+    let mut m2 = LeveledMap::new(map, vec![]);
+    m2.set_max_darts(12 * 4 - 1);
+    let e = m2.refine_uniform(1).unwrap_err();
+    assert!(refused(&e, 1), "{e:?}");
+    m2.set_max_darts(12 * 4);
+    assert_eq!(m2.refine_uniform(1).unwrap(), 2);
 }
 
 proptest! {
@@ -171,6 +238,29 @@ fn the_refine_command_rejects_bad_arguments_with_a_message() {
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(err.contains(needle), "{all:?}: {err}");
         assert!(!err.contains("panicked"), "{err}");
+    }
+    // A ball holding the whole liver to level 12 (1 852 · 8¹² tets; the default limit stops it at
+    // level 4, 182 M darts, after three levels: here a lower limit stops it at level 2, 2.8 M)
+    // is refused before that level starts, with the limit named; it used to allocate until the
+    // machine ran out of memory.
+    for (levels, limit, needle) in [("12", "1000000", "level 2"), ("1", "1000", "level 1")] {
+        let liver = liver();
+        let all = [
+            "refine",
+            liver.as_str(),
+            "--around",
+            "0,0,0",
+            "--radius",
+            "1e9",
+            "--levels",
+            levels,
+            "--max-darts",
+            limit,
+        ];
+        let out = Command::new(BIN).args(all).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{all:?}: {err}");
+        assert!(err.contains(needle) && err.contains("--max-darts"), "{all:?}: {err}");
     }
     let out =
         Command::new(BIN).args(["refine", "/no/such.msh", "--around", "0,0,0", "--radius", "1"]).output().unwrap();

@@ -185,6 +185,9 @@ pub fn run_remove(args: RemoveArgs) -> Result<(), CliError> {
     let before = stats(&body, 0.0);
     let mut ids: Vec<u32> = args.tets.clone();
     if let Some([x, y, z, r]) = args.sphere {
+        if !(r.is_finite() && r >= 0.0) {
+            return Err(CliError::Other(format!("--sphere radius must be a finite number ≥ 0, got {r}").into()));
+        }
         ids.extend(tets_in_ball(&body, [x, y, z], r));
     }
     let t = Instant::now();
@@ -301,7 +304,11 @@ fn write_vtu(body: &Body, path: &Path) -> Result<(), CliError> {
 fn parse_numbers<const K: usize>(s: &str) -> Result<[f64; K], String> {
     let parts: Vec<f64> = s
         .split(',')
-        .map(|t| t.trim().parse::<f64>().map_err(|e| format!("bad number {t:?}: {e}")))
+        .map(|t| match t.trim().parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok(v),
+            Ok(v) => Err(format!("number {v} is not finite")),
+            Err(e) => Err(format!("bad number {t:?}: {e}")),
+        })
         .collect::<Result<_, _>>()?;
     <[f64; K]>::try_from(parts.as_slice()).map_err(|_| format!("expected {K} comma-separated numbers, got {s:?}"))
 }

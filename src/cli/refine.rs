@@ -36,6 +36,10 @@ pub struct RefineArgs {
     /// Finest level to reach (1 = one 1→8 step).
     #[arg(long, default_value_t = 1)]
     pub levels: u8,
+    /// Refuse a level that would grow the map past this many darts (about 91 bytes each): the
+    /// command stops with an error naming the estimate before that level starts.
+    #[arg(long, default_value_t = topomech::subdivide::DEFAULT_MAX_DARTS)]
+    pub max_darts: usize,
     /// Mass density ρ (tet mass = ρ · volume).
     #[arg(long, default_value_t = Material::default().density)]
     pub density: f64,
@@ -182,6 +186,7 @@ pub fn run(args: RefineArgs) -> Result<(), CliError> {
         None => None,
     };
     let mut m = LeveledMap::new(loaded.map, loaded.mesh.points);
+    m.set_max_darts(args.max_darts);
     let (refinement, masses, mech, refine_ms) = refine(&args, &mut m, material)?;
     let mut report = report(&m, &masses, &refinement, refine_ms)?;
     let spring_laws = mech.as_ref().map(|(before, x)| fill_springs(&mut report, *before, x, &m));

@@ -100,13 +100,20 @@ fn parse_pin_below(s: &str) -> Result<(usize, f64), String> {
         other => return Err(format!("axis must be x, y or z, got {other:?}")),
     };
     let value: f64 = value.trim().parse().map_err(|e| format!("bad value {value:?}: {e}"))?;
+    if !value.is_finite() {
+        return Err(format!("value {value} is not finite"));
+    }
     Ok((axis, value))
 }
 
 fn parse_vec3(s: &str) -> Result<Vec3, String> {
     let parts: Vec<&str> = s.split(',').collect();
     let [x, y, z] = parts.as_slice() else { return Err(format!("expected X,Y,Z, got {s:?}")) };
-    let p = |t: &str| t.trim().parse::<f64>().map_err(|e| format!("bad number {t:?}: {e}"));
+    let p = |t: &str| match t.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(v) => Err(format!("number {v} is not finite")),
+        Err(e) => Err(format!("bad number {t:?}: {e}")),
+    };
     Ok([p(x)?, p(y)?, p(z)?])
 }
 

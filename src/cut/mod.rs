@@ -100,6 +100,10 @@ pub enum CutError {
         /// Normal.
         normal: [f64; 3],
     },
+    /// A tearing threshold that is NaN, infinite or negative (with NaN no vertex would ever
+    /// compare above it: tearing would silently never happen).
+    #[error("tear threshold {0} must be a finite number ≥ 0")]
+    BadThreshold(f64),
     /// A polyline sweep that is not a well-formed cut surface (too few points, non-finite,
     /// repeated points, zero sweep, a segment along the sweep).
     #[error("bad polyline sweep: {reason}")]

@@ -341,12 +341,13 @@ pub fn tear_vertex(body: &mut Body, v: CellId, direction: Vec3, hint: Option<Dar
 /// Cost: O(springs + slots) for the stresses, plus the tears and the update.
 ///
 /// # Errors
+/// [`CutError::BadThreshold`] for a NaN, infinite or negative threshold (nothing done);
 /// [`CutError::Body`] or [`CutError::Sim`] (bugs or a bad time step).
 ///
 /// # Examples
 ///
 /// ```
-/// use topomech::cut::tear_step;
+/// use topomech::cut::{tear_step, CutError};
 /// use topomech::generate::kuhn_cube;
 /// use topomech::mechanics::{Body, Integrator, Material, Simulation, StepConfig};
 ///
@@ -358,6 +359,7 @@ pub fn tear_vertex(body: &mut Body, v: CellId, direction: Vec3, hint: Option<Dar
 /// let step = tear_step(&mut body, &mut sim, 1.0, 1).unwrap();
 /// assert_eq!(step.tears.len(), 1);
 /// sim.step(&mut body).unwrap(); // the simulation followed the change
+/// assert!(matches!(tear_step(&mut body, &mut sim, f64::NAN, 1), Err(CutError::BadThreshold(_))));
 /// ```
 pub fn tear_step(
     body: &mut Body,
@@ -365,6 +367,9 @@ pub fn tear_step(
     threshold: f64,
     max_vertices: usize,
 ) -> Result<TearStep, CutError> {
+    if !(threshold.is_finite() && threshold >= 0.0) {
+        return Err(CutError::BadThreshold(threshold));
+    }
     let stress = principal_stress(body, sim);
     let mut order: Vec<usize> = (0..stress.len()).filter(|&v| stress[v].magnitude > threshold).collect();
     order.sort_by(|&a, &b| stress[b].magnitude.total_cmp(&stress[a].magnitude).then(a.cmp(&b)));

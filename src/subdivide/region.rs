@@ -318,7 +318,10 @@ impl LeveledMap<3> {
     /// O(Σ_L (volumes + refined · touched)); O(darts) per bulk level.
     ///
     /// Errors: those of [`Self::subdivide_tet`] (the map keeps the operations done before it);
-    /// [`SubdivideError::LevelTooHigh`] for `levels` above [`super::MAX_LEVEL`].
+    /// [`SubdivideError::LevelTooHigh`] for `levels` above [`super::MAX_LEVEL`];
+    /// [`SubdivideError::BadBall`] for a non-finite centre or radius or a negative radius and
+    /// [`SubdivideError::DartLimit`] for a level over the dart limit (both before any change at
+    /// that level).
     ///
     /// ```
     /// use topomech::subdivide::{LeveledMap, TetMasses};
@@ -340,6 +343,7 @@ impl LeveledMap<3> {
         masses: &mut TetMasses,
     ) -> Result<Refinement, SubdivideError> {
         self.check_op_level(levels)?;
+        Self::check_ball(center, radius)?;
         // Mass totals: a bulk level reports them (Σ over every volume), so O(darts) sweeps are
         // only made around per-op levels.
         let (mut before, mut after) = (None, None);
@@ -388,6 +392,7 @@ impl LeveledMap<3> {
         masses: &mut TetMasses,
     ) -> Result<Refinement, SubdivideError> {
         self.check_op_level(levels)?;
+        Self::check_ball(center, radius)?;
         let before = masses.total(self);
         let mut per_level = vec![0; levels as usize + 1];
         for level in self.max_level.max(1)..=levels {
@@ -409,10 +414,26 @@ impl LeveledMap<3> {
         masses: &mut TetMasses,
     ) -> Result<usize, SubdivideError> {
         let zone = self.zone_tets(level - 1, center, radius)?;
+        self.check_zone_limit(level, zone.len())?;
         for &d in &zone {
             self.subdivide_tet_with_mass(d, level, masses)?;
         }
         Ok(zone.len())
+    }
+
+    /// Refuses a ball with a non-finite centre or a radius that is not a finite number ≥ 0. O(1).
+    pub(super) fn check_ball(center: [f64; 3], radius: f64) -> Result<(), SubdivideError> {
+        if center.iter().all(|c| c.is_finite()) && radius.is_finite() && radius >= 0.0 {
+            return Ok(());
+        }
+        Err(SubdivideError::BadBall { center, radius })
+    }
+
+    /// Refuses a level that subdivides `zone` tets when the estimated darts after it
+    /// ([`super::DARTS_PER_SPLIT_TET`] per tet) exceed the limit. O(1).
+    pub(super) fn check_zone_limit(&self, level: u8, zone: usize) -> Result<(), SubdivideError> {
+        let estimate = self.map.dart_count().saturating_add(zone.saturating_mul(super::DARTS_PER_SPLIT_TET));
+        self.check_dart_limit(level, zone, estimate)
     }
 
     /// Whether a level of `refine_around` may take the bulk path: the ball holds every vertex and

@@ -733,6 +733,7 @@ impl LeveledMechanics {
         levels: u8,
     ) -> Result<Refinement, CouplingError> {
         m.check_op_level(levels)?;
+        LeveledMap::check_ball(center, radius)?;
         let before = self.masses.total(m);
         let mut per_level = vec![0; levels as usize + 1];
         for level in m.max_level().max(1)..=levels {
@@ -740,7 +741,9 @@ impl LeveledMechanics {
                 per_level[level as usize] = count;
                 continue;
             }
-            for d in m.zone_tets(level - 1, center, radius)? {
+            let zone = m.zone_tets(level - 1, center, radius)?;
+            m.check_zone_limit(level, zone.len())?;
+            for d in zone {
                 self.split_tet(m, d, level)?;
                 per_level[level as usize] += 1;
             }

@@ -451,6 +451,10 @@ impl<const N: usize> LeveledMap<N> {
         if m >= level {
             return Err(SubdivideError::AlreadyAtLevel { dart: first, dim: N, cell_level: m, level });
         }
+        // Every n-simplex becomes 2^n, each with as many darts as its parent.
+        let darts = self.map.dart_count();
+        let per_cell = if N == 3 { 24 } else { 6 };
+        self.check_dart_limit(level, darts / per_cell, darts.saturating_mul(1 << N))?;
         Ok(m)
     }
 

@@ -48,7 +48,7 @@ pub use region::{tet_distance, Refinement, TetMasses};
 pub use springs::{CouplingError, EdgeKey, LeveledMechanics, Spring};
 pub use springs_check::SpringLawError;
 
-use crate::gmap::{AlphaMask, DartId, GMap, InvariantViolation};
+use crate::gmap::{DartId, GMap, InvariantViolation};
 
 /// The largest level an operation may use.
 pub const MAX_LEVEL: u8 = 250;
@@ -689,15 +689,7 @@ impl<const N: usize> LeveledMap<N> {
                 out.link_raw(j, DartId(k as u32), DartId(target));
             }
         }
-        for dim in 0..=N {
-            let reps = out.one_dart_per_cell_by_traversal(dim);
-            for (id, &r) in reps.iter().enumerate() {
-                for x in out.orbit(r, AlphaMask::cell(N, dim)) {
-                    out.set_cell_raw(dim, x, id as u32);
-                }
-            }
-            out.set_id_alloc_raw(dim, reps.len() as u32, Vec::new());
-        }
+        out.label_cells_raw();
         Ok(LevelView { map: out, darts })
     }
 

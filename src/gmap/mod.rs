@@ -714,3 +714,59 @@ impl<const N: usize> GMap<N> {
         bytes as f64 / self.n_alive.max(1) as f64
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Darts `lo..hi` are live, each with the given rows.
+    fn check_rows(map: &GMap<2>, lo: u32, hi: u32, row: impl Fn(u32) -> ([u32; 3], [u32; 3])) {
+        for d in lo..hi {
+            assert!(map.contains(DartId(d)), "dart {d} should be live");
+            let (alpha, cell) = row(d);
+            assert_eq!(map.alpha_row(d), alpha, "links of {d}");
+            assert_eq!(map.cell_row(d), cell, "cell ids of {d}");
+        }
+    }
+
+    /// The bulk-build layer under `subdivide` and level extraction: darts allocated
+    /// (`alloc_darts_raw`, free and unlabelled) and rows pushed (`push_rows_raw`) after a
+    /// prefix whose length is no multiple of 64 (so the liveness words are filled from the
+    /// middle, across several words) are all live, and only they, with their rows; writes
+    /// through `rows_mut_raw` reach the map; `from_rows_raw` makes every row a live dart.
+    #[test]
+    fn bulk_rows_allocate_push_and_write_through() {
+        let mut map = GMap::<2>::new();
+        for _ in 0..70 {
+            map.create_dart().unwrap();
+        }
+        let free = |d: u32| ([d; 3], [NONE; 3]);
+        assert_eq!(map.alloc_darts_raw(10), 70); // fewer than the prefix
+        assert_eq!(map.alloc_darts_raw(100), 80); // more than the prefix
+        assert_eq!((map.capacity(), map.dart_count()), (180, 180));
+        check_rows(&map, 70, 180, free);
+        assert!(!map.contains(DartId(180)));
+        map.reserve_darts_raw(130);
+        let pushed = |d: u32| ([d, d, d], [7, d % 5, 9]);
+        let (alpha, cell): (Vec<u32>, Vec<u32>) = (180..310)
+            .flat_map(|d| {
+                let (a, c) = pushed(d);
+                a.into_iter().zip(c)
+            })
+            .unzip();
+        assert_eq!(map.push_rows_raw(&alpha, &cell), 180);
+        assert_eq!((map.capacity(), map.dart_count()), (310, 310));
+        check_rows(&map, 180, 310, pushed);
+        check_rows(&map, 70, 180, free); // the earlier darts are untouched
+        assert!(!map.contains(DartId(310)) && map.darts().count() == 310);
+        let (alpha, _) = map.rows_mut_raw();
+        alpha[3 * 75] = 76;
+        alpha[3 * 76] = 75;
+        assert_eq!(map.alpha_dyn(0, DartId(75)), DartId(76));
+        let rows = (0..65u32).flat_map(|d| [d, d, d]).collect::<Vec<_>>();
+        let map = GMap::<2>::from_rows_raw(rows.clone(), rows);
+        assert_eq!(map.dart_count(), 65);
+        check_rows(&map, 0, 65, |d| ([d; 3], [d; 3]));
+        assert!(!map.contains(DartId(65)) && map.darts().count() == 65);
+    }
+}

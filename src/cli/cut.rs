@@ -14,7 +14,7 @@ use topomech::mechanics::{check_conservation, Body, Integrator, Material, Simula
 use topomech::vtk::{body_tets, Frame};
 use topomech::CellId;
 
-use super::{print_warnings, CliError};
+use super::{parse_finite, print_warnings, CliError};
 
 /// Options shared by the three subcommands.
 #[derive(Debug, Clone, clap::Args)]
@@ -302,14 +302,7 @@ fn write_vtu(body: &Body, path: &Path) -> Result<(), CliError> {
 }
 
 fn parse_numbers<const K: usize>(s: &str) -> Result<[f64; K], String> {
-    let parts: Vec<f64> = s
-        .split(',')
-        .map(|t| match t.trim().parse::<f64>() {
-            Ok(v) if v.is_finite() => Ok(v),
-            Ok(v) => Err(format!("number {v} is not finite")),
-            Err(e) => Err(format!("bad number {t:?}: {e}")),
-        })
-        .collect::<Result<_, _>>()?;
+    let parts: Vec<f64> = s.split(',').map(parse_finite).collect::<Result<_, _>>()?;
     <[f64; K]>::try_from(parts.as_slice()).map_err(|_| format!("expected {K} comma-separated numbers, got {s:?}"))
 }
 

@@ -159,6 +159,23 @@ impl Characteristics {
     }
 }
 
+/// One number of a command-line value: NaN and ±∞ are refused with the value named (they
+/// would run silently or blow up far from the argument that caused it).
+pub(crate) fn parse_finite(t: &str) -> Result<f64, String> {
+    match t.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(v) => Err(format!("number {v} is not finite")),
+        Err(e) => Err(format!("bad number {t:?}: {e}")),
+    }
+}
+
+/// `X,Y,Z`: three finite numbers ([`parse_finite`]).
+pub(crate) fn parse_vec3(s: &str) -> Result<topomech::mechanics::Vec3, String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    let [x, y, z] = parts.as_slice() else { return Err(format!("expected X,Y,Z, got {s:?}")) };
+    Ok([parse_finite(x)?, parse_finite(y)?, parse_finite(z)?])
+}
+
 /// Prints the warnings of a load (mesh check, build report) to stderr, one line each.
 pub fn print_warnings(loaded: &Loaded) {
     let mut err = std::io::stderr().lock();

@@ -20,7 +20,7 @@ use topomech::subdivide::{
 };
 use topomech::vtk::Frame;
 
-use super::{print_warnings, CliError};
+use super::{parse_finite, parse_vec3, print_warnings, CliError};
 
 /// Arguments of `topomech refine`.
 #[derive(Debug, Clone, clap::Args)]
@@ -28,7 +28,7 @@ pub struct RefineArgs {
     /// Tetrahedral mesh file (any format `topomech info` reads).
     pub mesh: PathBuf,
     /// Centre of the refinement zone `X,Y,Z`.
-    #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     pub around: Vec3,
     /// Radius of the zone: every tet meeting the ball is refined.
     #[arg(long, allow_hyphen_values = true)]
@@ -130,17 +130,6 @@ pub struct RefineJson {
     pub spring_laws_ok: Option<bool>,
 }
 
-fn parse_point(s: &str) -> Result<Vec3, String> {
-    let parts: Vec<&str> = s.split(',').collect();
-    let [x, y, z] = parts.as_slice() else { return Err(format!("expected X,Y,Z, got {s:?}")) };
-    let p = |t: &str| match t.trim().parse::<f64>() {
-        Ok(v) if v.is_finite() => Ok(v),
-        Ok(v) => Err(format!("coordinate {v} is not finite")),
-        Err(e) => Err(format!("bad number {t:?}: {e}")),
-    };
-    Ok([p(x)?, p(y)?, p(z)?])
-}
-
 fn parse_plane(s: &str) -> Result<[f64; 6], String> {
     let parts: Vec<&str> = s.split(',').collect();
     if parts.len() != 6 {
@@ -148,11 +137,7 @@ fn parse_plane(s: &str) -> Result<[f64; 6], String> {
     }
     let mut out = [0.0; 6];
     for (o, t) in out.iter_mut().zip(&parts) {
-        *o = match t.trim().parse::<f64>() {
-            Ok(v) if v.is_finite() => v,
-            Ok(v) => return Err(format!("coordinate {v} is not finite")),
-            Err(e) => return Err(format!("bad number {t:?}: {e}")),
-        };
+        *o = parse_finite(t)?;
     }
     if out[3..].iter().all(|&c| c == 0.0) {
         return Err(format!("the normal of {s:?} is zero"));

@@ -11,7 +11,7 @@ use topomech::mechanics::{Body, Integrator, Material, PinSpec, Simulation, StepC
 use topomech::mesh::TetMesh;
 use topomech::vtk::{body_tets, Frame, Series};
 
-use super::{print_warnings, CliError};
+use super::{parse_finite, parse_vec3, print_warnings, CliError};
 
 /// Arguments of `topomech simulate`.
 #[derive(Debug, Clone, clap::Args)]
@@ -99,22 +99,7 @@ fn parse_pin_below(s: &str) -> Result<(usize, f64), String> {
         "z" | "2" => 2,
         other => return Err(format!("axis must be x, y or z, got {other:?}")),
     };
-    let value: f64 = value.trim().parse().map_err(|e| format!("bad value {value:?}: {e}"))?;
-    if !value.is_finite() {
-        return Err(format!("value {value} is not finite"));
-    }
-    Ok((axis, value))
-}
-
-fn parse_vec3(s: &str) -> Result<Vec3, String> {
-    let parts: Vec<&str> = s.split(',').collect();
-    let [x, y, z] = parts.as_slice() else { return Err(format!("expected X,Y,Z, got {s:?}")) };
-    let p = |t: &str| match t.trim().parse::<f64>() {
-        Ok(v) if v.is_finite() => Ok(v),
-        Ok(v) => Err(format!("number {v} is not finite")),
-        Err(e) => Err(format!("bad number {t:?}: {e}")),
-    };
-    Ok([p(x)?, p(y)?, p(z)?])
+    Ok((axis, parse_finite(value)?))
 }
 
 fn other(e: impl std::error::Error + Send + Sync + 'static) -> CliError {

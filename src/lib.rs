@@ -44,6 +44,7 @@ pub mod mechanics;
 pub mod mesh;
 pub mod ops;
 pub mod render;
+mod spare;
 pub mod store;
 pub mod subdivide;
 pub mod surface;

@@ -182,7 +182,7 @@ pub(crate) fn dissociate_all(body: &mut Body, faces: Vec<DartId>) -> Result<Inci
     let mut out = Incision { dissociations: Vec::with_capacity(faces.len()), touched: TouchedCells::default() };
     for d in faces {
         let dis = dissociate_face(body, d)?;
-        out.touched.extend(dis.touched.clone());
+        out.touched.extend(&dis.touched);
         out.dissociations.push(dis);
     }
     Ok(out)

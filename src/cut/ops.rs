@@ -474,7 +474,7 @@ impl Harness {
                 let d = DartId((24 * t + 6 * f) as u32);
                 let dis = super::dissociate_face(&mut self.body, d).map_err(|e| e.to_string())?;
                 self.oracle.cut.insert(key);
-                touched.extend(dis.touched);
+                touched.extend(&dis.touched);
             }
             Op::DissociateBoundary(k) => {
                 let live: Vec<(usize, usize)> = (0..self.oracle.tets.len())
@@ -508,7 +508,7 @@ impl Harness {
                 self.oracle.alive[t] = false;
                 self.removed_mass += r.removed_mass;
                 self.removed_stiffness += r.removed_stiffness;
-                touched.extend(r.touched);
+                touched.extend(&r.touched);
             }
             Op::RemoveAgain(k) => {
                 let dead: Vec<usize> = (0..self.oracle.tets.len()).filter(|&t| !self.oracle.alive[t]).collect();
@@ -542,7 +542,7 @@ impl Harness {
                 if inc.cut_faces() != expected {
                     return Err(format!("incision cut {} faces, oracle expects {expected}", inc.cut_faces()));
                 }
-                touched.extend(inc.touched);
+                touched.extend(&inc.touched);
             }
             Op::Tear(k, n) => {
                 let live: Vec<usize> = (0..self.oracle.tets.len()).filter(|&t| self.oracle.alive[t]).collect();
@@ -557,7 +557,7 @@ impl Harness {
                         return Err(format!("tear dissociated face {key:?} twice"));
                     }
                 }
-                touched.extend(tear.touched);
+                touched.extend(&tear.touched);
             }
         }
         self.projection.update(&self.body, &touched);

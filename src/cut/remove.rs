@@ -106,7 +106,7 @@ pub fn remove_volume(body: &mut Body, t: CellId) -> Result<Removal, CutError> {
     for x in one_dart_per_face(body.map(), &darts) {
         if !body.map().is_free(3, x) {
             let dis = dissociate_face(body, x)?;
-            touched.extend(dis.touched.clone());
+            touched.extend(&dis.touched);
             dissociations.push(dis);
         }
     }

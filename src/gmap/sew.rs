@@ -144,6 +144,9 @@ pub enum CellChange {
 
 /// Everything a sew or unsew changed in cell identities, in the order it happened.
 ///
+/// Dropping a report hands its emptied lists to the next unsew on the same thread
+/// (the crate-private `spare` module), so a loop of cuts and sews allocates nothing for its reports once warm.
+///
 /// # Examples
 ///
 /// ```
@@ -251,6 +254,36 @@ impl PartialEq for CellChanges {
 }
 
 impl Eq for CellChanges {}
+
+/// The buffers of a [`CellChanges`]: its changes and pairs, then its [`SplitSides`]' two lists.
+type ChangeLists = ((Vec<CellChange>, Vec<(DartId, DartId)>), (Vec<(u32, u32)>, Vec<DartId>));
+
+thread_local! {
+    /// The lists of the [`CellChanges`] last dropped on this thread, for the next unsew
+    /// (the crate-private `spare` module).
+    static SPARE_LISTS: std::cell::Cell<Option<ChangeLists>> = const { std::cell::Cell::new(None) };
+}
+
+impl CellChanges {
+    /// An empty report on this thread's spare lists. O(1).
+    fn on_spare_lists() -> Self {
+        let ((changes, pairs), (ends, darts)) = crate::spare::take(&SPARE_LISTS);
+        CellChanges { changes, pairs, new_sides: SplitSides { ends, darts } }
+    }
+}
+
+/// Gives the lists back to this thread's spare slot (the crate-private `spare` module); a sew's report (no side
+/// lists) does not displace an unsew's. O(1).
+impl Drop for CellChanges {
+    fn drop(&mut self) {
+        let SplitSides { ends, darts } = &mut self.new_sides;
+        let lists = (
+            (std::mem::take(&mut self.changes), std::mem::take(&mut self.pairs)),
+            (std::mem::take(ends), std::mem::take(darts)),
+        );
+        crate::spare::give_back(&SPARE_LISTS, lists);
+    }
+}
 
 impl CellChanges {
     /// Every dart of the new side of `changes[k]` (the whole cell that got the fresh id, in no
@@ -613,15 +646,15 @@ impl<const N: usize> GMap<N> {
         if self.is_free(i, d) {
             return Err(SewError::AlreadyFree { dart: d, i });
         }
-        let (pairs, cycle) = self.unsewn_pairs(i, d);
-        for &(x, y) in &pairs {
+        let mut report = CellChanges::on_spare_lists();
+        let cycle = self.unsewn_pairs(i, d, &mut report.pairs);
+        for &(x, y) in &report.pairs {
             // Bring the endpoints' cell rows in now (`split_cells` reads and writes them after
             // the ring walks): their cache misses overlap with each other and with the walks
             // instead of being paid one by one later. Reads only, no effect on the outcome.
             std::hint::black_box((self.cell_row(x.0)[0], self.cell_row(y.0)[0]));
             self.unlink_raw(i, x);
         }
-        let mut report = CellChanges { changes: Vec::with_capacity(8), pairs, new_sides: SplitSides::default() };
         let mut links = QuickLinks::none();
         if quick {
             links.find(self, i, &report.pairs, cycle.endpoints(report.pairs.len()).as_ref());
@@ -647,10 +680,10 @@ impl<const N: usize> GMap<N> {
     /// filtered on x < y. A two-generator orbit (the face ⟨α0, α1⟩ of an α3-unsew) is walked
     /// with no visited set and no list of its own, and also returned as a [`Cycle`] (closed or
     /// not). O(orbit · log orbit).
-    fn unsewn_pairs(&self, i: usize, d: DartId) -> (Vec<(DartId, DartId)>, Cycle) {
+    fn unsewn_pairs(&self, i: usize, d: DartId, pairs: &mut Vec<(DartId, DartId)>) -> Cycle {
         let mask = AlphaMask::commuting_with(N, i);
         let (gens, len) = generators(N, mask);
-        let mut pairs: Vec<(DartId, DartId)> = Vec::with_capacity(8);
+        pairs.clear();
         let mut cycle = Cycle::new([gens[0], gens[1]]);
         let pair_of = |x: DartId| {
             let y = self.alpha_dyn(i, x);
@@ -666,7 +699,7 @@ impl<const N: usize> GMap<N> {
         cycle.closed = closed;
         pairs.sort_unstable();
         pairs.dedup();
-        (pairs, cycle)
+        cycle
     }
 
     /// After unlinking, makes the dim-cell ids exact again. Every piece of a cell that fell apart
@@ -1440,6 +1473,40 @@ mod tests {
                 .all(|d| (0..=N).all(|k| a.alpha_dyn(k, d) == b.alpha_dyn(k, d) && a.cell_id(k, d) == b.cell_id(k, d)))
     }
 
+    /// A dropped report lends its lists to the next unsew on the thread, emptied: the next
+    /// report reuses the same buffers and lists only its own pairs and changes.
+    #[test]
+    fn a_dropped_report_lends_its_emptied_lists_to_the_next_unsew() {
+        let (points, tets) = kuhn_cube(2);
+        let (mut map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+        let inner: Vec<DartId> = map.one_dart_per_cell(2).into_iter().filter(|&d| !map.is_free(3, d)).collect();
+        let mut first = map.unsew::<3>(inner[0]).unwrap();
+        // A capacity no fresh list of an unsew would have marks the buffers.
+        first.pairs.reserve(1000);
+        first.changes.reserve(1000);
+        let pairs_len = first.pairs.len();
+        drop(first);
+        let second = map.unsew::<3>(inner[1]).unwrap();
+        assert!(second.pairs.capacity() >= 1000 && second.changes.capacity() >= 1000, "the lists were not reused");
+        assert_eq!(second.pairs.len(), pairs_len); // a triangle's six pairs, none left over
+        let face = map.cell_darts(2, inner[1]);
+        assert!(second
+            .pairs
+            .iter()
+            .all(|&(a, b)| map.is_free(3, a) && map.is_free(3, b) && (face.contains(&a) || face.contains(&b))));
+        // While a report is alive its lists are its own: a second live report gets other buffers.
+        let third = map.unsew::<3>(inner[2]).unwrap();
+        assert!(third.pairs.capacity() < 1000 && third.pairs.len() == pairs_len);
+        // Over the limit, lists are freed rather than kept.
+        let mut big = third;
+        big.pairs.reserve(crate::spare::CAPACITY_LIMIT + 1);
+        drop(second);
+        let fourth = map.unsew::<3>(inner[3]).unwrap(); // takes second's lists: the slot is empty
+        drop(big);
+        assert!(map.unsew::<3>(inner[4]).unwrap().pairs.capacity() <= crate::spare::CAPACITY_LIMIT);
+        assert!(fourth.pairs.capacity() >= 1000);
+    }
+
     /// Unsews every sewn dart of a Kuhn cube by αi (i = 0..=3, each on a fresh cube, in a
     /// scrambled order), with and without the quick proofs: the reports and the maps must be
     /// identical at every step, and real splits must have happened in every dimension.
@@ -1549,7 +1616,8 @@ mod tests {
             assert_eq!(map.tets_as_built(), m < 2);
             for (i, cycles) in cycles.iter_mut().enumerate() {
                 for d in map.darts().filter(|&d| !map.is_free(i, d)) {
-                    let (pairs, cycle) = map.unsewn_pairs(i, d);
+                    let mut pairs = Vec::new();
+                    let cycle = map.unsewn_pairs(i, d, &mut pairs);
                     let Some(ends) = cycle.endpoints(pairs.len()) else { continue };
                     let mut unlinked = map.clone();
                     for &(x, _) in &pairs {
@@ -1581,7 +1649,8 @@ mod tests {
             }
             let mut fast = tet.clone();
             fast.sew::<3>(d, e).unwrap();
-            let (pairs, cycle) = fast.unsewn_pairs(3, d);
+            let mut pairs = Vec::new();
+            let cycle = fast.unsewn_pairs(3, d, &mut pairs);
             if pairs.len() == 6 {
                 continue; // glued to another face
             }

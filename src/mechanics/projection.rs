@@ -513,6 +513,9 @@ impl TouchedCells {
         changes: &CellChanges,
         mut star: impl FnMut(&mut Self, DartId, Option<&[DartId]>),
     ) {
+        if self.vertices.capacity() == 0 && self.edges.capacity() == 0 && !changes.changes.is_empty() {
+            (self.vertices, self.edges) = crate::spare::take(&SPARE_TOUCHED);
+        }
         for (k, (kept, new, dk, dn)) in changes.splits_with_index(0) {
             push_pair(&mut self.vertices, [(kept, Some(dk)), (new, Some(dn))]);
             let side = changes.new_side(k);
@@ -584,13 +587,13 @@ impl TouchedCells {
     ///     let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
     ///     let cut = dissociate_face(&mut body, d).unwrap();
     ///     let n = batch.vertices.len() + cut.touched.vertices.len();
-    ///     batch.extend(cut.touched);
+    ///     batch.extend(&cut.touched);
     ///     assert_eq!(batch.vertices.len(), n);
     /// }
     /// ```
-    pub fn extend(&mut self, other: TouchedCells) {
-        self.vertices.extend(other.vertices);
-        self.edges.extend(other.edges);
+    pub fn extend(&mut self, other: &TouchedCells) {
+        self.vertices.extend_from_slice(&other.vertices);
+        self.edges.extend_from_slice(&other.edges);
     }
 
     /// Whether nothing was recorded. O(1).
@@ -610,6 +613,21 @@ impl TouchedCells {
     /// ```
     pub fn is_empty(&self) -> bool {
         self.vertices.is_empty() && self.edges.is_empty()
+    }
+}
+
+thread_local! {
+    /// The lists of the [`TouchedCells`] last dropped on this thread, for the next record
+    /// (the crate-private `spare` module).
+    static SPARE_TOUCHED: std::cell::Cell<Option<(TouchedList, TouchedList)>> = const { std::cell::Cell::new(None) };
+}
+
+type TouchedList = Vec<(CellId, Option<DartId>)>;
+
+/// Gives the lists back to this thread's spare slot (the crate-private `spare` module). O(1).
+impl Drop for TouchedCells {
+    fn drop(&mut self) {
+        crate::spare::give_back(&SPARE_TOUCHED, (std::mem::take(&mut self.vertices), std::mem::take(&mut self.edges)));
     }
 }
 

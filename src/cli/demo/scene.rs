@@ -229,7 +229,7 @@ impl Scene {
             let map = self.body.map();
             let pair = [map.cell_id(3, d), map.cell_id(3, map.alpha::<3>(d))];
             let dis = cut::dissociate_face(&mut self.body, d).map_err(|source| DemoError::Cut { stage, source })?;
-            touched.extend(dis.touched);
+            touched.extend(&dis.touched);
             self.incision_tets.extend(pair);
             run.cut_faces += 1;
         }
@@ -300,7 +300,7 @@ impl Scene {
             self.checker.removed(r.removed_mass, r.removed_stiffness);
             run.cut_faces += r.dissociations.len();
             run.operations += 1;
-            touched.extend(r.touched);
+            touched.extend(&r.touched);
         }
         self.incision_tets.retain(|&t| topomech::cut::volume_dart(&self.body, t).is_some());
         self.sim.update(&mut self.body, &touched).map_err(|source| DemoError::Sim { stage, source })?;

@@ -754,6 +754,8 @@ impl<const N: usize> GMap<N> {
                     (new, is_z_side)
                 }
                 None => {
+                    #[cfg(test)]
+                    tests::CELL_WALKS.set(tests::CELL_WALKS.get() + 1);
                     let out = sides.open();
                     let walked = match Shortcut::of(N, i, dim).filter(|_| quick) {
                         Some(Shortcut::Ring(ring)) => ring.split_side(self, anchor, z, out),
@@ -1471,6 +1473,41 @@ mod tests {
         a.capacity() == b.capacity()
             && a.darts()
                 .all(|d| (0..=N).all(|k| a.alpha_dyn(k, d) == b.alpha_dyn(k, d) && a.cell_id(k, d) == b.cell_id(k, d)))
+    }
+
+    thread_local! {
+        /// Cells whose split the unsews of this thread decided by a walk (the lockstep walk
+        /// or a shortcut), not by the quick proofs.
+        pub(super) static CELL_WALKS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+    }
+
+    /// The quick proofs do their job: an α3-unsew of an inner face that splits nothing (every
+    /// ring around its edges closed, its corners joined around) is settled with no walk at
+    /// all, and over all inner faces the proofs spare most of the walks that the exact path
+    /// makes. (Outcomes are checked by `quick_proofs_change_no_outcome`; this checks the
+    /// speed-only part, which a proof that never fires would pass.)
+    #[test]
+    fn quick_proofs_settle_unsplit_faces_without_walks() {
+        let (points, tets) = kuhn_cube(3);
+        let (mut map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+        let inner: Vec<DartId> = map.one_dart_per_cell(2).into_iter().filter(|&d| !map.is_free(3, d)).collect();
+        let (mut walks, mut unsplit) = ([0usize; 2], 0);
+        for &d in &inner {
+            let e = map.alpha::<3>(d);
+            for (slot, quick) in [(0, true), (1, false)] {
+                let before = CELL_WALKS.get();
+                let changes = map.unsew_with(3, d, quick).unwrap();
+                let n = CELL_WALKS.get() - before;
+                walks[slot] += n;
+                if quick && changes.splits(0).count() + changes.splits(1).count() == 0 {
+                    unsplit += 1;
+                    assert_eq!(n, 0, "face of {d}: split nothing but took {n} walks");
+                }
+                map.sew::<3>(d, e).unwrap();
+            }
+        }
+        assert!(unsplit > inner.len() / 4, "{unsplit} of {} inner faces split nothing", inner.len());
+        assert!(walks[0] * 4 < walks[1], "walks with the proofs {}, without {}", walks[0], walks[1]);
     }
 
     /// A dropped report lends its lists to the next unsew on the thread, emptied: the next

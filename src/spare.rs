@@ -2,9 +2,10 @@
 //! of the same kind, so that a loop of small topological operations (cut, sew back, cut…)
 //! allocates nothing for its reports in the steady state.
 //!
-//! Each report type owns one thread-local slot of its lists ([`crate::gmap::CellChanges`],
-//! [`crate::mechanics::TouchedCells`], [`crate::cut::Dissociation`]). Its `Drop` gives its
-//! lists back with [`give_back`]; its constructor takes them with [`take`]. When two reports
+//! Each report type that uses it owns one thread-local slot of its lists
+//! ([`crate::gmap::CellChanges`], [`crate::mechanics::TouchedCells`]; not
+//! [`crate::cut::Dissociation`], whose fields users move out). Its `Drop` gives its lists back
+//! with [`give_back`]; its constructor takes them with [`take`]. When two reports
 //! meet in the slot, each list keeps the larger of the two buffers; lists grown past
 //! [`CAPACITY_LIMIT`] are freed rather than kept (a bulk operation's report would otherwise hold
 //! its memory for the thread's lifetime). Costs O(1) per list: the elements are plain data.

@@ -144,8 +144,10 @@ pub enum CellChange {
 
 /// Everything a sew or unsew changed in cell identities, in the order it happened.
 ///
-/// Dropping a report hands its emptied lists to the next unsew on the same thread
-/// (the crate-private `spare` module), so a loop of cuts and sews allocates nothing for its reports once warm.
+/// Dropping a report hands its emptied lists to the next unsew on the same thread (the
+/// crate-private `spare` module), so a loop of cuts and sews allocates nothing for its reports
+/// once warm. Because of that `Drop`, move a list out with `std::mem::take`, not by
+/// destructuring.
 ///
 /// # Examples
 ///
@@ -272,8 +274,8 @@ impl CellChanges {
     }
 }
 
-/// Gives the lists back to this thread's spare slot (the crate-private `spare` module); a sew's report (no side
-/// lists) does not displace an unsew's. O(1).
+/// Gives the lists back to this thread's spare slot (the crate-private `spare` module); a
+/// sew's report (no side lists) does not displace an unsew's. O(1).
 impl Drop for CellChanges {
     fn drop(&mut self) {
         let SplitSides { ends, darts } = &mut self.new_sides;

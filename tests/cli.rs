@@ -312,6 +312,30 @@ fn non_finite_and_out_of_range_numbers_are_refused_with_a_message() {
 }
 
 #[test]
+fn remove_names_an_id_past_the_mesh_and_removes_a_repeated_id_once() {
+    let liver = "data/liver_547_v22.msh";
+    // An id past the last tet is refused before anything is removed, naming the id and the range
+    // (not "already removed", which is what the second removal of the list would have said).
+    let out = run(&["remove", liver, "--tets", "3,1852"]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("tet 1852 does not exist: the mesh has 1852 tets (ids 0 to 1851)"),
+        "{}",
+        stderr(&out)
+    );
+    // A repeated id is removed once: two tets go, not an error on the third mention.
+    let out = run(&["remove", liver, "--tets", "3,7,3,3", "--json"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&out)).expect("one JSON object");
+    assert_eq!(v["before"]["volumes"], 1852);
+    assert_eq!(v["after"]["volumes"], 1850);
+    assert_eq!(v["after"]["conservation_ok"], true);
+    let removed = v["after"]["removed_mass"].as_f64().unwrap();
+    let (before, after) = (v["before"]["total_mass"].as_f64().unwrap(), v["after"]["total_mass"].as_f64().unwrap());
+    assert!(removed > 0.0 && ((before - removed) - after).abs() <= 1e-12 * before, "{before} - {removed} != {after}");
+}
+
+#[test]
 fn ambiguity_subdivide_reports_the_mixed_campaign_and_rejects_a_bad_probability() {
     let o = run(&["ambiguity", "kuhn:1", "--cuts", "2", "--sequences", "3", "--subdivide", "0.5", "--json"]);
     assert!(o.status.success(), "{}", stderr(&o));

@@ -55,7 +55,8 @@ pub struct RemoveArgs {
     /// Mesh, density, output.
     #[command(flatten)]
     pub common: CommonArgs,
-    /// Tet ids to remove (0-based positions in the file), comma-separated.
+    /// Tet ids to remove (0-based positions in the file), comma-separated; an id listed twice is
+    /// removed once.
     #[arg(long, value_delimiter = ',', conflicts_with = "sphere")]
     pub tets: Vec<u32>,
     /// Remove the tets whose centroid lies in the ball `X,Y,Z,R`.
@@ -183,6 +184,16 @@ pub fn run(args: CutArgs) -> Result<(), CliError> {
 pub fn run_remove(args: RemoveArgs) -> Result<(), CliError> {
     let (mut body, load_us) = load_body(&args.common)?;
     let before = stats(&body, 0.0);
+    // A fresh body's volume ids are the tets' positions in the file: check them all before the
+    // first removal, so that a bad id is named as such (not as "already removed" after an
+    // earlier part of the list went through).
+    if let Some(&bad) = args.tets.iter().find(|&&id| id as usize >= before.volumes) {
+        let n = before.volumes;
+        return Err(CliError::Other(
+            format!("--tets: tet {bad} does not exist: the mesh has {n} tets (ids 0 to {})", n.saturating_sub(1))
+                .into(),
+        ));
+    }
     let mut ids: Vec<u32> = args.tets.clone();
     if let Some([x, y, z, r]) = args.sphere {
         if !(r.is_finite() && r >= 0.0) {
@@ -190,6 +201,9 @@ pub fn run_remove(args: RemoveArgs) -> Result<(), CliError> {
         }
         ids.extend(tets_in_ball(&body, [x, y, z], r));
     }
+    // Each listed tet removed once, in order of first mention.
+    let mut seen = std::collections::HashSet::new();
+    ids.retain(|&id| seen.insert(id));
     let t = Instant::now();
     let (mut removed, mut faces) = (0.0, 0);
     for id in ids {

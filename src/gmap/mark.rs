@@ -374,3 +374,57 @@ impl<const N: usize> GMap<N> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::GMap;
+
+    /// The law of marks: a mark is released clean. Dropping one with a dart still marked is a
+    /// bug of its user and asserts, naming how many darts were left.
+    #[test]
+    #[should_panic(expected = "a mark was dropped with 1 darts still marked")]
+    fn a_mark_dropped_with_darts_marked_asserts() {
+        let (mut map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+        let d = map.darts().next().unwrap();
+        let mut mark = map.reserve_mark();
+        mark.mark(d);
+        drop(mark);
+    }
+
+    /// Handing a dirty mark back to the pool asserts too (the next user would see its darts).
+    #[test]
+    #[should_panic(expected = "free_mark: 2 darts are still marked")]
+    fn a_mark_freed_with_darts_marked_asserts() {
+        let (mut map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+        let mut mark = map.reserve_mark();
+        for d in map.darts().take(2) {
+            mark.mark(d);
+        }
+        map.free_mark(mark);
+    }
+
+    /// A clean mark dropped or freed does not assert, and a pooled mark made when the map was
+    /// small still marks darts created after it (the set grows with the map).
+    #[test]
+    fn clean_marks_are_released_and_a_pooled_mark_covers_darts_created_later() {
+        let (mut map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+        let first = map.darts().next().unwrap();
+        let mut mark = map.reserve_mark();
+        assert!(mark.mark(first) && mark.unmark(first));
+        drop(mark);
+        let pooled = map.reserve_mark();
+        map.free_mark(pooled);
+        let late: Vec<_> = (0..200).map(|_| map.create_dart().unwrap()).collect();
+        let mut mark = map.reserve_mark();
+        assert_eq!(mark.count(), 0);
+        for &d in &late {
+            assert!(mark.mark(d));
+        }
+        assert!(late.iter().all(|&d| mark.is_marked(d)) && !mark.is_marked(first));
+        assert_eq!(mark.count(), late.len());
+        for &d in &late {
+            assert!(mark.unmark(d));
+        }
+        map.free_mark(mark);
+    }
+}

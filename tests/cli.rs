@@ -335,6 +335,85 @@ fn remove_names_an_id_past_the_mesh_and_removes_a_repeated_id_once() {
     assert!(removed > 0.0 && ((before - removed) - after).abs() <= 1e-12 * before, "{before} - {removed} != {after}");
 }
 
+/// `simulate --json` on liver_547 (20 steps of 1e-4 s): the printed line and its object.
+fn simulate_json(extra: &[&str]) -> (String, serde_json::Map<String, serde_json::Value>) {
+    let mut args = vec!["simulate", "data/liver_547_v22.msh", "--steps", "20", "--dt", "1e-4", "--json"];
+    args.extend_from_slice(extra);
+    let out = run(&args);
+    assert!(out.status.success(), "{args:?}: {}", stderr(&out));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&out)).expect("one JSON object");
+    (stdout(&out), v.as_object().expect("an object").clone())
+}
+
+#[test]
+fn simulate_writes_a_series_and_a_summary_that_follow_from_the_scene() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("topomech-cli-simulate");
+    let _ = std::fs::remove_dir_all(&dir);
+    let out_dir = dir.to_str().unwrap();
+    let (text, s) = simulate_json(&["--pin-below", "z=-1", "--frames", "5", "--out", out_dir]);
+    // Exactly the keys, in its order (as printed: the parsed map sorts them).
+    let keys = ["steps", "dt", "integrator", "step_us_median", "total_mass", "kinetic_energy", "max_displacement"];
+    assert_eq!(s.len(), keys.len(), "{text}");
+    let at: Vec<usize> = keys.iter().map(|k| text.find(&format!("\"{k}\":")).expect(k)).collect();
+    assert!(at.windows(2).all(|w| w[0] < w[1]), "keys out of order: {text}");
+    assert_eq!((s["steps"].as_u64(), s["dt"].as_f64(), s["integrator"].as_str()), (Some(20), Some(1e-4), Some("rk4")));
+    // The total mass is the body's: ρ × volume as the library builds it from the same file.
+    let mesh = topomech::io::read_mesh(Path::new("data/liver_547_v22.msh")).unwrap();
+    let (body, _) =
+        topomech::mechanics::Body::from_tets(&mesh.points, &mesh.tets, topomech::mechanics::Material::default())
+            .unwrap();
+    let mass = body.attrs().total_vertex_mass(body.map());
+    assert!((s["total_mass"].as_f64().unwrap() - mass).abs() <= 1e-12 * mass, "{s:?} vs {mass}");
+    // Gravity moved the free vertices from rest.
+    let (ke, disp) = (s["kinetic_energy"].as_f64().unwrap(), s["max_displacement"].as_f64().unwrap());
+    assert!(ke > 0.0 && ke.is_finite() && disp > 0.0 && disp.is_finite(), "{s:?}");
+    // 20 steps, a frame every 20 / 5 = 4 steps from step 0: six frames, each named by the series.
+    let pvd = std::fs::read_to_string(dir.join("frame.pvd")).expect("the series file");
+    let files: Vec<&str> = pvd.split("file=\"").skip(1).map(|r| r.split('"').next().unwrap()).collect();
+    assert_eq!(files, (0..6).map(|k| format!("frame_{k:06}.vtu")).collect::<Vec<_>>());
+    for f in &files {
+        let vtu = std::fs::read_to_string(dir.join(f)).expect("a frame the series names");
+        assert!(vtu.contains("NumberOfPoints=\"547\"") && vtu.contains("NumberOfCells=\"1852\""), "{f}");
+    }
+    // Two worker threads step the same bits; only the timing may differ.
+    let (_, two) = simulate_json(&["--pin-below", "z=-1", "--threads", "2"]);
+    for k in ["total_mass", "kinetic_energy", "max_displacement"] {
+        assert_eq!(two[k], s[k], "{k} on 2 threads");
+    }
+    // Every vertex pinned: nothing moves.
+    let (_, fixed) = simulate_json(&["--pin-below", "z=1e9"]);
+    assert_eq!((fixed["kinetic_energy"].as_f64(), fixed["max_displacement"].as_f64()), (Some(0.0), Some(0.0)));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn simulate_refuses_a_pinned_id_past_the_last_point() {
+    let out = run(&["simulate", "data/liver_547_v22.msh", "--steps", "1", "--pin", "3,547"]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("--pin: vertex 547 does not exist: the mesh has 547 points (ids 0 to 546)"),
+        "{}",
+        stderr(&out)
+    );
+    let ok = run(&["simulate", "data/liver_547_v22.msh", "--steps", "1", "--pin", "3,546"]);
+    assert!(ok.status.success(), "{}", stderr(&ok));
+}
+
+#[test]
+fn bench_step_reports_both_models_on_the_same_system() {
+    let out = run(&["bench", "step", "data/liver_547_v22.msh", "--rounds", "3", "--batch", "2", "--json"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&out)).expect("one JSON object");
+    let o = v.as_object().unwrap();
+    for k in ["map_step_us", "flat_step_us", "ratio", "springs", "vertices"] {
+        assert!(o.contains_key(k), "{k} missing: {v}");
+    }
+    assert_eq!((v["springs"].as_u64(), v["vertices"].as_u64()), (Some(2833), Some(547)));
+    let (map, flat, ratio) =
+        (v["map_step_us"].as_f64().unwrap(), v["flat_step_us"].as_f64().unwrap(), v["ratio"].as_f64().unwrap());
+    assert!(map > 0.0 && flat > 0.0 && ratio > 0.0, "{v}");
+}
+
 #[test]
 fn ambiguity_subdivide_reports_the_mixed_campaign_and_rejects_a_bad_probability() {
     let o = run(&["ambiguity", "kuhn:1", "--cuts", "2", "--sequences", "3", "--subdivide", "0.5", "--json"]);

@@ -30,7 +30,7 @@ pub struct SimulateArgs {
     /// Fix the vertices whose rest coordinate is at most VALUE, e.g. `x=0.5` or `z=-1`.
     #[arg(long, value_name = "AXIS=VALUE", value_parser = parse_pin_below)]
     pub pin_below: Option<(usize, f64)>,
-    /// Fix these vertex ids (comma-separated).
+    /// Fix these vertex ids (comma-separated; 0-based points of the file, each must exist).
     #[arg(long, value_delimiter = ',')]
     pub pin: Vec<u32>,
     /// Gravity acceleration `X,Y,Z`.
@@ -60,7 +60,7 @@ pub struct SimulateArgs {
     /// Worker threads (1 = serial; more splits the force passes, same results bit for bit).
     #[arg(long, default_value_t = 1)]
     pub threads: usize,
-    /// Write `frame_NNNNNN.vtu` files and `frames.pvd` into this directory.
+    /// Write `frame_NNNNNN.vtu` files and the series `frame.pvd` (for ParaView) into this directory.
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Frames to write when --out is given (evenly spaced, the initial state included).
@@ -110,8 +110,9 @@ fn other(e: impl std::error::Error + Send + Sync + 'static) -> CliError {
 /// JSON). Cost: O(steps · (springs + vertices)) plus the frames.
 ///
 /// # Errors
-/// [`CliError::Load`] for a bad mesh; [`CliError::Other`] for a bad material, a blow-up (naming
-/// the step and vertex), a bad thread count or an unwritable output directory.
+/// [`CliError::Load`] for a bad mesh; [`CliError::Other`] for a `--pin` id past the last point, a
+/// bad material, a blow-up (naming the step and vertex), a bad thread count or an unwritable
+/// output directory.
 pub fn run(args: SimulateArgs) -> Result<(), CliError> {
     let threads = args.threads.max(1);
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(other)?;
@@ -127,6 +128,13 @@ fn simulate(args: &SimulateArgs, parallel: bool) -> Result<(), CliError> {
     let material =
         Material { density: args.density, young: args.young, damping: args.damping, viscosity: args.viscosity };
     let (mut mesh, mut pin_ids) = (loaded.mesh, args.pin.clone());
+    // A pinned id that names no point would pin nothing, silently: refuse it.
+    if let Some(&bad) = pin_ids.iter().find(|&&v| v as usize >= mesh.points.len()) {
+        let n = mesh.points.len();
+        let msg =
+            format!("--pin: vertex {bad} does not exist: the mesh has {n} points (ids 0 to {})", n.saturating_sub(1));
+        return Err(CliError::Other(msg.into()));
+    }
     let reorders: [(bool, Renumbering); 2] =
         [(args.spatial_order, TetMesh::spatially_ordered), (args.rcm_order, TetMesh::bandwidth_ordered)];
     for (_, reorder) in reorders.into_iter().filter(|(wanted, _)| *wanted) {

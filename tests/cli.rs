@@ -415,6 +415,58 @@ fn bench_step_reports_both_models_on_the_same_system() {
 }
 
 #[test]
+fn remove_by_ball_takes_the_tets_whose_centroid_is_inside_and_writes_what_is_left() {
+    let liver = "data/liver_547_v22.msh";
+    let mesh = topomech::io::read_mesh(Path::new(liver)).unwrap();
+    let n = mesh.points.len() as f64;
+    let c: Vec<f64> = (0..3).map(|k| mesh.points.iter().map(|p| p[k]).sum::<f64>() / n).collect();
+    let r = 0.2
+        * (0..3).map(|k| mesh.points.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max) - c[k]).fold(0.0, f64::max);
+    // The expected tets, from the file alone: centroid within r of c; their mass is ρ·|V| (ρ = 2).
+    let inside: Vec<&[u32; 4]> = mesh
+        .tets
+        .iter()
+        .filter(|t| {
+            (0..3)
+                .map(|k| (t.iter().map(|&v| mesh.points[v as usize][k]).sum::<f64>() / 4.0 - c[k]).powi(2))
+                .sum::<f64>()
+                <= r * r
+        })
+        .collect();
+    assert!(inside.len() > 10 && inside.len() < mesh.tets.len() / 2, "{} tets in the ball", inside.len());
+    let p = |v: u32| mesh.points[v as usize];
+    let mass: f64 =
+        inside.iter().map(|t| 2.0 * topomech::mesh::signed_volume(p(t[0]), p(t[1]), p(t[2]), p(t[3])).abs()).sum();
+    let vtu = Path::new(env!("CARGO_TARGET_TMPDIR")).join("topomech-cli-remove-ball.vtu");
+    let _ = std::fs::remove_file(&vtu);
+    let ball = format!("{},{},{},{r}", c[0], c[1], c[2]);
+    let args = ["remove", liver, "--sphere", &ball, "--density", "2", "--out", vtu.to_str().unwrap(), "--json"];
+    let out = run(&args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&out)).expect("one JSON object");
+    let (before, after) = (&v["before"], &v["after"]);
+    assert_eq!(after["volumes"].as_u64(), Some(1852 - inside.len() as u64));
+    assert!((after["removed_mass"].as_f64().unwrap() - mass).abs() <= 1e-9 * mass, "{v}");
+    let left = before["total_mass"].as_f64().unwrap() - mass;
+    assert!((after["total_mass"].as_f64().unwrap() - left).abs() <= 1e-9 * left, "{v}");
+    assert_eq!((after["valid"].as_bool(), after["conservation_ok"].as_bool()), (Some(true), Some(true)));
+    assert!(v["timings_us"].get("write").is_some(), "{v}");
+    let written = std::fs::read_to_string(&vtu).expect("the VTU file");
+    assert!(written.contains(&format!("NumberOfCells=\"{}\"", 1852 - inside.len())), "cells of the written body");
+    // Without --json: the same figures as a table.
+    let text = run(&["remove", liver, "--sphere", &ball]);
+    assert!(text.status.success(), "{}", stderr(&text));
+    let table = stdout(&text);
+    assert!(
+        table.contains("cells V/E/F/T  547/2833/4139/1852 -> ")
+            && table.contains(&format!("/{}\n", 1852 - inside.len())),
+        "{table}"
+    );
+    assert!(table.contains("valid true  conservation true"), "{table}");
+    let _ = std::fs::remove_file(&vtu);
+}
+
+#[test]
 fn ambiguity_subdivide_reports_the_mixed_campaign_and_rejects_a_bad_probability() {
     let o = run(&["ambiguity", "kuhn:1", "--cuts", "2", "--sequences", "3", "--subdivide", "0.5", "--json"]);
     assert!(o.status.success(), "{}", stderr(&o));

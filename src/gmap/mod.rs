@@ -769,4 +769,25 @@ mod tests {
         check_rows(&map, 0, 65, |d| ([d; 3], [d; 3]));
         assert!(!map.contains(DartId(65)) && map.darts().count() == 65);
     }
+
+    /// The net under every public mutation: a broken law next to the darts an operation touches
+    /// is caught by `after_mutation` (local checks in debug builds, the full `validate()` under
+    /// `expensive-checks`), and the operation panics naming the law, instead of returning as if
+    /// the map were valid. The law is broken with a raw write (no public operation can break it),
+    /// then two triangles are 2-sewn next to it. Builds with neither check do nothing there.
+    #[test]
+    #[cfg(any(debug_assertions, feature = "expensive-checks"))]
+    #[should_panic(expected = "invariant broken after a mutation")]
+    fn a_mutation_next_to_a_broken_law_panics() {
+        let (mut map, _) = GMap::<2>::from_triangles(6, &[[0, 1, 2], [3, 4, 5]]).unwrap();
+        let x = DartId(0);
+        let y = map.darts().find(|&d| map.cell_id(2, d) != map.cell_id(2, x)).unwrap();
+        assert!(map.is_sewable::<2>(x, y));
+        // α1(x) is in x's face orbit ⟨α0, α1⟩ but now names another face; the 2-sew of x leaves
+        // faces alone, so only the check can notice.
+        let neighbour = map.alpha::<1>(x);
+        let other = map.cell_id(2, y).0;
+        map.set_cell_raw(2, neighbour, other);
+        let _ = map.sew::<2>(x, y);
+    }
 }

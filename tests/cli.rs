@@ -412,6 +412,17 @@ fn bench_step_reports_both_models_on_the_same_system() {
     let (map, flat, ratio) =
         (v["map_step_us"].as_f64().unwrap(), v["flat_step_us"].as_f64().unwrap(), v["ratio"].as_f64().unwrap());
     assert!(map > 0.0 && flat > 0.0 && ratio > 0.0, "{v}");
+    // `bench order`: the flat model under two point orders and on 2 threads, one small round.
+    let out = run(&["bench", "order", "data/liver_547_v22.msh", "--rounds", "1", "--batch", "1", "--json"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&out)).expect("one JSON object");
+    for k in ["zorder_step_us", "rcm_step_us", "rcm_2_threads_step_us", "rcm_over_zorder", "speedup_2_threads"] {
+        assert!(v[k].as_f64().is_some_and(|x| x > 0.0 && x.is_finite()), "{k}: {v}");
+    }
+    assert_eq!((v["springs"].as_u64(), v["vertices"].as_u64()), (Some(2833), Some(547)));
+    let per_spring = v["rcm_step_us"].as_f64().unwrap() * 1e3 / 2833.0;
+    assert!((v["rcm_ns_per_spring"].as_f64().unwrap() - per_spring).abs() <= 1e-9 * per_spring, "{v}");
+    assert!(["portable", "avx2", "avx512"].contains(&v["kernel"].as_str().unwrap()), "{v}");
 }
 
 #[test]

@@ -333,3 +333,40 @@ fn the_refine_command_reports_the_conforming_closure_and_the_cut_error() {
         assert!(err.contains(needle) && !err.contains("panicked"), "{plane}: {err}");
     }
 }
+
+/// `NumberOfCells` of a VTU file written by topomech.
+fn vtu_cells(path: &std::path::Path) -> u64 {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let at = text.find("NumberOfCells=\"").expect("a piece header") + "NumberOfCells=\"".len();
+    text[at..].split('"').next().unwrap().parse().unwrap()
+}
+
+#[test]
+fn the_refine_command_writes_the_refined_and_conforming_meshes_and_a_table_of_the_same_figures() {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("topomech-refine-out");
+    let _ = std::fs::remove_dir_all(&dir);
+    let common =
+        ["refine", &liver_path(), "--around", "-2.2,3.2,0.6", "--radius", "0.5", "--levels", "2", "--conforming"];
+    let json = Command::new(BIN).args(common).arg("--json").output().unwrap();
+    assert!(json.status.success(), "{}", String::from_utf8_lossy(&json.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
+    let levels: Vec<u64> = v["tets_per_level"].as_array().unwrap().iter().map(|x| x.as_u64().unwrap()).collect();
+    assert_eq!(levels.len(), 3, "{v}");
+    let table = Command::new(BIN).args(common).arg("--out").arg(&dir).output().unwrap();
+    assert!(table.status.success(), "{}", String::from_utf8_lossy(&table.stderr));
+    let text = String::from_utf8_lossy(&table.stdout);
+    // The table states the JSON's figures (the refinement is deterministic).
+    let row = |label: &str| {
+        let line =
+            text.lines().find(|l| l.trim_start().starts_with(label)).unwrap_or_else(|| panic!("{label}: {text}"));
+        line.trim_start()[label.len()..].trim().to_string()
+    };
+    assert_eq!(row("tets per level"), format!("{levels:?}"));
+    assert_eq!(row("darts"), v["darts"].to_string());
+    assert_eq!(row("valid / μ order / levels"), "true / true / true");
+    assert_eq!(row("conforming tets"), v["conforming_tets"].to_string());
+    // refined.vtu holds the finest level's tets, conforming.vtu the closure's.
+    assert_eq!(vtu_cells(&dir.join("refined.vtu")), *levels.last().unwrap());
+    assert_eq!(vtu_cells(&dir.join("conforming.vtu")), v["conforming_tets"].as_u64().unwrap());
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -478,6 +478,33 @@ fn remove_by_ball_takes_the_tets_whose_centroid_is_inside_and_writes_what_is_lef
 }
 
 #[test]
+fn ambiguity_writes_replayable_vectors_and_prints_its_table() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("topomech-cli-vectors");
+    let _ = std::fs::remove_dir_all(&dir);
+    let args = ["ambiguity", "kuhn:2", "--cuts", "4", "--sequences", "30", "--write-vectors", dir.to_str().unwrap()];
+    let out = run(&args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let table = stdout(&out);
+    assert!(table.starts_with("kuhn:2 (48 tets), seed 1\n") && table.contains("sequences_tried 30"), "{table}");
+    // Every file written is a vector that replays: the g-map and the indexed model rerun from
+    // its cuts and disagree as it records.
+    let mut files: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).collect();
+    files.sort();
+    assert!(!files.is_empty(), "the campaign's findings were written");
+    for f in &files {
+        let text = std::fs::read_to_string(f).unwrap();
+        let v: topomech::ambiguity::vector::Vector =
+            serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", f.display()));
+        assert_eq!(f.file_name().unwrap().to_str().unwrap(), format!("{}.json", v.name()));
+        v.check().unwrap_or_else(|e| panic!("{}: {e}", f.display()));
+    }
+    let bad = run(&["ambiguity", "kuhn:17"]);
+    assert_eq!(bad.status.code(), Some(1));
+    assert!(stderr(&bad).contains("kuhn:K needs K in 1..=16"), "{}", stderr(&bad));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn ambiguity_subdivide_reports_the_mixed_campaign_and_rejects_a_bad_probability() {
     let o = run(&["ambiguity", "kuhn:1", "--cuts", "2", "--sequences", "3", "--subdivide", "0.5", "--json"]);
     assert!(o.status.success(), "{}", stderr(&o));

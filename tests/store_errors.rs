@@ -309,3 +309,72 @@ fn a_checksum_cut_short_is_truncated_not_a_panic() {
         }
     }
 }
+
+/// The text file of `two_tets()` with row `d`'s field `k` (0 = the dart, 1..=4 its α0..α3, then
+/// "|", 6..=9 its cell ids) set to `value`, for each `(d, k, value)`.
+fn edited_rows(edits: &[(u32, usize, u32)]) -> String {
+    let text = String::from_utf8(store::encode(&Document::from_map(&two_tets()), Format::Text).unwrap()).unwrap();
+    let mut done = 0;
+    let rows: Vec<String> = text
+        .lines()
+        .map(|l| {
+            let mut t: Vec<String> = l.split_whitespace().map(str::to_string).collect();
+            if t.get(5).map(String::as_str) == Some("|") {
+                let row = t[0].clone();
+                for &(_, k, value) in edits.iter().filter(|e| row == e.0.to_string()) {
+                    t[k] = value.to_string();
+                    done += 1;
+                }
+                return t.join(" ");
+            }
+            l.to_string()
+        })
+        .collect();
+    assert_eq!(done, edits.len(), "every edited row exists");
+    rows.join("\n") + "\n"
+}
+
+/// `topomech check --json` on `text`: exit code and the (law, darts) of each finding.
+fn check_findings(name: &str, text: &str) -> (Option<i32>, Vec<(String, Vec<u64>)>) {
+    let path = std::env::temp_dir().join(format!("topomech-check-{name}-{}.tmap", std::process::id()));
+    std::fs::write(&path, text).unwrap();
+    let out = topomech().args(["check", "--json", path.to_str().unwrap()]).output().unwrap();
+    std::fs::remove_file(&path).unwrap();
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let findings = json["findings"].as_array().unwrap().iter();
+    let listed = findings
+        .map(|f| {
+            (
+                f["law"].as_str().unwrap().to_string(),
+                f["darts"].as_array().unwrap().iter().map(|d| d.as_u64().unwrap()).collect(),
+            )
+        })
+        .collect();
+    (out.status.code(), listed)
+}
+
+#[test]
+fn check_names_the_quasi_manifold_and_cell_id_laws_with_their_darts() {
+    let map = two_tets();
+    // Two α3 pairs whose first darts are α0-linked, re-paired crosswise: α3 stays an involution,
+    // α0α3 does not (the quasi-manifold law of j = i + 3).
+    let x = map.darts().find(|&d| !map.is_free(3, d)).unwrap();
+    let (x2, y, y2) = (map.alpha::<0>(x), map.alpha::<3>(x), map.alpha::<3>(map.alpha::<0>(x)));
+    let crossed = edited_rows(&[(x.0, 4, y2.0), (y2.0, 4, x.0), (x2.0, 4, y.0), (y.0, 4, x2.0)]);
+    let (code, findings) = check_findings("crossed", &crossed);
+    assert_eq!(code, Some(1));
+    assert!(findings.iter().all(|(law, _)| law == "quasi_manifold" || law.starts_with("cell_id")), "{findings:?}");
+    let qm: Vec<_> = findings.iter().filter(|(law, _)| law == "quasi_manifold").collect();
+    assert!(qm.iter().any(|(_, darts)| darts[0] == u64::from(x.0)), "{findings:?}");
+    // One dart given the vertex id of another vertex: its id differs from its orbit's
+    // (cell_id_constant, naming it and a neighbour), and the id now names two vertices.
+    let d = DartId(0);
+    let other = map.darts().map(|e| map.vertex_id(e)).find(|&v| v != map.vertex_id(d)).unwrap();
+    let (code, findings) = check_findings("vertex-id", &edited_rows(&[(d.0, 6, other.0)]));
+    assert_eq!(code, Some(1));
+    let constant: Vec<_> = findings.iter().filter(|(law, _)| law == "cell_id_constant").collect();
+    assert!(!constant.is_empty() && constant.iter().all(|(_, darts)| darts.len() == 2), "{findings:?}");
+    assert!(constant.iter().any(|(_, darts)| darts.contains(&0)), "{findings:?}");
+    assert!(findings.iter().any(|(law, darts)| law == "cell_id_unique" && darts.contains(&0)), "{findings:?}");
+    assert!(findings.iter().all(|(law, _)| law.starts_with("cell_id")), "{findings:?}");
+}

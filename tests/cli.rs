@@ -505,6 +505,36 @@ fn ambiguity_writes_replayable_vectors_and_prints_its_table() {
 }
 
 #[test]
+fn tear_splits_stressed_vertices_and_keeps_mass_stiffness_and_the_map_laws() {
+    let liver = "data/liver_547_v22.msh";
+    let tear = |threshold: &str| {
+        let out = run(&["tear", liver, "--threshold", threshold, "--steps", "3", "--json"]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        serde_json::from_str::<serde_json::Value>(&stdout(&out)).expect("one JSON object")
+    };
+    // Every stressed vertex is over a zero threshold: faces are dissociated, the body keeps all
+    // its tets, its mass and its summed stiffness (Kirchhoff), and every dissociated inner face
+    // leaves two boundary faces.
+    let v = tear("0");
+    let (b, a) = (&v["before"], &v["after"]);
+    let faces = v["cut_faces"].as_u64().unwrap();
+    assert!(faces > 0, "{v}");
+    assert!(a["vertices"].as_u64() > b["vertices"].as_u64(), "{v}");
+    assert_eq!(a["volumes"], b["volumes"]);
+    assert_eq!(a["boundary_faces"].as_u64(), Some(b["boundary_faces"].as_u64().unwrap() + 2 * faces));
+    for k in ["total_mass", "stiffness_sum"] {
+        let (x, y) = (b[k].as_f64().unwrap(), a[k].as_f64().unwrap());
+        assert!((x - y).abs() <= 1e-12 * x, "{k}: {x} -> {y}");
+    }
+    assert_eq!((a["valid"].as_bool(), a["conservation_ok"].as_bool()), (Some(true), Some(true)));
+    assert!(v["timings_us"].get("tear").is_some() && v["timings_us"].get("steps").is_some(), "{v}");
+    // No vertex is that stressed: nothing is torn and the body is as it was.
+    let v = tear("1e30");
+    assert_eq!(v["cut_faces"], 0);
+    assert_eq!(v["after"], v["before"]);
+}
+
+#[test]
 fn ambiguity_subdivide_reports_the_mixed_campaign_and_rejects_a_bad_probability() {
     let o = run(&["ambiguity", "kuhn:1", "--cuts", "2", "--sequences", "3", "--subdivide", "0.5", "--json"]);
     assert!(o.status.success(), "{}", stderr(&o));

@@ -405,3 +405,57 @@ fn squeeze(text: &str) -> String {
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::flatten_scalar_arrays;
+    use proptest::prelude::*;
+    use serde_json::{json, Value};
+
+    /// JSON values whose strings hold the characters the flattener must step over: quotes,
+    /// backslashes, brackets, commas, spaces and newlines.
+    fn values() -> impl Strategy<Value = Value> {
+        let text = || proptest::string::string_regex("[a-c \\[\\]{},:\"\\\\\n]{0,8}").unwrap();
+        let leaf = prop_oneof![
+            any::<i32>().prop_map(Value::from),
+            any::<bool>().prop_map(Value::from),
+            text().prop_map(Value::from),
+            Just(Value::Null),
+        ];
+        leaf.prop_recursive(4, 40, 5, move |inner| {
+            prop_oneof![
+                proptest::collection::vec(inner.clone(), 0..5).prop_map(Value::Array),
+                proptest::collection::btree_map(text(), inner, 0..4)
+                    .prop_map(|m| Value::Object(m.into_iter().collect())),
+            ]
+        })
+    }
+
+    /// An array with no array or object inside is on one line; other lines keep their indent.
+    #[test]
+    fn scalar_arrays_go_on_one_line_and_strings_are_untouched() {
+        // `\" ]`: a quote that does not end its string, then a bracket that closes nothing.
+        let tricky = "q\\\" ] [ \\\\\" {";
+        let v = json!({"a [b]": ["x, \"y\" ]", "\\", 1], "nested": [[1, 2], {"k": [true, null]}], "e": [], "t": [tricky, [tricky]]});
+        let flat = flatten_scalar_arrays(&serde_json::to_string_pretty(&v).unwrap());
+        assert_eq!(serde_json::from_str::<Value>(&flat).unwrap(), v);
+        assert!(flat.contains(r#""a [b]": ["x, \"y\" ]", "\\", 1]"#), "{flat}");
+        assert!(flat.contains(r#"[1, 2]"#) && flat.contains(r#""k": [true, null]"#), "{flat}");
+        assert!(flat.contains("\"e\": []"), "{flat}");
+        assert!(flat.contains(&format!("[{}]", serde_json::to_string(tricky).unwrap())), "{flat}");
+    }
+
+    proptest! {
+        /// The flattened text is the same JSON value: only whitespace outside strings changed.
+        #[test]
+        fn flattening_keeps_the_value(v in values()) {
+            let pretty = serde_json::to_string_pretty(&v).unwrap();
+            let flat = flatten_scalar_arrays(&pretty);
+            prop_assert_eq!(serde_json::from_str::<Value>(&flat).unwrap(), v);
+            let squeeze = |s: &str| s.chars().filter(|c| !c.is_whitespace()).collect::<String>();
+            // Equal up to whitespace (whitespace inside strings included, so this also shows
+            // that no string lost or gained a character).
+            prop_assert_eq!(squeeze(&flat), squeeze(&pretty));
+        }
+    }
+}

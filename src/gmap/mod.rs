@@ -759,6 +759,10 @@ mod tests {
         check_rows(&map, 180, 310, pushed);
         check_rows(&map, 70, 180, free); // the earlier darts are untouched
         assert!(!map.contains(DartId(310)) && map.darts().count() == 310);
+        // The liveness words end with the slots: no bit past the last one (a later slot appended
+        // by a raw writer must not find itself live already).
+        assert_eq!(map.alive.len(), 310usize.div_ceil(64));
+        assert_eq!(map.alive[4] >> (310 % 64), 0, "liveness bits past the last slot");
         let (alpha, _) = map.rows_mut_raw();
         alpha[3 * 75] = 76;
         alpha[3 * 76] = 75;

@@ -429,3 +429,35 @@ fn mechanics_and_levels_sections_coexist() {
         assert_eq!(back, doc, "{format:?}");
     }
 }
+
+/// `topomech check` on a leveled file whose level-0 link history was broken by hand (as in
+/// `a_broken_history_breaks_a_level_and_check_names_it`): it exits 1 and names a level law at
+/// the broken dart, with the leveled map's dart ids, in JSON and in the table.
+#[test]
+fn check_command_names_a_broken_level_with_the_leveled_darts() {
+    let mut m = grid(1);
+    apply(&mut m, &[(0, 1, true)]);
+    let mut doc = Document::from_leveled(&m);
+    let levels = doc.levels.as_mut().unwrap();
+    let (d, rec) = levels
+        .darts
+        .iter_mut()
+        .enumerate()
+        .find(|(d, r)| r.level == 0 && r.history.iter().any(|h| h.old as usize != *d))
+        .unwrap();
+    rec.history.iter_mut().find(|h| h.old as usize != d).unwrap().old = d as u32;
+    let path = std::env::temp_dir().join(format!("topomech-broken-level-{}.tmap", std::process::id()));
+    store::save_document(&doc, &path, Format::Text).unwrap();
+    let out = topomech().args(["check", "--json", path.to_str().unwrap()]).output().unwrap();
+    assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let findings = json["findings"].as_array().unwrap();
+    let level_law = |f: &serde_json::Value| ["level_valid", "level_closed"].contains(&f["law"].as_str().unwrap_or(""));
+    assert!(findings.iter().all(level_law), "only level laws are broken: {json}");
+    let at_d = |f: &&serde_json::Value| f["darts"].as_array().unwrap().iter().any(|x| x.as_u64() == Some(d as u64));
+    let named = findings.iter().find(at_d).unwrap_or_else(|| panic!("no finding names dart {d}: {json}"));
+    let out = topomech().args(["check", path.to_str().unwrap()]).output().unwrap();
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(table.contains("INVALID") && table.contains(&format!("[{}]", named["law"].as_str().unwrap())), "{table}");
+    std::fs::remove_file(&path).unwrap();
+}

@@ -288,22 +288,27 @@ fn a_broken_mu_order_is_refused_by_load_and_listed_by_check() {
             if dart.0 == d || other.0 == d)));
 }
 
-#[test]
-fn a_broken_history_breaks_a_level_and_check_names_it() {
+/// A refined 1×1 grid whose level-0 history is broken at one dart d: a dart of level 0 whose link
+/// at level 0 (remembered in its history) went to another dart is made to remember itself
+/// instead, so G_0 is no longer an involution at d and its partner. Returns the file and d.
+fn broken_level_history() -> (Document, usize) {
     let mut m = grid(1);
     apply(&mut m, &[(0, 1, true)]);
     let mut doc = Document::from_leveled(&m);
     let levels = doc.levels.as_mut().unwrap();
-    // A dart of level 0 whose link at level 0 (remembered in its history) went to another dart:
-    // make it remember itself instead, so G_0 is no longer an involution at d and its partner.
     let (d, rec) = levels
         .darts
         .iter_mut()
         .enumerate()
         .find(|(d, r)| r.level == 0 && r.history.iter().any(|h| h.old as usize != *d))
         .unwrap();
-    let h = rec.history.iter_mut().find(|h| h.old as usize != d).unwrap();
-    h.old = d as u32;
+    rec.history.iter_mut().find(|h| h.old as usize != d).unwrap().old = d as u32;
+    (doc, d)
+}
+
+#[test]
+fn a_broken_history_breaks_a_level_and_check_names_it() {
+    let (doc, d) = broken_level_history();
     let report = store::check_all_laws(&doc, 100);
     assert!(!report.valid);
     let names_d = |ds: &[DartId]| ds.iter().any(|x| x.index() == d);
@@ -430,22 +435,12 @@ fn mechanics_and_levels_sections_coexist() {
     }
 }
 
-/// `topomech check` on a leveled file whose level-0 link history was broken by hand (as in
-/// `a_broken_history_breaks_a_level_and_check_names_it`): it exits 1 and names a level law at
-/// the broken dart, with the leveled map's dart ids, in JSON and in the table.
+/// `topomech check` on a leveled file whose level-0 link history was broken by hand
+/// ([`broken_level_history`]): it exits 1 and names a level law at the broken dart, with the
+/// leveled map's dart ids, in JSON and in the table.
 #[test]
 fn check_command_names_a_broken_level_with_the_leveled_darts() {
-    let mut m = grid(1);
-    apply(&mut m, &[(0, 1, true)]);
-    let mut doc = Document::from_leveled(&m);
-    let levels = doc.levels.as_mut().unwrap();
-    let (d, rec) = levels
-        .darts
-        .iter_mut()
-        .enumerate()
-        .find(|(d, r)| r.level == 0 && r.history.iter().any(|h| h.old as usize != *d))
-        .unwrap();
-    rec.history.iter_mut().find(|h| h.old as usize != d).unwrap().old = d as u32;
+    let (doc, d) = broken_level_history();
     let path = std::env::temp_dir().join(format!("topomech-broken-level-{}.tmap", std::process::id()));
     store::save_document(&doc, &path, Format::Text).unwrap();
     let out = topomech().args(["check", "--json", path.to_str().unwrap()]).output().unwrap();

@@ -14,7 +14,7 @@ use topomech::mechanics::{check_conservation, Body, Integrator, Material, Simula
 use topomech::vtk::{body_tets, Frame};
 use topomech::CellId;
 
-use super::{parse_finite, print_warnings, CliError};
+use super::{check_ids, parse_finite, print_warnings, CliError};
 
 /// Options shared by the three subcommands.
 #[derive(Debug, Clone, clap::Args)]
@@ -187,13 +187,7 @@ pub fn run_remove(args: RemoveArgs) -> Result<(), CliError> {
     // A fresh body's volume ids are the tets' positions in the file: check them all before the
     // first removal, so that a bad id is named as such (not as "already removed" after an
     // earlier part of the list went through).
-    if let Some(&bad) = args.tets.iter().find(|&&id| id as usize >= before.volumes) {
-        let n = before.volumes;
-        return Err(CliError::Other(
-            format!("--tets: tet {bad} does not exist: the mesh has {n} tets (ids 0 to {})", n.saturating_sub(1))
-                .into(),
-        ));
-    }
+    check_ids("--tets", ("tet", "tets"), &args.tets, before.volumes)?;
     let mut ids: Vec<u32> = args.tets.clone();
     if let Some([x, y, z, r]) = args.sphere {
         if !(r.is_finite() && r >= 0.0) {

@@ -159,6 +159,19 @@ impl Characteristics {
     }
 }
 
+/// Refuses the first of `ids` that is not below `n`, naming the flag, the id and the range
+/// (e.g. `--pin: vertex 547 does not exist: the mesh has 547 points (ids 0 to 546)`), so that a
+/// bad id is neither ignored nor reported as something else later. O(ids).
+pub(crate) fn check_ids(flag: &str, (one, many): (&str, &str), ids: &[u32], n: usize) -> Result<(), CliError> {
+    match ids.iter().find(|&&id| id as usize >= n) {
+        Some(bad) => Err(CliError::Other(
+            format!("{flag}: {one} {bad} does not exist: the mesh has {n} {many} (ids 0 to {})", n.saturating_sub(1))
+                .into(),
+        )),
+        None => Ok(()),
+    }
+}
+
 /// One number of a command-line value: NaN and ±∞ are refused with the value named (they
 /// would run silently or blow up far from the argument that caused it).
 pub(crate) fn parse_finite(t: &str) -> Result<f64, String> {

@@ -11,7 +11,7 @@ use topomech::mechanics::{Body, Integrator, Material, PinSpec, Simulation, StepC
 use topomech::mesh::TetMesh;
 use topomech::vtk::{body_tets, Frame, Series};
 
-use super::{parse_finite, parse_vec3, print_warnings, CliError};
+use super::{check_ids, parse_finite, parse_vec3, print_warnings, CliError};
 
 /// Arguments of `topomech simulate`.
 #[derive(Debug, Clone, clap::Args)]
@@ -129,12 +129,7 @@ fn simulate(args: &SimulateArgs, parallel: bool) -> Result<(), CliError> {
         Material { density: args.density, young: args.young, damping: args.damping, viscosity: args.viscosity };
     let (mut mesh, mut pin_ids) = (loaded.mesh, args.pin.clone());
     // A pinned id that names no point would pin nothing, silently: refuse it.
-    if let Some(&bad) = pin_ids.iter().find(|&&v| v as usize >= mesh.points.len()) {
-        let n = mesh.points.len();
-        let msg =
-            format!("--pin: vertex {bad} does not exist: the mesh has {n} points (ids 0 to {})", n.saturating_sub(1));
-        return Err(CliError::Other(msg.into()));
-    }
+    check_ids("--pin", ("vertex", "points"), &pin_ids, mesh.points.len())?;
     let reorders: [(bool, Renumbering); 2] =
         [(args.spatial_order, TetMesh::spatially_ordered), (args.rcm_order, TetMesh::bandwidth_ordered)];
     for (_, reorder) in reorders.into_iter().filter(|(wanted, _)| *wanted) {

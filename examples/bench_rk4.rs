@@ -13,6 +13,13 @@
 //! of the minima. With `TOPOMECH_BENCH_THREADS=T` (T > 1) the steps run in parallel on a pool of
 //! T threads and the figures are wall-clock (the calling thread's CPU time would miss the
 //! workers).
+//!
+//! With `floor` in place of `ab`, the batches alternate between the RK4 step and a **floor**: the
+//! one square root and one division per spring and stage that the spring scale needs
+//! (s = (k (l − L) l + c d·ḋ) / l², l = √l²), four stages per step, in a loop that does nothing
+//! else (no loads of positions, no sums, no state update), compiled for AVX-512 or AVX2 when the
+//! CPU has them. No RK4 step on IEEE doubles with correctly rounded √ and ÷ can take less; the
+//! ratio step / floor says how much of the step the divider alone explains.
 
 use std::path::Path;
 
@@ -57,6 +64,9 @@ fn main() {
     let mut stepper =
         Box::new(Stepper::new(config, &flat.system, &flat.position, &flat.velocity).expect("the stepper builds"));
     let ab = args.get(3).is_some_and(|s| s == "ab");
+    if args.get(3).is_some_and(|s| s == "floor") {
+        return step_against_floor(&mut flat, &mut stepper, batches, steps);
+    }
     let paths: &[bool] = if ab { &[true, false] } else { &[true] };
     let mut per_step = vec![Vec::with_capacity(batches); paths.len()];
     for batch in 0..batches {
@@ -101,5 +111,92 @@ fn main() {
     }
     if ab {
         println!("[rk4 ab] sums / gather (minima): {:.3}", minima[0] / minima[1]);
+    }
+}
+
+/// `floor` mode: RK4 steps and the √/÷ floor alternated batch by batch (module docs).
+fn step_against_floor(flat: &mut FlatModel, stepper: &mut Stepper, batches: usize, steps: usize) {
+    let sys = &flat.system;
+    let l2: Vec<f64> = sys
+        .ends
+        .iter()
+        .map(|&[a, b]| {
+            let (p, q) = (flat.position[a as usize], flat.position[b as usize]);
+            (0..3).map(|c| (q[c] - p[c]) * (q[c] - p[c])).sum()
+        })
+        .collect();
+    let damped: Vec<f64> = sys.damping.iter().map(|c| 0.25 * c).collect();
+    let mut scale = vec![0.0; l2.len()];
+    let (mut step_us, mut floor_us) = (f64::INFINITY, f64::INFINITY);
+    for _ in 0..batches {
+        let t0 = now();
+        for _ in 0..steps {
+            stepper.step(&flat.system, &mut flat.position, &mut flat.velocity).expect("the step is finite");
+        }
+        step_us = step_us.min((now() - t0) * 1e6 / steps as f64);
+        let t0 = now();
+        for _ in 0..4 * steps {
+            floor::scales(&l2, &flat.system.rest, &flat.system.stiffness, &damped, &mut scale);
+            std::hint::black_box(&mut scale);
+        }
+        floor_us = floor_us.min((now() - t0) * 1e6 / steps as f64);
+    }
+    let springs = flat.system.springs() as f64;
+    println!(
+        "[rk4 floor] springs {springs} kernel {}: step min {step_us:.2} us, sqrt+div floor ({}) min {floor_us:.2} us \
+         ({:.2} ns per spring and stage), step / floor {:.2}",
+        stepper.kernel().name(),
+        floor::isa(),
+        floor_us * 1e3 / (4.0 * springs),
+        step_us / floor_us
+    );
+}
+
+/// The √/÷ floor of the spring scale, compiled for the widest vectors the CPU has.
+mod floor {
+    /// s_j = (k_j (l_j − L_j) l_j + c_j) / l²_j with l_j = √l²_j: one √ and one ÷ per spring.
+    #[inline(always)]
+    fn body(l2: &[f64], rest: &[f64], k: &[f64], c: &[f64], out: &mut [f64]) {
+        let n = l2.len().min(rest.len()).min(k.len()).min(c.len()).min(out.len());
+        for j in 0..n {
+            let l = l2[j].sqrt();
+            out[j] = (k[j] * (l - rest[j]) * l + c[j]) / l2[j].max(f64::MIN_POSITIVE);
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512vl,avx2,fma")]
+    fn avx512(l2: &[f64], rest: &[f64], k: &[f64], c: &[f64], out: &mut [f64]) {
+        body(l2, rest, k, c, out)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    fn avx2(l2: &[f64], rest: &[f64], k: &[f64], c: &[f64], out: &mut [f64]) {
+        body(l2, rest, k, c, out)
+    }
+
+    pub fn isa() -> &'static str {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if is_x86_feature_detected!("avx512f") && is_x86_feature_detected!("avx512vl") {
+                return "avx512";
+            }
+            if is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma") {
+                return "avx2";
+            }
+        }
+        "baseline"
+    }
+
+    pub fn scales(l2: &[f64], rest: &[f64], k: &[f64], c: &[f64], out: &mut [f64]) {
+        #[cfg(target_arch = "x86_64")]
+        match isa() {
+            // SAFETY: the CPU has the features each function is compiled for (checked by `isa`).
+            "avx512" => return unsafe { avx512(l2, rest, k, c, out) },
+            "avx2" => return unsafe { avx2(l2, rest, k, c, out) },
+            _ => {}
+        }
+        body(l2, rest, k, c, out)
     }
 }

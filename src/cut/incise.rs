@@ -187,3 +187,24 @@ pub(crate) fn dissociate_all(body: &mut Body, faces: Vec<DartId>) -> Result<Inci
     }
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The side rule is strict: a point on the plane (a tet centroid there, say) is not on the
+    /// positive side, whatever the normal's length or sign, and the nearest doubles off the
+    /// plane are on the side the normal says.
+    #[test]
+    fn a_point_on_the_plane_is_not_positive() {
+        let point = [0.25, 0.5, 0.75];
+        let above = [0.25, 0.5, f64::from_bits(0.75f64.to_bits() + 1)];
+        let below = [0.25, 0.5, f64::from_bits(0.75f64.to_bits() - 1)];
+        for normal in [[0.0, 0.0, 1.0], [1.0, -2.0, 0.5], [0.0, 0.0, -3.0], [4.0, 0.0, 0.0]] {
+            let plane = Plane { point, normal };
+            assert!(!plane.positive(point), "on the plane, normal {normal:?}");
+            assert_eq!(plane.positive(above), normal[2] > 0.0, "one ulp above, normal {normal:?}");
+            assert_eq!(plane.positive(below), normal[2] < 0.0, "one ulp below, normal {normal:?}");
+        }
+    }
+}

@@ -438,4 +438,25 @@ mod tests {
             assert!(checked > 100);
         }
     }
+
+    /// The start face's normal is the geometric one: the star of the centre vertex of the
+    /// 2×2×2 Kuhn cube holds faces in the three axis planes through it, and for a direction
+    /// along an axis the fan must start on a face of the plane normal to it (checked on the
+    /// face's corner positions, not with the code's own normals, which the test above uses on
+    /// both sides).
+    #[test]
+    fn the_fan_starts_on_a_face_normal_to_the_direction() {
+        let (points, tets) = crate::generate::kuhn_cube(2);
+        let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+        let (map, position) = (body.map(), &body.attrs().position);
+        let centre = map.darts().find(|&d| position[map.vertex_id(d)] == [1.0; 3]).unwrap();
+        for axis in 0..3 {
+            let mut direction = [0.0; 3];
+            direction[axis] = 1.0;
+            let mut copy = body.clone();
+            let tear = tear_vertex(&mut copy, map.vertex_id(centre), direction, Some(centre)).unwrap();
+            let corners = triangle_vertices(map, tear.fan[0]).unwrap().map(|v| position[v]);
+            assert!(corners.iter().all(|p| p[axis] == 1.0), "axis {axis}: first fan face {corners:?}");
+        }
+    }
 }

@@ -130,6 +130,7 @@ fn spring_sums_and_the_gather_step_the_same_bits_on_every_kernel_and_thread_coun
                 let mut stepper = Stepper::new(config, &sys, &x, &v).unwrap();
                 stepper.set_kernel(kernel);
                 stepper.set_spring_sums(sums);
+                assert_eq!(stepper.takes_spring_sums(&sys), sums && sorted, "{name}: the path compared");
                 for _ in 0..2 {
                     stepper.step(&sys, &mut x, &mut v).unwrap();
                 }
@@ -296,6 +297,41 @@ fn rk4_reports_a_runaway_at_the_most_energetic_slot_and_a_nan_at_its_slot() {
                 assert!((0..slot).all(|i| x[i].iter().chain(&v[i]).all(|c| c.is_finite())), "first bad slot");
             }
             other => panic!("infinity not reported with {}: {other:?}", kernel.name()),
+        }
+    }
+}
+
+/// The runaway law is strict: a kinetic energy *equal* to `runaway_factor` × the starting energy
+/// scale is not a blow-up, one just above it is. Two free unit-speed slots of mass 2 with no
+/// spring, no gravity and no viscosity keep their kinetic energy 2 exactly under every scheme,
+/// and their energy scale is that same 2, so the limit is met with equality at factor 1.
+#[test]
+fn a_kinetic_energy_at_the_runaway_limit_is_not_a_blow_up() {
+    let mut sys = SpringSystem::default();
+    sys.gravity = [0.0; 3];
+    for _ in 0..2 {
+        sys.push_slot(2.0, false, 0.0);
+    }
+    let x0: Vec<Vec3> = vec![[0.0; 3], [1.0, 0.0, 0.0]];
+    let v0: Vec<Vec3> = vec![[1.0, 0.0, 0.0], [0.0, -1.0, 0.0]];
+    assert_eq!(sys.kinetic_energy(&v0), 2.0);
+    let schemes = [Integrator::Euler, Integrator::Symplectic, Integrator::Rk4, Integrator::Implicit];
+    for (integrator, kernel) in schemes.into_iter().flat_map(|s| Kernel::available().into_iter().map(move |k| (s, k))) {
+        let run = |factor: f64| {
+            let mut config = StepConfig::new(integrator, 1e-2);
+            config.runaway_factor = factor;
+            let mut stepper = Stepper::new(config, &sys, &x0, &v0).unwrap();
+            stepper.set_kernel(kernel);
+            let (mut x, mut v) = (x0.clone(), v0.clone());
+            let outcome = stepper.step(&sys, &mut x, &mut v);
+            (outcome, v)
+        };
+        let (at_limit, v) = run(1.0);
+        assert_eq!(v, v0, "{integrator:?}: no force, so the velocities stay exactly");
+        assert!(at_limit.is_ok(), "{integrator:?} with {}: energy at the limit: {at_limit:?}", kernel.name());
+        match run(1.0 - f64::EPSILON).0 {
+            Err(StepError::BlowUp { step: 0, reason, .. }) => assert!(reason.contains("runaway"), "{reason}"),
+            other => panic!("{integrator:?} with {}: energy above the limit not reported: {other:?}", kernel.name()),
         }
     }
 }

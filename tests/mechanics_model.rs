@@ -307,3 +307,50 @@ fn unsew3_of_a_boundary_dart_is_refused_and_changes_nothing() {
     assert_eq!(body.version(), version);
     check_conservation(body.map(), body.attrs()).unwrap();
 }
+
+/// The merge rule of vertex state (the inverse of a split): when a sew joins two vertices, the
+/// kept one takes the mass-weighted mean of both positions and velocities and is pinned if
+/// either side was. Checked on the plane x = 1 of a 2-cube after its two halves were moved,
+/// given different velocities and one side pinned.
+#[test]
+fn sew3_merges_vertices_by_mass_weighted_state_and_keeps_pins() {
+    let (points, tets) = kuhn_cube(2);
+    let (mut body, _) = Body::from_tets(&points, &tets, material()).unwrap();
+    let mut partners = Vec::new();
+    let mut split = Vec::new();
+    for d in faces_in_plane(&body, &points, 1.0) {
+        partners.push((d, body.map().alpha::<3>(d)));
+        split.extend(body.unsew3(d).unwrap().splits(0).map(|(kept, new, _, _)| (kept, new)));
+    }
+    assert_eq!(split.len(), 9);
+    for (i, &(kept, new)) in split.iter().enumerate() {
+        let m = body.attrs_mut();
+        let p = m.position[kept];
+        m.position[new] = [p[0] + 0.25, p[1] + 0.1 * i as f64, p[2] - 0.05];
+        m.velocity[kept] = [1.0, 0.0, 0.5 * i as f64];
+        m.velocity[new] = [-3.0, 2.0, 0.0];
+        m.pinned[new] = i % 2 == 0;
+    }
+    let before = body.attrs().clone();
+    let mut merged = Vec::new();
+    for &(d, e) in &partners {
+        merged.extend(body.sew3(d, e).unwrap().merges(0));
+        check_conservation(body.map(), body.attrs()).unwrap();
+    }
+    assert_eq!(merged.len(), 9, "every split vertex joins again once");
+    let m = body.attrs();
+    for &(kept, absorbed) in &merged {
+        let (mk, ma) = (before.vertex_mass(kept), before.vertex_mass(absorbed));
+        assert!(mk > 0.0 && ma > 0.0);
+        let mix = |a: Vec3, b: Vec3| -> Vec3 { std::array::from_fn(|k| (mk * a[k] + ma * b[k]) / (mk + ma)) };
+        let want_x = mix(before.position[kept], before.position[absorbed]);
+        let want_v = mix(before.velocity[kept], before.velocity[absorbed]);
+        assert_ne!(want_x, before.position[kept], "the two sides were apart");
+        for k in 0..3 {
+            assert!((m.position[kept][k] - want_x[k]).abs() < 1e-12, "position of {kept:?}: {:?} vs {want_x:?}", m.position[kept]);
+            assert!((m.velocity[kept][k] - want_v[k]).abs() < 1e-12, "velocity of {kept:?}: {:?} vs {want_v:?}", m.velocity[kept]);
+        }
+        assert_eq!(m.pinned[kept], before.pinned[kept] || before.pinned[absorbed], "pin of {kept:?}");
+    }
+    assert!(merged.iter().any(|&(k, _)| m.pinned[k]) && merged.iter().any(|&(k, _)| !m.pinned[k]));
+}

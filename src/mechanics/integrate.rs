@@ -412,6 +412,28 @@ impl Stepper {
         self.spring_sums = allowed;
     }
 
+    /// Whether an RK4 step of `sys` takes the one-pass spring sums: they are allowed
+    /// ([`Stepper::set_spring_sums`]) and `sys` is sorted by first end. Tests that compare the two
+    /// paths read it to know they compared two paths. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{FlatModel, Integrator, Material, StepConfig, Stepper};
+    ///
+    /// let (points, tets) = kuhn_cube(2);
+    /// let flat = FlatModel::from_tets(&points, &tets, Material::default(), [0.0; 3], &vec![false; points.len()]).unwrap();
+    /// let (x, v) = (&flat.position, &flat.velocity);
+    /// let mut stepper = Stepper::new(StepConfig::new(Integrator::Rk4, 1e-4), &flat.system, x, v).unwrap();
+    /// assert!(stepper.takes_spring_sums(&flat.system)); // a fresh flat model is sorted
+    /// stepper.set_spring_sums(false);
+    /// assert!(!stepper.takes_spring_sums(&flat.system));
+    /// ```
+    pub fn takes_spring_sums(&self, sys: &SpringSystem) -> bool {
+        self.spring_sums && sys.sorted_by_first_end()
+    }
+
     /// Advances (x, v) by one step of the configured scheme, then checks for blow-up.
     /// O(slots + springs) (times the CG iterations for the implicit scheme).
     ///
@@ -484,7 +506,7 @@ impl Stepper {
         }
         // A system sorted by first end sums its spring forces per slot in one pass over the
         // springs (no force array, no incidence lists); any other uses the two-pass gather.
-        let sorted = self.spring_sums && sys.sorted_by_first_end();
+        let sorted = self.takes_spring_sums(sys);
         self.sums.resize(x.len(), [0.0; 4]);
         if sorted {
             sys.plan_sums(par, &mut self.plan);

@@ -347,8 +347,16 @@ fn sew3_merges_vertices_by_mass_weighted_state_and_keeps_pins() {
         let want_v = mix(before.velocity[kept], before.velocity[absorbed]);
         assert_ne!(want_x, before.position[kept], "the two sides were apart");
         for k in 0..3 {
-            assert!((m.position[kept][k] - want_x[k]).abs() < 1e-12, "position of {kept:?}: {:?} vs {want_x:?}", m.position[kept]);
-            assert!((m.velocity[kept][k] - want_v[k]).abs() < 1e-12, "velocity of {kept:?}: {:?} vs {want_v:?}", m.velocity[kept]);
+            assert!(
+                (m.position[kept][k] - want_x[k]).abs() < 1e-12,
+                "position of {kept:?}: {:?} vs {want_x:?}",
+                m.position[kept]
+            );
+            assert!(
+                (m.velocity[kept][k] - want_v[k]).abs() < 1e-12,
+                "velocity of {kept:?}: {:?} vs {want_v:?}",
+                m.velocity[kept]
+            );
         }
         assert_eq!(m.pinned[kept], before.pinned[kept] || before.pinned[absorbed], "pin of {kept:?}");
     }

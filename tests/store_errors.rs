@@ -115,6 +115,30 @@ fn huge_counts_are_refused_before_allocating() {
     assert!(matches!(e, StoreError::BadCount { .. }), "{e}");
 }
 
+/// A count is bounded by the bytes left over the real size of one record, so a count one record
+/// past what the file can hold is refused at once as a bad count, not read until the bytes run
+/// out. Checked on the vertex records of a body (14 f64 and a flag byte each: 113 bytes).
+#[test]
+fn a_vertex_count_past_what_the_file_holds_is_a_bad_count() {
+    let doc = Document::from_body(&small_body());
+    let mech = doc.mechanics.as_ref().unwrap();
+    let mut bin = store::encode(&doc, Format::Binary).unwrap();
+    let material: Vec<u8> = mech.material.iter().flat_map(|x| x.to_le_bytes()).collect();
+    let at = bin.windows(32).position(|w| w == material).expect("the material precedes the vertex count") + 32;
+    assert_eq!(bin[at..at + 4], (mech.vertices.len() as u32).to_le_bytes(), "the vertex count follows the material");
+    let left = bin.len() - (at + 4); // an upper bound: the checksum is not payload
+    let count = left / 113 + 1;
+    bin[at..at + 4].copy_from_slice(&(count as u32).to_le_bytes());
+    reseal(&mut bin);
+    match store::decode(&bin).unwrap_err() {
+        StoreError::BadCount { what: "vertex records", count: c, limit, .. } => {
+            assert_eq!(c, count as u64);
+            assert!(limit as usize * 113 <= left, "limit {limit} allows more records than the {left} bytes left");
+        }
+        e => panic!("a vertex count past the end must be a bad count: {e}"),
+    }
+}
+
 #[test]
 fn out_of_range_dart_and_nan_are_located() {
     let text =

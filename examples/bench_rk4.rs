@@ -127,6 +127,7 @@ fn step_against_floor(flat: &mut FlatModel, stepper: &mut Stepper, batches: usiz
         .collect();
     let damped: Vec<f64> = sys.damping.iter().map(|c| 0.25 * c).collect();
     let mut scale = vec![0.0; l2.len()];
+    let (isa, scales) = floor::widest();
     let (mut step_us, mut floor_us) = (f64::INFINITY, f64::INFINITY);
     for _ in 0..batches {
         let t0 = now();
@@ -136,7 +137,7 @@ fn step_against_floor(flat: &mut FlatModel, stepper: &mut Stepper, batches: usiz
         step_us = step_us.min((now() - t0) * 1e6 / steps as f64);
         let t0 = now();
         for _ in 0..4 * steps {
-            floor::scales(&l2, &flat.system.rest, &flat.system.stiffness, &damped, &mut scale);
+            scales(&l2, &flat.system.rest, &flat.system.stiffness, &damped, &mut scale);
             std::hint::black_box(&mut scale);
         }
         floor_us = floor_us.min((now() - t0) * 1e6 / steps as f64);
@@ -146,7 +147,7 @@ fn step_against_floor(flat: &mut FlatModel, stepper: &mut Stepper, batches: usiz
         "[rk4 floor] springs {springs} kernel {}: step min {step_us:.2} us, sqrt+div floor ({}) min {floor_us:.2} us \
          ({:.2} ns per spring and stage), step / floor {:.2}",
         stepper.kernel().name(),
-        floor::isa(),
+        isa,
         floor_us * 1e3 / (4.0 * springs),
         step_us / floor_us
     );
@@ -176,27 +177,23 @@ mod floor {
         body(l2, rest, k, c, out)
     }
 
-    pub fn isa() -> &'static str {
+    /// One floor pass: the √/÷ loop compiled for one instruction set.
+    pub type Scales = fn(&[f64], &[f64], &[f64], &[f64], &mut [f64]);
+
+    /// The widest instruction set the CPU has and its floor pass, chosen once (not per pass).
+    pub fn widest() -> (&'static str, Scales) {
         #[cfg(target_arch = "x86_64")]
         {
-            if is_x86_feature_detected!("avx512f") && is_x86_feature_detected!("avx512vl") {
-                return "avx512";
+            let has_avx2 = is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma");
+            if has_avx2 && is_x86_feature_detected!("avx512f") && is_x86_feature_detected!("avx512vl") {
+                // SAFETY: every feature `avx512` is compiled for was detected just above.
+                return ("avx512", |l2, rest, k, c, out| unsafe { avx512(l2, rest, k, c, out) });
             }
-            if is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma") {
-                return "avx2";
+            if has_avx2 {
+                // SAFETY: avx2 and fma were detected just above.
+                return ("avx2", |l2, rest, k, c, out| unsafe { avx2(l2, rest, k, c, out) });
             }
         }
-        "baseline"
-    }
-
-    pub fn scales(l2: &[f64], rest: &[f64], k: &[f64], c: &[f64], out: &mut [f64]) {
-        #[cfg(target_arch = "x86_64")]
-        match isa() {
-            // SAFETY: the CPU has the features each function is compiled for (checked by `isa`).
-            "avx512" => return unsafe { avx512(l2, rest, k, c, out) },
-            "avx2" => return unsafe { avx2(l2, rest, k, c, out) },
-            _ => {}
-        }
-        body(l2, rest, k, c, out)
+        ("baseline", body)
     }
 }

@@ -120,6 +120,7 @@ fn huge_counts_are_refused_before_allocating() {
 /// out. Checked on the vertex records of a body (14 f64 and a flag byte each: 113 bytes).
 #[test]
 fn a_vertex_count_past_what_the_file_holds_is_a_bad_count() {
+    const RECORD: usize = 14 * 8 + 1;
     let doc = Document::from_body(&small_body());
     let mech = doc.mechanics.as_ref().unwrap();
     let mut bin = store::encode(&doc, Format::Binary).unwrap();
@@ -127,13 +128,13 @@ fn a_vertex_count_past_what_the_file_holds_is_a_bad_count() {
     let at = bin.windows(32).position(|w| w == material).expect("the material precedes the vertex count") + 32;
     assert_eq!(bin[at..at + 4], (mech.vertices.len() as u32).to_le_bytes(), "the vertex count follows the material");
     let left = bin.len() - (at + 4); // an upper bound: the checksum is not payload
-    let count = left / 113 + 1;
+    let count = left / RECORD + 1;
     bin[at..at + 4].copy_from_slice(&(count as u32).to_le_bytes());
     reseal(&mut bin);
     match store::decode(&bin).unwrap_err() {
         StoreError::BadCount { what: "vertex records", count: c, limit, .. } => {
             assert_eq!(c, count as u64);
-            assert!(limit as usize * 113 <= left, "limit {limit} allows more records than the {left} bytes left");
+            assert!(limit as usize * RECORD <= left, "limit {limit} allows more records than the {left} bytes left");
         }
         e => panic!("a vertex count past the end must be a bad count: {e}"),
     }

@@ -21,6 +21,8 @@
 
 use std::fmt;
 
+use crate::mechanics::geom::{cross, dot, norm, sub};
+
 /// Relative tolerance under which a cell counts as degenerate (a warning, not an error).
 ///
 /// A tetrahedron is *zero-volume* when `|6 V| <= DEGENERACY_TOLERANCE * l^3`, where `l` is its
@@ -278,22 +280,6 @@ impl TriMeshReport {
     pub fn is_clean(&self) -> bool {
         self.zero_area_triangles.is_empty() && self.unreferenced_points.is_empty()
     }
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn norm(a: [f64; 3]) -> f64 {
-    dot(a, a).sqrt()
 }
 
 /// Signed volume of the tetrahedron `(a, b, c, d)`: `det[b - a, c - a, d - a] / 6`.

@@ -13,7 +13,7 @@ use topomech::ambiguity::mixed::{campaign_mixed, MixedRun, MixedStats};
 use topomech::ambiguity::vector::Vector;
 use topomech::generate::{kuhn_cube, SplitMix64};
 
-use super::CliError;
+use super::{print_report, CliError};
 
 /// Arguments of `topomech ambiguity`.
 #[derive(Debug, Clone, clap::Args)]
@@ -170,15 +170,7 @@ pub fn run(args: AmbiguityArgs) -> Result<(), CliError> {
             pairs: c.pairs.into_iter().map(|p| (p.name, p.description)).collect(),
         }),
     };
-    let mut out = std::io::stdout().lock();
-    if args.json {
-        serde_json::to_writer(&mut out, &report)?;
-        writeln!(out)?;
-    } else {
-        write_table(&mut out, &report)?;
-    }
-    out.flush()?;
-    Ok(())
+    print_report(args.json, &report, |out| write_table(out, &report))
 }
 
 /// The mixed campaign for every k, with its own generator (seeded by `seed`), so adding

@@ -18,7 +18,7 @@ use topomech::mechanics::{Body, FlatModel, Integrator, Material, PinSpec, Simula
 use topomech::mesh::TetMesh;
 
 use super::simulate::median;
-use super::{print_warnings, CliError};
+use super::{print_report, print_warnings, CliError};
 
 /// Arguments of `topomech bench`.
 #[derive(Debug, Clone, clap::Args)]
@@ -258,11 +258,7 @@ fn run_step(args: StepBenchArgs) -> Result<(), CliError> {
         vertices: body.map().count_cells().0[0],
         kernel: sim.stepper.kernel().name(),
     };
-    let mut out = std::io::stdout().lock();
-    if args.json {
-        serde_json::to_writer(&mut out, &report)?;
-        writeln!(out)?;
-    } else {
+    print_report(args.json, &report, |out| {
         writeln!(
             out,
             "{} ({} integrator, dt = {dt:.3e}, {} rounds × {batch} steps)",
@@ -274,10 +270,8 @@ fn run_step(args: StepBenchArgs) -> Result<(), CliError> {
         writeln!(out, "  {:<22}{}", "kernel", report.kernel)?;
         writeln!(out, "  {:<22}{:.2} µs", "map-driven step", map_us)?;
         writeln!(out, "  {:<22}{:.2} µs", "flat baseline step", flat_us)?;
-        writeln!(out, "  {:<22}{:.3}", "ratio", report.ratio)?;
-    }
-    out.flush()?;
-    Ok(())
+        writeln!(out, "  {:<22}{:.3}", "ratio", report.ratio)
+    })
 }
 
 #[cfg(test)]

@@ -11,7 +11,7 @@ use topomech::gmap::InvariantViolation;
 use topomech::store::{self, CheckReport, Finding};
 use topomech::subdivide::{LevelError, LevelPartsError};
 
-use super::CliError;
+use super::{print_report, CliError};
 
 /// Arguments of `topomech check`.
 #[derive(Debug, Clone, clap::Args)]
@@ -44,15 +44,8 @@ pub fn run(args: CheckArgs) -> Result<(), CliError> {
     let report = store::check_all_laws(&doc, args.limit);
     let darts = doc.map.capacity as usize - doc.map.free_darts.len();
     let levels = doc.levels.as_ref().map(|l| l.max_level);
-    let mut out = std::io::stdout().lock();
-    if args.json {
-        let value = json_report(&args, doc.map.dimension, darts, levels, &report);
-        serde_json::to_writer(&mut out, &value)?;
-        writeln!(out)?;
-    } else {
-        write_table(&mut out, &args, (doc.map.dimension, darts, levels), &report)?;
-    }
-    out.flush()?;
+    let value = json_report(&args, doc.map.dimension, darts, levels, &report);
+    print_report(args.json, &value, |out| write_table(out, &args, (doc.map.dimension, darts, levels), &report))?;
     if !report.valid {
         std::process::exit(1);
     }

@@ -159,6 +159,24 @@ impl Characteristics {
     }
 }
 
+/// Prints a command's report on stdout: the JSON object of `report` on one line when `json`,
+/// else what `table` writes (the human-readable form). O(size of the report).
+pub(crate) fn print_report(
+    json: bool,
+    report: &impl serde::Serialize,
+    table: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<(), CliError> {
+    let mut out = std::io::stdout().lock();
+    if json {
+        serde_json::to_writer(&mut out, report)?;
+        writeln!(out)?;
+    } else {
+        table(&mut out)?;
+    }
+    out.flush()?;
+    Ok(())
+}
+
 /// Refuses the first of `ids` that is not below `n`, naming the flag, the id and the range
 /// (e.g. `--pin: vertex 547 does not exist: the mesh has 547 points (ids 0 to 546)`), so that a
 /// bad id is neither ignored nor reported as something else later. O(ids).

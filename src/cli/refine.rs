@@ -20,7 +20,7 @@ use topomech::subdivide::{
 };
 use topomech::vtk::Frame;
 
-use super::{parse_finite, parse_vec3, print_warnings, CliError};
+use super::{parse_finite, parse_vec3, print_report, print_warnings, CliError};
 
 /// Arguments of `topomech refine`.
 #[derive(Debug, Clone, clap::Args)]
@@ -193,14 +193,7 @@ pub fn run(args: RefineArgs) -> Result<(), CliError> {
             write_conforming(c, dir)?;
         }
     }
-    let mut out = std::io::stdout().lock();
-    if args.json {
-        serde_json::to_writer(&mut out, &report)?;
-        writeln!(out)?;
-    } else {
-        write_table(&mut out, &report)?;
-    }
-    out.flush()?;
+    print_report(args.json, &report, |out| write_table(out, &report))?;
     if let Some(Err(e)) = spring_laws {
         return Err(other(format!("{}: the spring coupling breaks a law (a topomech bug): {e}", args.mesh.display())));
     }

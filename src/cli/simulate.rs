@@ -1,7 +1,7 @@
 //! `topomech simulate MESH --steps N --dt DT --integrator euler|symplectic|rk4|implicit …`: run the
 //! map-driven mass/spring simulation of a mesh, write ParaView frames, print a summary.
 
-use std::io::{IsTerminal, Write};
+use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -11,7 +11,7 @@ use topomech::mechanics::{Body, Integrator, Material, PinSpec, Simulation, StepC
 use topomech::mesh::TetMesh;
 use topomech::vtk::{body_tets, Frame, Series};
 
-use super::{check_ids, parse_finite, parse_vec3, print_warnings, CliError};
+use super::{check_ids, parse_finite, parse_vec3, print_report, print_warnings, CliError};
 
 /// Arguments of `topomech simulate`.
 #[derive(Debug, Clone, clap::Args)]
@@ -181,11 +181,7 @@ fn print_summary(
     sim: &Simulation,
     pvd: Option<PathBuf>,
 ) -> Result<(), CliError> {
-    let mut out = std::io::stdout().lock();
-    if args.json {
-        serde_json::to_writer(&mut out, s)?;
-        writeln!(out)?;
-    } else {
+    print_report(args.json, s, |out| {
         let sys = &sim.projection.system;
         let fixed = sys.inv_mass.iter().zip(&sys.mass).filter(|(&w, &m)| w == 0.0 && m > 0.0).count();
         writeln!(out, "{}", args.mesh.display())?;
@@ -199,9 +195,8 @@ fn print_summary(
         if let Some(p) = pvd {
             writeln!(out, "  {:<22}{}", "ParaView series", p.display())?;
         }
-    }
-    out.flush()?;
-    Ok(())
+        Ok(())
+    })
 }
 
 /// A progress bar on stderr, hidden when stderr is not a terminal.

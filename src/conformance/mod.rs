@@ -342,26 +342,14 @@ fn flatten_scalar_arrays(pretty: &str) -> String {
     let mut out = String::with_capacity(pretty.len());
     // For each open array: where it starts in `out`, and whether it holds only scalars so far.
     let mut open: Vec<(usize, bool)> = Vec::new();
-    let (mut in_string, mut escaped) = (false, false);
+    let mut strings = JsonStrings::default();
     for c in pretty.chars() {
-        if in_string {
+        if strings.literal(c) {
             out.push(c);
-            (in_string, escaped) = match (escaped, c) {
-                (true, _) => (true, false),
-                (false, '\\') => (true, true),
-                (false, '"') => (false, false),
-                _ => (true, false),
-            };
             continue;
         }
-        match c {
-            '"' => in_string = true,
-            '[' | '{' => {
-                if let Some(top) = open.last_mut() {
-                    top.1 = false;
-                }
-            }
-            _ => {}
+        if let ('[' | '{', Some(top)) = (c, open.last_mut()) {
+            top.1 = false;
         }
         if c == '[' {
             open.push((out.len(), true));
@@ -378,26 +366,41 @@ fn flatten_scalar_arrays(pretty: &str) -> String {
     out
 }
 
+/// Where a left-to-right scan of JSON text stands with respect to string literals.
+#[derive(Default)]
+struct JsonStrings {
+    inside: bool,
+    escaped: bool,
+}
+
+impl JsonStrings {
+    /// Steps over `c`: true when `c` belongs to a string literal (its quotes included), whose
+    /// characters are to be copied untouched. O(1).
+    fn literal(&mut self, c: char) -> bool {
+        if !self.inside {
+            self.inside = c == '"';
+            return self.inside;
+        }
+        (self.inside, self.escaped) = match (self.escaped, c) {
+            (true, _) => (true, false),
+            (false, '\\') => (true, true),
+            (false, '"') => (false, false),
+            _ => (true, false),
+        };
+        true
+    }
+}
+
 /// `[\n  1,\n  2\n` → `[1, 2` (whitespace outside strings dropped, `,` followed by one space).
 fn squeeze(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
-    let (mut in_string, mut escaped) = (false, false);
+    let mut strings = JsonStrings::default();
     for c in text.chars() {
-        if in_string {
+        if strings.literal(c) {
             out.push(c);
-            (in_string, escaped) = match (escaped, c) {
-                (true, _) => (true, false),
-                (false, '\\') => (true, true),
-                (false, '"') => (false, false),
-                _ => (true, false),
-            };
             continue;
         }
         match c {
-            '"' => {
-                in_string = true;
-                out.push(c);
-            }
             ',' => out.push_str(", "),
             c if c.is_whitespace() => {}
             c => out.push(c),

@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use super::build::{bounded_count, gmsh_element_kind, MeshBuilder};
-use super::msh22::node_records;
+use super::msh22::{parse_sections, Dialect};
 use super::scan::Scanner;
 use super::ReadError;
 
@@ -14,42 +14,13 @@ const MIN_ELEMENT: usize = 12;
 
 /// Parses an MSH v1 file into a builder.
 pub(crate) fn parse(data: &[u8], path: &Path) -> Result<MeshBuilder, ReadError> {
-    let mut sc = Scanner::new(data, path);
-    let mut b = MeshBuilder::new();
-    let (mut seen_nodes, mut seen_elements) = (false, false);
-    while let Some(t) = sc.next_raw() {
-        match t.raw {
-            b"$NOD" => {
-                sc.section = "$NOD";
-                node_records(&mut sc, &mut b)?;
-                sc.expect_marker("$ENDNOD")?;
-                seen_nodes = true;
-            }
-            b"$ELM" => {
-                sc.section = "$ELM";
-                if !seen_nodes {
-                    return Err(ReadError::Malformed {
-                        path: path.to_path_buf(),
-                        at: sc.location_of(&t),
-                        message: "`$ELM` before `$NOD`".into(),
-                    });
-                }
-                element_records(&mut sc, &mut b)?;
-                sc.expect_marker("$ENDELM")?;
-                seen_elements = true;
-            }
-            _ => {
-                sc.section = "top level";
-                return Err(sc.garbage(&t, "`$NOD` or `$ELM`"));
-            }
-        }
-    }
-    for (seen, section) in [(seen_nodes, "$NOD"), (seen_elements, "$ELM")] {
-        if !seen {
-            return Err(ReadError::MissingSection { path: path.to_path_buf(), section });
-        }
-    }
-    Ok(b)
+    let v1 = Dialect {
+        nodes: ["$NOD", "$ENDNOD"],
+        elements: ["$ELM", "$ENDELM"],
+        skips_unknown: false,
+        expected: "`$NOD` or `$ELM`",
+    };
+    parse_sections(&mut Scanner::new(data, path), &v1, element_records)
 }
 
 /// The body of `$ELM`: a count, then element records.

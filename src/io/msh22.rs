@@ -12,45 +12,73 @@ const MIN_NODE: usize = 8;
 /// Smallest number of bytes one element record takes (`1 15 0 1\n`).
 const MIN_ELEMENT: usize = 8;
 
+/// The section names of one Gmsh ASCII dialect, for [`parse_sections`].
+pub(crate) struct Dialect {
+    /// Start and end markers of the node section.
+    pub nodes: [&'static str; 2],
+    /// Start and end markers of the element section.
+    pub elements: [&'static str; 2],
+    /// Whether other `$Name` ... `$EndName` sections are skipped (2.x) or are garbage (v1).
+    pub skips_unknown: bool,
+    /// What the error names as expected at top level.
+    pub expected: &'static str,
+}
+
+const MSH22: Dialect = Dialect {
+    nodes: ["$Nodes", "$EndNodes"],
+    elements: ["$Elements", "$EndElements"],
+    skips_unknown: true,
+    expected: "a section start such as `$Nodes`",
+};
+
 /// Parses an MSH 2.x ASCII file into a builder.
 pub(crate) fn parse(data: &[u8], path: &Path) -> Result<MeshBuilder, ReadError> {
     let mut sc = Scanner::new(data, path);
     parse_header(&mut sc)?;
+    parse_sections(&mut sc, &MSH22, element_records)
+}
+
+/// The top-level loop of the Gmsh ASCII dialects: one node section (`tag x y z` records), then
+/// one element section read by `elements`, both required, nodes first. O(bytes).
+pub(crate) fn parse_sections(
+    sc: &mut Scanner<'_>,
+    dialect: &Dialect,
+    elements: fn(&mut Scanner<'_>, &mut MeshBuilder) -> Result<(), ReadError>,
+) -> Result<MeshBuilder, ReadError> {
+    let path = sc.path();
     let mut b = MeshBuilder::new();
     let (mut seen_nodes, mut seen_elements) = (false, false);
+    let ([nodes, end_nodes], [elems, end_elems]) = (dialect.nodes, dialect.elements);
     while let Some(t) = sc.next_raw() {
         match t.raw {
-            b"$Nodes" => {
-                sc.section = "$Nodes";
-                node_records(&mut sc, &mut b)?;
-                sc.expect_marker("$EndNodes")?;
+            name if name == nodes.as_bytes() => {
+                sc.section = nodes;
+                node_records(sc, &mut b)?;
+                sc.expect_marker(end_nodes)?;
                 seen_nodes = true;
             }
-            b"$Elements" => {
-                sc.section = "$Elements";
+            name if name == elems.as_bytes() => {
+                sc.section = elems;
                 if !seen_nodes {
-                    return Err(ReadError::Malformed {
-                        path: path.to_path_buf(),
-                        at: sc.location_of(&t),
-                        message: "`$Elements` before `$Nodes`".into(),
-                    });
+                    let message = format!("`{elems}` before `{nodes}`");
+                    return Err(ReadError::Malformed { path: path.to_path_buf(), at: sc.location_of(&t), message });
                 }
-                element_records(&mut sc, &mut b)?;
-                sc.expect_marker("$EndElements")?;
+                elements(sc, &mut b)?;
+                sc.expect_marker(end_elems)?;
                 seen_elements = true;
             }
-            name if name.starts_with(b"$") && !name.starts_with(b"$End") => {
+            name if dialect.skips_unknown && name.starts_with(b"$") && !name.starts_with(b"$End") => {
                 sc.section = "unknown";
                 let end = format!("$End{}", String::from_utf8_lossy(&name[1..]));
                 sc.skip_section(&end)?;
             }
             _ => {
                 sc.section = "top level";
-                return Err(sc.garbage(&t, "a section start such as `$Nodes`"));
+                return Err(sc.garbage(&t, dialect.expected));
             }
         }
     }
-    for (seen, section) in [(seen_nodes, "$Nodes"), (seen_elements, "$Elements")] {
+    for (seen, section) in [(seen_nodes, nodes), (seen_elements, elems)] {
         if !seen {
             return Err(ReadError::MissingSection { path: path.to_path_buf(), section });
         }

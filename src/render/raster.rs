@@ -1,5 +1,6 @@
 //! The rasterizer: camera-space transform, near-plane clipping, z-buffered triangle fill.
 
+pub(crate) use crate::mechanics::geom::{cross, dot, norm, scale, sub};
 use crate::mechanics::Vec3;
 
 use super::{Image, RenderError};
@@ -139,26 +140,6 @@ fn clip_near(tri: [Vec3; 3], near: f64) -> Vec<Vec3> {
         }
     }
     out
-}
-
-pub(crate) fn sub(a: Vec3, b: Vec3) -> Vec3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-pub(crate) fn scale(a: Vec3, s: f64) -> Vec3 {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
-
-pub(crate) fn dot(a: Vec3, b: Vec3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-pub(crate) fn cross(a: Vec3, b: Vec3) -> Vec3 {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-
-pub(crate) fn norm(a: Vec3) -> f64 {
-    dot(a, a).sqrt()
 }
 
 #[cfg(test)]

@@ -255,17 +255,8 @@ fn decode_mechanics(r: &mut Reader<'_>) -> Result<RawMechanics, StoreError> {
         for x in &mut xs {
             *x = r.f64("vertex attribute", k)?;
         }
-        let v3 = |o: usize| [xs[o], xs[o + 1], xs[o + 2]];
         let pinned = r.flag("pinned")?;
-        m.vertices.push(VertexRecord {
-            rest: v3(0),
-            position: v3(3),
-            velocity: v3(6),
-            force: v3(9),
-            mass: xs[12],
-            viscosity: xs[13],
-            pinned,
-        });
+        m.vertices.push(VertexRecord::from_attributes(&xs, pinned));
     }
     let ne = r.count("edge records", 24)?;
     for k in 0..ne {

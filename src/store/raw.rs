@@ -241,6 +241,23 @@ pub struct VertexRecord {
     pub pinned: bool,
 }
 
+impl VertexRecord {
+    /// The record of the 14 numbers a store file holds per vertex, in file order: rest,
+    /// position, velocity and force (x, y, z each), then mass and viscosity. O(1).
+    pub(crate) fn from_attributes(xs: &[f64; 14], pinned: bool) -> VertexRecord {
+        let v3 = |o: usize| [xs[o], xs[o + 1], xs[o + 2]];
+        VertexRecord {
+            rest: v3(0),
+            position: v3(3),
+            velocity: v3(6),
+            force: v3(9),
+            mass: xs[12],
+            viscosity: xs[13],
+            pinned,
+        }
+    }
+}
+
 /// Every mechanical attribute of a body, one record per cell id (live or dead).
 ///
 /// # Examples

@@ -335,18 +335,12 @@ fn decode_mechanics(lines: &mut Lines<'_>, no: usize, head: &[&str]) -> Result<R
     let mut m = RawMechanics { material, ..RawMechanics::default() };
     for k in 0..counts[0] {
         let (no, t) = record(lines, "v", k, 16)?;
-        let xs = floats_of(&t[2..16], no, "vertex attribute", k)?;
-        let v3 = |o: usize| [xs[o], xs[o + 1], xs[o + 2]];
+        let mut xs = [0.0; 14];
+        for (x, tok) in xs.iter_mut().zip(&t[2..16]) {
+            *x = float(tok, no, "vertex attribute", k)?;
+        }
         let pinned = flag(t[16], no)?;
-        m.vertices.push(VertexRecord {
-            rest: v3(0),
-            position: v3(3),
-            velocity: v3(6),
-            force: v3(9),
-            mass: xs[12],
-            viscosity: xs[13],
-            pinned,
-        });
+        m.vertices.push(VertexRecord::from_attributes(&xs, pinned));
     }
     for k in 0..counts[1] {
         let (no, t) = record(lines, "e", k, 4)?;

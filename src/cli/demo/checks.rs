@@ -112,12 +112,8 @@ impl Checker {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use topomech::{cut, generate};
-
-    fn cube() -> Body {
-        let (points, tets) = generate::kuhn_cube(2);
-        Body::from_tets(&points, &tets, cut::ops::material()).unwrap().0
-    }
+    use crate::cli::demo::test_cube as cube;
+    use topomech::cut;
 
     #[test]
     fn a_fresh_body_passes_the_four_checks() {

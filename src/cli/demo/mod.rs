@@ -491,3 +491,11 @@ fn write_footer(out: &mut dyn Write, s: &DemoJson) -> std::io::Result<()> {
     }
     writeln!(out, "  ({:.0} ms in all)", s.wall_ms)
 }
+
+/// The body the demo modules' unit tests run on: the Kuhn cube k = 2 (48 tets) with the cut
+/// material.
+#[cfg(test)]
+fn test_cube() -> topomech::mechanics::Body {
+    let (points, tets) = topomech::generate::kuhn_cube(2);
+    topomech::mechanics::Body::from_tets(&points, &tets, topomech::cut::ops::material()).unwrap().0
+}

@@ -307,12 +307,8 @@ fn cross(a: Vec3, b: Vec3) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::cli::demo::test_cube as cube;
     use topomech::{cut, generate};
-
-    fn cube() -> Body {
-        let (points, tets) = generate::kuhn_cube(2);
-        Body::from_tets(&points, &tets, cut::ops::material()).unwrap().0
-    }
 
     #[test]
     fn refining_some_tets_keeps_the_enclosed_volume_and_marks_their_level() {

@@ -281,8 +281,8 @@ fn a_bad_command_line_is_a_usage_error_not_a_panic() {
 }
 
 /// Numbers that parse but make no sense are refused with a message, not run silently: a NaN
-/// tear threshold (no vertex compares above NaN, so nothing would ever tear) and a negative
-/// removal radius (an empty ball).
+/// tear threshold (no vertex compares above NaN, so nothing would ever tear), a negative
+/// removal radius (an empty ball), negative time steps and material constants.
 #[test]
 fn non_finite_and_out_of_range_numbers_are_refused_with_a_message() {
     let liver = concat!(env!("CARGO_MANIFEST_DIR"), "/data/liver_547_v22.msh");
@@ -290,6 +290,12 @@ fn non_finite_and_out_of_range_numbers_are_refused_with_a_message() {
         (vec!["tear", liver, "--threshold", "NaN", "--steps", "1"], "threshold NaN"),
         (vec!["tear", liver, "--threshold", "inf", "--steps", "1"], "threshold inf"),
         (vec!["remove", liver, "--sphere", "0,0,0,-1"], "radius"),
+        // A negative number reaches the command's own check (not clap's "unexpected argument").
+        (vec!["tear", liver, "--threshold", "-1", "--steps", "1"], "threshold -1"),
+        (vec!["simulate", liver, "--steps", "1", "--dt", "-1"], "time step -1"),
+        (vec!["simulate", liver, "--steps", "1", "--young", "-5"], "young = -5"),
+        (vec!["refine", liver, "--around", "0,0,0", "--radius", "-1"], "radius must be"),
+        (vec!["cut", liver, "--plane", "0,0,0,1,0,0", "--density", "-2"], "density = -2"),
     ] {
         let out = run(&args);
         assert_eq!(out.status.code(), Some(1), "{args:?}: {}", stderr(&out));
@@ -303,6 +309,7 @@ fn non_finite_and_out_of_range_numbers_are_refused_with_a_message() {
         (vec!["simulate", liver, "--steps", "1", "--pin-below", "z=nan"], "not finite"),
         (vec!["remove", liver, "--sphere", "nan,0,0,1"], "not finite"),
         (vec!["cut", liver, "--plane", "0,0,0,inf,0,0"], "not finite"),
+        (vec!["simulate", liver, "--steps", "-3"], "invalid value '-3' for '--steps"),
     ] {
         let out = run(&args);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));

@@ -25,14 +25,14 @@ pub struct AmbiguityArgs {
     #[arg(long, value_delimiter = ',', default_values_t = vec![1usize, 5, 10, 50])]
     pub cuts: Vec<usize>,
     /// Seed of the random cut sequences.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     pub seed: u64,
     /// Random sequences per number of cuts.
-    #[arg(long, default_value_t = 100)]
+    #[arg(long, default_value_t = 100, allow_negative_numbers = true)]
     pub sequences: usize,
     /// Also run the mixed campaign: sequences of K ops (K from --cuts), each a tet subdivision
     /// with probability P (in 0..=1) and a cut otherwise.
-    #[arg(long, value_name = "P", value_parser = probability)]
+    #[arg(long, value_name = "P", value_parser = probability, allow_negative_numbers = true)]
     pub subdivide: Option<f64>,
     /// Print one JSON object (keys pairs_found, graph_kind, sequences_tried, mesh, tets, per_k,
     /// first_pairs, subdivide with --subdivide, and catalogue with --catalogue).
@@ -45,7 +45,7 @@ pub struct AmbiguityArgs {
     #[arg(long, value_name = "DIR")]
     pub write_vectors: Option<PathBuf>,
     /// Most tests per delta-debugging pass when shrinking a finding for --write-vectors.
-    #[arg(long, default_value_t = 4000)]
+    #[arg(long, default_value_t = 4000, allow_negative_numbers = true)]
     pub shrink_budget: usize,
 }
 

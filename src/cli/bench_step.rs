@@ -47,10 +47,10 @@ pub struct OrderBenchArgs {
     #[arg(long, default_value = "rk4")]
     pub integrator: Integrator,
     /// Rounds (each times one batch of each variant, the first variant rotating).
-    #[arg(long, default_value_t = 9)]
+    #[arg(long, default_value_t = 9, allow_negative_numbers = true)]
     pub rounds: usize,
     /// Steps per batch.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, allow_negative_numbers = true)]
     pub batch: usize,
     /// Print one JSON object (the keys of [`OrderJson`]).
     #[arg(long)]
@@ -90,10 +90,10 @@ pub struct StepBenchArgs {
     #[arg(long, default_value = "rk4")]
     pub integrator: Integrator,
     /// Rounds (each times one batch of each model).
-    #[arg(long, default_value_t = 200)]
+    #[arg(long, default_value_t = 200, allow_negative_numbers = true)]
     pub rounds: usize,
     /// Steps per batch.
-    #[arg(long, default_value_t = 50)]
+    #[arg(long, default_value_t = 50, allow_negative_numbers = true)]
     pub batch: usize,
     /// Print one JSON object: map_step_us, flat_step_us, ratio, springs, vertices, kernel.
     #[arg(long)]

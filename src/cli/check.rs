@@ -23,7 +23,7 @@ pub struct CheckArgs {
     #[arg(long)]
     pub json: bool,
     /// List at most this many broken laws.
-    #[arg(long, default_value_t = 100)]
+    #[arg(long, default_value_t = 100, allow_negative_numbers = true)]
     pub limit: usize,
 }
 

@@ -22,7 +22,7 @@ pub struct CommonArgs {
     /// Tetrahedral mesh file (any format `topomech info` reads).
     pub mesh: PathBuf,
     /// Mass density ρ.
-    #[arg(long, default_value_t = Material::default().density)]
+    #[arg(long, default_value_t = Material::default().density, allow_negative_numbers = true)]
     pub density: f64,
     /// Write the cut body to this VTU file.
     #[arg(long)]
@@ -71,13 +71,13 @@ pub struct TearArgs {
     #[command(flatten)]
     pub common: CommonArgs,
     /// Tear vertices whose largest principal tensile stress exceeds this force.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub threshold: f64,
     /// Time steps (symplectic Euler); tearing is checked after each.
-    #[arg(long, default_value_t = 200)]
+    #[arg(long, default_value_t = 200, allow_negative_numbers = true)]
     pub steps: u64,
     /// Time step (seconds).
-    #[arg(long, default_value_t = 1e-4)]
+    #[arg(long, default_value_t = 1e-4, allow_negative_numbers = true)]
     pub dt: f64,
     /// Fix the vertices whose rest z is at most this value (default: the lowest 10% of the body).
     #[arg(long, allow_hyphen_values = true)]
@@ -86,7 +86,7 @@ pub struct TearArgs {
     #[arg(long, default_value_t = -200.0, allow_hyphen_values = true)]
     pub gravity_z: f64,
     /// Vertices torn per step at most.
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = 4, allow_negative_numbers = true)]
     pub per_step: usize,
 }
 

@@ -34,14 +34,14 @@ pub struct RefineArgs {
     #[arg(long, allow_hyphen_values = true)]
     pub radius: f64,
     /// Finest level to reach (1 = one 1→8 step).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     pub levels: u8,
     /// Refuse a level that would grow the map past this many darts (about 91 bytes each): the
     /// command stops with an error naming the estimate before that level starts.
-    #[arg(long, default_value_t = topomech::subdivide::DEFAULT_MAX_DARTS)]
+    #[arg(long, default_value_t = topomech::subdivide::DEFAULT_MAX_DARTS, allow_negative_numbers = true)]
     pub max_darts: usize,
     /// Mass density ρ (tet mass = ρ · volume).
-    #[arg(long, default_value_t = Material::default().density)]
+    #[arg(long, default_value_t = Material::default().density, allow_negative_numbers = true)]
     pub density: f64,
     /// Build the conforming closure (tets only, no hanging vertex) and a body on it.
     #[arg(long)]

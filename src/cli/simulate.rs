@@ -19,10 +19,10 @@ pub struct SimulateArgs {
     /// Tetrahedral mesh file (any format `topomech info` reads).
     pub mesh: PathBuf,
     /// Number of time steps.
-    #[arg(long, default_value_t = 1000)]
+    #[arg(long, default_value_t = 1000, allow_negative_numbers = true)]
     pub steps: u64,
     /// Time step (seconds). Explicit schemes need dt below about 2/ω_max (printed on stderr).
-    #[arg(long, default_value_t = 1e-4)]
+    #[arg(long, default_value_t = 1e-4, allow_negative_numbers = true)]
     pub dt: f64,
     /// euler, symplectic, rk4 or implicit.
     #[arg(long, default_value = "rk4")]
@@ -37,16 +37,16 @@ pub struct SimulateArgs {
     #[arg(long, value_parser = parse_vec3, default_value = "0,0,-9.81", allow_hyphen_values = true)]
     pub gravity: Vec3,
     /// Mass density ρ.
-    #[arg(long, default_value_t = Material::default().density)]
+    #[arg(long, default_value_t = Material::default().density, allow_negative_numbers = true)]
     pub density: f64,
     /// Young's modulus E (spring stiffness k = Σ E·V_t/L²).
-    #[arg(long, default_value_t = Material::default().young)]
+    #[arg(long, default_value_t = Material::default().young, allow_negative_numbers = true)]
     pub young: f64,
     /// Stiffness-proportional spring damping β in seconds (c = β·k).
-    #[arg(long, default_value_t = Material::default().damping)]
+    #[arg(long, default_value_t = Material::default().damping, allow_negative_numbers = true)]
     pub damping: f64,
     /// Ambient viscosity per unit mass ν in 1/s (γ = ν·m).
-    #[arg(long, default_value_t = Material::default().viscosity)]
+    #[arg(long, default_value_t = Material::default().viscosity, allow_negative_numbers = true)]
     pub viscosity: f64,
     /// Renumber points and tets along a Z-order curve before building (faster on large meshes:
     /// fewer cache misses). `--pin` ids still name the points of the file; frames use the new order.
@@ -58,13 +58,13 @@ pub struct SimulateArgs {
     #[arg(long)]
     pub rcm_order: bool,
     /// Worker threads (1 = serial; more splits the force passes, same results bit for bit).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     pub threads: usize,
     /// Write `frame_NNNNNN.vtu` files and the series `frame.pvd` (for ParaView) into this directory.
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Frames to write when --out is given (evenly spaced, the initial state included).
-    #[arg(long, default_value_t = 50)]
+    #[arg(long, default_value_t = 50, allow_negative_numbers = true)]
     pub frames: u64,
     /// Print one JSON object: steps, dt, integrator, step_us_median, total_mass,
     /// kinetic_energy, max_displacement.
@@ -146,7 +146,7 @@ fn simulate(args: &SimulateArgs, parallel: bool) -> Result<(), CliError> {
     let omega = sim.projection.system.omega_max();
     if args.integrator != Integrator::Implicit && omega * args.dt > 2.0 {
         eprintln!(
-            "topomech: warning: dt = {} exceeds the explicit stability bound 2/ω_max = {:.3e}",
+            "topomech: warning: dt = {:.3e} exceeds the explicit stability bound 2/ω_max = {:.3e}",
             args.dt,
             2.0 / omega
         );

@@ -57,7 +57,7 @@ pub struct DemoArgs {
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
     /// Sag steps; the incision and tear stages run N/2 steps each, the removal N/4.
-    #[arg(long, default_value_t = DEFAULT_STEPS)]
+    #[arg(long, default_value_t = DEFAULT_STEPS, allow_negative_numbers = true)]
     pub steps: u64,
     /// Print one JSON object (the summary; its key "mesh" is `topomech info --json` of the mesh).
     #[arg(long)]

@@ -449,8 +449,11 @@ fn tri_meshes_obj_and_msh() {
     // A surface file has no tetrahedra.
     let e = io::read_mesh(&fixture("cube_surface_v22.msh")).unwrap_err().to_string();
     assert_contains(&e, &["empty mesh", "cube_surface_v22.msh"]);
+    // An OBJ file is refused by its extension, with the reason and the reader to use instead
+    // (not as an MSH file with an unrecognised header).
     let e = io::read_mesh(&fixture("cube_surface.obj")).unwrap_err();
     assert!(matches!(e, ReadError::UnknownFormat { .. }), "{e}");
+    assert_contains(&e.to_string(), &["cube_surface.obj", "OBJ holds a surface", "read_tri_mesh"]);
 }
 
 #[test]

@@ -435,6 +435,51 @@ fn liver_547_through_binary_converter() {
     assert_eq!(a, b);
 }
 
+/// In a binary file the data starts after the line of the marker before it; blanks and a
+/// carriage return (a file written on Windows) may end that line.
+#[test]
+fn binary_markers_may_end_in_blanks_and_crlf() {
+    let reference = msh(TET41).unwrap();
+    let plain = ascii41_to_binary(TET41, false, 8);
+    let mut padded = plain.clone();
+    for (from, to) in [
+        (&b"4.1 1 8\n"[..], &b"4.1 1 8 \t\r\n"[..]),
+        (b"$Nodes\n", b"$Nodes  \r\n"),
+        (b"$Elements\n", b"$Elements\t\r\n"),
+    ] {
+        let at = padded.windows(from.len()).position(|w| w == from).unwrap();
+        padded.splice(at..at + from.len(), to.iter().copied());
+    }
+    assert_eq!(padded.len(), plain.len() + 3 + 3 + 2);
+    let m = io::parse_msh(&padded, Path::new("crlf.msh")).unwrap();
+    assert_eq!(m, reference);
+    // Anything else after a marker is garbage, named with its line.
+    let at = plain.windows(7).position(|w| w == b"$Nodes\n").unwrap() + 6;
+    let mut bad = plain.clone();
+    bad.splice(at..at, *b" x");
+    let e = io::parse_msh(&bad, Path::new("x.msh")).unwrap_err().to_string();
+    assert_contains(&e, &["x.msh", "garbage token `x`", "expected end of line"]);
+}
+
+/// The count of a binary element block is bounded by the bytes left over one element's
+/// record, (nodes + 1) size_t values: a count that passes a weaker bound but not this one is
+/// refused before reading, not found truncated afterwards.
+#[test]
+fn binary_element_count_is_bounded_by_the_record_size() {
+    let mut bytes = ascii41_to_binary(TET41, false, 8);
+    let section = bytes.windows(10).position(|w| w == b"$Elements\n").unwrap() + 10;
+    // size_t blocks, total, min tag, max tag; int dim, tag, type; size_t count.
+    let (total, count) = (section + 8, section + 4 * 8 + 3 * 4);
+    assert_eq!(bytes[count..count + 8], 1u64.to_le_bytes());
+    // Left after the count: one tet record (5 × 8 bytes) and "\n$EndElements\n" (14): 54
+    // bytes, enough for two records of 13 bytes but not for two of 40.
+    for at in [total, count] {
+        bytes[at..at + 8].copy_from_slice(&2u64.to_le_bytes());
+    }
+    let e = io::parse_msh(&bytes, Path::new("b.msh")).unwrap_err().to_string();
+    assert_contains(&e, &["b.msh", "element count 2 is too large for the 54 bytes left"]);
+}
+
 #[test]
 fn tri_meshes_obj_and_msh() {
     let obj = io::read_tri_mesh(&fixture("cube_surface.obj")).unwrap();

@@ -702,9 +702,12 @@ fn stage_slots(
             for k in 0..n {
                 let vi = unpad(ys[k].v);
                 let a = acceleration(k, first + k, vi, sums);
-                x[k] = madd(x[k], c, add(ax[k], vi));
-                v[k] = madd(v[k], c, add(av[k], a));
-                probe.add(sys.mass[first + k], x[k], v[k]);
+                // The probe takes the new state from registers: read back from `x` and `v`,
+                // its loads straddled the two stores of each Vec3 just written, and the
+                // store-to-load forwarding failed (a stall per slot).
+                let (xk, vk) = (madd(x[k], c, add(ax[k], vi)), madd(v[k], c, add(av[k], a)));
+                (x[k], v[k]) = (xk, vk);
+                probe.add(sys.mass[first + k], xk, vk);
             }
         }
     }

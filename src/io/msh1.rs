@@ -12,15 +12,17 @@ use super::ReadError;
 /// Smallest number of bytes one element record takes (`1 15 0 0 1 1\n`).
 const MIN_ELEMENT: usize = 12;
 
+/// The v1 markers; any other section is garbage.
+const MSH1: Dialect = Dialect {
+    nodes: ["$NOD", "$ENDNOD"],
+    elements: ["$ELM", "$ENDELM"],
+    skips_unknown: false,
+    expected: "`$NOD` or `$ELM`",
+};
+
 /// Parses an MSH v1 file into a builder.
 pub(crate) fn parse(data: &[u8], path: &Path) -> Result<MeshBuilder, ReadError> {
-    let v1 = Dialect {
-        nodes: ["$NOD", "$ENDNOD"],
-        elements: ["$ELM", "$ENDELM"],
-        skips_unknown: false,
-        expected: "`$NOD` or `$ELM`",
-    };
-    parse_sections(&mut Scanner::new(data, path), &v1, element_records)
+    parse_sections(&mut Scanner::new(data, path), &MSH1, element_records)
 }
 
 /// The body of `$ELM`: a count, then element records.

@@ -24,6 +24,7 @@ pub(crate) struct Dialect {
     pub expected: &'static str,
 }
 
+/// The 2.x markers; other `$Name` sections are skipped.
 const MSH22: Dialect = Dialect {
     nodes: ["$Nodes", "$EndNodes"],
     elements: ["$Elements", "$EndElements"],

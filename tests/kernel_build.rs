@@ -93,6 +93,29 @@ fn unsewing_every_face_of_a_cube_gives_free_tets_and_sewing_back_is_isomorphic()
     let _ = AlphaMask::all(3);
 }
 
+/// Reports compare by their changes and pairs: the same unsew on two copies of a map gives
+/// equal reports, an unsew and the sew that undoes it (splits against merges), or unsews of
+/// two different faces, do not.
+#[test]
+fn change_reports_are_equal_exactly_when_their_changes_and_pairs_are() {
+    let (points, tets) = kuhn_cube(1);
+    let (original, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+    let inner: Vec<_> = original.darts().filter(|&d| !original.is_free(3, d)).collect();
+    let d = inner[0];
+    let e = *inner.iter().find(|&&e| original.cell_id(2, e) != original.cell_id(2, d)).unwrap();
+    let (mut a, mut b) = (original.clone(), original.clone());
+    let unsew_a = a.unsew::<3>(d).unwrap();
+    let unsew_b = b.unsew::<3>(d).unwrap();
+    assert!(!unsew_a.changes.is_empty());
+    assert_eq!(unsew_a, unsew_b);
+    let other_face = b.unsew::<3>(e).unwrap();
+    assert_ne!(unsew_a, other_face);
+    let sew_back = a.sew::<3>(d, original.alpha::<3>(d)).unwrap();
+    assert_eq!(sew_back.pairs.len(), unsew_a.pairs.len());
+    assert_ne!(sew_back, unsew_a);
+    assert!(a.is_isomorphic(&original));
+}
+
 /// The id numbering `from_tets` documents, on Kuhn cubes with tets removed (pinched vertices,
 /// split edges): scanning darts in increasing order, face, edge and fresh vertex ids first
 /// appear in increasing order (faces in order of first appearance, edges and extra vertex

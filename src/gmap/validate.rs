@@ -570,6 +570,24 @@ pub(super) fn tet_rewired_inside() -> GMap<3> {
 mod tests {
     use super::*;
 
+    /// `validate`'s fast path says "valid" exactly when the detailed walk finds nothing, on
+    /// both of its branches (tets as built, generic): a fast path stuck at "invalid" would
+    /// only cost time, so only this test sees it.
+    #[test]
+    fn the_fast_path_agrees_with_the_detailed_walk() {
+        let (built, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+        let mut generic = built.clone();
+        generic.tets_as_built = false;
+        for map in [&built, &generic] {
+            assert!(map.laws_hold() && map.validate_detailed().is_ok());
+        }
+        let broken = tet_rewired_inside();
+        assert!(!broken.laws_hold() && broken.validate_detailed().is_err());
+        let mut broken_generic = broken.clone();
+        broken_generic.tets_as_built = false;
+        assert!(!broken_generic.laws_hold() && broken_generic.validate_detailed().is_err());
+    }
+
     /// A local minimum is a dart none of whose neighbours is smaller: a free link (αj(d) = d)
     /// is not a smaller neighbour, a link to a smaller dart is, and only the dimensions whose
     /// generators include that link lose the minimum.

@@ -435,6 +435,11 @@ fn liver_547_through_binary_converter() {
     assert_eq!(a, b);
 }
 
+/// Index of the first occurrence of `pattern` in `bytes`.
+fn find_bytes(bytes: &[u8], pattern: &[u8]) -> usize {
+    bytes.windows(pattern.len()).position(|w| w == pattern).unwrap()
+}
+
 /// In a binary file the data starts after the line of the marker before it; blanks and a
 /// carriage return (a file written on Windows) may end that line.
 #[test]
@@ -447,14 +452,14 @@ fn binary_markers_may_end_in_blanks_and_crlf() {
         (b"$Nodes\n", b"$Nodes  \r\n"),
         (b"$Elements\n", b"$Elements\t\r\n"),
     ] {
-        let at = padded.windows(from.len()).position(|w| w == from).unwrap();
+        let at = find_bytes(&padded, from);
         padded.splice(at..at + from.len(), to.iter().copied());
     }
     assert_eq!(padded.len(), plain.len() + 3 + 3 + 2);
     let m = io::parse_msh(&padded, Path::new("crlf.msh")).unwrap();
     assert_eq!(m, reference);
     // Anything else after a marker is garbage, named with its line.
-    let at = plain.windows(7).position(|w| w == b"$Nodes\n").unwrap() + 6;
+    let at = find_bytes(&plain, b"$Nodes\n") + "$Nodes".len();
     let mut bad = plain.clone();
     bad.splice(at..at, *b" x");
     let e = io::parse_msh(&bad, Path::new("x.msh")).unwrap_err().to_string();
@@ -467,7 +472,7 @@ fn binary_markers_may_end_in_blanks_and_crlf() {
 #[test]
 fn binary_element_count_is_bounded_by_the_record_size() {
     let mut bytes = ascii41_to_binary(TET41, false, 8);
-    let section = bytes.windows(10).position(|w| w == b"$Elements\n").unwrap() + 10;
+    let section = find_bytes(&bytes, b"$Elements\n") + "$Elements\n".len();
     // size_t blocks, total, min tag, max tag; int dim, tag, type; size_t count.
     let (total, count) = (section + 8, section + 4 * 8 + 3 * 4);
     assert_eq!(bytes[count..count + 8], 1u64.to_le_bytes());

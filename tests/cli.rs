@@ -407,6 +407,23 @@ fn simulate_refuses_a_pinned_id_past_the_last_point() {
 }
 
 #[test]
+fn simulate_refuses_a_thread_count_of_zero_or_past_the_limit() {
+    for (threads, message) in [
+        ("0", "the thread count must be from 1 to 256, got 0"),
+        ("257", "the thread count must be from 1 to 256, got 257"),
+        ("100000", "the thread count must be from 1 to 256, got 100000"),
+        ("-2", "expected a whole number of threads, got \"-2\""),
+        ("two", "expected a whole number of threads, got \"two\""),
+    ] {
+        let out = run(&["simulate", "data/liver_547_v22.msh", "--steps", "1", "--threads", threads]);
+        assert_eq!(out.status.code(), Some(2), "--threads {threads}: {}", stderr(&out));
+        assert!(stderr(&out).contains(message), "--threads {threads}: {}", stderr(&out));
+    }
+    let ok = run(&["simulate", "data/liver_547_v22.msh", "--steps", "1", "--threads", "256", "--json"]);
+    assert!(ok.status.success(), "{}", stderr(&ok));
+}
+
+#[test]
 fn bench_step_reports_both_models_on_the_same_system() {
     let out = run(&["bench", "step", "data/liver_547_v22.msh", "--rounds", "3", "--batch", "2", "--json"]);
     assert!(out.status.success(), "{}", stderr(&out));

@@ -57,8 +57,8 @@ pub struct SimulateArgs {
     /// ids still name the points of the file; frames use the new order.
     #[arg(long)]
     pub rcm_order: bool,
-    /// Worker threads (1 = serial; more splits the force passes, same results bit for bit).
-    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
+    /// Worker threads, 1 to 256 (1 = serial; more splits the force passes, same results bit for bit).
+    #[arg(long, default_value_t = 1, value_parser = parse_threads, allow_negative_numbers = true)]
     pub threads: usize,
     /// Write `frame_NNNNNN.vtu` files and the series `frame.pvd` (for ParaView) into this directory.
     #[arg(long)]
@@ -102,6 +102,20 @@ fn parse_pin_below(s: &str) -> Result<(usize, f64), String> {
     Ok((axis, parse_finite(value)?))
 }
 
+/// Most worker threads `--threads` takes: far above the cores of any machine this runs on, and
+/// low enough that a slip of the keyboard (`--threads 20000`) is an error, not minutes spent
+/// creating threads.
+const MAX_THREADS: usize = 256;
+
+/// `--threads`: a whole number from 1 to [`MAX_THREADS`] (0 is refused, not read as "serial").
+fn parse_threads(s: &str) -> Result<usize, String> {
+    let n: u64 = s.trim().parse().map_err(|_| format!("expected a whole number of threads, got {s:?}"))?;
+    match usize::try_from(n) {
+        Ok(n) if (1..=MAX_THREADS).contains(&n) => Ok(n),
+        _ => Err(format!("the thread count must be from 1 to {MAX_THREADS}, got {n}")),
+    }
+}
+
 fn other(e: impl std::error::Error + Send + Sync + 'static) -> CliError {
     CliError::Other(Box::new(e))
 }
@@ -111,10 +125,10 @@ fn other(e: impl std::error::Error + Send + Sync + 'static) -> CliError {
 ///
 /// # Errors
 /// [`CliError::Load`] for a bad mesh; [`CliError::Other`] for a `--pin` id past the last point, a
-/// bad material, a blow-up (naming the step and vertex), a bad thread count or an unwritable
+/// bad material, a blow-up (naming the step and vertex), a thread pool the system refuses or an unwritable
 /// output directory.
 pub fn run(args: SimulateArgs) -> Result<(), CliError> {
-    let threads = args.threads.max(1);
+    let threads = args.threads;
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(other)?;
     pool.install(|| simulate(&args, threads > 1))
 }

@@ -717,6 +717,19 @@ fn element_types() {
     assert_contains(&e, &["unsupported element type 5", "hexahedron"]);
     let e = msh_err(&TET1.replace("1 4 1 1 4", "1 4 1 1 5"));
     assert_contains(&e, &["declares 5 nodes"]);
+    // Each ASCII dialect names the parts of its own element records.
+    for (file, record, broken, expected) in [
+        (TET1, "1 4 1 1 4 1 2 3 4", "x 4 1 1 4 1 2 3 4", "expected an element number"),
+        (TET1, "1 4 1 1 4 1 2 3 4", "1 4 1 x 4 1 2 3 4", "expected the elementary region"),
+        (TET1, "1 4 1 1 4 1 2 3 4", "1 4 1 1 4 1 2 x 4", "expected an element node number"),
+        (TET22, "1 4 2 1 1 1 2 3 4", "x 4 2 1 1 1 2 3 4", "expected an element tag"),
+        (TET22, "1 4 2 1 1 1 2 3 4", "1 4 2 1 x 1 2 3 4", "expected an element tag (physical, elementary"),
+        (TET22, "1 4 2 1 1 1 2 3 4", "1 4 2 1 1 1 2 x 4", "expected an element node tag"),
+    ] {
+        assert!(file.contains(record));
+        let e = msh_err(&file.replace(record, broken));
+        assert_contains(&e, &["garbage token `x`", expected]);
+    }
     let e = tetgen_err(NODE, "1 10 0\n1 1 2 3 4 1 2 3 4 1 2\n");
     assert_contains(&e, &["t.ele", "unsupported element type", "10-node"]);
 }

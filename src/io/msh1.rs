@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
-use super::build::{bounded_count, gmsh_element_kind, MeshBuilder};
-use super::msh22::{parse_sections, Dialect};
+use super::build::MeshBuilder;
+use super::msh22::{parse_sections, Dialect, ElementRecords};
 use super::scan::Scanner;
 use super::ReadError;
 
@@ -18,45 +18,23 @@ const MSH1: Dialect = Dialect {
     elements: ["$ELM", "$ENDELM"],
     skips_unknown: false,
     expected: "`$NOD` or `$ELM`",
+    records: ElementRecords {
+        min_bytes: MIN_ELEMENT,
+        tag: "an element number",
+        node: "an element node number",
+        fields: regions_and_node_count,
+    },
 };
 
 /// Parses an MSH v1 file into a builder.
 pub(crate) fn parse(data: &[u8], path: &Path) -> Result<MeshBuilder, ReadError> {
-    parse_sections(&mut Scanner::new(data, path), &MSH1, element_records)
+    parse_sections(&mut Scanner::new(data, path), &MSH1)
 }
 
-/// The body of `$ELM`: a count, then element records.
-fn element_records(sc: &mut Scanner<'_>, b: &mut MeshBuilder) -> Result<(), ReadError> {
-    let path = sc.path();
-    let at = sc.here();
-    let count = sc.u64("the number of elements")?;
-    let n = bounded_count(path, at, "element", count, MIN_ELEMENT, sc.remaining())?;
-    let mut nodes: Vec<u64> = Vec::new();
-    for _ in 0..n {
-        let at = sc.here();
-        let tag = sc.u64("an element number")?;
-        let type_at = sc.here();
-        let element_type = sc.i64("an element type")?;
-        sc.i64("the physical region")?;
-        sc.i64("the elementary region")?;
-        let declared = sc.u64("the number of nodes")?;
-        let kind = gmsh_element_kind(path, type_at, element_type)?;
-        if declared != kind.nodes as u64 {
-            return Err(ReadError::Malformed {
-                path: path.to_path_buf(),
-                at,
-                message: format!(
-                    "element {tag} of type {element_type} declares {declared} nodes, \
-                     but that type has {}",
-                    kind.nodes
-                ),
-            });
-        }
-        nodes.clear();
-        for _ in 0..kind.nodes {
-            nodes.push(sc.u64("an element node number")?);
-        }
-        b.add_element(path, at, tag, kind.usage, &nodes)?;
-    }
-    Ok(())
+/// The v1 fields between an element's type and its nodes: the physical and elementary regions
+/// and the declared number of nodes.
+fn regions_and_node_count(sc: &mut Scanner<'_>) -> Result<Option<u64>, ReadError> {
+    sc.i64("the physical region")?;
+    sc.i64("the elementary region")?;
+    sc.u64("the number of nodes").map(Some)
 }

@@ -22,6 +22,22 @@ pub(crate) struct Dialect {
     pub skips_unknown: bool,
     /// What the error names as expected at top level.
     pub expected: &'static str,
+    /// How an element record is laid out.
+    pub records: ElementRecords,
+}
+
+/// The layout of one dialect's element records, `tag type <fields> node...`, for
+/// [`element_records`].
+pub(crate) struct ElementRecords {
+    /// Fewest bytes one record takes (the declared count is bounded by the bytes left).
+    pub min_bytes: usize,
+    /// What the dialect calls an element's id (the messages name it).
+    pub tag: &'static str,
+    /// What the dialect calls a node id in an element record.
+    pub node: &'static str,
+    /// Reads the fields between the type and the nodes; returns the node count the record
+    /// declares, when it declares one (checked against the type's).
+    pub fields: fn(&mut Scanner<'_>) -> Result<Option<u64>, ReadError>,
 }
 
 /// The 2.x markers; other `$Name` sections are skipped.
@@ -30,22 +46,34 @@ const MSH22: Dialect = Dialect {
     elements: ["$Elements", "$EndElements"],
     skips_unknown: true,
     expected: "a section start such as `$Nodes`",
+    records: ElementRecords {
+        min_bytes: MIN_ELEMENT,
+        tag: "an element tag",
+        node: "an element node tag",
+        fields: tag_list,
+    },
 };
+
+/// The 2.x fields between an element's type and its nodes: a count, then that many tags
+/// (physical, elementary, partition...). No node count is declared.
+fn tag_list(sc: &mut Scanner<'_>) -> Result<Option<u64>, ReadError> {
+    let tag_count = sc.u64("the number of element tags")?;
+    for _ in 0..tag_count {
+        sc.i64("an element tag (physical, elementary, partition)")?;
+    }
+    Ok(None)
+}
 
 /// Parses an MSH 2.x ASCII file into a builder.
 pub(crate) fn parse(data: &[u8], path: &Path) -> Result<MeshBuilder, ReadError> {
     let mut sc = Scanner::new(data, path);
     parse_header(&mut sc)?;
-    parse_sections(&mut sc, &MSH22, element_records)
+    parse_sections(&mut sc, &MSH22)
 }
 
 /// The top-level loop of the Gmsh ASCII dialects: one node section (`tag x y z` records), then
-/// one element section read by `elements`, both required, nodes first. O(bytes).
-pub(crate) fn parse_sections(
-    sc: &mut Scanner<'_>,
-    dialect: &Dialect,
-    elements: fn(&mut Scanner<'_>, &mut MeshBuilder) -> Result<(), ReadError>,
-) -> Result<MeshBuilder, ReadError> {
+/// one element section laid out as `dialect.records`, both required, nodes first. O(bytes).
+pub(crate) fn parse_sections(sc: &mut Scanner<'_>, dialect: &Dialect) -> Result<MeshBuilder, ReadError> {
     let path = sc.path();
     let mut b = MeshBuilder::new();
     let (mut seen_nodes, mut seen_elements) = (false, false);
@@ -64,7 +92,7 @@ pub(crate) fn parse_sections(
                     let message = format!("`{elems}` before `{nodes}`");
                     return Err(ReadError::Malformed { path: path.to_path_buf(), at: sc.location_of(&t), message });
                 }
-                elements(sc, &mut b)?;
+                element_records(sc, &mut b, &dialect.records)?;
                 sc.expect_marker(end_elems)?;
                 seen_elements = true;
             }
@@ -127,27 +155,31 @@ pub(crate) fn node_records(sc: &mut Scanner<'_>, b: &mut MeshBuilder) -> Result<
     Ok(())
 }
 
-/// The body of `$Elements`: a count, then
-/// `tag type number-of-tags tag... node-tag...` records.
-fn element_records(sc: &mut Scanner<'_>, b: &mut MeshBuilder) -> Result<(), ReadError> {
+/// The body of an element section (`$Elements`, `$ELM`): a count, then `tag type <fields>
+/// node...` records, the fields and the words of the messages as `layout` says. O(bytes).
+fn element_records(sc: &mut Scanner<'_>, b: &mut MeshBuilder, layout: &ElementRecords) -> Result<(), ReadError> {
     let path = sc.path();
     let at = sc.here();
     let count = sc.u64("the number of elements")?;
-    let n = bounded_count(path, at, "element", count, MIN_ELEMENT, sc.remaining())?;
+    let n = bounded_count(path, at, "element", count, layout.min_bytes, sc.remaining())?;
     let mut nodes: Vec<u64> = Vec::new();
     for _ in 0..n {
         let at = sc.here();
-        let tag = sc.u64("an element tag")?;
+        let tag = sc.u64(layout.tag)?;
         let type_at = sc.here();
         let element_type = sc.i64("an element type")?;
-        let tag_count = sc.u64("the number of element tags")?;
-        for _ in 0..tag_count {
-            sc.i64("an element tag (physical, elementary, partition)")?;
-        }
+        let declared = (layout.fields)(sc)?;
         let kind = gmsh_element_kind(path, type_at, element_type)?;
+        if let Some(declared) = declared.filter(|&d| d != kind.nodes as u64) {
+            let message = format!(
+                "element {tag} of type {element_type} declares {declared} nodes, but that type has {}",
+                kind.nodes
+            );
+            return Err(ReadError::Malformed { path: path.to_path_buf(), at, message });
+        }
         nodes.clear();
         for _ in 0..kind.nodes {
-            nodes.push(sc.u64("an element node tag")?);
+            nodes.push(sc.u64(layout.node)?);
         }
         b.add_element(path, at, tag, kind.usage, &nodes)?;
     }

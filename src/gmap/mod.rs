@@ -588,11 +588,12 @@ impl<const N: usize> GMap<N> {
     }
 
     /// Reserves room for `count` more darts (rows), so that [`Self::push_rows_raw`] does not
-    /// reallocate. O(1) amortized.
+    /// reallocate. The liveness words need ⌈(c + count)/64⌉ − ⌈c/64⌉ ≤ ⌈count/64⌉ more for c
+    /// slots (equal when c is a multiple of 64). O(1) amortized.
     pub(crate) fn reserve_darts_raw(&mut self, count: usize) {
         self.alpha.reserve_exact(count * (N + 1));
         self.cell.reserve_exact(count * (N + 1));
-        self.alive.reserve_exact(count.div_ceil(64) + 1);
+        self.alive.reserve_exact(count.div_ceil(64));
     }
 
     /// Appends live darts whose rows are given (`alpha` and `cell`, n + 1 entries per dart, the
@@ -734,6 +735,24 @@ mod tests {
     /// prefix whose length is no multiple of 64 (so the liveness words are filled from the
     /// middle, across several words) are all live, and only they, with their rows; writes
     /// through `rows_mut_raw` reach the map; `from_rows_raw` makes every row a live dart.
+    /// `reserve_darts_raw(k)` leaves room for k more rows in each array (so that the pushes of a
+    /// bulk refinement never reallocate), from slot counts on and off a word boundary.
+    #[test]
+    fn reserve_leaves_room_for_the_rows_pushed_after_it() {
+        for (start, count) in [(128, 130), (128, 64), (180, 70), (0, 1), (64, 65), (63, 2)] {
+            let mut map = GMap::<3>::new();
+            if start > 0 {
+                map.alloc_darts_raw(start);
+            }
+            assert_eq!(map.alive.len(), start.div_ceil(64));
+            map.reserve_darts_raw(count);
+            let total = start + count;
+            let room = (map.alpha.capacity(), map.cell.capacity(), map.alive.capacity());
+            assert!(room.0 >= 4 * total && room.1 >= 4 * total, "{start} + {count}: rows {room:?}");
+            assert!(room.2 >= total.div_ceil(64), "{start} + {count}: liveness words {room:?}");
+        }
+    }
+
     #[test]
     fn bulk_rows_allocate_push_and_write_through() {
         let mut map = GMap::<2>::new();

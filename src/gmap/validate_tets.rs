@@ -321,6 +321,26 @@ mod tests {
     /// Folds face 0 of a lone tet onto itself: α3 = (0 1)(2 5)(3 4) on its flags, the reflection
     /// that swaps corners a and b and fixes c (it commutes with α0 and α1, so the map is lawful
     /// once a and b, and the edges bc and ca, carry one id each).
+    /// `join` keeps its documented forest: every root is the smallest element of its tree, and
+    /// it reports a join exactly when the two were apart (checked against a naive labelling).
+    #[test]
+    fn join_keeps_each_tree_rooted_at_its_smallest_element() {
+        let n = 60u32;
+        let mut rng = SplitMix64(31);
+        let mut forest: Vec<u32> = (0..n).collect();
+        let mut label: Vec<u32> = (0..n).collect(); // the smallest element of each one's set
+        for _ in 0..200 {
+            let (a, b) = ((rng.next_u64() % u64::from(n)) as u32, (rng.next_u64() % u64::from(n)) as u32);
+            let (la, lb) = (label[a as usize], label[b as usize]);
+            assert_eq!(join(&mut forest, a, b), la != lb, "join({a}, {b})");
+            let merged = la.min(lb);
+            label.iter_mut().filter(|l| **l == la || **l == lb).for_each(|l| *l = merged);
+            for x in 0..n {
+                assert_eq!(find_root(&mut forest, x), label[x as usize], "root of {x} after join({a}, {b})");
+            }
+        }
+    }
+
     #[test]
     fn a_face_folded_onto_itself_is_lawful_on_both_paths() {
         let (mut map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();

@@ -341,6 +341,23 @@ mod tests {
         }
     }
 
+    /// The tet paths read whole 24-dart blocks: `live_tet_blocks` gives their number only for a
+    /// 3-map whose slots are whole blocks, all live, and `None` for a dead slot, a partial block
+    /// or another dimension (each condition alone).
+    #[test]
+    fn live_tet_blocks_need_n_3_whole_blocks_and_every_slot_live() {
+        let (map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+        assert_eq!(map.live_tet_blocks(), Some(2));
+        let mut dead = map.clone();
+        dead.kill_dart_raw(DartId(47)); // 48 slots, 47 live
+        assert_eq!((dead.capacity(), dead.live_tet_blocks()), (48, None));
+        let mut partial = map.clone();
+        partial.create_dart().unwrap(); // 49 slots, all live
+        assert_eq!((partial.dart_count(), partial.live_tet_blocks()), (49, None));
+        let (flat, _) = GMap::<2>::from_triangles(6, &[[0, 1, 2], [3, 4, 5], [0, 1, 3], [2, 4, 5]]).unwrap();
+        assert_eq!((flat.dart_count(), flat.live_tet_blocks()), (24, None)); // 24 live darts, n = 2
+    }
+
     #[test]
     fn a_face_folded_onto_itself_is_lawful_on_both_paths() {
         let (mut map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();

@@ -4,37 +4,14 @@
 //! against cell counts derived by hand.
 
 use proptest::prelude::*;
-use topomech::generate::grid_triangles;
 use topomech::subdivide::{LeveledMap, SubdivideError};
 use topomech::{DartId, GMap};
 
+mod subdivide_common;
+use subdivide_common::{check_levels, grid, level_counts, triangle_mesh};
+
 fn single_triangle() -> LeveledMap<2> {
-    let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
-    LeveledMap::new(map, vec![[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]])
-}
-
-fn grid(n: usize) -> LeveledMap<2> {
-    let (points, tris) = grid_triangles(n);
-    let (map, _) = GMap::<2>::from_triangles(points.len(), &tris).unwrap();
-    LeveledMap::new(map, points)
-}
-
-/// Every law, plus: the top level is the finest map itself, and every level has the Euler
-/// characteristic of level 0 (subdivision never changes the topology of the surface).
-fn check(m: &LeveledMap<2>) {
-    m.check_all().unwrap();
-    let top = m.level(m.max_level()).unwrap();
-    assert!(top.map.is_isomorphic(m.map()), "level k must be the finest map");
-    let chi0 = m.level(0).unwrap().map.euler_characteristic();
-    for i in 0..=m.max_level() {
-        let view = m.level(i).unwrap();
-        assert_eq!(view.map.euler_characteristic(), chi0, "level {i}");
-        assert!(view.darts.iter().all(|&d| m.dart_level(d) <= i));
-        if i > 0 {
-            let below = m.level(i - 1).unwrap();
-            assert!(below.darts.iter().all(|d| view.darts.binary_search(d).is_ok()), "B_{} ⊄ B_{i}", i - 1);
-        }
-    }
+    triangle_mesh(vec![[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]], &[[0, 1, 2]])
 }
 
 /// One dart of every face whose face level is below `level`.
@@ -46,7 +23,7 @@ fn refine_uniformly(m: &mut LeveledMap<2>, levels: u8) {
     for level in 1..=levels {
         for d in faces_below(m, level) {
             m.subdivide_triangle(d, level).unwrap();
-            check(m);
+            check_levels(m);
         }
     }
 }
@@ -64,17 +41,13 @@ fn a_triangle_refined_to_level_k_has_4_pow_k_triangles() {
     insta::assert_json_snapshot!("subdivide_2d_single_triangle_counts", level_counts(&m));
 }
 
-fn level_counts(m: &LeveledMap<2>) -> Vec<Vec<usize>> {
-    (0..=m.max_level()).map(|i| m.level(i).unwrap().map.count_cells().0).collect()
-}
-
 #[test]
 fn edge_split_makes_the_neighbour_a_quad_at_the_new_level_only() {
     let (map, _) = GMap::<2>::from_triangles(4, &[[0, 1, 2], [1, 3, 2]]).unwrap();
     let mut m = LeveledMap::new(map, vec![[0.0; 3], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0], [2.0, 2.0, 0.0]]);
     let inner = m.map().darts().find(|&d| !m.map().is_free(2, d)).unwrap();
     let mid = m.split_edge(inner, 1).unwrap();
-    check(&m);
+    check_levels(&m);
     assert_eq!(m.level(0).unwrap().map.count_cells().0, vec![4, 5, 2]);
     assert_eq!(m.level(1).unwrap().map.count_cells().0, vec![5, 6, 2]);
     // Both faces now have 4 vertices (8 darts) at level 1 and keep face level 0.
@@ -96,19 +69,19 @@ fn neighbour_keeps_the_shared_midpoint_and_levels_follow_the_paper() {
     let mut m = LeveledMap::new(map, vec![[0.0; 3], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0], [2.0, 2.0, 0.0]]);
     let faces = m.map().one_dart_per_cell(2);
     m.subdivide_triangle(faces[0], 1).unwrap();
-    check(&m);
+    check_levels(&m);
     // Level 1: 4 children + the neighbour (a quad, face level 0, shared edge level 1).
     assert_eq!(m.level(1).unwrap().map.count_cells().0, vec![7, 11, 5]);
     let neighbour = m.map().darts().find(|&d| m.mu(d).face == 0).unwrap();
     assert_eq!(m.map().cell_darts(2, neighbour).len(), 8);
     m.subdivide_triangle(neighbour, 1).unwrap();
-    check(&m);
+    check_levels(&m);
     // Level 1 is now the uniform refinement of the square: 9 vertices, 16 edges, 8 triangles.
     assert_eq!(m.level(1).unwrap().map.count_cells().0, vec![9, 16, 8]);
     assert!(m.map().darts().all(|d| m.mu(d).face == 1 && m.mu(d).edge == 1));
     let child = m.map().one_dart_per_cell(2)[0];
     m.subdivide_triangle(child, 2).unwrap();
-    check(&m);
+    check_levels(&m);
     assert_eq!(m.level(2).unwrap().map.count_cells().0, vec![9 + 3, 16 + 3 + 3, 8 - 1 + 4]);
 }
 
@@ -124,7 +97,7 @@ fn level_order_and_bad_input_are_errors() {
     assert!(matches!(m.subdivide_triangle(kids[0], 251), Err(SubdivideError::LevelTooHigh(251))));
     // Levels 0 and 1 are both the single triangle (nothing happened at level 1).
     assert_eq!(m.level(1).unwrap().map.count_cells().0, vec![3, 3, 1]);
-    check(&m);
+    check_levels(&m);
 }
 
 #[test]
@@ -171,7 +144,7 @@ proptest! {
             let before = m.map().clone();
             let r = if face { m.subdivide_triangle(d, level).map(|_| ()) } else { m.split_edge(d, level).map(|_| ()) };
             match r {
-                Ok(()) => check(&m),
+                Ok(()) => check_levels(&m),
                 Err(SubdivideError::AlreadyAtLevel { .. }) => prop_assert!(before.is_isomorphic(m.map())),
                 Err(e) => prop_assert!(false, "unexpected error {e}"),
             }

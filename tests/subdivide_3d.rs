@@ -1,27 +1,19 @@
 //! Adaptive-resolution subdivision in tetrahedral meshes (seed 004, §4.3.2–§4.3.3): edge splits
 //! and face 1→4 in 3-G-maps, with the α2 and α3 neighbours updated, checked after every
 //! operation (finest map valid, μt ≤ μf ≤ μa, every level a valid G-map, Euler characteristic).
-//! Tetrahedron 1→8 is not implemented yet.
+//! Tetrahedron 1→8 has its own suite (`subdivide_tet.rs`).
 
 use proptest::prelude::*;
 use topomech::generate::kuhn_cube;
 use topomech::subdivide::{LeveledMap, SubdivideError};
 use topomech::{DartId, GMap};
 
-fn two_tets() -> LeveledMap<3> {
-    let (map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
-    let pts = vec![[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.0], [0.0, 0.0, -2.0]];
-    LeveledMap::new(map, pts)
-}
+mod subdivide_common;
+use subdivide_common::{check_levels, tet_mesh};
 
-fn check(m: &LeveledMap<3>) {
-    m.check_all().unwrap();
-    let top = m.level(m.max_level()).unwrap();
-    assert!(top.map.is_isomorphic(m.map()), "level k must be the finest map");
-    let chi0 = m.level(0).unwrap().map.euler_characteristic();
-    for i in 0..=m.max_level() {
-        assert_eq!(m.level(i).unwrap().map.euler_characteristic(), chi0, "level {i}");
-    }
+fn two_tets() -> LeveledMap<3> {
+    let pts = vec![[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.0], [0.0, 0.0, -2.0]];
+    tet_mesh(pts, &[[0, 1, 2, 3], [0, 1, 2, 4]])
 }
 
 #[test]
@@ -29,7 +21,7 @@ fn shared_face_split_is_seen_by_both_tets() {
     let mut m = two_tets();
     let shared = m.map().darts().find(|&d| !m.map().is_free(3, d)).unwrap();
     m.subdivide_triangle(shared, 1).unwrap();
-    check(&m);
+    check_levels(&m);
     assert_eq!(m.level(0).unwrap().map.count_cells().0, vec![5, 9, 7, 2]);
     // +3 midpoints, +3 half edges, +3 inserted edges; the shared face becomes 4 faces.
     assert_eq!(m.level(1).unwrap().map.count_cells().0, vec![8, 15, 10, 2]);
@@ -47,11 +39,11 @@ fn boundary_face_then_edge_of_its_child() {
     let mut m = two_tets();
     let boundary = m.map().darts().find(|&d| m.map().is_free(3, d)).unwrap();
     let kids = m.subdivide_triangle(boundary, 1).unwrap();
-    check(&m);
+    check_levels(&m);
     m.split_edge(kids[3], 2).unwrap();
-    check(&m);
+    check_levels(&m);
     let grand = m.subdivide_triangle(kids[0], 2).unwrap();
-    check(&m);
+    check_levels(&m);
     assert!(matches!(m.subdivide_triangle(grand[0], 2), Err(SubdivideError::AlreadyAtLevel { dim: 2, .. })));
 }
 
@@ -69,7 +61,7 @@ proptest! {
             let level = (m.max_level() + up as u8).max(1);
             let r = if face { m.subdivide_triangle(d, level).map(|_| ()) } else { m.split_edge(d, level).map(|_| ()) };
             match r {
-                Ok(()) => check(&m),
+                Ok(()) => check_levels(&m),
                 Err(SubdivideError::AlreadyAtLevel { .. }) => {}
                 Err(e) => prop_assert!(false, "unexpected error {e}"),
             }

@@ -6,30 +6,23 @@
 //! - mass laws: Σ tet masses unchanged; Σ vertex masses = Σ tet masses; every tet's mass equals
 //!   ρ · its volume (children share the parent's mass by volume and midpoint subdivision divides
 //!   volume exactly);
-//! - the Euler characteristic of every extracted level equals that of level 0.
+//! - the laws of every leveled map (`check_levels`: level k is the finest map, B_{i−1} ⊂ B_i, the
+//!   Euler characteristic of every extracted level equals that of level 0).
 
 use std::process::Command;
 
 use proptest::prelude::*;
-use topomech::generate::kuhn_cube;
 use topomech::mechanics::Material;
 use topomech::subdivide::{tet_distance, CouplingError, LeveledMap, LeveledMechanics, SubdivideError, TetMasses};
 use topomech::GMap;
 
+mod subdivide_common;
+use subdivide_common::{check_levels, cube};
+
 const RHO: f64 = 3.0;
 
-fn cube(k: usize) -> LeveledMap<3> {
-    let (points, tets) = kuhn_cube(k);
-    let (map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
-    LeveledMap::new(map, points)
-}
-
 fn check_laws(m: &LeveledMap<3>, masses: &TetMasses, center: [f64; 3], radius: f64, levels: u8, mass0: f64) {
-    m.check_all().unwrap();
-    let chi0 = m.level(0).unwrap().map.euler_characteristic();
-    for i in 0..=m.max_level() {
-        assert_eq!(m.level(i).unwrap().map.euler_characteristic(), chi0, "level {i}");
-    }
+    check_levels(m);
     let map = m.map();
     for d in map.one_dart_per_cell(3) {
         let corners = m.tet_vertices(d).unwrap().map(|v| m.points()[v as usize]);

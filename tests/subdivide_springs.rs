@@ -9,12 +9,10 @@ use topomech::subdivide::fuzz::{decode, Op, MAX_DARTS, MAX_FUZZ_LEVEL};
 use topomech::subdivide::{CouplingError, EdgeKey, LeveledMap, LeveledMechanics, SpringLawError};
 use topomech::{DartId, GMap};
 
-const TET: [[f64; 3]; 4] = [[0.0, 0.0, 0.0], [1.0, 0.1, 0.0], [0.2, 1.0, 0.1], [0.1, 0.3, 1.0]];
+mod subdivide_common;
+use subdivide_common::tet_mesh;
 
-fn leveled(points: Vec<[f64; 3]>, tets: &[[u32; 4]]) -> LeveledMap<3> {
-    let (map, _) = GMap::<3>::from_tets(points.len(), tets).unwrap();
-    LeveledMap::new(map, points)
-}
+const TET: [[f64; 3]; 4] = [[0.0, 0.0, 0.0], [1.0, 0.1, 0.0], [0.2, 1.0, 0.1], [0.1, 0.3, 1.0]];
 
 fn material() -> Material {
     Material { density: 2.0, young: 500.0, damping: 0.01, viscosity: 0.5 }
@@ -76,10 +74,10 @@ fn check_interpolation(mech: &LeveledMechanics, m: &LeveledMap<3>, from: usize) 
 fn run(bytes: &[u8]) -> Result<usize, String> {
     let (mesh, ops) = decode(bytes);
     let mut m = match mesh {
-        topomech::subdivide::fuzz::Mesh::Tet => leveled(TET.to_vec(), &[[0, 1, 2, 3]]),
+        topomech::subdivide::fuzz::Mesh::Tet => tet_mesh(TET.to_vec(), &[[0, 1, 2, 3]]),
         _ => {
             let (p, t) = kuhn_cube(1);
-            leveled(p, &t)
+            tet_mesh(p, &t)
         }
     };
     let mut mech = LeveledMechanics::new(&m, material()).map_err(|e| e.to_string())?;
@@ -178,7 +176,7 @@ fn the_test_deformation_stretches_every_edge() {
 
 #[test]
 fn split_edges_interpolated_after_deformation_are_in_equilibrium_with_the_coarse_reactions() {
-    let mut m = leveled(TET.to_vec(), &[[0, 1, 2, 3]]);
+    let mut m = tet_mesh(TET.to_vec(), &[[0, 1, 2, 3]]);
     let mut mech = LeveledMechanics::new(&m, material()).unwrap();
     for (v, &p) in TET.iter().enumerate() {
         mech.position[v] = deformed(p, v);
@@ -204,7 +202,7 @@ fn a_relaxed_refined_chain_network_has_the_coarse_static_response() {
     // Series law as physics: with the corners held in a deformed position, the midpoints (moved off
     // their equilibrium) relax under damped implicit dynamics and the reactions at the corners are
     // the coarse network's: each chain stretches the same total amount as its coarse spring.
-    let mut m = leveled(TET.to_vec(), &[[0, 1, 2, 3]]);
+    let mut m = tet_mesh(TET.to_vec(), &[[0, 1, 2, 3]]);
     let heavy = Material { viscosity: 200.0, ..material() };
     let mut mech = LeveledMechanics::new(&m, heavy).unwrap();
     split_all_edges(&mut mech, &mut m, 2);
@@ -215,11 +213,11 @@ fn a_relaxed_refined_chain_network_has_the_coarse_static_response() {
         let j = jitter(7 * v as u64);
         mech.position[v] = [0, 1, 2].map(|k| mech.position[v][k] + 0.05 * j[k]);
     }
-    let coarse = LeveledMechanics::new(&leveled(TET.to_vec(), &[[0, 1, 2, 3]]), heavy).unwrap();
+    let coarse = LeveledMechanics::new(&tet_mesh(TET.to_vec(), &[[0, 1, 2, 3]]), heavy).unwrap();
     let mut x_coarse = coarse.position.clone();
     (0..4).for_each(|v| x_coarse[v] = mech.position[v]);
     let f_coarse =
-        spring_forces(&coarse.spring_system(&leveled(TET.to_vec(), &[[0, 1, 2, 3]]), [0.0; 3], &[]), &x_coarse);
+        spring_forces(&coarse.spring_system(&tet_mesh(TET.to_vec(), &[[0, 1, 2, 3]]), [0.0; 3], &[]), &x_coarse);
     let sys = mech.spring_system(&m, [0.0; 3], &[true; 4]);
     let mut stepper =
         Stepper::new(StepConfig::new(Integrator::Implicit, 1e-2), &sys, &mech.position, &mech.velocity).unwrap();
@@ -244,7 +242,7 @@ fn affine(x: &[Vec3]) -> Vec<Vec3> {
 #[test]
 fn refinement_never_softens_and_chains_alone_keep_the_coarse_energy() {
     let (points, tets) = kuhn_cube(1);
-    let mut m = leveled(points.clone(), &tets);
+    let mut m = tet_mesh(points.clone(), &tets);
     let mech0 = LeveledMechanics::new(&m, material()).unwrap();
     let e_coarse = mech0.spring_system(&m, [0.0; 3], &[]).elastic_energy(&affine(m.points()));
     // Edge splits only: the network is the coarse one in series, same energy under affine motion.
@@ -253,7 +251,7 @@ fn refinement_never_softens_and_chains_alone_keep_the_coarse_energy() {
     let e_chains = mech.spring_system(&m, [0.0; 3], &[]).elastic_energy(&affine(m.points()));
     assert!((e_chains - e_coarse).abs() < 1e-12 * e_coarse, "{e_chains} vs {e_coarse}");
     // 1→8 adds inner springs: at least as stiff.
-    let mut m2 = leveled(points, &tets);
+    let mut m2 = tet_mesh(points, &tets);
     let mut mech2 = LeveledMechanics::new(&m2, material()).unwrap();
     mech2.refine_around(&mut m2, [0.5; 3], 10.0, 2).unwrap();
     mech2.check(&m2).unwrap();
@@ -264,7 +262,7 @@ fn refinement_never_softens_and_chains_alone_keep_the_coarse_energy() {
 #[test]
 fn masses_are_conserved_exactly_and_every_vertex_has_mass() {
     let (points, tets) = kuhn_cube(2);
-    let mut m = leveled(points, &tets);
+    let mut m = tet_mesh(points, &tets);
     let mut mech = LeveledMechanics::new(&m, material()).unwrap();
     let r = mech.refine_around(&mut m, [0.7, 0.6, 0.5], 0.3, 2).unwrap();
     assert!(r.subdivided_per_level[1] > 0 && r.subdivided_per_level[2] > 0);
@@ -281,7 +279,7 @@ fn masses_are_conserved_exactly_and_every_vertex_has_mass() {
 #[test]
 fn a_refined_zone_simulates_from_the_projection_without_a_tet_list() {
     let (points, tets) = kuhn_cube(2);
-    let mut m = leveled(points, &tets);
+    let mut m = tet_mesh(points, &tets);
     let mut mech = LeveledMechanics::new(&m, Material::default()).unwrap();
     mech.refine_around(&mut m, [1.0, 1.0, 2.0], 0.4, 2).unwrap();
     let fixed: Vec<bool> = m.points().iter().map(|p| p[2] == 0.0).collect();
@@ -303,7 +301,7 @@ type Expect = Box<dyn Fn(&SpringLawError) -> bool>;
 #[test]
 fn tampering_is_flagged_naming_the_edge_or_vertex() {
     let (points, tets) = kuhn_cube(1);
-    let mut m = leveled(points, &tets);
+    let mut m = tet_mesh(points, &tets);
     let mut mech = LeveledMechanics::new(&m, material()).unwrap();
     let d = m.map().darts().next().unwrap();
     mech.subdivide_tet(&mut m, d, 1).unwrap();
@@ -604,7 +602,7 @@ fn a_ball_holding_everything_takes_the_bulk_path_with_the_per_tet_springs() {
             *p = [0, 1, 2].map(|k| p[k] + 0.1 * j[k]);
         }
     }
-    let base = leveled(points, &tets);
+    let base = tet_mesh(points, &tets);
     let (mut bulk, mut perop) = (base.clone(), base.clone());
     let mut mb = LeveledMechanics::new(&bulk, material()).unwrap();
     let mut mp = mb.clone();

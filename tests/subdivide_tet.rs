@@ -4,35 +4,14 @@
 //! counts derived below, and against volume conservation computed from the stored positions.
 
 use proptest::prelude::*;
-use topomech::generate::kuhn_cube;
 use topomech::subdivide::{LeveledMap, SubdivideError};
 use topomech::{DartId, GMap};
 
+mod subdivide_common;
+use subdivide_common::{check_levels, cube, level_counts, tet_mesh};
+
 fn one_tet(points: Vec<[f64; 3]>) -> LeveledMap<3> {
-    let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
-    LeveledMap::new(map, points)
-}
-
-fn cube(k: usize) -> LeveledMap<3> {
-    let (points, tets) = kuhn_cube(k);
-    let (map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
-    LeveledMap::new(map, points)
-}
-
-/// Every law after an operation.
-fn check(m: &LeveledMap<3>) {
-    m.check_all().unwrap();
-    let top = m.level(m.max_level()).unwrap();
-    assert!(top.map.is_isomorphic(m.map()), "level k must be the finest map");
-    let chi0 = m.level(0).unwrap().map.euler_characteristic();
-    for i in 0..=m.max_level() {
-        let view = m.level(i).unwrap();
-        assert_eq!(view.map.euler_characteristic(), chi0, "level {i}");
-        if i > 0 {
-            let below = m.level(i - 1).unwrap();
-            assert!(below.darts.iter().all(|d| view.darts.binary_search(d).is_ok()), "B_{} ⊄ B_{i}", i - 1);
-        }
-    }
+    tet_mesh(points, &[[0, 1, 2, 3]])
 }
 
 /// Refines every tet of level < L at level L, for L = 1..=levels, checking after every operation.
@@ -41,13 +20,9 @@ fn refine_uniformly(m: &mut LeveledMap<3>, levels: u8) {
         let tets: Vec<DartId> = m.map().one_dart_per_cell(3).into_iter().filter(|&d| m.mu(d).tet < level).collect();
         for d in tets {
             m.subdivide_tet(d, level).unwrap();
-            check(m);
+            check_levels(m);
         }
     }
-}
-
-fn level_counts(m: &LeveledMap<3>) -> Vec<Vec<usize>> {
-    (0..=m.max_level()).map(|i| m.level(i).unwrap().map.count_cells().0).collect()
 }
 
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
@@ -113,7 +88,7 @@ fn one_tet_refined_to_level_2_has_64_tets_of_equal_volume() {
 fn the_octahedron_is_split_along_its_shortest_diagonal() {
     let mut m = one_tet(IRREGULAR.to_vec());
     m.subdivide_tet(DartId(0), 1).unwrap();
-    check(&m);
+    check_levels(&m);
     // The only edge of level 1 with no boundary dart is the diagonal.
     let inner: Vec<DartId> = m
         .map()
@@ -151,7 +126,7 @@ fn neighbour_reuses_the_split_face_and_errors_leave_the_map_unchanged() {
     let pts = vec![[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.0], [0.0, 0.0, -2.0]];
     let mut m = LeveledMap::new(map, pts);
     m.subdivide_tet(DartId(0), 1).unwrap();
-    check(&m);
+    check_levels(&m);
     // The neighbour (tet 1, darts 24..48) sees the shared face split in 4 and keeps μt = 0.
     assert_eq!(m.mu(DartId(24)).tet, 0);
     assert_eq!(m.level(1).unwrap().map.count_cells().0, vec![11, 28, 27, 9]);
@@ -159,7 +134,7 @@ fn neighbour_reuses_the_split_face_and_errors_leave_the_map_unchanged() {
     assert!(matches!(m.subdivide_tet(DartId(0), 1), Err(SubdivideError::AlreadyAtLevel { dim: 3, .. })));
     assert!(m.map().is_isomorphic(before.map()));
     m.subdivide_tet(DartId(24), 1).unwrap();
-    check(&m);
+    check_levels(&m);
     // Both refined: V = 5 + 9 = 14, F = 4·7 + 16 = 44, T = 16, E = 2·9 + 3·7 + 2 = 41 (χ = 1).
     assert_eq!(m.level(1).unwrap().map.count_cells().0, vec![14, 41, 44, 16]);
     assert_eq!(m.level(0).unwrap().map.count_cells().0, vec![5, 9, 7, 2]);
@@ -183,7 +158,7 @@ proptest! {
                 _ => m.subdivide_tet(d, level).map(|_| ()),
             };
             match r {
-                Ok(()) => check(&m),
+                Ok(()) => check_levels(&m),
                 Err(SubdivideError::AlreadyAtLevel { .. } | SubdivideError::FaceRefinedTooFar { .. }) => {}
                 Err(e) => prop_assert!(false, "unexpected error {e}"),
             }

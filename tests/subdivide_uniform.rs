@@ -17,6 +17,9 @@ use topomech::generate::{disk_fan, grid_triangles, kuhn_cube, SplitMix64};
 use topomech::subdivide::{LeveledMap, Refinement, SubdivideError, TetMasses};
 use topomech::{DartId, GMap};
 
+mod subdivide_common;
+use subdivide_common::triangle_mesh;
+
 /// The leveled map of `tets` with one position per vertex id (a point whose tets form several
 /// fans becomes several vertex ids: each gets the point's position). Dart 24t + 6f + k of
 /// `from_tets` lies at the local vertex [a, b, b, c, c, a][k] of face f's corners (a, b, c).
@@ -35,11 +38,6 @@ fn tets_map(points: Vec<[f64; 3]>, tets: &[[u32; 4]]) -> LeveledMap<3> {
         }
     }
     LeveledMap::new(map, by_vid.into_iter().map(|p| p.unwrap_or([0.0; 3])).collect())
-}
-
-fn tri_map(points: Vec<[f64; 3]>, tris: &[[u32; 3]]) -> LeveledMap<2> {
-    let (map, _) = GMap::<2>::from_triangles(points.len(), tris).unwrap();
-    LeveledMap::new(map, points)
 }
 
 /// The correspondence f: bulk dart → per-op dart, from the level-0 darts (same ids in both).
@@ -270,16 +268,16 @@ fn random_complex(seed: u64, k: usize, keep: usize, jitter: f64) -> LeveledMap<3
 
 #[test]
 fn triangles_grids_and_disk_match_per_op() {
-    compare_tris(tri_map(vec![[0.0; 3], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]], &[[0, 1, 2]]), 2);
+    compare_tris(triangle_mesh(vec![[0.0; 3], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]], &[[0, 1, 2]]), 2);
     for n in [1, 3, 5] {
         let (p, t) = grid_triangles(n);
-        compare_tris(tri_map(p, &t), 1);
+        compare_tris(triangle_mesh(p, &t), 1);
     }
     let (p, t) = grid_triangles(2);
-    compare_tris(tri_map(p, &t), 3);
+    compare_tris(triangle_mesh(p, &t), 3);
     // A disk: a fan of 7 triangles around the centre.
     let (pts, tris) = disk_fan(7);
-    compare_tris(tri_map(pts, &tris), 2);
+    compare_tris(triangle_mesh(pts, &tris), 2);
 }
 
 #[test]
@@ -304,7 +302,7 @@ fn refusals_leave_the_map_unchanged() {
     assert!(matches!(u.refine_uniform(251, &mut mu), Err(SubdivideError::LevelTooHigh(251))));
     assert_eq!(u.to_parts(), snapshot);
     // 2D: an inserted vertex (split edge) is refused.
-    let mut t = tri_map(vec![[0.0; 3], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]], &[[0, 1, 2]]);
+    let mut t = triangle_mesh(vec![[0.0; 3], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]], &[[0, 1, 2]]);
     let d = t.map().darts().next().unwrap();
     t.split_edge(d, 1).unwrap();
     let snap = t.to_parts();
@@ -368,6 +366,6 @@ proptest! {
         for q in &mut p {
             q[0] += 0.2 * ((rng.below(1001) as f64) / 1000.0 - 0.5);
         }
-        compare_tris(tri_map(p, &t), levels);
+        compare_tris(triangle_mesh(p, &t), levels);
     }
 }

@@ -1,0 +1,56 @@
+//! Shared by the subdivision suites: leveled maps of the generated meshes, and the laws every
+//! leveled map obeys after any operation.
+#![allow(dead_code)]
+
+use topomech::generate::{grid_triangles, kuhn_cube};
+use topomech::subdivide::LeveledMap;
+use topomech::GMap;
+
+/// The leveled map (all at level 0) of a tet mesh with one position per point. O(tets).
+pub fn tet_mesh(points: Vec<[f64; 3]>, tets: &[[u32; 4]]) -> LeveledMap<3> {
+    let (map, _) = GMap::<3>::from_tets(points.len(), tets).unwrap();
+    LeveledMap::new(map, points)
+}
+
+/// The leveled map (all at level 0) of a triangle mesh with one position per point. O(triangles).
+pub fn triangle_mesh(points: Vec<[f64; 3]>, triangles: &[[u32; 3]]) -> LeveledMap<2> {
+    let (map, _) = GMap::<2>::from_triangles(points.len(), triangles).unwrap();
+    LeveledMap::new(map, points)
+}
+
+/// The Kuhn cube of k³ unit cells (6k³ tets).
+pub fn cube(k: usize) -> LeveledMap<3> {
+    let (points, tets) = kuhn_cube(k);
+    tet_mesh(points, &tets)
+}
+
+/// The n × n grid of unit squares, each cut into 2 triangles.
+pub fn grid(n: usize) -> LeveledMap<2> {
+    let (points, triangles) = grid_triangles(n);
+    triangle_mesh(points, &triangles)
+}
+
+/// The laws of a leveled map after any operation: every law of `check_all` (the finest map
+/// valid, μt ≤ μf ≤ μa, every level a valid G-map); level k is the finest map itself (up to
+/// isomorphism); the darts of level i are at level ≤ i, and B_{i−1} ⊂ B_i; every level has the
+/// Euler characteristic of level 0 (subdivision never changes the topology). O(k · darts).
+pub fn check_levels<const N: usize>(m: &LeveledMap<N>) {
+    m.check_all().unwrap();
+    let top = m.level(m.max_level()).unwrap();
+    assert!(top.map.is_isomorphic(m.map()), "level k must be the finest map");
+    let chi0 = m.level(0).unwrap().map.euler_characteristic();
+    for i in 0..=m.max_level() {
+        let view = m.level(i).unwrap();
+        assert_eq!(view.map.euler_characteristic(), chi0, "level {i}");
+        assert!(view.darts.iter().all(|&d| m.dart_level(d) <= i), "a dart of B_{i} is finer than level {i}");
+        if i > 0 {
+            let below = m.level(i - 1).unwrap();
+            assert!(below.darts.iter().all(|d| view.darts.binary_search(d).is_ok()), "B_{} ⊄ B_{i}", i - 1);
+        }
+    }
+}
+
+/// The cell counts per dimension of every level, coarsest first.
+pub fn level_counts<const N: usize>(m: &LeveledMap<N>) -> Vec<Vec<usize>> {
+    (0..=m.max_level()).map(|i| m.level(i).unwrap().map.count_cells().0).collect()
+}

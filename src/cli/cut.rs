@@ -14,7 +14,7 @@ use topomech::mechanics::{check_conservation, Body, Integrator, Material, Simula
 use topomech::vtk::{body_tets, Frame};
 use topomech::CellId;
 
-use super::{check_ids, parse_finite, print_warnings, CliError};
+use super::{check_ids, parse_finite, print_warnings, CellCensus, CliError};
 
 /// Options shared by the three subcommands.
 #[derive(Debug, Clone, clap::Args)]
@@ -93,18 +93,9 @@ pub struct TearArgs {
 /// The characteristics of a body in the JSON report (exactly these keys, in this order).
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct BodyStats {
-    /// 0-cells.
-    pub vertices: usize,
-    /// 1-cells (springs).
-    pub edges: usize,
-    /// 2-cells.
-    pub faces: usize,
-    /// 3-cells (tets).
-    pub volumes: usize,
-    /// α3-free faces.
-    pub boundary_faces: usize,
-    /// Connected components.
-    pub components: usize,
+    /// Cells, boundary faces, components.
+    #[serde(flatten)]
+    pub cells: CellCensus,
     /// Σ_v m_v.
     pub total_mass: f64,
     /// Mass removed so far.
@@ -133,15 +124,9 @@ pub struct CutReport {
 /// The statistics of `body`. O(darts).
 pub fn stats(body: &Body, removed_mass: f64) -> BodyStats {
     let map = body.map();
-    let counts = map.count_cells().0;
     let mech = body.attrs();
     BodyStats {
-        vertices: counts[0],
-        edges: counts[1],
-        faces: counts[2],
-        volumes: counts[3],
-        boundary_faces: map.boundary_cell_count(),
-        components: map.components().len(),
+        cells: CellCensus::of(map),
         total_mass: mech.total_vertex_mass(map),
         removed_mass,
         stiffness_sum: map.one_dart_per_cell(1).into_iter().map(|d| mech.edge_stiffness(map.cell_id(1, d))).sum(),
@@ -187,7 +172,7 @@ pub fn run_remove(args: RemoveArgs) -> Result<(), CliError> {
     // A fresh body's volume ids are the tets' positions in the file: check them all before the
     // first removal, so that a bad id is named as such (not as "already removed" after an
     // earlier part of the list went through).
-    check_ids("--tets", ("tet", "tets"), &args.tets, before.volumes)?;
+    check_ids("--tets", ("tet", "tets"), &args.tets, before.cells.volumes)?;
     let mut ids: Vec<u32> = args.tets.clone();
     if let Some([x, y, z, r]) = args.sphere {
         if !(r.is_finite() && r >= 0.0) {
@@ -285,14 +270,15 @@ fn finish(
         writeln!(out, "{}", serde_json::to_string_pretty(&report)?)?;
     } else {
         let (b, a) = (&report.before, &report.after);
+        let (bc, ac) = (&b.cells, &a.cells);
         writeln!(out, "cut faces      {}", report.cut_faces)?;
         writeln!(
             out,
             "cells V/E/F/T  {}/{}/{}/{} -> {}/{}/{}/{}",
-            b.vertices, b.edges, b.faces, b.volumes, a.vertices, a.edges, a.faces, a.volumes
+            bc.vertices, bc.edges, bc.faces, bc.volumes, ac.vertices, ac.edges, ac.faces, ac.volumes
         )?;
-        writeln!(out, "boundary faces {} -> {}", b.boundary_faces, a.boundary_faces)?;
-        writeln!(out, "components     {} -> {}", b.components, a.components)?;
+        writeln!(out, "boundary faces {} -> {}", bc.boundary_faces, ac.boundary_faces)?;
+        writeln!(out, "components     {} -> {}", bc.components, ac.components)?;
         writeln!(out, "total mass     {} -> {} (removed {})", b.total_mass, a.total_mass, a.removed_mass)?;
         writeln!(out, "valid {}  conservation {}", a.valid, a.conservation_ok)?;
     }

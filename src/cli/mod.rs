@@ -47,11 +47,10 @@ pub enum CliError {
     Other(Box<dyn std::error::Error + Send + Sync>),
 }
 
-/// The characteristics `topomech info --json` prints: exactly these keys, in this order.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct InfoJson {
-    /// Live darts (24 per tet).
-    pub darts: usize,
+/// The cell census of a 3-map that every report carries (flattened into its JSON object: these
+/// keys, in this order): cells per dimension, boundary faces, connected components.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub struct CellCensus {
     /// 0-cells.
     pub vertices: usize,
     /// 1-cells (the springs of a mass/spring model).
@@ -64,6 +63,32 @@ pub struct InfoJson {
     pub boundary_faces: usize,
     /// Connected components (orbits of all involutions).
     pub components: usize,
+}
+
+impl CellCensus {
+    /// The census of `map`: counts from the cell-id allocators, one pass over the boundary and one
+    /// over the components. O(darts).
+    pub fn of(map: &GMap<3>) -> Self {
+        let cells = map.count_cells().0;
+        CellCensus {
+            vertices: cells[0],
+            edges: cells[1],
+            faces: cells[2],
+            volumes: cells[3],
+            boundary_faces: map.boundary_cell_count(),
+            components: map.components().len(),
+        }
+    }
+}
+
+/// The characteristics `topomech info --json` prints: exactly these keys, in this order.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct InfoJson {
+    /// Live darts (24 per tet).
+    pub darts: usize,
+    /// Cells, boundary faces, components.
+    #[serde(flatten)]
+    pub cells: CellCensus,
     /// V − E + F − T.
     pub euler_characteristic: i64,
     /// Whether `validate()` passed.
@@ -99,12 +124,7 @@ impl Characteristics {
         Characteristics {
             json: InfoJson {
                 darts: map.dart_count(),
-                vertices: cells.0[0],
-                edges: cells.0[1],
-                faces: cells.0[2],
-                volumes: cells.0[3],
-                boundary_faces: map.boundary_cell_count(),
-                components: map.components().len(),
+                cells: CellCensus::of(map),
                 euler_characteristic: cells.euler_characteristic(),
                 valid: violation.is_none(),
                 build_ms: (loaded.build_ms * 1e3).round() / 1e3,
@@ -132,12 +152,12 @@ impl Characteristics {
         let rows: [(&str, String); 14] = [
             ("file points / tets", format!("{} / {}", self.points, self.tets)),
             ("darts", j.darts.to_string()),
-            ("vertices", j.vertices.to_string()),
-            ("edges", j.edges.to_string()),
-            ("faces", j.faces.to_string()),
-            ("volumes", j.volumes.to_string()),
-            ("boundary faces", j.boundary_faces.to_string()),
-            ("components", j.components.to_string()),
+            ("vertices", j.cells.vertices.to_string()),
+            ("edges", j.cells.edges.to_string()),
+            ("faces", j.cells.faces.to_string()),
+            ("volumes", j.cells.volumes.to_string()),
+            ("boundary faces", j.cells.boundary_faces.to_string()),
+            ("components", j.cells.components.to_string()),
             ("Euler characteristic", j.euler_characteristic.to_string()),
             ("orientable", yes_no(self.orientable).to_string()),
             ("valid", yes_no(j.valid).to_string()),

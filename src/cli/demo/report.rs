@@ -11,7 +11,7 @@ use super::checks::{total_mass, total_stiffness};
 use super::refine::{Refined, RefinedSim};
 use super::scene::{Scene, StageRun};
 use crate::cli::simulate::median;
-use crate::cli::InfoJson;
+use crate::cli::{CellCensus, InfoJson};
 
 /// One stage of the summary (JSON keys in this order). For the refinement, the mass is Σ tet mass
 /// of the finest level, the stiffness sum Σ k over its springs and the stiffness residual `None`
@@ -20,18 +20,9 @@ use crate::cli::InfoJson;
 pub struct StageRow {
     /// Stage name: rest, sag, incision, tear, removal, refinement.
     pub stage: &'static str,
-    /// 0-cells.
-    pub vertices: usize,
-    /// 1-cells.
-    pub edges: usize,
-    /// 2-cells.
-    pub faces: usize,
-    /// 3-cells.
-    pub volumes: usize,
-    /// α3-free faces.
-    pub boundary_faces: usize,
-    /// Connected components.
-    pub components: usize,
+    /// Cells, boundary faces, components.
+    #[serde(flatten)]
+    pub cells: CellCensus,
     /// Σ_v m_v.
     pub total_mass: Option<f64>,
     /// Mass removed with tets so far.
@@ -61,16 +52,10 @@ pub struct StageRow {
 }
 
 fn counts_row(stage: &'static str, map: &GMap<3>, run: &StageRun) -> StageRow {
-    let c = map.count_cells().0;
     let mut times = run.step_us.clone();
     StageRow {
         stage,
-        vertices: c[0],
-        edges: c[1],
-        faces: c[2],
-        volumes: c[3],
-        boundary_faces: map.boundary_cell_count(),
-        components: map.components().len(),
+        cells: CellCensus::of(map),
         total_mass: None,
         removed_mass: None,
         mass_residual: None,
@@ -224,12 +209,12 @@ pub fn write_table(out: &mut dyn Write, rows: &[StageRow]) -> std::io::Result<()
             out,
             "  {:<11}{:>6}{:>7}{:>7}{:>7}{:>6}{:>5}{:>13}{:>10}{:>10}{:>7}{:>9}",
             r.stage,
-            r.vertices,
-            r.edges,
-            r.faces,
-            r.volumes,
-            r.boundary_faces,
-            r.components,
+            r.cells.vertices,
+            r.cells.edges,
+            r.cells.faces,
+            r.cells.volumes,
+            r.cells.boundary_faces,
+            r.cells.components,
             opt(r.total_mass, |m| format!("{m:.6}")),
             opt(r.mass_residual, |x| format!("{x:.1e}")),
             opt(r.stiffness_residual, |x| format!("{x:.1e}")),

@@ -342,32 +342,7 @@ impl LeveledMap<3> {
         levels: u8,
         masses: &mut TetMasses,
     ) -> Result<Refinement, SubdivideError> {
-        self.check_op_level(levels)?;
-        Self::check_ball(center, radius)?;
-        // Mass totals: a bulk level reports them (Σ over every volume), so O(darts) sweeps are
-        // only made around per-op levels.
-        let (mut before, mut after) = (None, None);
-        let mut per_level = vec![0; levels as usize + 1];
-        for level in self.max_level.max(1)..=levels {
-            if self.bulk_applies(center, radius, level) {
-                if let Ok(r) = self.refine_uniform(level, masses) {
-                    per_level[level as usize] = r.subdivided_per_level[level as usize];
-                    before.get_or_insert(r.total_mass_before);
-                    after = Some(r.total_mass_after);
-                    continue;
-                }
-            }
-            if before.is_none() {
-                before = Some(masses.total(self));
-            }
-            after = None;
-            per_level[level as usize] = self.refine_level_per_op(level, center, radius, masses)?;
-        }
-        Ok(Refinement {
-            subdivided_per_level: per_level,
-            total_mass_before: before.unwrap_or_else(|| masses.total(self)),
-            total_mass_after: after.unwrap_or_else(|| masses.total(self)),
-        })
+        self.refine_zone(center, radius, levels, masses, true)
     }
 
     /// [`Self::refine_around`] op by op only ([`Self::subdivide_tet_with_mass`] on every tet of
@@ -391,17 +366,44 @@ impl LeveledMap<3> {
         levels: u8,
         masses: &mut TetMasses,
     ) -> Result<Refinement, SubdivideError> {
+        self.refine_zone(center, radius, levels, masses, false)
+    }
+
+    /// [`Self::refine_around`] (`bulk`: a level may go through [`Self::refine_uniform`]) or
+    /// [`Self::refine_around_per_op`] (not `bulk`).
+    fn refine_zone(
+        &mut self,
+        center: [f64; 3],
+        radius: f64,
+        levels: u8,
+        masses: &mut TetMasses,
+        bulk: bool,
+    ) -> Result<Refinement, SubdivideError> {
         self.check_op_level(levels)?;
         Self::check_ball(center, radius)?;
-        let before = masses.total(self);
+        // Mass totals: a bulk level reports them (Σ over every volume), so O(darts) sweeps are
+        // only made around per-op levels.
+        let (mut before, mut after) = (None, None);
         let mut per_level = vec![0; levels as usize + 1];
         for level in self.max_level.max(1)..=levels {
+            if bulk && self.bulk_applies(center, radius, level) {
+                if let Ok(r) = self.refine_uniform(level, masses) {
+                    per_level[level as usize] = r.subdivided_per_level[level as usize];
+                    before.get_or_insert(r.total_mass_before);
+                    after = Some(r.total_mass_after);
+                    continue;
+                }
+            }
+            if before.is_none() {
+                before = Some(masses.total(self));
+            }
+            after = None;
             per_level[level as usize] = self.refine_level_per_op(level, center, radius, masses)?;
         }
         Ok(Refinement {
             subdivided_per_level: per_level,
-            total_mass_before: before,
-            total_mass_after: masses.total(self),
+            total_mass_before: before.unwrap_or_else(|| masses.total(self)),
+            total_mass_after: after.unwrap_or_else(|| masses.total(self)),
         })
     }
 

@@ -1056,23 +1056,16 @@ pub fn spring_force(xa: Vec3, xb: Vec3, va: Vec3, vb: Vec3, rest: f64, k: f64, c
 }
 
 /// The scalar s with F_s = s·d: s = [k (l − L) l + c (dv·d)] / l², one sqrt and one division;
-/// zero when l = 0.
+/// zero when l = 0. This is [`spring_scale_padded`] with pads −0: x + (−0) = x for every x, so
+/// the compiler drops the addition (the same machine code as a copy without it).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn spring_scale(dx: f64, dy: f64, dz: f64, dvx: f64, dvy: f64, dvz: f64, rest: f64, k: f64, c: f64) -> f64 {
-    let l2 = dx * dx + dy * dy + dz * dz;
-    let l = l2.sqrt();
-    let num = k * (l - rest) * l + c * (dvx * dx + dvy * dy + dvz * dz);
-    // Division by max(l2, tiny) keeps the loop branch-free; the select zeroes l = 0.
-    let q = num / l2.max(f64::MIN_POSITIVE);
-    if l2 > 0.0 {
-        q
-    } else {
-        0.0
-    }
+    spring_scale_padded(dx, dy, dz, dvx, dvy, dvz, -0.0, rest, k, c)
 }
 
-/// [`spring_scale`] with `pads` (+0) added to l²: the same bits.
+/// [`spring_scale`] with `pads` (±0) added to l²: the same bits. Division by max(l², tiny) keeps
+/// the loop branch-free; the select zeroes l = 0.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn spring_scale_padded(

@@ -131,6 +131,31 @@ fn nodes_per_gmsh_type(t: &str) -> usize {
     }
 }
 
+/// Writes the start of a block section (`$Nodes` or `$Elements`): its name, then its block count
+/// and three more counts as size_t. Returns the block count.
+fn section_header<'a>(w: &mut BinWriter, name: &str, next: &mut impl FnMut() -> &'a str) -> u64 {
+    w.text(&format!("{name}\n"));
+    let blocks = next();
+    w.size_t(blocks);
+    for _ in 0..3 {
+        w.size_t(next());
+    }
+    blocks.parse().unwrap()
+}
+
+/// Writes a block header: entity dimension and tag, a third int (the parametric flag of a node
+/// block, the element type of an element block) and the entry count as size_t. Returns the third
+/// int's text and the count.
+fn block_header<'a>(w: &mut BinWriter, next: &mut impl FnMut() -> &'a str) -> (&'a str, usize) {
+    w.int(next());
+    w.int(next());
+    let third = next();
+    w.int(third);
+    let n = next();
+    w.size_t(n);
+    (third, n.parse().unwrap())
+}
+
 /// Converts an ASCII MSH 4.1 file to binary: `$Entities`, `$Nodes` (non-parametric) and
 /// `$Elements` are encoded, other sections are copied as text.
 fn ascii41_to_binary(text: &str, big_endian: bool, size_t: usize) -> Vec<u8> {
@@ -176,21 +201,9 @@ fn ascii41_to_binary(text: &str, big_endian: bool, size_t: usize) -> Vec<u8> {
                 }
             }
             "$Nodes" => {
-                w.text("$Nodes\n");
-                let blocks = next();
-                w.size_t(blocks);
-                for _ in 0..3 {
-                    w.size_t(next());
-                }
-                for _ in 0..blocks.parse::<u64>().unwrap() {
-                    w.int(next());
-                    w.int(next());
-                    let parametric = next();
+                for _ in 0..section_header(&mut w, name, &mut next) {
+                    let (parametric, n) = block_header(&mut w, &mut next);
                     assert_eq!(parametric, "0");
-                    w.int(parametric);
-                    let n = next();
-                    w.size_t(n);
-                    let n: usize = n.parse().unwrap();
                     for _ in 0..n {
                         w.size_t(next());
                     }
@@ -200,21 +213,9 @@ fn ascii41_to_binary(text: &str, big_endian: bool, size_t: usize) -> Vec<u8> {
                 }
             }
             "$Elements" => {
-                w.text("$Elements\n");
-                let blocks = next();
-                w.size_t(blocks);
-                for _ in 0..3 {
-                    w.size_t(next());
-                }
-                for _ in 0..blocks.parse::<u64>().unwrap() {
-                    w.int(next());
-                    w.int(next());
-                    let ty = next();
-                    w.int(ty);
-                    let n = next();
-                    w.size_t(n);
-                    let per = 1 + nodes_per_gmsh_type(ty);
-                    for _ in 0..per * n.parse::<usize>().unwrap() {
+                for _ in 0..section_header(&mut w, name, &mut next) {
+                    let (ty, n) = block_header(&mut w, &mut next);
+                    for _ in 0..(1 + nodes_per_gmsh_type(ty)) * n {
                         w.size_t(next());
                     }
                 }

@@ -1512,6 +1512,31 @@ mod tests {
         assert!(walks[0] * 4 < walks[1], "walks with the proofs {}, without {}", walks[0], walks[1]);
     }
 
+    /// The same on a 2-map: an α2-unsew of an inner edge that splits neither end vertex (both
+    /// inner, their rings ⟨α1, α2⟩ closed) is settled with no walk. No generator of a 2-map
+    /// commutes with both α1 and α2, so the ring of each of the edge's two pairs must be walked:
+    /// a walk skipped by a wrong "already covered" bit leaves a vertex to the lockstep walk.
+    #[test]
+    fn quick_proofs_settle_unsplit_edges_without_walks_in_2d() {
+        let (points, triangles) = crate::generate::grid_triangles(4);
+        let (mut map, _) = GMap::<2>::from_triangles(points.len(), &triangles).unwrap();
+        let inner: Vec<DartId> = map.one_dart_per_cell(1).into_iter().filter(|&d| !map.is_free(2, d)).collect();
+        let mut unsplit = 0;
+        for &d in &inner {
+            let e = map.alpha::<2>(d);
+            let before = CELL_WALKS.get();
+            let changes = map.unsew_with(2, d, true).unwrap();
+            let n = CELL_WALKS.get() - before;
+            if changes.splits(0).count() == 0 {
+                unsplit += 1;
+                assert_eq!(n, 0, "edge of {d}: split no vertex but took {n} walks");
+            }
+            map.sew::<2>(d, e).unwrap();
+        }
+        // 4 × 4 squares: the 3 × 3 inner vertices are joined by 12 axis edges and 4 diagonals.
+        assert_eq!(unsplit, 16, "{unsplit} of {} inner edges split no vertex", inner.len());
+    }
+
     /// A dropped report lends its lists to the next unsew on the thread, emptied: the next
     /// report reuses the same buffers and lists only its own pairs and changes.
     #[test]

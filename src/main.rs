@@ -43,7 +43,7 @@ enum Command {
     Ambiguity(cli::ambiguity::AmbiguityArgs),
     /// Run the mass/spring simulation of a mesh (frames for ParaView, JSON summary).
     Simulate(cli::simulate::SimulateArgs),
-    /// Benchmarks: `bench step MESH` times map-driven vs flat-array steps.
+    /// Benchmarks: `bench step MESH` (map-driven vs flat-array steps), `bench order MESH` (point orders, 1 vs 2 threads).
     Bench(cli::bench_step::BenchArgs),
     /// Cut a body along a plane (face separation) and report before/after.
     Cut(cli::cut::CutArgs),

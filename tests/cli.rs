@@ -256,6 +256,38 @@ fn a_nan_coordinate_names_the_node_and_line() {
     assert!(err.contains("line 9"), "{err}");
 }
 
+/// A mesh that loads (a flat tet is a valid map) but on which no mass/spring model can stand:
+/// every command that builds one fails with one line naming the file, the law and the file's
+/// node tags of the flat tet (2nd in the file, with a Z-order that would renumber it).
+#[test]
+fn a_flat_tet_is_refused_by_the_model_naming_the_file_and_its_nodes() {
+    let nodes = ["0 0 0", "1 0 0", "0 1 0", "0 0 1", "2 0 0", "3 0 0", "4 0 0", "2 1 0"];
+    let text = msh22(&nodes, &["1 2 3 4", "5 6 7 8"]);
+    let path = scratch("flat_tet.msh", text.as_bytes());
+    let p = path.to_str().unwrap();
+    let commands: [&[&str]; 6] = [
+        &["simulate", p, "--steps", "2"],
+        &["simulate", p, "--steps", "2", "--spatial-order"],
+        &["cut", p, "--plane", "0,0,0.5,0,0,1"],
+        &["tear", p, "--threshold", "2"],
+        &["bench", "step", p],
+        &["demo", "--mesh", p, "--steps", "2"],
+    ];
+    for args in commands {
+        let out = run(args);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        let last = err.lines().last().unwrap_or_default();
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        assert!(
+            last.starts_with(&format!("topomech: error: {p}: cannot build the mass/spring model")),
+            "{args:?}: {err}"
+        );
+        assert!(last.contains("zero volume") && last.contains("file node tags [5, 6, 7, 8]"), "{args:?}: {err}");
+    }
+    assert_eq!(run(&["info", p]).status.code(), Some(0), "info reports the map, which is valid");
+}
+
 #[test]
 fn warnings_go_to_stderr_and_the_load_succeeds() {
     // Tet 2 is inverted (node 5 is below the base, like node 4 above it) and node 6 is unused.

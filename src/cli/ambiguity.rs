@@ -13,7 +13,7 @@ use topomech::ambiguity::mixed::{campaign_mixed, MixedRun, MixedStats};
 use topomech::ambiguity::vector::Vector;
 use topomech::generate::{kuhn_cube, SplitMix64};
 
-use super::{print_report, CliError};
+use super::{other, print_report, CliError};
 
 /// Arguments of `topomech ambiguity`.
 #[derive(Debug, Clone, clap::Args)]
@@ -201,10 +201,6 @@ fn mixed_campaign(
         per_k,
         first_runs,
     })
-}
-
-fn other(e: impl std::error::Error + Send + Sync + 'static) -> CliError {
-    CliError::Other(Box::new(e))
 }
 
 fn count(s: &KStats, symptom: &str) -> usize {

@@ -14,11 +14,11 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use topomech::load;
-use topomech::mechanics::{Body, FlatModel, Integrator, Material, PinSpec, Simulation, StepConfig, Stepper};
+use topomech::mechanics::{FlatModel, Integrator, Material, PinSpec, Simulation, StepConfig, Stepper};
 use topomech::mesh::TetMesh;
 
 use super::simulate::median;
-use super::{print_report, print_warnings, CliError};
+use super::{build_body, other, print_report, print_warnings, CliError};
 
 /// Arguments of `topomech bench`.
 #[derive(Debug, Clone, clap::Args)]
@@ -115,10 +115,6 @@ pub struct BenchJson {
     pub vertices: usize,
     /// Instruction set of the hot loops (`portable`, `avx2`, `avx512`; see `mechanics::Kernel`).
     pub kernel: &'static str,
-}
-
-fn other(e: impl std::error::Error + Send + Sync + 'static) -> CliError {
-    CliError::Other(Box::new(e))
 }
 
 /// Runs the benchmark and prints the report. Cost: 2 · rounds · batch steps (`step`),
@@ -227,7 +223,7 @@ fn run_step(args: StepBenchArgs) -> Result<(), CliError> {
     let gravity = [0.0, 0.0, -9.81];
     let (lo, hi) = points.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p[0]), hi.max(p[0])));
     let pins = PinSpec { below: Some((0, lo + 0.1 * (hi - lo))), ..PinSpec::default() };
-    let (mut body, _) = Body::from_tets(points, tets, material).map_err(other)?;
+    let mut body = build_body(&args.mesh, &loaded.mesh, material)?;
     body.attrs_mut().pin_where(|id, p| pins.pins(id, p));
     let pinned: Vec<bool> = points.iter().enumerate().map(|(i, &p)| pins.pins(topomech::CellId(i as u32), p)).collect();
     let mut flat = FlatModel::from_tets(points, tets, material, gravity, &pinned).map_err(other)?;

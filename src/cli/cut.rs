@@ -14,7 +14,7 @@ use topomech::mechanics::{check_conservation, Body, Integrator, Material, Simula
 use topomech::vtk::{body_tets, Frame};
 use topomech::CellId;
 
-use super::{check_ids, parse_finite, print_warnings, CellCensus, CliError};
+use super::{build_body, check_ids, other, parse_finite, print_warnings, CellCensus, CliError};
 
 /// Options shared by the three subcommands.
 #[derive(Debug, Clone, clap::Args)]
@@ -228,7 +228,7 @@ fn load_body(common: &CommonArgs) -> Result<(Body, u64), CliError> {
     let loaded = load::load_tet_map(&common.mesh)?;
     print_warnings(&loaded);
     let material = Material { density: common.density, ..Material::default() };
-    let (body, _) = Body::from_tets(&loaded.mesh.points, &loaded.mesh.tets, material).map_err(other)?;
+    let body = build_body(&common.mesh, &loaded.mesh, material)?;
     Ok((body, t.elapsed().as_micros() as u64))
 }
 
@@ -307,8 +307,4 @@ pub struct Polyline(pub Vec<Vec3>);
 /// `X,Y,Z;X,Y,Z;…` → points (the cut checks their number and shape).
 fn parse_polyline(s: &str) -> Result<Polyline, String> {
     s.split(';').filter(|t| !t.trim().is_empty()).map(parse_numbers::<3>).collect::<Result<_, _>>().map(Polyline)
-}
-
-fn other(e: impl std::error::Error + Send + Sync + 'static) -> CliError {
-    CliError::Other(Box::new(e))
 }

@@ -15,9 +15,11 @@ pub mod refine;
 pub mod simulate;
 
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use topomech::load::{self, LoadError, Loaded};
+use topomech::mechanics::{Body, Material, ModelError};
+use topomech::mesh::TetMesh;
 use topomech::{GMap, InvariantViolation};
 
 /// Why a subcommand failed. `main` prints it as `topomech: error: {self}`.
@@ -41,10 +43,49 @@ pub enum CliError {
     /// The JSON report could not be encoded.
     #[error("cannot encode the JSON report: {0}")]
     Json(#[from] serde_json::Error),
+    /// The mesh loaded, but the mass/spring model cannot stand on it (a zero-volume tet, a bad
+    /// material): the message names the file and the element.
+    #[error("{}: cannot build the mass/spring model: {source}{at}", .path.display())]
+    Model {
+        /// The mesh file.
+        path: PathBuf,
+        /// Why the model refused it.
+        source: ModelError,
+        /// The file's node tags of the points named, when the mesh knows them (empty otherwise):
+        /// they survive the point reorderings, the tet index does not.
+        at: String,
+    },
     /// Any other failure of a subcommand, with its own message (for subcommands whose errors are
     /// defined in the library, e.g. the mechanics).
     #[error(transparent)]
     Other(Box<dyn std::error::Error + Send + Sync>),
+}
+
+/// [`CliError::Other`] from a library error or a message. O(1).
+pub(crate) fn other(e: impl Into<Box<dyn std::error::Error + Send + Sync>>) -> CliError {
+    CliError::Other(e.into())
+}
+
+/// The mass/spring body of `mesh`, read from `path`; a model error names the file and the file's
+/// node tags of the points at fault ([`model_error`]). O(tets).
+pub(crate) fn build_body(path: &Path, mesh: &TetMesh, material: Material) -> Result<Body, CliError> {
+    Body::from_tets(&mesh.points, &mesh.tets, material).map(|(body, _)| body).map_err(|e| model_error(path, mesh, e))
+}
+
+/// [`CliError::Model`] for a model built on `mesh`, read from `path`: names the file's node tags
+/// of the points of the tet or the point at fault, when the mesh knows them. O(1).
+pub(crate) fn model_error(path: &Path, mesh: &TetMesh, source: ModelError) -> CliError {
+    let points: Vec<u32> = match &source {
+        ModelError::DegenerateTet { tet } => mesh.tets.get(*tet).map_or(Vec::new(), |t| t.to_vec()),
+        ModelError::NonFinitePoint { point, .. } => vec![*point as u32],
+        _ => Vec::new(),
+    };
+    let tags: Option<Vec<u64>> = points.iter().map(|&p| mesh.node_tags.get(p as usize).copied()).collect();
+    let at = match tags {
+        Some(tags) if !tags.is_empty() => format!(" (file node tags {tags:?})"),
+        _ => String::new(),
+    };
+    CliError::Model { path: path.to_path_buf(), source, at }
 }
 
 /// The cell census of a 3-map that every report carries (flattened into its JSON object: these

@@ -20,7 +20,7 @@ use topomech::subdivide::{
 };
 use topomech::vtk::Frame;
 
-use super::{parse_finite, parse_vec3, print_report, print_warnings, CliError};
+use super::{other, parse_finite, parse_vec3, print_report, print_warnings, CliError};
 
 /// Arguments of `topomech refine`.
 #[derive(Debug, Clone, clap::Args)]
@@ -143,10 +143,6 @@ fn parse_plane(s: &str) -> Result<[f64; 6], String> {
         return Err(format!("the normal of {s:?} is zero"));
     }
     Ok(out)
-}
-
-fn other(msg: String) -> CliError {
-    CliError::Other(msg.into())
 }
 
 /// Loads, refines, checks and reports (see the [module docs](self)). Cost: one load, the

@@ -11,7 +11,7 @@ use topomech::mechanics::{Body, Integrator, Material, PinSpec, Simulation, StepC
 use topomech::mesh::TetMesh;
 use topomech::vtk::{body_tets, Frame, Series};
 
-use super::{check_ids, parse_finite, parse_vec3, print_report, print_warnings, CliError};
+use super::{build_body, check_ids, other, parse_finite, parse_vec3, print_report, print_warnings, CliError};
 
 /// Arguments of `topomech simulate`.
 #[derive(Debug, Clone, clap::Args)]
@@ -116,10 +116,6 @@ fn parse_threads(s: &str) -> Result<usize, String> {
     }
 }
 
-fn other(e: impl std::error::Error + Send + Sync + 'static) -> CliError {
-    CliError::Other(Box::new(e))
-}
-
 /// Loads the mesh, builds the body, runs `--steps` steps and prints the summary (a table, or
 /// JSON). Cost: O(steps · (springs + vertices)) plus the frames.
 ///
@@ -151,7 +147,7 @@ fn simulate(args: &SimulateArgs, parallel: bool) -> Result<(), CliError> {
         pin_ids = pin_ids.iter().map(|&v| new_of_old.get(v as usize).copied().unwrap_or(v)).collect();
         mesh = ordered;
     }
-    let (mut body, _) = Body::from_tets(&mesh.points, &mesh.tets, material).map_err(other)?;
+    let mut body = build_body(&args.mesh, &mesh, material)?;
     let pins = PinSpec { ids: pin_ids, below: args.pin_below, inside: None };
     body.attrs_mut().pin_where(|id, p| pins.pins(id, p));
     let mut config = StepConfig::new(args.integrator, args.dt);

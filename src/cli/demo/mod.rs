@@ -42,7 +42,7 @@ use self::output::Output;
 use self::refine::RefinedSim;
 use self::report::{DemoJson, FilesJson, SceneJson, SpringsJson, StageRow};
 use self::scene::{Scene, StageRun};
-use super::{print_warnings, Characteristics, CliError};
+use super::{model_error, print_warnings, Characteristics, CliError};
 
 /// Default number of sag steps.
 pub const DEFAULT_STEPS: u64 = 2000;
@@ -199,7 +199,8 @@ pub enum DemoError {
 ///
 /// # Errors
 /// [`CliError::Load`] if `--mesh` cannot be read (the message names the file), [`CliError::Invalid`]
-/// if the loaded map breaks a law, [`CliError::Other`] with a [`DemoError`] when a stage fails or a
+/// if the loaded map breaks a law, [`CliError::Model`] if the mass/spring model cannot stand on
+/// it, [`CliError::Other`] with a [`DemoError`] when a stage fails or a
 /// file cannot be written, [`CliError::Output`] when stdout fails.
 pub fn run(args: DemoArgs) -> Result<(), CliError> {
     let start = Instant::now();
@@ -215,7 +216,10 @@ pub fn run(args: DemoArgs) -> Result<(), CliError> {
     let summary = {
         let log: &mut dyn Write = if args.json { &mut sink } else { &mut stdout };
         write_header(log, &args, &loaded, &info)?;
-        let played = play(&args, &loaded, log).map_err(|e| CliError::Other(Box::new(e)))?;
+        let played = play(&args, &loaded, log).map_err(|e| match e {
+            DemoError::Model(source) => model_error(&loaded.path, &loaded.mesh, source),
+            e => CliError::Other(Box::new(e)),
+        })?;
         let summary = played.summary(&args, &loaded, &info, start);
         if !args.json {
             write_footer(log, &summary)?;

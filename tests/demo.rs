@@ -229,3 +229,20 @@ fn other_mesh_files_run_the_same_scene() {
     assert_eq!(int(stage(&s, "rest"), "volumes"), 1566);
     assert!(int(stage(&s, "incision"), "cut_faces") > 0);
 }
+
+/// A mesh whose removal ball at the free tip holds every tet (one tet, and two unused points that
+/// stretch the scene's box): the removal keeps the tet farthest from the tip, so the refinement
+/// and its checks still have a body to work on (before, it emptied the body and the refinement
+/// failed on a NaN mass residual).
+#[test]
+fn the_removal_never_takes_the_whole_body() {
+    let dir = fresh_dir("one-tet-mesh");
+    let mesh = dir.join("one_tet_two_free_points.msh");
+    let text_mesh = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n6\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n\
+                     5 9 9 9\n6 8 8 8\n$EndNodes\n$Elements\n1\n1 4 2 0 0 1 2 3 4\n$EndElements\n";
+    std::fs::write(&mesh, text_mesh).unwrap();
+    let s = demo_on(&mesh, "one-tet");
+    assert_eq!(int(stage(&s, "removal"), "operations"), 0, "the only tet stays");
+    assert_eq!(int(stage(&s, "removal"), "volumes"), 1);
+    assert_eq!(int(stage(&s, "refinement"), "components"), 1);
+}

@@ -362,3 +362,38 @@ fn sew3_merges_vertices_by_mass_weighted_state_and_keeps_pins() {
     }
     assert!(merged.iter().any(|&(k, _)| m.pinned[k]) && merged.iter().any(|&(k, _)| !m.pinned[k]));
 }
+
+/// A model whose volume or totals overflow f64 is refused at build, naming the tet and the
+/// quantity, by the map-driven body and the flat model alike; the same mesh at a sane scale
+/// builds, with the same totals in both.
+#[test]
+fn a_model_whose_totals_overflow_is_refused_naming_the_tet_and_quantity() {
+    use topomech::mechanics::ModelError;
+    let (points, tets) = kuhn_cube(2);
+    let scaled = |s: f64| points.iter().map(|p| p.map(|c| c * s)).collect::<Vec<Vec3>>();
+    let with = |density: f64, young: f64, damping: f64| Material { density, young, damping, viscosity: 0.0 };
+    let cases: [(Vec<Vec3>, Material, &str); 4] = [
+        (scaled(1e110), with(1.0, 1.0, 0.0), "volume"),
+        (scaled(1e100), with(1e10, 1.0, 0.0), "total mass"),
+        (scaled(1.0), with(1.0, 1e308, 0.0), "total stiffness"),
+        (scaled(1.0), with(1.0, 1e300, 1e10), "total damping"),
+    ];
+    for (points, material, what) in cases {
+        let body = Body::from_tets(&points, &tets, material).map(|_| ());
+        let flat = FlatModel::from_tets(&points, &tets, material, G, &[]).map(|_| ());
+        for got in [body, flat] {
+            match got {
+                Err(ModelError::Overflow { tet, quantity, value }) => {
+                    assert_eq!(quantity, what);
+                    assert!(tet < tets.len() && !value.is_finite(), "{what}: tet {tet}, value {value}");
+                }
+                other => panic!("{what}: expected an overflow, got {other:?}"),
+            }
+        }
+    }
+    let (body, _) = Body::from_tets(&scaled(1e50), &tets, with(1.0, 1.0, 1.0)).unwrap();
+    check_conservation(body.map(), body.attrs()).unwrap();
+    let flat = FlatModel::from_tets(&scaled(1e50), &tets, with(1.0, 1.0, 1.0), G, &[]).unwrap();
+    let total: f64 = flat.system.mass.iter().sum();
+    assert!(rel_close(total, body.attrs().total_vertex_mass(body.map()), 1e-12) && total.is_finite());
+}

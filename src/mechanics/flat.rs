@@ -9,7 +9,7 @@
 
 use super::force::SpringSystem;
 use super::geom::{norm, sub, tet_volume, Vec3};
-use super::model::{stiffness_contribution, Material, ModelError};
+use super::model::{stiffness_contribution, Material, ModelError, ModelTotals};
 use crate::build::BuildError;
 
 /// A flat mass/spring model: its [`SpringSystem`] and its own state arrays.
@@ -46,7 +46,8 @@ impl FlatModel {
     ///
     /// # Errors
     /// [`ModelError::Build`] for a bad index or repeated point, [`ModelError::DegenerateTet`] for a
-    /// zero-volume tet, [`ModelError::NonFinitePoint`].
+    /// zero-volume tet, [`ModelError::NonFinitePoint`], [`ModelError::Overflow`] when a volume or a
+    /// total (mass, stiffness, damping) overflows f64.
     ///
     /// # Examples
     ///
@@ -71,12 +72,11 @@ impl FlatModel {
         let n = points.len();
         let mut mass = vec![0.0; n];
         let mut contributions: Vec<(u64, f64)> = Vec::with_capacity(6 * tets.len());
+        let mut totals = ModelTotals::default();
         for (t, tet) in tets.iter().enumerate() {
             let c = tet.map(|v| points[v as usize]);
             let volume = tet_volume(c[0], c[1], c[2], c[3]);
-            if volume == 0.0 {
-                return Err(ModelError::DegenerateTet { tet: t });
-            }
+            totals.add(t, c, volume, &material)?;
             for &v in tet {
                 mass[v as usize] += material.density * volume / 4.0;
             }

@@ -121,6 +121,18 @@ pub enum ModelError {
         /// Tet index (= volume id).
         tet: usize,
     },
+    /// A sum of the model overflows f64 from this tet on: its volume, the total mass or the total
+    /// stiffness (coordinates, density or Young's modulus too large). Every vertex mass and spring
+    /// stiffness is a part of those non-negative totals, so finite totals make them all finite.
+    #[error("tetrahedron {tet}: {quantity} = {value:e} overflows (coordinates, density or Young's modulus too large for f64)")]
+    Overflow {
+        /// Tet index (= volume id): the first at which a total stops being finite.
+        tet: usize,
+        /// What overflowed: "volume", "total mass", "total stiffness" or "total damping".
+        quantity: &'static str,
+        /// Its value there (infinite or NaN).
+        value: f64,
+    },
 }
 
 /// The mechanical attributes of a tetrahedral 3-G-map, all in arrays keyed by cell id.
@@ -890,6 +902,39 @@ fn vertex_points(map: &GMap<3>, tets: &[[u32; 4]]) -> Vec<u32> {
     point_of
 }
 
+/// The totals a model's build accumulates tet by tet (mass, stiffness and damping over all
+/// springs), to refuse the first tet from which one stops being finite: all terms are
+/// non-negative, so every partial sum (a vertex mass, a spring's stiffness) is bounded by its total.
+#[derive(Default)]
+pub(crate) struct ModelTotals {
+    mass: f64,
+    stiffness: f64,
+}
+
+impl ModelTotals {
+    /// Adds tet `t` (its corners and volume) and returns its mass ρ·V.
+    ///
+    /// # Errors
+    /// [`ModelError::DegenerateTet`] for a zero volume, [`ModelError::Overflow`] when the volume or
+    /// a total is no longer finite. O(1).
+    pub(crate) fn add(&mut self, t: usize, c: [Vec3; 4], volume: f64, m: &Material) -> Result<f64, ModelError> {
+        if volume == 0.0 {
+            return Err(ModelError::DegenerateTet { tet: t });
+        }
+        let mass = m.density * volume;
+        self.mass += mass;
+        for (i, j) in [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)] {
+            self.stiffness += stiffness_contribution(m.young, volume, norm(sub(c[j], c[i])));
+        }
+        let totals = [("volume", volume), ("total mass", self.mass), ("total stiffness", self.stiffness)];
+        let damping = ("total damping", m.damping * self.stiffness);
+        match totals.into_iter().chain([damping]).find(|(_, v)| !v.is_finite()) {
+            Some((quantity, value)) => Err(ModelError::Overflow { tet: t, quantity, value }),
+            None => Ok(mass),
+        }
+    }
+}
+
 fn check_material(m: &Material) -> Result<(), ModelError> {
     let bad = |name, value: f64, rule| ModelError::BadMaterial { name, value, rule };
     if !(m.density.is_finite() && m.density > 0.0) {
@@ -913,7 +958,8 @@ impl Embedded<3, Mechanics> {
     /// O(T log T).
     ///
     /// # Errors
-    /// [`ModelError`]: bad material, non-finite point, zero-volume tet, or a build error.
+    /// [`ModelError`]: bad material, non-finite point, zero-volume tet, a volume or total (mass,
+    /// stiffness, damping) that overflows f64, or a build error.
     ///
     /// # Examples
     ///
@@ -942,12 +988,11 @@ impl Embedded<3, Mechanics> {
         let (map, report) = GMap::<3>::from_tets(points.len(), tets)?;
         let mut mech = Mechanics::empty(material);
         mech.grow_to(&map);
+        let mut totals = ModelTotals::default();
         for (t, tet) in tets.iter().enumerate() {
             let [a, b, c, d] = tet.map(|v| points[v as usize]);
             let volume = tet_volume(a, b, c, d);
-            if volume == 0.0 {
-                return Err(ModelError::DegenerateTet { tet: t });
-            }
+            totals.add(t, [a, b, c, d], volume, &material)?;
             mech.tet_rest_volume[CellId(t as u32)] = volume;
             mech.tet_mass[CellId(t as u32)] = material.density * volume;
             mech.tet_young[CellId(t as u32)] = material.young;

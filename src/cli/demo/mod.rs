@@ -388,6 +388,7 @@ fn finish_stage(
     let mut sizes: Vec<usize> = topomech::cut::components(&scene.body).iter().map(|c| c.volumes).collect();
     sizes.sort_unstable_by(|a, b| b.cmp(a));
     let parts = match sizes.as_slice() {
+        [] => "no tet left".to_string(),
         [_] => "1 component".to_string(),
         _ => format!(
             "{} components ({} tets)",

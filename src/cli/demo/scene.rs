@@ -293,9 +293,16 @@ impl Scene {
     pub fn remove_ball(&mut self, run: &mut StageRun) -> Result<(), DemoError> {
         let stage = run.name;
         let t = Instant::now();
-        let victims = self.tets_in_ball(self.free_tip(), REMOVAL_RADIUS * self.config.extent());
+        let mut victims = self.tets_in_ball(self.free_tip(), REMOVAL_RADIUS * self.config.extent());
+        // Never the whole body (a mesh of a few tets, or points far from its tets): the stages
+        // after this one need tissue, so the victim farthest from the tip stays.
+        if victims.len() == self.body.map().count_cells().0[3] {
+            if let Some(k) = (0..victims.len()).max_by(|&a, &b| victims[a].1.total_cmp(&victims[b].1)) {
+                victims.remove(k);
+            }
+        }
         let mut touched = TouchedCells::default();
-        for id in victims {
+        for (id, _) in victims {
             let r = cut::remove_volume(&mut self.body, id).map_err(|source| DemoError::Cut { stage, source })?;
             self.checker.removed(r.removed_mass, r.removed_stiffness);
             run.cut_faces += r.dissociations.len();
@@ -322,8 +329,9 @@ impl Scene {
         })
     }
 
-    /// Volume ids whose centroid (current positions) is within `r` of `c`. O(darts).
-    fn tets_in_ball(&self, c: Vec3, r: f64) -> Vec<CellId> {
+    /// Volume ids whose centroid (current positions) is within `r` of `c`, with the squared
+    /// distance, by id. O(darts).
+    fn tets_in_ball(&self, c: Vec3, r: f64) -> Vec<(CellId, f64)> {
         let (map, x) = (self.body.map(), &self.body.attrs().position);
         let mut out = Vec::new();
         for d in map.one_dart_per_cell(3) {
@@ -331,11 +339,12 @@ impl Scene {
             ids.sort_unstable();
             ids.dedup();
             let g = centroid(ids.iter().map(|&v| x[v]));
-            if (0..3).map(|k| (g[k] - c[k]).powi(2)).sum::<f64>() <= r * r {
-                out.push(map.cell_id(3, d));
+            let d2 = (0..3).map(|k| (g[k] - c[k]).powi(2)).sum::<f64>();
+            if d2 <= r * r {
+                out.push((map.cell_id(3, d), d2));
             }
         }
-        out.sort_unstable();
+        out.sort_unstable_by_key(|&(id, _)| id);
         out
     }
 }

@@ -80,6 +80,9 @@ pub enum BuildError {
     /// More darts than 32-bit ids can name.
     #[error("the mesh is too large: {0} darts exceed the 32-bit dart ids")]
     TooLarge(usize),
+    /// More points than 32-bit vertex ids can name (vertex id = point index).
+    #[error("the mesh has {0} points: vertex ids are 32-bit, at most 4294967294 points")]
+    TooManyPoints(usize),
 }
 
 /// What the build found worth knowing about the input, besides the map.
@@ -161,8 +164,12 @@ const fn face_corners(f: usize) -> [usize; 3] {
 
 const TET: TetTemplate = tet_template();
 
-/// Checks indices and repeated points of `K`-point elements.
+/// Checks the point count (32-bit vertex ids), the indices and repeated points of `K`-point
+/// elements.
 fn check_elements<const K: usize>(points: usize, elements: &[[u32; K]]) -> Result<(), BuildError> {
+    if points > u32::MAX as usize - 1 {
+        return Err(BuildError::TooManyPoints(points));
+    }
     for (element, e) in elements.iter().enumerate() {
         for (corner, &index) in e.iter().enumerate() {
             if index as usize >= points {

@@ -184,3 +184,21 @@ fn edges_shared_only_by_edge_touching_tets_are_reported_each() {
     assert_eq!(report.split_edges, vec![([0, 1], 2), ([7, 8], 3)]);
     assert_eq!(map.count_cells().0[1], 6 * 5, "no edge is shared through a face: 6 edges per tet");
 }
+
+/// A point count past the 32-bit vertex ids is refused before anything is allocated (the face
+/// matching sized a bucket array by it: usize::MAX overflowed, 10¹² would have asked for 4 TB),
+/// in 3D and 2D; the largest allowed count passes that check and fails only on the indices.
+#[test]
+fn a_point_count_past_the_vertex_ids_is_refused() {
+    let max = u32::MAX as usize - 1;
+    for points in [max + 1, 1 << 40, usize::MAX] {
+        assert!(
+            matches!(GMap::<3>::from_tets(points, &[[0, 1, 2, 3]]), Err(BuildError::TooManyPoints(p)) if p == points)
+        );
+        assert!(
+            matches!(GMap::<2>::from_triangles(points, &[[0, 1, 2]]), Err(BuildError::TooManyPoints(p)) if p == points)
+        );
+    }
+    let bad_index = [[0, 1, 2, u32::MAX]];
+    assert!(matches!(GMap::<3>::from_tets(max, &bad_index), Err(BuildError::IndexOutOfRange { index: u32::MAX, .. })));
+}

@@ -233,6 +233,18 @@ pub enum SubdivideError {
         /// The radius given.
         radius: f64,
     },
+    /// A geometric query (a volume, a distance to a ball, a mass from a density) reached a vertex
+    /// without a position: the points given to [`LeveledMap::new`] stop before its id.
+    #[error("vertex {vertex} has no position (the map was given {points} points)")]
+    NoPosition {
+        /// The vertex id.
+        vertex: u32,
+        /// How many positions the map has.
+        points: usize,
+    },
+    /// A density for [`TetMasses::from_density`] that is not a finite number > 0.
+    #[error("density {0} must be a finite number > 0")]
+    BadDensity(f64),
     /// A refinement would grow the map past its dart limit ([`LeveledMap::set_max_darts`]):
     /// refused before anything changed at that level (the levels done before it are kept).
     #[error(
@@ -376,7 +388,8 @@ pub struct LeveledMap<const N: usize> {
 impl<const N: usize> LeveledMap<N> {
     /// Wraps a G-map as level 0: every dart gets level 0 and μ = 0. `points[v]` is the position of
     /// the vertex with id v (may be empty when geometry is not needed; new vertices then get the
-    /// origin). O(capacity).
+    /// origin). The geometric queries (volumes, balls, masses from a density) refuse a vertex
+    /// past the end of `points` with [`SubdivideError::NoPosition`]. O(capacity).
     ///
     /// # Examples
     ///

@@ -70,21 +70,29 @@ pub struct Refinement {
 impl TetMasses {
     /// Masses ρ · |V_t| from the positions of the map's vertices. O(darts).
     ///
-    /// Errors: [`SubdivideError::NotATetrahedron`] if a volume does not have 4 vertices.
+    /// Errors: [`SubdivideError::BadDensity`] unless the density is finite and > 0;
+    /// [`SubdivideError::NotATetrahedron`] if a volume does not have 4 vertices;
+    /// [`SubdivideError::NoPosition`] for a vertex without a position.
     ///
     /// # Examples
     ///
     /// ```
     /// # use topomech::subdivide::LeveledMap;
     /// # use topomech::GMap;
-    /// # use topomech::subdivide::TetMasses;
+    /// # use topomech::subdivide::{SubdivideError, TetMasses};
     /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
     /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-    /// let m = LeveledMap::new(map, pts);
+    /// let m = LeveledMap::new(map.clone(), pts.clone());
     /// let masses = TetMasses::from_density(&m, 6.0).unwrap(); // the volume is 1/6
+    /// assert!(matches!(TetMasses::from_density(&m, f64::NAN), Err(SubdivideError::BadDensity(_))));
+    /// let short = LeveledMap::new(map, pts[..3].to_vec()); // vertex 3 has no position
+    /// assert!(matches!(TetMasses::from_density(&short, 6.0), Err(SubdivideError::NoPosition { vertex: 3, points: 3 })));
     /// assert!((masses.total(&m) - 1.0).abs() < 1e-12);
     /// ```
     pub fn from_density(m: &LeveledMap<3>, density: f64) -> Result<Self, SubdivideError> {
+        if !(density.is_finite() && density > 0.0) {
+            return Err(SubdivideError::BadDensity(density));
+        }
         let map = m.map();
         let mut mass = vec![0.0; map.cell_id_bound(3)];
         for d in map.one_dart_per_cell(3) {
@@ -235,12 +243,20 @@ impl LeveledMap<3> {
     /// assert!((sum - 1.0 / 6.0).abs() < 1e-14);
     /// ```
     pub fn tet_volume(&self, d: DartId) -> Result<f64, SubdivideError> {
-        let p = self.tet_vertices(d)?.map(|v| self.vertex_position(v));
+        let p = self.corner_positions(self.tet_vertices(d)?)?;
         Ok(crate::mesh::signed_volume(p[0], p[1], p[2], p[3]))
     }
 
-    fn vertex_position(&self, v: u32) -> [f64; 3] {
-        self.points.get(v as usize).copied().unwrap_or([0.0; 3])
+    /// The positions of the corners `t`; [`SubdivideError::NoPosition`] for one without. O(1).
+    fn corner_positions(&self, t: [u32; 4]) -> Result<[[f64; 3]; 4], SubdivideError> {
+        let mut p = [[0.0; 3]; 4];
+        for (k, &v) in t.iter().enumerate() {
+            p[k] = *self
+                .points
+                .get(v as usize)
+                .ok_or(SubdivideError::NoPosition { vertex: v, points: self.points.len() })?;
+        }
+        Ok(p)
     }
 
     /// Whether the tet of `d` meets the closed ball B(center, radius). O(volume).
@@ -258,7 +274,7 @@ impl LeveledMap<3> {
     /// assert!(!m.tet_in_ball(d, [2.0, 0.0, 0.0], 0.5).unwrap());
     /// ```
     pub fn tet_in_ball(&self, d: DartId, center: [f64; 3], radius: f64) -> Result<bool, SubdivideError> {
-        let p = self.tet_vertices(d)?.map(|v| self.vertex_position(v));
+        let p = self.corner_positions(self.tet_vertices(d)?)?;
         Ok(tet_distance(center, p) <= radius)
     }
 
@@ -491,7 +507,7 @@ impl LeveledMap<3> {
         let mut out = Vec::new();
         for d in self.map.one_dart_per_cell(3) {
             let mut t = self.tet_vertices(d)?;
-            let p = t.map(|v| self.vertex_position(v));
+            let p = self.corner_positions(t)?;
             if crate::mesh::signed_volume(p[0], p[1], p[2], p[3]) < 0.0 {
                 t.swap(2, 3);
             }

@@ -99,3 +99,35 @@ fn tear_vertex_splits_an_interior_vertex() {
     check_conservation(body.map(), body.attrs()).unwrap();
     assert!((total_mass(&body) - mass).abs() <= 1e-12 * mass);
 }
+
+/// A tear direction that is NaN, infinite or zero picks no face (every score ties or is NaN): it
+/// is refused and the body is left as it was; the simulation refuses a non-finite gravity and
+/// stepping parameters whose tests would never fire (NaN runaway factor, zero CG tolerance).
+#[test]
+fn bad_directions_gravity_and_step_parameters_are_refused() {
+    use topomech::cut::CutError;
+    use topomech::mechanics::{SimError, StepError};
+    let (mut body, _) = stretched_cube(0.0);
+    let darts = body.map().dart_count();
+    let v = topomech::CellId(21);
+    for dir in [[f64::NAN, 0.0, 0.0], [0.0, f64::INFINITY, 0.0], [0.0; 3]] {
+        let err = cut::tear_vertex(&mut body, v, dir, None).unwrap_err();
+        assert!(
+            matches!(err, CutError::BadDirection(d) if d.iter().zip(&dir).all(|(a, b)| a.to_bits() == b.to_bits()))
+        );
+        assert_eq!(body.map().dart_count(), darts);
+    }
+    body.map().validate().unwrap();
+    let config = StepConfig::new(Integrator::Rk4, 1e-3);
+    let err = Simulation::new(&mut body, [0.0, f64::NAN, 0.0], config).err().unwrap();
+    assert!(matches!(err, SimError::BadGravity(_)), "{err}");
+    let bad = [
+        ("runaway_factor", StepConfig { runaway_factor: f64::NAN, ..config }),
+        ("cg_tolerance", StepConfig { cg_tolerance: 0.0, ..config }),
+    ];
+    for (name, config) in bad {
+        let err = Simulation::new(&mut body, [0.0, 0.0, -9.81], config).err().unwrap();
+        assert!(matches!(err, SimError::Step(StepError::BadParameter { name: n, .. }) if n == name), "{err}");
+    }
+    assert!(Simulation::new(&mut body, [0.0, 0.0, -9.81], config).is_ok());
+}

@@ -464,8 +464,8 @@ impl Runner {
         if !tet.contains(&vertex) {
             return Err(self.bad(step, format!("point {vertex} is not a corner of tet {t} {tet:?}")));
         }
-        if direction.iter().any(|c| !c.is_finite()) {
-            return Err(self.bad(step, format!("tear direction {direction:?} is not finite")));
+        if direction.iter().any(|c| !c.is_finite()) || direction == [0.0; 3] {
+            return Err(self.bad(step, format!("tear direction {direction:?} is not finite and non-zero")));
         }
         if self.dart(t, 0).is_none() {
             return Ok(Outcome { refused: Some(Refusal::RemovedTet), dissociated: Vec::new() });

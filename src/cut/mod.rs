@@ -36,7 +36,7 @@ pub use sweep::{incise_sweep, sweep_faces, PolylineSweep};
 pub use tear::{fan_darts, principal_stress, tear_step, tear_vertex, Stress, Tear, TearStep};
 
 use crate::gmap::{DartError, SewError};
-use crate::mechanics::{BodyError, SimError};
+use crate::mechanics::{BodyError, SimError, Vec3};
 use crate::{CellId, DartId};
 
 pub use crate::mechanics::TouchedCells;
@@ -104,6 +104,9 @@ pub enum CutError {
     /// compare above it: tearing would silently never happen).
     #[error("tear threshold {0} must be a finite number ≥ 0")]
     BadThreshold(f64),
+    /// A tear direction that is not finite or is zero (no face normal can be closest to it).
+    #[error("tear direction {0:?} must be finite and non-zero")]
+    BadDirection(Vec3),
     /// A polyline sweep that is not a well-formed cut surface (too few points, non-finite,
     /// repeated points, zero sweep, a segment along the sweep).
     #[error("bad polyline sweep: {reason}")]

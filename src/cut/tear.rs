@@ -292,8 +292,9 @@ fn start_face(body: &Body, start: DartId, direction: Vec3) -> Option<DartId> {
 /// Cost: O(star of v) to choose the face and walk the fan, plus one dissociation per fan face.
 ///
 /// # Errors
-/// [`CutError::NoSuchVertex`] (no live dart carries `v`; body unchanged); [`CutError::Body`] is a
-/// bug. A vertex with no inner face is left as is (an empty fan).
+/// [`CutError::NoSuchVertex`] (no live dart carries `v`; body unchanged);
+/// [`CutError::BadDirection`] for a non-finite or zero direction; [`CutError::Body`] is a bug. A
+/// vertex with no inner face is left as is (an empty fan).
 ///
 /// # Examples
 ///
@@ -312,6 +313,9 @@ fn start_face(body: &Body, start: DartId, direction: Vec3) -> Option<DartId> {
 /// check_conservation(body.map(), body.attrs()).unwrap();
 /// ```
 pub fn tear_vertex(body: &mut Body, v: CellId, direction: Vec3, hint: Option<DartId>) -> Result<Tear, CutError> {
+    if direction.iter().any(|c| !c.is_finite()) || direction == [0.0; 3] {
+        return Err(CutError::BadDirection(direction));
+    }
     let map = body.map();
     let on_v = |d: DartId| map.contains(d) && map.vertex_id(d) == v;
     let start = hint.filter(|&d| on_v(d)).or_else(|| map.darts().find(|&d| on_v(d)));

@@ -140,6 +140,15 @@ pub enum StepError {
     /// The time step is not a positive finite number.
     #[error("time step {0} must be positive and finite")]
     BadTimeStep(f64),
+    /// A parameter of the stepping other than the time step is not a finite number > 0 (with
+    /// NaN the runaway test or the solver's stopping test would never fire).
+    #[error("step parameter {name} = {value} must be a finite number > 0")]
+    BadParameter {
+        /// `runaway_factor` or `cg_tolerance`.
+        name: &'static str,
+        /// The value given.
+        value: f64,
+    },
     /// The state slices do not match the system.
     #[error("state has {got} slots, the system {expected}")]
     SizeMismatch {
@@ -282,6 +291,11 @@ impl Stepper {
     pub fn new(config: StepConfig, sys: &SpringSystem, x: &[Vec3], v: &[Vec3]) -> Result<Self, StepError> {
         if !(config.dt.is_finite() && config.dt > 0.0) {
             return Err(StepError::BadTimeStep(config.dt));
+        }
+        for (name, value) in [("runaway_factor", config.runaway_factor), ("cg_tolerance", config.cg_tolerance)] {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(StepError::BadParameter { name, value });
+            }
         }
         check_len(sys, x)?;
         check_len(sys, v)?;

@@ -53,6 +53,9 @@ pub enum SimError {
     /// A step failed; for a body, the slot is the vertex id.
     #[error(transparent)]
     Step(#[from] StepError),
+    /// A gravity vector with a NaN or infinite component.
+    #[error("gravity {0:?} must be finite")]
+    BadGravity(Vec3),
     /// The body changed topologically since the projection was built.
     #[error("the projection was built at body version {built} but the body is at version {now}: rebuild it")]
     StaleProjection {
@@ -157,6 +160,9 @@ impl Simulation {
     /// assert!(Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Rk4, -1.0)).is_err());
     /// ```
     pub fn new(body: &mut Body, gravity: Vec3, config: StepConfig) -> Result<Self, SimError> {
+        if gravity.iter().any(|g| !g.is_finite()) {
+            return Err(SimError::BadGravity(gravity));
+        }
         let mech = body.attrs_mut();
         for (v, &p) in mech.velocity.as_mut_slice().iter_mut().zip(mech.pinned.as_slice()) {
             if p {

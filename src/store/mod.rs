@@ -756,7 +756,9 @@ pub fn save_document(doc: &Document, path: &Path, format: Format) -> Result<(), 
 /// topomech::store::write_atomically(&path, b"first").unwrap();
 /// topomech::store::write_atomically(&path, b"second").unwrap();
 /// assert_eq!(std::fs::read(&path).unwrap(), b"second");
-/// assert!(topomech::store::write_atomically(&path.join("no/such/dir"), b"x").is_err());
+/// let missing = path.with_extension("d").join("no/such/dir.bin");
+/// let err = topomech::store::write_atomically(&missing, b"x").unwrap_err();
+/// assert!(matches!(&err, topomech::store::StoreError::Io { path, .. } if *path == missing), "{err}");
 /// # std::fs::remove_file(&path).unwrap();
 /// ```
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), StoreError> {
@@ -773,10 +775,11 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), StoreError> {
         move |source| StoreError::Io { path: p, source }
     };
     let result = (|| {
-        let mut file = std::fs::OpenOptions::new().write(true).create_new(true).open(&tmp).map_err(io(&tmp))?;
-        file.write_all(bytes).map_err(io(&tmp))?;
-        file.flush().map_err(io(&tmp))?;
-        file.sync_all().map_err(io(&tmp))?;
+        // Errors name `path`, the file the caller asked for, not the temporary beside it.
+        let mut file = std::fs::OpenOptions::new().write(true).create_new(true).open(&tmp).map_err(io(path))?;
+        file.write_all(bytes).map_err(io(path))?;
+        file.flush().map_err(io(path))?;
+        file.sync_all().map_err(io(path))?;
         drop(file);
         std::fs::rename(&tmp, path).map_err(io(path))
     })();

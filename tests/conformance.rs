@@ -350,6 +350,13 @@ fn cli_generate_writes_the_committed_set() {
         let fresh = std::fs::read_to_string(d.join(file.file_name().unwrap())).unwrap();
         assert!(fresh == std::fs::read_to_string(&file).unwrap(), "{}", file.display());
     }
+    // A directory that cannot be made (a file stands at its path) is named in the error.
+    let (first, _) = committed().into_iter().next().expect("committed vectors");
+    let blocker = d.join(first.file_name().unwrap());
+    assert!(blocker.is_file());
+    let (code, _, err) = topomech(&["conformance", "generate", blocker.to_str().unwrap()]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains(blocker.to_str().unwrap()) && !err.contains("panicked"), "{err}");
     let _ = std::fs::remove_dir_all(&d);
 }
 

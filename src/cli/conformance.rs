@@ -57,7 +57,8 @@ pub fn run(args: ConformanceArgs) -> Result<(), CliError> {
 
 fn generate(dir: &Path, root: &Path) -> Result<(), CliError> {
     let vectors = standard::generate_all(root).map_err(|e| CliError::Other(Box::new(e)))?;
-    std::fs::create_dir_all(dir)?;
+    std::fs::create_dir_all(dir)
+        .map_err(|source| CliError::Other(Box::new(ConformanceError::Io { path: dir.to_path_buf(), source })))?;
     let mut out = std::io::stdout().lock();
     for v in &vectors {
         let path = dir.join(format!("{}.json", v.name));

@@ -207,10 +207,9 @@ fn build_hint(err: &BuildError, mesh: &TetMesh) -> String {
         BuildError::RepeatedVertex { point, .. } => std::slice::from_ref(point),
         _ => return String::new(),
     };
-    let tags: Option<Vec<u64>> = points.iter().map(|&p| mesh.node_tags.get(p as usize).copied()).collect();
-    match tags {
-        Some(tags) if !tags.is_empty() => format!(" (file node tags {tags:?}; element numbers are 0-based tets)"),
-        _ => String::new(),
+    match mesh.file_tags(points) {
+        Some(tags) => format!(" (file node tags {tags:?}; element numbers are 0-based tets)"),
+        None => String::new(),
     }
 }
 

@@ -393,6 +393,16 @@ fn unreferenced<const N: usize>(point_count: usize, cells: &[[u32; N]]) -> Vec<u
 }
 
 impl TetMesh {
+    /// The file's node tags of `points`, when the mesh knows a tag for each (error messages name
+    /// points by them: they survive the reorderings, point indices do not). O(points).
+    pub fn file_tags(&self, points: &[u32]) -> Option<Vec<u64>> {
+        points
+            .iter()
+            .map(|&p| self.node_tags.get(p as usize).copied())
+            .collect::<Option<Vec<u64>>>()
+            .filter(|t| !t.is_empty())
+    }
+
     /// The same mesh renumbered along a Z-order (Morton) space-filling curve: points sorted by the
     /// Morton code of their position (21 bits per axis over the bounding box, ties by old
     /// index), tets relabelled and sorted by the code of their centroid, file triangles relabelled.

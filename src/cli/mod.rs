@@ -82,11 +82,7 @@ pub(crate) fn model_error(path: &Path, mesh: &TetMesh, source: ModelError) -> Cl
         ModelError::NonFinitePoint { point, .. } => vec![*point as u32],
         _ => Vec::new(),
     };
-    let tags: Option<Vec<u64>> = points.iter().map(|&p| mesh.node_tags.get(p as usize).copied()).collect();
-    let at = match tags {
-        Some(tags) if !tags.is_empty() => format!(" (file node tags {tags:?})"),
-        _ => String::new(),
-    };
+    let at = mesh.file_tags(&points).map_or(String::new(), |tags| format!(" (file node tags {tags:?})"));
     CliError::Model { path: path.to_path_buf(), source, at }
 }
 

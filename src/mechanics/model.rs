@@ -912,17 +912,16 @@ pub(crate) struct ModelTotals {
 }
 
 impl ModelTotals {
-    /// Adds tet `t` (its corners and volume) and returns its mass ρ·V.
+    /// Adds tet `t` (its corners and volume) to the totals.
     ///
     /// # Errors
     /// [`ModelError::DegenerateTet`] for a zero volume, [`ModelError::Overflow`] when the volume or
     /// a total is no longer finite. O(1).
-    pub(crate) fn add(&mut self, t: usize, c: [Vec3; 4], volume: f64, m: &Material) -> Result<f64, ModelError> {
+    pub(crate) fn add(&mut self, t: usize, c: [Vec3; 4], volume: f64, m: &Material) -> Result<(), ModelError> {
         if volume == 0.0 {
             return Err(ModelError::DegenerateTet { tet: t });
         }
-        let mass = m.density * volume;
-        self.mass += mass;
+        self.mass += m.density * volume;
         for (i, j) in [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)] {
             self.stiffness += stiffness_contribution(m.young, volume, norm(sub(c[j], c[i])));
         }
@@ -930,7 +929,7 @@ impl ModelTotals {
         let damping = ("total damping", m.damping * self.stiffness);
         match totals.into_iter().chain([damping]).find(|(_, v)| !v.is_finite()) {
             Some((quantity, value)) => Err(ModelError::Overflow { tet: t, quantity, value }),
-            None => Ok(mass),
+            None => Ok(()),
         }
     }
 }

@@ -53,6 +53,14 @@ pub enum SurfaceError {
         /// The number of points.
         points: usize,
     },
+    /// A tetrahedron names one point twice (its faces would be degenerate triangles).
+    #[error("tet {tet} uses point {point} twice")]
+    RepeatedPoint {
+        /// The tet's index.
+        tet: usize,
+        /// The repeated point index.
+        point: u32,
+    },
     /// The OBJ file could not be written (the cause names the file or its temporary sibling).
     #[error("cannot write the surface OBJ file {}: {source}", .path.display())]
     Write {
@@ -148,7 +156,8 @@ pub fn boundary_surface(body: &Body) -> Surface {
 /// Cost: O(T) expected (one hash of each of the 4T sorted face triples).
 ///
 /// # Errors
-/// [`SurfaceError::PointOutOfRange`] naming the first tet with a bad index.
+/// [`SurfaceError::PointOutOfRange`] naming the first tet with a bad index, then
+/// [`SurfaceError::RepeatedPoint`] naming the first tet that uses a point twice.
 ///
 /// ```
 /// use topomech::surface::boundary_surface_of_tets;
@@ -158,12 +167,17 @@ pub fn boundary_surface(body: &Body) -> Surface {
 /// assert_eq!(s.triangles.len(), 4);
 /// assert!((s.enclosed_volume() - 1.0 / 6.0).abs() < 1e-15);
 /// assert!(boundary_surface_of_tets(&points, &[[0, 1, 2, 9]]).is_err());
+/// assert!(boundary_surface_of_tets(&points, &[[0, 1, 2, 3], [0, 2, 2, 3]]).is_err());
 /// ```
 pub fn boundary_surface_of_tets(points: &[Vec3], tets: &[[u32; 4]]) -> Result<Surface, SurfaceError> {
     if let Some((tet, &point)) =
         tets.iter().enumerate().find_map(|(t, tet)| tet.iter().find(|&&p| p as usize >= points.len()).map(|p| (t, p)))
     {
         return Err(SurfaceError::PointOutOfRange { tet, point, points: points.len() });
+    }
+    let repeated = |t: &[u32; 4]| (1..4).find_map(|j| t[..j].contains(&t[j]).then_some(t[j]));
+    if let Some((tet, point)) = tets.iter().enumerate().find_map(|(k, t)| repeated(t).map(|p| (k, p))) {
+        return Err(SurfaceError::RepeatedPoint { tet, point });
     }
     let face = |tet: &[u32; 4], f: usize| -> [u32; 3] {
         let mut k = 0;

@@ -45,6 +45,32 @@ pub enum VtkError {
         /// The number of points.
         expected: usize,
     },
+    /// A tetrahedron names a point the frame does not have (readers would accept the file and
+    /// index past their point array).
+    #[error("tetrahedron {tet} names point {point}, but the frame has {points} points")]
+    BadTet {
+        /// The tet's index in the frame.
+        tet: usize,
+        /// The point index out of range.
+        point: u32,
+        /// The number of points.
+        points: usize,
+    },
+    /// A series stem that is empty or holds a path separator or a control character (the frames
+    /// would land outside the series directory, or under a name no listing shows).
+    #[error("series stem {stem:?} must be a non-empty file name without '/', '\\' or control characters")]
+    BadStem {
+        /// The stem given.
+        stem: String,
+    },
+    /// A frame time that is NaN or infinite (ParaView orders frames by time).
+    #[error("frame {frame} has time {time}, which is not finite")]
+    BadTime {
+        /// The frame's index in the series.
+        frame: usize,
+        /// The time given.
+        time: f64,
+    },
 }
 
 /// One frame: points, tets and named per-point vectors.
@@ -75,8 +101,12 @@ pub struct Frame<'a> {
 impl Frame<'_> {
     /// The frame as VTU XML text. O(points + tets).
     ///
+    /// Array names are written as XML attribute values (`&`, `<`, `>`, `"` and `'` as entities),
+    /// so a reader gets back the name as given.
+    ///
     /// # Errors
-    /// [`VtkError::BadArray`] when a vector array has the wrong length.
+    /// [`VtkError::BadArray`] when a vector array has the wrong length, [`VtkError::BadTet`]
+    /// when a tetrahedron names a point past the end of `points`.
     ///
     /// # Examples
     ///
@@ -88,8 +118,12 @@ impl Frame<'_> {
     /// let frame = Frame { points: &points, tets: &[[0, 1, 2, 3]], vectors: vec![("velocity", &velocity[..])] };
     /// let xml = frame.to_vtu().unwrap();
     /// assert!(xml.contains("NumberOfPoints=\"4\" NumberOfCells=\"1\"") && xml.contains("Name=\"velocity\""));
-    /// let bad = Frame { vectors: vec![("velocity", &velocity[..3])], ..frame };
+    /// let bad = Frame { vectors: vec![("velocity", &velocity[..3])], ..frame.clone() };
     /// assert!(matches!(bad.to_vtu(), Err(VtkError::BadArray { got: 3, expected: 4, .. })));
+    /// let bad = Frame { tets: &[[0, 1, 2, 3], [1, 2, 3, 4]], ..frame.clone() };
+    /// assert!(matches!(bad.to_vtu(), Err(VtkError::BadTet { tet: 1, point: 4, points: 4 })));
+    /// let named = Frame { vectors: vec![("v<&>w", &velocity[..])], ..frame };
+    /// assert!(named.to_vtu().unwrap().contains("Name=\"v&lt;&amp;&gt;w\""));
     /// ```
     pub fn to_vtu(&self) -> Result<String, VtkError> {
         let n = self.points.len();
@@ -97,6 +131,10 @@ impl Frame<'_> {
             if values.len() != n {
                 return Err(VtkError::BadArray { name: name.to_string(), got: values.len(), expected: n });
             }
+        }
+        let outside = |t: &[u32; 4]| t.iter().copied().find(|&p| p as usize >= n);
+        if let Some((tet, point)) = self.tets.iter().enumerate().find_map(|(k, t)| outside(t).map(|p| (k, p))) {
+            return Err(VtkError::BadTet { tet, point, points: n });
         }
         let mut s = String::with_capacity(64 * (n + self.tets.len()) + 512);
         s.push_str("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n");
@@ -147,11 +185,32 @@ impl Frame<'_> {
 }
 
 fn vector_array(s: &mut String, name: &str, values: &[Vec3]) {
+    let name = xml_attribute(name);
     let _ = writeln!(s, "<DataArray type=\"Float64\" Name=\"{name}\" NumberOfComponents=\"3\" format=\"ascii\">");
     for v in values {
         let _ = writeln!(s, "{:e} {:e} {:e}", v[0], v[1], v[2]);
     }
     s.push_str("</DataArray>\n");
+}
+
+/// `text` as an XML attribute value: the five markup characters as entities, every other
+/// character as given. O(text).
+fn xml_attribute(text: &str) -> std::borrow::Cow<'_, str> {
+    if !text.contains(['&', '<', '>', '"', '\'']) {
+        return text.into();
+    }
+    let mut out = String::with_capacity(text.len() + 16);
+    for c in text.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&apos;"),
+            c => out.push(c),
+        }
+    }
+    out.into()
 }
 
 fn write_file(path: &Path, text: &str) -> Result<(), VtkError> {
@@ -188,7 +247,8 @@ impl Series {
     /// A series of files `DIR/STEM_NNNNNN.vtu` and `DIR/STEM.pvd`; creates DIR.
     ///
     /// # Errors
-    /// [`VtkError::Io`] if DIR cannot be created.
+    /// [`VtkError::BadStem`] for an empty stem or one with a path separator or a control
+    /// character; [`VtkError::Io`] if DIR cannot be created.
     ///
     /// # Examples
     ///
@@ -202,8 +262,14 @@ impl Series {
     /// assert!(matches!(err, Err(VtkError::Io { .. })));
     /// let series = Series::new(&std::env::temp_dir(), "run").unwrap();
     /// assert!(series.pvd_path().ends_with("run.pvd"));
+    /// for stem in ["", "../run", "a\\b", "run\n"] {
+    ///     assert!(matches!(Series::new(&std::env::temp_dir(), stem), Err(VtkError::BadStem { .. })));
+    /// }
     /// ```
     pub fn new(dir: &Path, stem: &str) -> Result<Self, VtkError> {
+        if stem.is_empty() || stem.contains(['/', '\\']) || stem.chars().any(char::is_control) {
+            return Err(VtkError::BadStem { stem: stem.to_string() });
+        }
         std::fs::create_dir_all(dir).map_err(|source| VtkError::Io { path: dir.to_path_buf(), source })?;
         Ok(Series { dir: dir.to_path_buf(), stem: stem.to_string(), frames: Vec::new() })
     }
@@ -212,12 +278,13 @@ impl Series {
     /// O(frame + frames so far).
     ///
     /// # Errors
-    /// [`VtkError`].
+    /// [`VtkError::BadTime`] for a time that is not finite (nothing is written), and the errors
+    /// of [`Frame::write`].
     ///
     /// # Examples
     ///
     /// ```
-    /// use topomech::vtk::{Frame, Series};
+    /// use topomech::vtk::{Frame, Series, VtkError};
     ///
     /// let dir = std::env::temp_dir().join(format!("topomech-doc-vtk-{}", std::process::id()));
     /// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
@@ -225,11 +292,15 @@ impl Series {
     /// let mut series = Series::new(&dir, "run").unwrap();
     /// assert!(series.push(0.0, &frame).unwrap().ends_with("run_000000.vtu"));
     /// series.push(0.1, &frame).unwrap();
+    /// assert!(matches!(series.push(f64::NAN, &frame), Err(VtkError::BadTime { frame: 2, .. })));
     /// let pvd = std::fs::read_to_string(series.pvd_path()).unwrap();
     /// std::fs::remove_dir_all(&dir).unwrap();
     /// assert_eq!(pvd.matches("<DataSet").count(), 2);
     /// ```
     pub fn push(&mut self, time: f64, frame: &Frame<'_>) -> Result<PathBuf, VtkError> {
+        if !time.is_finite() {
+            return Err(VtkError::BadTime { frame: self.frames.len(), time });
+        }
         let name = format!("{}_{:06}.vtu", self.stem, self.frames.len());
         let path = self.dir.join(&name);
         frame.write(&path)?;
@@ -259,7 +330,7 @@ impl Series {
         let mut s =
             String::from("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n");
         for (time, name) in &self.frames {
-            let _ = writeln!(s, "<DataSet timestep=\"{time:e}\" part=\"0\" file=\"{name}\"/>");
+            let _ = writeln!(s, "<DataSet timestep=\"{time:e}\" part=\"0\" file=\"{}\"/>", xml_attribute(name));
         }
         s.push_str("</Collection>\n</VTKFile>\n");
         write_file(&self.pvd_path(), &s)

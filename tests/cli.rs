@@ -288,6 +288,28 @@ fn a_flat_tet_is_refused_by_the_model_naming_the_file_and_its_nodes() {
     assert_eq!(run(&["info", p]).status.code(), Some(0), "info reports the map, which is valid");
 }
 
+/// A cube of six tets squashed flat: the cut campaign runs (it needs no geometry), the mixed
+/// campaign refuses it naming the file and the nodes. (Before, it panicked on a lookup, or paired
+/// children with the wrong volumes and reported made-up findings.)
+#[test]
+fn the_mixed_campaign_refuses_a_mesh_without_volume_naming_the_file_and_nodes() {
+    let nodes = ["0 0 0", "1 0 0", "0 1 0", "1 1 0", "0 0 0", "1 0 0", "0 1 0", "1 1 0"];
+    let tets = ["1 2 4 8", "1 2 6 8", "1 3 4 8", "1 3 7 8", "1 5 6 8", "1 5 7 8"];
+    let path = scratch("flat_cube.msh", msh22(&nodes, &tets).as_bytes());
+    let p = path.to_str().unwrap();
+    let cuts = ["ambiguity", p, "--cuts", "3", "--sequences", "4"];
+    assert_eq!(run(&cuts).status.code(), Some(0), "{}", stderr(&run(&cuts)));
+    for probability in ["0.5", "1"] {
+        let out = run(&[&cuts[..], &["--subdivide", probability]].concat());
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert!(!err.contains("panicked"), "{err}");
+        let last = err.lines().last().unwrap_or_default();
+        assert!(last.starts_with(&format!("topomech: error: {p}: the mixed campaign cannot run")), "{err}");
+        assert!(last.contains("tet 0 has zero volume") && last.contains("file node tags [1, 2, 4, 8]"), "{err}");
+    }
+}
+
 #[test]
 fn warnings_go_to_stderr_and_the_load_succeeds() {
     // Tet 2 is inverted (node 5 is below the base, like node 4 above it) and node 6 is unused.

@@ -208,6 +208,22 @@ fn a_tet_with_a_bad_point_index_is_an_error() {
     }
 }
 
+/// Before, a tet with a repeated point gave degenerate boundary triangles without a word.
+#[test]
+fn a_tet_that_uses_a_point_twice_is_an_error() {
+    let (points, tets) = kuhn_cube(1);
+    for (j, k) in [(0, 1), (0, 3), (1, 2), (2, 3)] {
+        let mut bad = tets.clone();
+        bad[4][j] = bad[4][k];
+        match boundary_surface_of_tets(&points, &bad) {
+            Err(e @ SurfaceError::RepeatedPoint { tet: 4, .. }) => {
+                assert!(e.to_string().contains(&format!("point {} twice", tets[4][k])), "{e}")
+            }
+            other => panic!("corners {j}, {k}: {other:?}"),
+        }
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Rendering
 

@@ -136,3 +136,46 @@ fn pvpython_reads_back_a_series_and_a_frame() {
     assert_eq!(v["frames"], serde_json::json!([expect(&before), expect(&after)]));
     assert_eq!(v["single"], serde_json::json!([after.0.len(), after.1.len()]));
 }
+
+const NAMES_SCRIPT: &str = r#"
+import json, sys
+from paraview import servermanager
+from paraview.simple import PVDReader
+series = PVDReader(FileName=sys.argv[1])
+series.UpdatePipeline(0.0)
+d = servermanager.Fetch(series)
+pd = d.GetPointData()
+names = [pd.GetArrayName(k) for k in range(pd.GetNumberOfArrays())]
+print(json.dumps({"points": d.GetNumberOfPoints(), "names": names}))
+"#;
+
+const MESHIO_NAMES_SCRIPT: &str = r#"
+import json, sys, meshio
+m = meshio.read(sys.argv[1])
+print(json.dumps(sorted(m.point_data)))
+"#;
+
+/// A stem and an array name holding XML's markup characters: both clients read the series and
+/// the frame, under the names given. (Before, the raw `&` made a file no reader could open.)
+#[test]
+fn names_with_markup_characters_read_back_as_given() {
+    let (points, tets) = topomech::generate::kuhn_cube(1);
+    let name = "v<&>\"w'";
+    let dir = scratch("names");
+    let mut series = Series::new(&dir, "a&b <c>").unwrap();
+    let frame = Frame { points: &points, tets: &tets, vectors: vec![(name, &points[..])] };
+    let vtu = series.push(0.0, &frame).unwrap();
+    if let Some(text) = run_client("meshio", "python3", &["-c", MESHIO_NAMES_SCRIPT, vtu.to_str().unwrap()]) {
+        let names: Vec<String> = serde_json::from_str(text.trim()).unwrap();
+        assert_eq!(names, vec![name.to_string()], "meshio read other array names");
+    }
+    let script = dir.join("names.py");
+    std::fs::write(&script, NAMES_SCRIPT).unwrap();
+    let pvd = series.pvd_path();
+    let args = ["--no-mpi", script.to_str().unwrap(), pvd.to_str().unwrap()];
+    let Some(text) = run_client("pvpython", "pvpython", &args) else { return };
+    let json_line = text.lines().rev().find(|l| l.starts_with('{')).expect("pvpython printed the JSON line");
+    let v: serde_json::Value = serde_json::from_str(json_line).unwrap();
+    assert_eq!(v["points"], serde_json::json!(points.len()));
+    assert_eq!(v["names"], serde_json::json!([name]));
+}

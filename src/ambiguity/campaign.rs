@@ -153,7 +153,7 @@ impl Run {
 /// ```
 pub fn run_cuts(points: usize, tets: &[[u32; 4]], cuts: &[[u32; 2]]) -> Result<Run, CampaignError> {
     let (mut gmap, _) = GMap::<3>::from_tets(points, tets)?;
-    let mut model = IndexedModel::new(points, tets);
+    let mut model = IndexedModel::new(points, tets)?;
     let mut outcomes: Vec<CutOutcome> = Vec::with_capacity(cuts.len());
     let mut skeleton_unchanged = true;
     for &[t1, t2] in cuts {

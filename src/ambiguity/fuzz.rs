@@ -277,7 +277,8 @@ fn check_mixed(selector: u8, rest: &[u8]) -> Result<FuzzReport, FuzzFailure> {
 
 /// The indexed model's points and tets after the cuts.
 fn indexed_tets(points: usize, tets: &[[u32; 4]], cuts: &[[u32; 2]]) -> Result<(usize, Vec<[u32; 4]>), FuzzFailure> {
-    let mut model = crate::ambiguity::indexed::IndexedModel::new(points, tets);
+    let mut model = crate::ambiguity::indexed::IndexedModel::new(points, tets)
+        .map_err(|e| FuzzFailure::Unexpected(e.to_string()))?;
     for &[a, b] in cuts {
         model.cut(a, b).map_err(|e| FuzzFailure::Unexpected(e.to_string()))?;
     }

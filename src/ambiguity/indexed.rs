@@ -32,7 +32,7 @@ use crate::BuildError;
 /// use topomech::ambiguity::indexed::IndexedModel;
 ///
 /// // Three tets around the edge (0, 1): cutting one face separates point 3 only.
-/// let mut model = IndexedModel::new(5, &[[0, 1, 2, 3], [0, 1, 3, 4], [0, 1, 4, 2]]);
+/// let mut model = IndexedModel::new(5, &[[0, 1, 2, 3], [0, 1, 3, 4], [0, 1, 4, 2]]).unwrap();
 /// let out = model.cut(0, 1).unwrap();
 /// assert_eq!(out.kept, vec![0, 1]);
 /// assert_eq!(out.duplicated, vec![(3, 5)]);
@@ -56,7 +56,7 @@ pub struct IndexedModel {
 ///
 /// ```
 /// use topomech::ambiguity::indexed::IndexedModel;
-/// let mut model = IndexedModel::new(5, &[[0, 1, 2, 3], [1, 2, 3, 4]]);
+/// let mut model = IndexedModel::new(5, &[[0, 1, 2, 3], [1, 2, 3, 4]]).unwrap();
 /// let out = model.cut(0, 1).unwrap();
 /// assert_eq!(out.duplicated.len(), 3); // the three points of the shared face
 /// assert!(out.kept.is_empty() && !out.face_still_shared);
@@ -78,7 +78,7 @@ pub struct CutOutcome {
 ///
 /// ```
 /// use topomech::ambiguity::indexed::{IndexedError, IndexedModel};
-/// let mut model = IndexedModel::new(6, &[[0, 1, 2, 3], [2, 3, 4, 5]]);
+/// let mut model = IndexedModel::new(6, &[[0, 1, 2, 3], [2, 3, 4, 5]]).unwrap();
 /// assert_eq!(model.cut(0, 7), Err(IndexedError::NoSuchTet { tet: 7, tets: 2 }));
 /// assert!(matches!(model.cut(0, 1), Err(IndexedError::NoSharedFace(0, 1))));
 /// ```
@@ -95,6 +95,24 @@ pub enum IndexedError {
     /// The two tets do not share three points.
     #[error("tets {0} and {1} share no face in the indexed model")]
     NoSharedFace(u32, u32),
+    /// A tet names a point past the end.
+    #[error("tet {tet} names point {point}, but the model has {points} points")]
+    NoSuchPoint {
+        /// The tet: its index in the input list, or the index it would take.
+        tet: usize,
+        /// The point.
+        point: u32,
+        /// Number of points.
+        points: usize,
+    },
+}
+
+/// [`IndexedError::NoSuchPoint`] for the first point of `tet` (tet number `t`) past `points`.
+fn check_points(t: usize, tet: &[u32; 4], points: usize) -> Result<(), IndexedError> {
+    match tet.iter().find(|&&p| p as usize >= points) {
+        Some(&point) => Err(IndexedError::NoSuchPoint { tet: t, point, points }),
+        None => Ok(()),
+    }
 }
 
 /// The comparison of an indexed model with the g-map cut the same way.
@@ -170,26 +188,30 @@ impl Audit {
 impl IndexedModel {
     /// A model of `tets` over `points` points. O(tets).
     ///
+    /// # Errors
+    /// [`IndexedError::NoSuchPoint`] for the first tet naming a point past `points`.
+    ///
     /// # Examples
     ///
     /// ```
-    /// use topomech::ambiguity::indexed::IndexedModel;
+    /// use topomech::ambiguity::indexed::{IndexedError, IndexedModel};
     ///
-    /// let model = IndexedModel::new(5, &[[0, 1, 2, 3], [1, 2, 3, 4]]);
+    /// let model = IndexedModel::new(5, &[[0, 1, 2, 3], [1, 2, 3, 4]]).unwrap();
     /// assert_eq!((model.points, model.tets.len()), (5, 2));
     /// assert_eq!(model.origin, vec![0, 1, 2, 3, 4]);
     /// assert_eq!(model.used_points(), 5);
+    /// let e = IndexedModel::new(4, &[[0, 1, 2, 3], [1, 2, 3, 4]]).unwrap_err();
+    /// assert_eq!(e, IndexedError::NoSuchPoint { tet: 1, point: 4, points: 4 });
     /// ```
-    pub fn new(points: usize, tets: &[[u32; 4]]) -> Self {
+    pub fn new(points: usize, tets: &[[u32; 4]]) -> Result<Self, IndexedError> {
         let mut around = vec![Vec::new(); points];
         for (t, tet) in tets.iter().enumerate() {
+            check_points(t, tet, points)?;
             for &p in tet {
-                if let Some(list) = around.get_mut(p as usize) {
-                    list.push(t as u32);
-                }
+                around[p as usize].push(t as u32);
             }
         }
-        IndexedModel { points, tets: tets.to_vec(), around, origin: (0..points as u32).collect() }
+        Ok(IndexedModel { points, tets: tets.to_vec(), around, origin: (0..points as u32).collect() })
     }
 
     fn tet(&self, t: u32) -> Result<[u32; 4], IndexedError> {
@@ -209,7 +231,7 @@ impl IndexedModel {
     /// ```
     /// use topomech::ambiguity::indexed::{IndexedError, IndexedModel};
     ///
-    /// let mut model = IndexedModel::new(5, &[[0, 1, 2, 3], [1, 2, 3, 4]]);
+    /// let mut model = IndexedModel::new(5, &[[0, 1, 2, 3], [1, 2, 3, 4]]).unwrap();
     /// let out = model.cut(0, 1).unwrap();
     /// assert_eq!(out.duplicated.len(), 3);
     /// assert!(out.kept.is_empty() && !out.face_still_shared);
@@ -282,7 +304,7 @@ impl IndexedModel {
     /// ```
     /// use topomech::ambiguity::indexed::IndexedModel;
     ///
-    /// let mut model = IndexedModel::new(4, &[[0, 1, 2, 3]]);
+    /// let mut model = IndexedModel::new(4, &[[0, 1, 2, 3]]).unwrap();
     /// let p = model.add_point();
     /// assert_eq!((p, model.points, model.origin[4]), (4, 5, 4));
     /// assert!(!model.is_used(p));
@@ -295,47 +317,62 @@ impl IndexedModel {
         p
     }
 
-    /// Replaces tet t by `tet` (t must exist, the points of `tet` too). O(tets around its points).
+    /// Replaces tet t by `tet`. O(tets around its points).
+    ///
+    /// # Errors
+    /// [`IndexedError::NoSuchTet`] when t does not exist, [`IndexedError::NoSuchPoint`] when a
+    /// point of `tet` does not; the model is then unchanged.
     ///
     /// # Examples
     ///
     /// ```
-    /// use topomech::ambiguity::indexed::IndexedModel;
+    /// use topomech::ambiguity::indexed::{IndexedError, IndexedModel};
     ///
-    /// let mut model = IndexedModel::new(5, &[[0, 1, 2, 3]]);
-    /// model.set_tet(0, [1, 2, 3, 4]);
+    /// let mut model = IndexedModel::new(5, &[[0, 1, 2, 3]]).unwrap();
+    /// assert_eq!(model.set_tet(7, [1, 2, 3, 4]), Err(IndexedError::NoSuchTet { tet: 7, tets: 1 }));
+    /// assert_eq!(model.set_tet(0, [1, 2, 3, 9]), Err(IndexedError::NoSuchPoint { tet: 0, point: 9, points: 5 }));
+    /// assert_eq!(model.tets, vec![[0, 1, 2, 3]]);
+    /// model.set_tet(0, [1, 2, 3, 4]).unwrap();
     /// assert_eq!(model.tets, vec![[1, 2, 3, 4]]);
     /// assert!(!model.is_used(0) && model.is_used(4));
     /// ```
-    pub fn set_tet(&mut self, t: u32, tet: [u32; 4]) {
-        for p in self.tets[t as usize] {
+    pub fn set_tet(&mut self, t: u32, tet: [u32; 4]) -> Result<(), IndexedError> {
+        let old = self.tet(t)?;
+        check_points(t as usize, &tet, self.points)?;
+        for p in old {
             self.around[p as usize].retain(|&u| u != t);
         }
         for p in tet {
             self.around[p as usize].push(t);
         }
         self.tets[t as usize] = tet;
+        Ok(())
     }
 
     /// Appends a tet over existing points and returns its index. O(1).
     ///
+    /// # Errors
+    /// [`IndexedError::NoSuchPoint`] when a point of `tet` does not exist (nothing is appended).
+    ///
     /// # Examples
     ///
     /// ```
-    /// use topomech::ambiguity::indexed::IndexedModel;
+    /// use topomech::ambiguity::indexed::{IndexedError, IndexedModel};
     ///
-    /// let mut model = IndexedModel::new(5, &[[0, 1, 2, 3]]);
+    /// let mut model = IndexedModel::new(5, &[[0, 1, 2, 3]]).unwrap();
     /// assert_eq!(model.used_points(), 4);
-    /// assert_eq!(model.push_tet([1, 2, 3, 4]), 1);
+    /// assert_eq!(model.push_tet([1, 2, 3, 4]), Ok(1));
+    /// assert_eq!(model.push_tet([1, 2, 3, 5]), Err(IndexedError::NoSuchPoint { tet: 2, point: 5, points: 5 }));
     /// assert_eq!(model.used_points(), 5);
     /// ```
-    pub fn push_tet(&mut self, tet: [u32; 4]) -> u32 {
+    pub fn push_tet(&mut self, tet: [u32; 4]) -> Result<u32, IndexedError> {
         let t = self.tets.len() as u32;
+        check_points(t as usize, &tet, self.points)?;
         self.tets.push(tet);
         for p in tet {
             self.around[p as usize].push(t);
         }
-        t
+        Ok(t)
     }
 
     /// Whether some tet uses point p. O(1).
@@ -345,7 +382,7 @@ impl IndexedModel {
     /// ```
     /// use topomech::ambiguity::indexed::IndexedModel;
     ///
-    /// let model = IndexedModel::new(6, &[[0, 1, 2, 3]]);
+    /// let model = IndexedModel::new(6, &[[0, 1, 2, 3]]).unwrap();
     /// assert!(model.is_used(3));
     /// assert!(!model.is_used(5) && !model.is_used(99));
     /// ```
@@ -360,7 +397,7 @@ impl IndexedModel {
     /// ```
     /// use topomech::ambiguity::indexed::IndexedModel;
     ///
-    /// let mut model = IndexedModel::new(5, &[[0, 1, 2, 3], [1, 2, 3, 4]]);
+    /// let mut model = IndexedModel::new(5, &[[0, 1, 2, 3], [1, 2, 3, 4]]).unwrap();
     /// model.cut(0, 1).unwrap();
     /// assert_eq!(model.used_points(), 8); // the three points of the cut face are duplicated
     /// ```
@@ -380,7 +417,7 @@ impl IndexedModel {
     /// use topomech::ambiguity::indexed::IndexedModel;
     ///
     /// let tets = [[0, 1, 2, 3], [1, 2, 3, 4]];
-    /// let mut model = IndexedModel::new(5, &tets);
+    /// let mut model = IndexedModel::new(5, &tets).unwrap();
     /// let out = model.cut(0, 1).unwrap();
     /// let gmap = CutComplex { points: 5, tets: tets.to_vec(), cuts: vec![[0, 1]] }.build().unwrap();
     /// let audit = model.audit(&gmap, &[[0, 1]], &[out]).unwrap();
@@ -428,7 +465,7 @@ mod tests {
     #[test]
     fn cutting_the_only_face_of_two_tets_duplicates_its_three_points() {
         let tets = [[0, 1, 2, 3], [1, 2, 3, 4]];
-        let mut model = IndexedModel::new(5, &tets);
+        let mut model = IndexedModel::new(5, &tets).unwrap();
         let out = model.cut(0, 1).expect("shared face");
         assert_eq!(out.duplicated.len(), 3);
         assert!(out.kept.is_empty() && !out.face_still_shared);
@@ -443,7 +480,7 @@ mod tests {
         // Three tets around the edge (0, 1), ring 2-3-4: the points 0 and 1 keep their tets
         // connected around the cut, point 3 is separated; the indexed model gets it right.
         let tets = [[0, 1, 2, 3], [0, 1, 3, 4], [0, 1, 4, 2]];
-        let mut model = IndexedModel::new(5, &tets);
+        let mut model = IndexedModel::new(5, &tets).unwrap();
         let out = model.cut(0, 1).expect("shared face");
         assert_eq!(out.kept, vec![0, 1]);
         assert_eq!(out.duplicated.len(), 1);
@@ -464,7 +501,7 @@ mod tests {
             let mut gmap = fresh.clone();
             let d = crate::ambiguity::construct::shared_face_dart(&gmap, t1, t2).expect("glued");
             let changes = gmap.unsew::<3>(d).expect("sewn");
-            let mut model = IndexedModel::new(points.len(), &tets);
+            let mut model = IndexedModel::new(points.len(), &tets).unwrap();
             let out = model.cut(t1, t2).expect("shared face");
             assert_eq!(out.face_still_shared, changes.splits(0).count() == 0, "cut {t1}-{t2}");
             let audit = model.audit(&gmap, &[[t1, t2]], &[out]).expect("builds");
@@ -479,7 +516,7 @@ mod tests {
 
     #[test]
     fn bad_cuts_are_errors() {
-        let mut model = IndexedModel::new(5, &[[0, 1, 2, 3], [1, 2, 3, 4]]);
+        let mut model = IndexedModel::new(5, &[[0, 1, 2, 3], [1, 2, 3, 4]]).unwrap();
         assert_eq!(model.cut(0, 7), Err(IndexedError::NoSuchTet { tet: 7, tets: 2 }));
         assert_eq!(model.cut(0, 0), Err(IndexedError::NoSharedFace(0, 0)));
     }

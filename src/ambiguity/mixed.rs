@@ -88,9 +88,24 @@ pub enum MixedError {
     /// An indexed cut failed where it cannot.
     #[error(transparent)]
     Indexed(#[from] IndexedError),
-    /// A child of a subdivision has no g-map counterpart with the same corner positions.
+    /// A child of a subdivision has no g-map counterpart with the same corner positions (or only
+    /// one already paired with another child).
     #[error("child tet {0} of a subdivision matches no g-map volume")]
     Unpaired(u32),
+    /// A g-map volume stands for no tet of the indexed model.
+    #[error("the g-map volume of {0:?} stands for no tet of the indexed model")]
+    NoModelTet(DartId),
+    /// The input has a tet of zero volume or with a corner that is not finite, and the ops
+    /// subdivide: the children of a subdivision are paired with the g-map's by the positions of
+    /// their corners, which needs the ten points of every tet (corners and edge midpoints) to be
+    /// distinct.
+    #[error("tet {tet} has {} and the ops subdivide: the children of a subdivision are paired by corner positions, which needs every tet to have volume", if volume.is_finite() { "zero volume" } else { "a corner that is not finite" })]
+    Degenerate {
+        /// The tet's index in the input.
+        tet: usize,
+        /// Its signed volume (zero, or not finite).
+        volume: f64,
+    },
     /// A level of the leveled map cannot be extracted.
     #[error("level {0} cannot be extracted: {1}")]
     Level(u8, String),
@@ -232,8 +247,9 @@ struct Snapshot {
 /// Runs `ops` on both models built from the mesh. O(ops · (mesh + darts)) plus one comparison
 /// per level (each O(tets + darts · n) and a VF2 when maps differ but graph invariants agree).
 ///
-/// Errors: [`MixedError::Build`] / [`MixedError::Pinched`] for a bad mesh; the other variants
-/// are bugs.
+/// Errors: [`MixedError::Build`] / [`MixedError::Pinched`] for a bad mesh, and
+/// [`MixedError::Degenerate`] for a tet of zero volume or with a non-finite corner when `ops`
+/// subdivide; the other variants are bugs.
 ///
 /// # Examples
 ///
@@ -253,9 +269,12 @@ pub fn run_ops(points: &[[f64; 3]], tets: &[[u32; 4]], ops: &[Op]) -> Result<Mix
     if !report.pinched_vertices.is_empty() {
         return Err(MixedError::Pinched(report.pinched_vertices.len()));
     }
+    if ops.iter().any(|op| matches!(op, Op::Subdivide(_))) {
+        check_volumes(points, tets)?;
+    }
     let mut s = Sides {
         lm: LeveledMap::new(map, points.to_vec()),
-        model: RefinedModel::new(points, tets),
+        model: RefinedModel::new(points, tets)?,
         vol_dart: (0..tets.len()).map(|t| DartId(24 * t as u32)).collect(),
     };
     let mut run = MixedRun {
@@ -303,6 +322,18 @@ pub fn run_ops(points: &[[f64; 3]], tets: &[[u32; 4]], ops: &[Op]) -> Result<Mix
     Ok(run)
 }
 
+/// The first tet of zero or non-finite signed volume, as [`MixedError::Degenerate`]. O(tets).
+fn check_volumes(points: &[[f64; 3]], tets: &[[u32; 4]]) -> Result<(), MixedError> {
+    for (tet, t) in tets.iter().enumerate() {
+        let [a, b, c, d] = t.map(|v| points[v as usize]);
+        let volume = crate::mesh::signed_volume(a, b, c, d);
+        if volume == 0.0 || !volume.is_finite() {
+            return Err(MixedError::Degenerate { tet, volume });
+        }
+    }
+    Ok(())
+}
+
 /// One dart per glued face of the finest map, in dart order. O(darts).
 ///
 /// # Examples
@@ -331,7 +362,8 @@ fn cut(s: &mut Sides, i: u32, run: &mut MixedRun) -> Result<(), MixedError> {
     let map = s.lm.map();
     let tet_of: FxHashMap<u32, u32> =
         s.vol_dart.iter().enumerate().map(|(t, &x)| (map.cell_id(3, x).0, t as u32)).collect();
-    let (t1, t2) = (tet_of[&map.cell_id(3, d).0], tet_of[&map.cell_id(3, map.alpha::<3>(d)).0]);
+    let tet = |x: DartId| tet_of.get(&map.cell_id(3, x).0).copied().ok_or(MixedError::NoModelTet(x));
+    let (t1, t2) = (tet(d)?, tet(map.alpha::<3>(d))?);
     let before_counts = map.count_cells();
     let before = (map.dart_count() <= SKELETON_CHECK_DARTS).then(|| map.clone());
     s.lm.unsew_face(d, s.lm.max_level())?;
@@ -373,11 +405,15 @@ fn subdivide(s: &mut Sides, i: u32, run: &mut MixedRun, snapshots: &mut Vec<Snap
     let diagonal: Vec<[f64; 3]> =
         sets[4].iter().copied().filter(|p| sets[5..].iter().all(|set| set.contains(p))).collect();
     let hint = <[[f64; 3]; 2]>::try_from(diagonal.as_slice()).ok();
-    let children = s.model.subdivide(t, hint);
+    let children = s.model.subdivide(t, hint)?;
     s.vol_dart.resize(s.model.model.tets.len(), DartId(0));
+    let mut paired = [false; 8];
     for c in children {
         let corners = s.model.model.tets[c as usize].map(|p| s.model.position(p));
-        let k = (0..8).find(|&k| corners.iter().all(|p| sets[k].contains(p))).ok_or(MixedError::Unpaired(c))?;
+        let k = (0..8)
+            .find(|&k| !paired[k] && corners.iter().all(|p| sets[k].contains(p)))
+            .ok_or(MixedError::Unpaired(c))?;
+        paired[k] = true;
         s.vol_dart[c as usize] = kids[k];
     }
     run.subdivisions += 1;
@@ -408,7 +444,7 @@ fn volume_positions(lm: &LeveledMap<3>, d: DartId) -> Vec<[f64; 3]> {
 ///
 /// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
-/// let model = RefinedModel::new(&points, &[[0, 1, 2, 3]]);
+/// let model = RefinedModel::new(&points, &[[0, 1, 2, 3]]).unwrap();
 /// let c = compare(&map, &[DartId(0)], &model).unwrap();
 /// assert!(!c.map_differs && !c.ambiguous());
 /// assert_eq!((c.gmap_vertices, c.indexed_vertices, c.graph_pair), (4, 4, None));
@@ -656,6 +692,34 @@ mod tests {
         assert_eq!(stats.skeleton_violations, 0);
         assert!(stats.skeleton_pairs > 0, "a Kuhn cube has faces whose cut splits nothing: {stats:?}");
         assert!(stats.wrong >= stats.lost, "a lost cut is a different gluing: {stats:?}");
+    }
+
+    /// Before the check, a flat cube paired every child with the first volume whose corners it
+    /// met: an all-subdivide run passed with a made-up pairing, and a cut after a subdivision
+    /// panicked on a volume that stood for no tet.
+    #[test]
+    fn subdividing_a_mesh_without_volume_is_refused_and_cutting_it_is_not() {
+        let (p, t) = cube();
+        let flat: Vec<[f64; 3]> = p.iter().map(|&[x, y, _]| [x, y, 0.0]).collect();
+        let zero = vec![[0.0; 3]; p.len()];
+        let mut nan = p.clone();
+        nan[7][2] = f64::NAN;
+        let ops = [Op::Subdivide(0), Op::Cut(1), Op::Subdivide(3), Op::Cut(2)];
+        for points in [&flat, &zero, &nan] {
+            match run_ops(points, &t, &ops) {
+                Err(MixedError::Degenerate { tet, volume }) => {
+                    assert!(tet < t.len() && (volume == 0.0 || volume.is_nan()), "{tet} {volume}");
+                    let message = MixedError::Degenerate { tet, volume }.to_string();
+                    assert!(message.contains(&format!("tet {tet} has")), "{message}");
+                }
+                other => panic!("expected Degenerate, got {other:?}"),
+            }
+            let run = run_ops(points, &t, &[Op::Cut(1), Op::Cut(2)]).expect("cuts need no geometry");
+            assert_eq!((run.cuts, run.subdivisions), (2, 0));
+        }
+        let e = run_ops(&nan, &t, &ops).unwrap_err();
+        assert!(e.to_string().contains("a corner that is not finite"), "{e}");
+        assert!(run_ops(&p, &t, &ops).is_ok(), "the cube itself runs");
     }
 
     #[test]

@@ -14,7 +14,7 @@
 
 use rustc_hash::FxHashMap;
 
-use crate::ambiguity::indexed::IndexedModel;
+use crate::ambiguity::indexed::{IndexedError, IndexedModel};
 
 /// The six edges of a tet as pairs of corner indices (midpoint label = 4 + index).
 const PAIRS: [(usize, usize); 6] = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
@@ -27,9 +27,9 @@ const PAIRS: [(usize, usize); 6] = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 
 /// use topomech::ambiguity::refine::RefinedModel;
 ///
 /// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 1.0]];
-/// let mut r = RefinedModel::new(&points, &[[0, 1, 2, 3], [1, 2, 3, 4]]);
-/// r.subdivide(0, None);
-/// r.subdivide(1, None); // then its neighbour (tet indices never change)
+/// let mut r = RefinedModel::new(&points, &[[0, 1, 2, 3], [1, 2, 3, 4]]).unwrap();
+/// r.subdivide(0, None).unwrap();
+/// r.subdivide(1, None).unwrap(); // then its neighbour (tet indices never change)
 /// assert_eq!(r.hanging_edges(), 0);
 /// assert_eq!(r.model.points, 5 + 9); // the shared face's three midpoints are reused
 /// ```
@@ -53,16 +53,16 @@ impl RefinedModel {
     /// use topomech::ambiguity::refine::RefinedModel;
     ///
     /// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-    /// let r = RefinedModel::new(&points, &[[0, 1, 2, 3]]);
+    /// let r = RefinedModel::new(&points, &[[0, 1, 2, 3]]).unwrap();
     /// assert_eq!((r.model.points, r.model.tets.len()), (4, 1));
     /// assert_eq!(r.hanging_edges(), 0);
     /// ```
-    pub fn new(points: &[[f64; 3]], tets: &[[u32; 4]]) -> Self {
-        RefinedModel {
-            model: IndexedModel::new(points.len(), tets),
+    pub fn new(points: &[[f64; 3]], tets: &[[u32; 4]]) -> Result<Self, IndexedError> {
+        Ok(RefinedModel {
+            model: IndexedModel::new(points.len(), tets)?,
             positions: points.to_vec(),
             midpoint: FxHashMap::default(),
-        }
+        })
     }
 
     /// The position of point p (the origin if unknown). O(1).
@@ -73,9 +73,9 @@ impl RefinedModel {
     /// use topomech::ambiguity::refine::RefinedModel;
     ///
     /// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-    /// let mut r = RefinedModel::new(&points, &[[0, 1, 2, 3]]);
+    /// let mut r = RefinedModel::new(&points, &[[0, 1, 2, 3]]).unwrap();
     /// assert_eq!(r.position(3), [0.0, 0.0, 1.0]);
-    /// r.subdivide(0, None);
+    /// r.subdivide(0, None).unwrap();
     /// assert_eq!(r.position(4), [0.5, 0.0, 0.0]); // the first midpoint: edge (0, 1)
     /// ```
     pub fn position(&self, p: u32) -> [f64; 3] {
@@ -103,7 +103,10 @@ impl RefinedModel {
     /// diagonal whose end positions are nearest `diagonal` (the g-map's choice, so both models
     /// take the same one), or along the shortest one when `diagonal` is `None`. Returns the
     /// children: t itself (now the corner tet at its first corner), then seven new indices.
-    /// O(1) amortised plus the point lists of the corners. Panics if t does not exist.
+    /// O(1) amortised plus the point lists of the corners.
+    ///
+    /// # Errors
+    /// [`IndexedError::NoSuchTet`] when t does not exist (nothing changes).
     ///
     /// # Examples
     ///
@@ -112,14 +115,16 @@ impl RefinedModel {
     /// use topomech::GMap;
     ///
     /// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-    /// let mut r = RefinedModel::new(&points, &[[0, 1, 2, 3]]);
-    /// let kids = r.subdivide(0, None);
+    /// let mut r = RefinedModel::new(&points, &[[0, 1, 2, 3]]).unwrap();
+    /// assert!(r.subdivide(1, None).is_err()); // no tet 1
+    /// let kids = r.subdivide(0, None).unwrap();
     /// assert_eq!((kids[0], r.model.tets.len(), r.model.points), (0, 8, 10));
     /// let (map, _) = GMap::<3>::from_tets(r.model.points, &r.model.tets).unwrap();
     /// assert_eq!(map.count_cells().0, vec![10, 25, 24, 8]);
     /// ```
-    pub fn subdivide(&mut self, t: u32, diagonal: Option<[[f64; 3]; 2]>) -> [u32; 8] {
-        let c = self.model.tets[t as usize];
+    pub fn subdivide(&mut self, t: u32, diagonal: Option<[[f64; 3]; 2]>) -> Result<[u32; 8], IndexedError> {
+        let tets = self.model.tets.len();
+        let c = *self.model.tets.get(t as usize).ok_or(IndexedError::NoSuchTet { tet: t, tets })?;
         let m: Vec<u32> = PAIRS.iter().map(|&(x, y)| self.midpoint_of(c[x], c[y])).collect();
         let mid = |x: usize, y: usize| m[PAIRS.iter().position(|&p| p == (x.min(y), x.max(y))).expect("x ≠ y")];
         let mut children: Vec<[u32; 4]> = (0..4)
@@ -143,11 +148,11 @@ impl RefinedModel {
             children.push([m[k], m[5 - k], cycle[i], cycle[(i + 1) % 4]]);
         }
         let mut out = [t; 8];
-        self.model.set_tet(t, children[0]);
+        self.model.set_tet(t, children[0])?;
         for (i, &child) in children.iter().enumerate().skip(1) {
-            out[i] = self.model.push_tet(child);
+            out[i] = self.model.push_tet(child)?;
         }
-        out
+        Ok(out)
     }
 
     /// Edges of some tet whose midpoint exists and is used by another tet: T-junctions the
@@ -159,8 +164,8 @@ impl RefinedModel {
     /// use topomech::ambiguity::refine::RefinedModel;
     ///
     /// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 1.0]];
-    /// let mut r = RefinedModel::new(&points, &[[0, 1, 2, 3], [1, 2, 3, 4]]);
-    /// r.subdivide(0, None);
+    /// let mut r = RefinedModel::new(&points, &[[0, 1, 2, 3], [1, 2, 3, 4]]).unwrap();
+    /// r.subdivide(0, None).unwrap();
     /// assert_eq!(r.hanging_edges(), 3); // the edges of the face shared with the unrefined tet
     /// ```
     pub fn hanging_edges(&self) -> usize {
@@ -191,8 +196,8 @@ mod tests {
     #[test]
     fn one_subdivided_tet_is_eight_tets_glued_like_the_g_map() {
         let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-        let mut r = RefinedModel::new(&points, &[[0, 1, 2, 3]]);
-        let kids = r.subdivide(0, None);
+        let mut r = RefinedModel::new(&points, &[[0, 1, 2, 3]]).unwrap();
+        let kids = r.subdivide(0, None).unwrap();
         assert_eq!(r.model.tets.len(), 8);
         assert_eq!(r.model.points, 10);
         assert_eq!(kids[0], 0);
@@ -205,12 +210,12 @@ mod tests {
     #[test]
     fn a_refined_neighbour_leaves_hanging_edges_until_the_other_refines() {
         let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 1.0]];
-        let mut r = RefinedModel::new(&points, &[[0, 1, 2, 3], [1, 2, 3, 4]]);
-        r.subdivide(0, None);
+        let mut r = RefinedModel::new(&points, &[[0, 1, 2, 3], [1, 2, 3, 4]]).unwrap();
+        r.subdivide(0, None).unwrap();
         assert_eq!(r.hanging_edges(), 3, "the three edges of the shared face");
         assert_eq!(r.model.points, 11);
         let other = r.model.tets.iter().position(|t| t.contains(&4)).expect("tet 1 unrefined") as u32;
-        r.subdivide(other, None);
+        r.subdivide(other, None).unwrap();
         assert_eq!(r.hanging_edges(), 0);
         assert_eq!(r.model.points, 5 + 9, "the shared face's midpoints are reused");
         let (map, _) = GMap::<3>::from_tets(r.model.points, &r.model.tets).expect("builds");

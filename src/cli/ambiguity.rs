@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 
 use topomech::ambiguity::campaign::{campaign_k, KStats, Run};
 use topomech::ambiguity::catalogue::{campaign_vectors, catalogue, symptom_name, Bounds, Catalogue};
-use topomech::ambiguity::mixed::{campaign_mixed, MixedRun, MixedStats};
+use topomech::ambiguity::mixed::{campaign_mixed, MixedError, MixedRun, MixedStats};
 use topomech::ambiguity::vector::Vector;
 use topomech::generate::{kuhn_cube, SplitMix64};
 
@@ -136,7 +136,7 @@ pub struct CatalogueJson {
 /// [`CliError::Load`] when the mesh cannot be read or built; [`CliError::Other`] when a cut fails
 /// (a bug) or the vectors cannot be written; [`CliError::Output`] / [`CliError::Json`] on output.
 pub fn run(args: AmbiguityArgs) -> Result<(), CliError> {
-    let (name, positions, tets) = load_mesh(args.mesh.as_deref())?;
+    let (name, positions, tets, node_tags) = load_mesh(args.mesh.as_deref())?;
     let points = positions.len();
     let mut rng = SplitMix64(args.seed);
     let mut per_k = Vec::new();
@@ -147,7 +147,10 @@ pub fn run(args: AmbiguityArgs) -> Result<(), CliError> {
         firsts.extend(runs.into_iter().map(|r| (k, r)));
     }
     let subdivide = match args.subdivide {
-        Some(p) => Some(mixed_campaign(&positions, &tets, &args.cuts, p, args.sequences, args.seed)?),
+        Some(p) => Some(
+            mixed_campaign(&positions, &tets, &args.cuts, p, args.sequences, args.seed)
+                .map_err(|e| mixed_error(&name, &tets, &node_tags, e))?,
+        ),
         None => None,
     };
     let cat = args.catalogue.then(|| catalogue(Bounds::CATALOGUE));
@@ -173,6 +176,19 @@ pub fn run(args: AmbiguityArgs) -> Result<(), CliError> {
     print_report(args.json, &report, |out| write_table(out, &report))
 }
 
+/// A mixed campaign's error as the CLI reports it: a degenerate tet is named in the mesh's own
+/// terms (the mesh name and the file's node tags of its corners, when the file had tags).
+fn mixed_error(name: &str, tets: &[[u32; 4]], node_tags: &[u64], e: MixedError) -> CliError {
+    let tags = match &e {
+        MixedError::Degenerate { tet, .. } => tets
+            .get(*tet)
+            .and_then(|t| t.iter().map(|&v| node_tags.get(v as usize).copied()).collect::<Option<Vec<u64>>>()),
+        _ => None,
+    };
+    let at = tags.map_or(String::new(), |t| format!(" (file node tags {t:?})"));
+    CliError::Other(format!("{name}: the mixed campaign cannot run: {e}{at}").into())
+}
+
 /// The mixed campaign for every k, with its own generator (seeded by `seed`), so adding
 /// `--subdivide` leaves the cut campaign's figures unchanged.
 fn mixed_campaign(
@@ -182,12 +198,12 @@ fn mixed_campaign(
     p: f64,
     sequences: usize,
     seed: u64,
-) -> Result<SubdivideJson, CliError> {
+) -> Result<SubdivideJson, MixedError> {
     let mut rng = SplitMix64(seed);
     let mut per_k = Vec::new();
     let mut first_runs = Vec::new();
     for &k in ks {
-        let (stats, runs) = campaign_mixed(positions, tets, k, p, sequences, &mut rng).map_err(other)?;
+        let (stats, runs) = campaign_mixed(positions, tets, k, p, sequences, &mut rng)?;
         per_k.push(stats);
         first_runs.extend(runs);
     }
@@ -207,8 +223,8 @@ fn count(s: &KStats, symptom: &str) -> usize {
     s.symptoms.iter().filter(|(x, _)| symptom_name(*x) == symptom).map(|x| x.1).sum()
 }
 
-/// A mesh for the campaigns: (name, point positions, tets).
-type NamedMesh = (String, Vec<[f64; 3]>, Vec<[u32; 4]>);
+/// A mesh for the campaigns: (name, point positions, tets, the file's node tags or none).
+type NamedMesh = (String, Vec<[f64; 3]>, Vec<[u32; 4]>, Vec<u64>);
 
 /// The mesh: the file given, `kuhn:K`, or the built-in liver.
 fn load_mesh(path: Option<&Path>) -> Result<NamedMesh, CliError> {
@@ -216,7 +232,7 @@ fn load_mesh(path: Option<&Path>) -> Result<NamedMesh, CliError> {
     match (path, kuhn) {
         (_, Some(Ok(k))) if (1..=16).contains(&k) => {
             let (points, tets) = kuhn_cube(k);
-            Ok((format!("kuhn:{k}"), points, tets))
+            Ok((format!("kuhn:{k}"), points, tets, Vec::new()))
         }
         (_, Some(_)) => Err(CliError::Other("kuhn:K needs K in 1..=16".into())),
         (Some(p), None) => from_loaded(topomech::load::load_tet_map(p)?),
@@ -225,7 +241,8 @@ fn load_mesh(path: Option<&Path>) -> Result<NamedMesh, CliError> {
 }
 
 fn from_loaded(loaded: topomech::load::Loaded) -> Result<NamedMesh, CliError> {
-    Ok((loaded.path.display().to_string(), loaded.mesh.points, loaded.mesh.tets))
+    let mesh = loaded.mesh;
+    Ok((loaded.path.display().to_string(), mesh.points, mesh.tets, mesh.node_tags))
 }
 
 /// A run as a finding (shrinking is `--write-vectors`'s job).

@@ -579,6 +579,17 @@ fn ambiguity_writes_replayable_vectors_and_prints_its_table() {
     let bad = run(&["ambiguity", "kuhn:17"]);
     assert_eq!(bad.status.code(), Some(1));
     assert!(stderr(&bad).contains("kuhn:K needs K in 1..=16"), "{}", stderr(&bad));
+    // A vector directory under a file: the error names it (before: "cannot write the output:
+    // Not a directory").
+    let under_file = files[0].join("sub");
+    let bad = run(&[&args[..7], &[under_file.to_str().unwrap()]].concat());
+    assert_eq!(bad.status.code(), Some(1));
+    assert!(stderr(&bad).contains(&format!("cannot create the vector directory {}", under_file.display())));
+    // A sequence of no cut changes nothing, so it cannot be a pair: refused (before, every
+    // empty sequence counted as a "skeleton_unchanged" pair).
+    let bad = run(&["ambiguity", "kuhn:1", "--cuts", "1,0", "--sequences", "2"]);
+    assert_eq!(bad.status.code(), Some(2), "{}", stderr(&bad));
+    assert!(stderr(&bad).contains("a sequence needs at least 1 cut"), "{}", stderr(&bad));
     let _ = std::fs::remove_dir_all(&dir);
 }
 

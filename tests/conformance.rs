@@ -123,6 +123,10 @@ fn floats_are_compared_to_the_relative_tolerance() {
     // A vector may ask for a looser tolerance.
     beyond.tolerance = 1e-7;
     replay_in(&beyond, root()).unwrap();
+    // Far-off figures are printed short and exact (`to_string` printed 1e308 as 309 digits).
+    beyond.steps[1].expect.total_mass = -1e308;
+    let e = replay_in(&beyond, root()).unwrap_err().to_string();
+    assert!(e.contains("expected -1e308, got ") && e.len() < 300, "{e}");
 }
 
 #[test]
@@ -177,6 +181,18 @@ fn operations_naming_what_the_mesh_lacks_are_rejected() {
     wrong.mesh = MeshSpec::File { path: "data/missing.msh".into(), points: 1, tets: 1 };
     let e = replay_in(&wrong, root()).unwrap_err();
     assert!(matches!(e, ConformanceError::Mesh { .. }) && e.to_string().contains("missing.msh"), "{e}");
+    // A path outside the repository is refused before anything is read (it read any file
+    // before, and echoed its first line in the error).
+    let inside = root().join("data/liver_547_v22.msh").canonicalize().unwrap();
+    let up =
+        format!("../{}/data/liver_547_v22.msh", root().canonicalize().unwrap().file_name().unwrap().to_str().unwrap());
+    for path in [inside.to_str().unwrap(), &up, "", "data/../data/liver_547_v22.msh"] {
+        wrong.mesh = MeshSpec::File { path: path.into(), points: 547, tets: 1852 };
+        let e = replay_in(&wrong, root()).unwrap_err();
+        assert!(e.to_string().contains("must be relative to the repository root"), "{path}: {e}");
+    }
+    wrong.mesh = MeshSpec::File { path: "./data/liver_547_v22.msh".into(), points: 547, tets: 1852 };
+    assert!(!matches!(replay_in(&wrong, root()), Err(ConformanceError::Mesh { .. })), "a plain relative path loads");
     let mut neg = v.clone();
     neg.tolerance = -1.0;
     assert!(matches!(replay_in(&neg, root()), Err(ConformanceError::Invalid { .. })));

@@ -21,8 +21,8 @@ pub struct AmbiguityArgs {
     /// Tetrahedral mesh file (any format `topomech info` reads). Default: the built-in liver_547
     /// (547 points, 1852 tets); `kuhn:K` builds a Kuhn cube with 6K³ tets instead.
     pub mesh: Option<PathBuf>,
-    /// Cuts per sequence; several values separated by commas.
-    #[arg(long, value_delimiter = ',', default_values_t = vec![1usize, 5, 10, 50])]
+    /// Cuts per sequence (each at least 1); several values separated by commas.
+    #[arg(long, value_delimiter = ',', default_values_t = vec![1usize, 5, 10, 50], value_parser = cut_count)]
     pub cuts: Vec<usize>,
     /// Seed of the random cut sequences.
     #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
@@ -111,6 +111,15 @@ pub struct SubdivideJson {
     pub per_k: Vec<MixedStats>,
     /// The first ambiguous run and the first run with a graph pair (ops and comparisons).
     pub first_runs: Vec<MixedRun>,
+}
+
+/// Parses a number of cuts per sequence: at least 1 (a sequence of no cut changes nothing).
+fn cut_count(s: &str) -> Result<usize, String> {
+    match s.parse::<usize>() {
+        Ok(0) => Err("a sequence needs at least 1 cut".into()),
+        Ok(k) => Ok(k),
+        Err(e) => Err(format!("{s:?} is not a count: {e}")),
+    }
 }
 
 /// Parses a probability in 0..=1.
@@ -258,7 +267,8 @@ fn write_vectors(
     cat: Option<&Catalogue>,
     budget: usize,
 ) -> Result<(), CliError> {
-    std::fs::create_dir_all(dir)?;
+    std::fs::create_dir_all(dir)
+        .map_err(|e| other(format!("cannot create the vector directory {}: {e}", dir.display())))?;
     let runs: Vec<Run> = firsts.iter().map(|(_, r)| r.clone()).collect();
     let (indexed, pairs) = campaign_vectors(points, tets, &runs, budget.max(1)).map_err(other)?;
     let mut vectors: Vec<Vector> = indexed.into_iter().map(|i| Vector::Indexed(Box::new(i))).collect();
@@ -268,7 +278,8 @@ fn write_vectors(
     }
     for v in &vectors {
         let file = dir.join(format!("{}.json", v.name()));
-        std::fs::write(&file, serde_json::to_string_pretty(v)? + "\n")?;
+        std::fs::write(&file, serde_json::to_string_pretty(v)? + "\n")
+            .map_err(|e| other(format!("cannot write {}: {e}", file.display())))?;
     }
     Ok(())
 }

@@ -1,7 +1,7 @@
 //! Running a vector's operations on a [`Body`]: generation records what happens, replay compares
 //! it with what the vector says. Both share [`Runner`], so the two cannot drift apart.
 
-use std::path::Path;
+use std::path::{Component, Path};
 
 use crate::cut::ops::{self as shared, Oracle};
 use crate::cut::{self, CutError, Plane};
@@ -298,7 +298,7 @@ fn compare(v: &Vector, step: Option<usize>, want: &Expect, got: &Expect) -> Resu
         ("total_stiffness", want.total_stiffness, got.total_stiffness),
     ] {
         if !close(a, b) {
-            return Err(fail(field, a.to_string(), b.to_string()));
+            return Err(fail(field, format!("{a:?}"), format!("{b:?}")));
         }
     }
     let (a, b) = (&want.component_masses, &got.component_masses);
@@ -316,6 +316,12 @@ fn mesh_of(name: &str, spec: &MeshSpec, root: &Path) -> Result<(Vec<Vec3>, Vec<[
         MeshSpec::KuhnCube { k } if (1..=MAX_KUHN).contains(k) => Ok(kuhn_cube(*k)),
         MeshSpec::KuhnCube { k } => Err(fail(format!("kuhn_cube k = {k} is outside 1..={MAX_KUHN}"))),
         MeshSpec::File { path, points, tets } => {
+            let inside = |c: Component<'_>| matches!(c, Component::Normal(_) | Component::CurDir);
+            if path.is_empty() || !Path::new(path).components().all(inside) {
+                return Err(fail(format!(
+                    "mesh path {path:?} must be relative to the repository root and stay inside it (no root, no '..')"
+                )));
+            }
             let full = root.join(path);
             let loaded = if !full.exists() && Path::new(path) == Path::new("data/liver_547_v22.msh") {
                 load::load_builtin()

@@ -70,7 +70,8 @@ pub enum MeshSpec {
     },
     /// A mesh file, relative to the repository root; the declared sizes are checked.
     File {
-        /// Path relative to the repository root (e.g. `data/liver_547_v22.msh`).
+        /// Path relative to the repository root (e.g. `data/liver_547_v22.msh`); a root or a `..`
+        /// component is refused, so a vector reads nothing outside the repository.
         path: String,
         /// Points the file holds.
         points: usize,

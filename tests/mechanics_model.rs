@@ -3,8 +3,8 @@
 use topomech::embedding::CellRules;
 use topomech::generate::{kuhn_cube, SplitMix64};
 use topomech::mechanics::{
-    check_conservation, forces_by_coverage, Body, ConservationError, FlatModel, Integrator, Material, Projection,
-    SimError, Simulation, StepConfig, Vec3,
+    check_conservation, forces_by_coverage, Body, BodyError, ConservationError, FlatModel, Integrator, Material,
+    Projection, SimError, Simulation, StepConfig, Vec3,
 };
 use topomech::{CellId, DartId};
 
@@ -361,6 +361,58 @@ fn sew3_merges_vertices_by_mass_weighted_state_and_keeps_pins() {
         assert_eq!(m.pinned[kept], before.pinned[kept] || before.pinned[absorbed], "pin of {kept:?}");
     }
     assert!(merged.iter().any(|&(k, _)| m.pinned[k]) && merged.iter().any(|&(k, _)| !m.pinned[k]));
+}
+
+/// A sew may only merge vertices that coincide at rest. Before, `sew3` of two boundary faces on
+/// opposite sides of a cube succeeded and left the rest lengths of the merged edges wrong (law 3
+/// broken, found by `check_conservation` only afterwards), and a face could be sewn onto itself
+/// by a reflection. Now both are refused before the map changes, naming the two vertices, and
+/// the body is untouched; sewing a dissociated face back still works.
+#[test]
+fn a_sew_that_merges_vertices_apart_at_rest_is_refused_and_changes_nothing() {
+    let (points, tets) = kuhn_cube(2);
+    let (mut body, _) = Body::from_tets(&points, &tets, material()).unwrap();
+    let map = body.map();
+    let free: Vec<DartId> = map.darts().filter(|&d| map.is_free(3, d)).collect();
+    let rest = |d: DartId| body.attrs().rest_position[body.map().vertex_id(d)];
+    let a = free[0];
+    // Faces on the opposite side: no vertex of theirs is at a's rest position.
+    let far: Vec<DartId> =
+        free.iter().copied().filter(|&b| (0..3).all(|k| (rest(a)[k] - rest(b)[k]).abs() > 1.5)).collect();
+    let mut tried = 0;
+    for b in far {
+        if !body.map().is_sewable_dyn(3, a, b) {
+            continue;
+        }
+        tried += 1;
+        let (version, darts, attrs) = (body.version(), body.map().dart_count(), format!("{:?}", body.attrs()));
+        match body.sew3(a, b) {
+            Err(e @ BodyError::Refused { source: ConservationError::SewApart { distance, .. }, .. }) => {
+                assert!(distance > 1.5, "{e}");
+                assert!(e.to_string().contains("only faces that coincide at rest can be sewn"), "{e}");
+            }
+            other => panic!("sew3({a:?}, {b:?}): expected SewApart, got {other:?}"),
+        }
+        assert_eq!((body.version(), body.map().dart_count()), (version, darts));
+        assert!(body.map().is_free(3, a) && body.map().is_free(3, b));
+        assert_eq!(format!("{:?}", body.attrs()), attrs, "the attributes are untouched");
+        body.map().validate().unwrap();
+        check_conservation(body.map(), body.attrs()).unwrap();
+    }
+    assert!(tried > 0, "some far face is sewable to a's topologically");
+    // Folded onto itself by a reflection (a with α1(a)): two corners of the triangle would merge.
+    let fold = body.map().alpha::<1>(a);
+    assert!(body.map().is_sewable_dyn(3, a, fold));
+    assert!(matches!(body.sew3(a, fold), Err(BodyError::Refused { source: ConservationError::SewApart { .. }, .. })));
+    // A dissociated face sews back, after its two sides have moved apart (current positions).
+    let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+    let e = body.map().alpha::<3>(d);
+    let splits: Vec<CellId> = body.unsew3(d).unwrap().splits(0).map(|(_, new, _, _)| new).collect();
+    for v in splits {
+        body.attrs_mut().position[v][2] += 0.5;
+    }
+    body.sew3(d, e).unwrap();
+    check_conservation(body.map(), body.attrs()).unwrap();
 }
 
 /// A model whose volume or totals overflow f64 is refused at build, naming the tet and the

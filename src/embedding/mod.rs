@@ -235,6 +235,17 @@ pub trait CellRules<const N: usize> {
         let _ = (map, changes);
     }
 
+    /// Whether the rules can keep their laws through an i-sew that would link `pairs` (each
+    /// (x, y) becomes αi-linked and their cells merge), asked before the map changes. The
+    /// default accepts every sew. O(pairs) typically.
+    ///
+    /// # Errors
+    /// `Self::Error` naming what the merge could not keep; the sew is then refused.
+    fn check_sew(&self, map: &GMap<N>, i: usize, pairs: &[(DartId, DartId)]) -> Result<(), Self::Error> {
+        let _ = (map, i, pairs);
+        Ok(())
+    }
+
     /// Checks the attributes against the map (laws such as conservation). O(model) typically.
     ///
     /// # Errors
@@ -313,6 +324,17 @@ pub enum EmbedError<E: std::error::Error + 'static> {
     /// The topological operation was refused; map and attributes are unchanged.
     #[error(transparent)]
     Sew(#[from] SewError),
+    /// The rules cannot keep their laws through the operation ([`CellRules::check_sew`]); map
+    /// and attributes are unchanged.
+    #[error("{op} of {dart} refused: {source}")]
+    Refused {
+        /// "sew".
+        op: &'static str,
+        /// The dart the operation was called with.
+        dart: DartId,
+        /// What the rules could not keep.
+        source: E,
+    },
     /// The rules left the attributes inconsistent (only with `expensive-checks`).
     #[error("attributes broken after {op} of {dart}: {source}")]
     Check {
@@ -452,7 +474,8 @@ impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
     /// Cost: the kernel's sew plus the rules (for the mechanical model, O(size of merged cells)).
     ///
     /// # Errors
-    /// [`EmbedError::Sew`] when the kernel refuses (nothing changed); [`EmbedError::Check`] under
+    /// [`EmbedError::Sew`] when the kernel refuses, [`EmbedError::Refused`] when the rules do
+    /// ([`CellRules::check_sew`]; nothing changed either way); [`EmbedError::Check`] under
     /// `expensive-checks` when the attributes fail their check afterwards.
     ///
     /// # Examples
@@ -471,7 +494,13 @@ impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
     /// assert!(changes.merges(0).count() > 0 && body.check().is_ok());
     /// ```
     pub fn sew(&mut self, i: usize, d1: DartId, d2: DartId) -> Result<CellChanges, EmbedError<E::Error>> {
-        let changes = self.map.sew_dyn(i, d1, d2)?;
+        let pairs = self.map.sew_pairs(i, d1, d2)?;
+        self.attrs.check_sew(&self.map, i, &pairs).map_err(|source| EmbedError::Refused {
+            op: "sew",
+            dart: d1,
+            source,
+        })?;
+        let changes = self.map.link_sew_pairs(i, d1, pairs);
         self.apply(&changes);
         self.after("sew", d1)?;
         Ok(changes)

@@ -437,7 +437,7 @@ impl<const N: usize> GMap<N> {
     }
 
     /// The pairs an i-sew of d1 and d2 would link, or why it may not. O(|O1| · n).
-    fn sew_pairs(&self, i: usize, d1: DartId, d2: DartId) -> Result<Vec<(DartId, DartId)>, SewError> {
+    pub(crate) fn sew_pairs(&self, i: usize, d1: DartId, d2: DartId) -> Result<Vec<(DartId, DartId)>, SewError> {
         Self::check_index(i)?;
         self.check_dart(d1)?;
         self.check_dart(d2)?;
@@ -570,6 +570,12 @@ impl<const N: usize> GMap<N> {
     /// ```
     pub fn sew_dyn(&mut self, i: usize, d1: DartId, d2: DartId) -> Result<CellChanges, SewError> {
         let pairs = self.sew_pairs(i, d1, d2)?;
+        Ok(self.link_sew_pairs(i, d1, pairs))
+    }
+
+    /// Links `pairs`, the result of [`Self::sew_pairs`] for (i, d1, ·) on the map as it is, and
+    /// merges the cells that meet. O(|pairs| · n + merged cells).
+    pub(crate) fn link_sew_pairs(&mut self, i: usize, d1: DartId, pairs: Vec<(DartId, DartId)>) -> CellChanges {
         for &(x, y) in &pairs {
             self.link_raw(i, x, y);
         }
@@ -582,7 +588,7 @@ impl<const N: usize> GMap<N> {
             }
         }
         self.after_mutation(&touched(&report.pairs));
-        Ok(report)
+        report
     }
 
     /// After a link, makes the dim-cells of x and y carry one id: x's, unless y's is `keep` (the

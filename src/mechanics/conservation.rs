@@ -121,6 +121,22 @@ pub enum ConservationError {
         /// Σ_t m_t.
         tets: f64,
     },
+    /// A sew would merge two vertices that are apart at rest: the merged vertex has one rest
+    /// position, so the rest lengths (law 3) of the edges of one side would be wrong. Raised
+    /// before the sew ([`crate::embedding::CellRules::check_sew`]), which is then refused.
+    #[error("sewing {dart} to {other} would merge vertex {vertex} with vertex {other_vertex}, {distance} apart at rest (only faces that coincide at rest can be sewn)")]
+    SewApart {
+        /// A dart of the sew.
+        dart: DartId,
+        /// The dart it would be linked with.
+        other: DartId,
+        /// The vertex of `dart`.
+        vertex: CellId,
+        /// The vertex of `other`.
+        other_vertex: CellId,
+        /// The distance between their rest positions.
+        distance: f64,
+    },
 }
 
 /// What the volume-centred scatter recomputes.

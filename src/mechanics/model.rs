@@ -790,6 +790,24 @@ impl CellRules<3> for Mechanics {
         }
     }
 
+    /// An i-sew (i ≥ 1) merges the vertices of each linked pair; they must have the same rest
+    /// position, exactly (as the two sides of a dissociated face do: a split copies it), or the
+    /// rest lengths of one side's edges would no longer be the distances of their ends.
+    fn check_sew(&self, map: &GMap<3>, i: usize, pairs: &[(DartId, DartId)]) -> Result<(), ConservationError> {
+        if i == 0 {
+            return Ok(()); // an α0 link joins the two ends of an edge: no vertex merges
+        }
+        for &(x, y) in pairs {
+            let (vx, vy) = (map.vertex_id(x), map.vertex_id(y));
+            let (p, q) = (self.rest_position[vx], self.rest_position[vy]);
+            if vx != vy && p != q {
+                let distance = norm(sub(p, q));
+                return Err(ConservationError::SewApart { dart: x, other: y, vertex: vx, other_vertex: vy, distance });
+            }
+        }
+        Ok(())
+    }
+
     fn on_merge(&mut self, _map: &GMap<3>, dim: usize, kept: CellId, absorbed: CellId) {
         match dim {
             // Masses and stiffnesses of merged cells are recomputed in `after_operation`, which

@@ -38,7 +38,9 @@ use crate::mechanics::geom::{cross, dot, sub};
 /// ```
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TetMasses {
-    /// `mass[t]`: the mass of volume t (0 for ids no volume uses).
+    /// `mass[t]`: the mass of volume t (0 for ids no volume uses). An id past the end has mass
+    /// 0 too, in every function of this module (e.g. a volume created by an operation without
+    /// masses, or masses made for a smaller map).
     pub mass: Vec<f64>,
 }
 
@@ -116,10 +118,16 @@ impl TetMasses {
     /// let mut masses = TetMasses::from_density(&m, 12.0).unwrap();
     /// m.subdivide_tet_with_mass(d, 1, &mut masses).unwrap();
     /// assert!((masses.total(&m) - 2.0).abs() < 1e-12);
+    /// assert_eq!(TetMasses::default().total(&m), 0.0); // ids past the end weigh nothing
     /// ```
     pub fn total(&self, m: &LeveledMap<3>) -> f64 {
         let map = m.map();
-        map.one_dart_per_cell(3).into_iter().map(|d| self.mass[map.cell_id(3, d).index()]).sum()
+        map.one_dart_per_cell(3).into_iter().map(|d| self.of(map.cell_id(3, d))).sum()
+    }
+
+    /// The mass of volume `t`, 0 past the end of `mass`. O(1).
+    fn of(&self, t: CellId) -> f64 {
+        self.mass.get(t.index()).copied().unwrap_or(0.0)
     }
 
     /// Vertex masses m_v = Σ_{t ∋ v} m_t / 4, indexed by vertex id. O(darts).
@@ -136,12 +144,13 @@ impl TetMasses {
     /// let masses = TetMasses::from_density(&m, 6.0).unwrap();
     /// let v = masses.vertex_masses(&m).unwrap();
     /// assert!(v.iter().all(|&x| (x - 0.25).abs() < 1e-12));
+    /// assert!(TetMasses::default().vertex_masses(&m).unwrap().iter().all(|&x| x == 0.0));
     /// ```
     pub fn vertex_masses(&self, m: &LeveledMap<3>) -> Result<Vec<f64>, SubdivideError> {
         let map = m.map();
         let mut out = vec![0.0; map.cell_id_bound(0)];
         for d in map.one_dart_per_cell(3) {
-            let share = self.mass[map.cell_id(3, d).index()] / 4.0;
+            let share = self.of(map.cell_id(3, d)) / 4.0;
             for v in m.tet_vertices(d)? {
                 out[v as usize] += share;
             }
@@ -203,7 +212,8 @@ impl LeveledMap<3> {
     /// tet outside a refined zone may carry inserted vertices of its neighbours on its sides in
     /// the finest map; they are not corners). O(volume).
     ///
-    /// Errors: [`SubdivideError::NotATetrahedron`] when the volume at its level is not a tet,
+    /// Errors: [`SubdivideError::NoSuchDart`] when `d` is not live,
+    /// [`SubdivideError::NotATetrahedron`] when the volume at its level is not a tet,
     /// [`SubdivideError::OpenEdge`] when it is not closed.
     ///
     /// # Examples
@@ -216,10 +226,14 @@ impl LeveledMap<3> {
     /// let mut m = LeveledMap::new(map, pts);
     /// let d = m.map().darts().next().unwrap();
     /// assert_eq!(m.tet_vertices(d).unwrap(), [0, 1, 2, 3]);
+    /// assert!(m.tet_vertices(topomech::DartId(99)).is_err()); // no such dart
     /// let children = m.subdivide_tet(d, 1).unwrap();
     /// assert!(children.iter().all(|&c| m.tet_vertices(c).unwrap().iter().all(|&v| v < 10)));
     /// ```
     pub fn tet_vertices(&self, d: DartId) -> Result<[u32; 4], SubdivideError> {
+        if !self.map.contains(d) {
+            return Err(SubdivideError::NoSuchDart(d));
+        }
         let mut corners = self.tet_corners(d, self.mu[d.index()].tet)?;
         corners.sort_unstable();
         Ok(corners)
@@ -261,6 +275,9 @@ impl LeveledMap<3> {
 
     /// Whether the tet of `d` meets the closed ball B(center, radius). O(volume).
     ///
+    /// Errors: [`SubdivideError::BadBall`] unless the centre is finite and the radius finite and
+    /// ≥ 0; those of [`Self::tet_vertices`]; [`SubdivideError::NoPosition`].
+    ///
     /// # Examples
     ///
     /// ```
@@ -272,8 +289,10 @@ impl LeveledMap<3> {
     /// let d = m.map().darts().next().unwrap();
     /// assert!(m.tet_in_ball(d, [2.0, 0.0, 0.0], 1.5).unwrap());
     /// assert!(!m.tet_in_ball(d, [2.0, 0.0, 0.0], 0.5).unwrap());
+    /// assert!(m.tet_in_ball(d, [2.0, 0.0, 0.0], f64::NAN).is_err()); // BadBall, not "no"
     /// ```
     pub fn tet_in_ball(&self, d: DartId, center: [f64; 3], radius: f64) -> Result<bool, SubdivideError> {
+        Self::check_ball(center, radius)?;
         let p = self.corner_positions(self.tet_vertices(d)?)?;
         Ok(tet_distance(center, p) <= radius)
     }

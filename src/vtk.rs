@@ -35,6 +35,14 @@ pub enum VtkError {
         /// The cause.
         source: std::io::Error,
     },
+    /// The series directory could not be created.
+    #[error("cannot create the directory {path}: {source}")]
+    CreateDir {
+        /// The directory.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
     /// A point array does not have one entry per point.
     #[error("point array {name} has {got} entries for {expected} points")]
     BadArray {
@@ -248,7 +256,7 @@ impl Series {
     ///
     /// # Errors
     /// [`VtkError::BadStem`] for an empty stem or one with a path separator or a control
-    /// character; [`VtkError::Io`] if DIR cannot be created.
+    /// character; [`VtkError::CreateDir`] if DIR cannot be created.
     ///
     /// # Examples
     ///
@@ -259,7 +267,7 @@ impl Series {
     /// std::fs::write(&file, "not a directory").unwrap();
     /// let err = Series::new(&file.join("frames"), "run"); // a directory under a file: refused
     /// std::fs::remove_file(&file).unwrap();
-    /// assert!(matches!(err, Err(VtkError::Io { .. })));
+    /// assert!(matches!(err, Err(VtkError::CreateDir { .. })));
     /// let series = Series::new(&std::env::temp_dir(), "run").unwrap();
     /// assert!(series.pvd_path().ends_with("run.pvd"));
     /// for stem in ["", "../run", "a\\b", "run\n"] {
@@ -270,7 +278,7 @@ impl Series {
         if stem.is_empty() || stem.contains(['/', '\\']) || stem.chars().any(char::is_control) {
             return Err(VtkError::BadStem { stem: stem.to_string() });
         }
-        std::fs::create_dir_all(dir).map_err(|source| VtkError::Io { path: dir.to_path_buf(), source })?;
+        std::fs::create_dir_all(dir).map_err(|source| VtkError::CreateDir { path: dir.to_path_buf(), source })?;
         Ok(Series { dir: dir.to_path_buf(), stem: stem.to_string(), frames: Vec::new() })
     }
 

@@ -361,6 +361,7 @@ fn non_finite_and_out_of_range_numbers_are_refused_with_a_message() {
     for (args, needle) in [
         (vec!["simulate", liver, "--steps", "1", "--gravity", "nan,0,0"], "not finite"),
         (vec!["simulate", liver, "--steps", "1", "--pin-below", "z=nan"], "not finite"),
+        (vec!["tear", liver, "--threshold", "1", "--steps", "1", "--pin-z", "nan"], "not finite"),
         (vec!["remove", liver, "--sphere", "nan,0,0,1"], "not finite"),
         (vec!["cut", liver, "--plane", "0,0,0,inf,0,0"], "not finite"),
         (vec!["simulate", liver, "--steps", "-3"], "invalid value '-3' for '--steps"),
@@ -444,6 +445,8 @@ fn simulate_writes_a_series_and_a_summary_that_follow_from_the_scene() {
     // Every vertex pinned: nothing moves.
     let (_, fixed) = simulate_json(&["--pin-below", "z=1e9"]);
     assert_eq!((fixed["kinetic_energy"].as_f64(), fixed["max_displacement"].as_f64()), (Some(0.0), Some(0.0)));
+    // … and says so without a sign (an empty f64 `sum` is −0: it printed "kinetic_energy":-0.0).
+    assert_eq!(fixed["kinetic_energy"].to_string(), "0.0");
     let _ = std::fs::remove_dir_all(&dir);
 }
 

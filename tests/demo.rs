@@ -184,6 +184,19 @@ fn the_text_report_ends_with_a_table_of_every_stage() {
     assert!(!dir.join("out").exists(), "and the default is not");
 }
 
+/// An output directory where a file stands: refused before any stage, with a message that says
+/// a directory could not be created (it said "cannot write out: File exists").
+#[test]
+fn an_output_path_that_is_a_file_is_named_as_a_directory_that_cannot_be_created() {
+    let dir = fresh_dir("out-is-a-file");
+    std::fs::write(dir.join("taken"), "a file").unwrap();
+    let out = run_in(&dir, &["demo", "--json", "--steps", "4", "--out", "taken"]);
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("cannot create the directory taken"), "{err}");
+    assert!(text(&out.stdout).is_empty(), "no summary: {}", text(&out.stdout));
+}
+
 fn expect_mesh_error(dir: &Path, mesh: &Path) -> String {
     let out = run_in(dir, &["demo", "--steps", "5", "--mesh", mesh.to_str().unwrap(), "--out", "out"]);
     let err = text(&out.stderr);

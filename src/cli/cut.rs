@@ -80,7 +80,7 @@ pub struct TearArgs {
     #[arg(long, default_value_t = 1e-4, allow_negative_numbers = true)]
     pub dt: f64,
     /// Fix the vertices whose rest z is at most this value (default: the lowest 10% of the body).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_finite)]
     pub pin_z: Option<f64>,
     /// Gravity along z (negative pulls down); large values stretch the body.
     #[arg(long, default_value_t = -200.0, allow_hyphen_values = true)]

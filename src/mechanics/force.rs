@@ -626,7 +626,7 @@ impl SpringSystem {
             .zip(v)
             .filter(|((_, &w), _)| w > 0.0)
             .map(|((&m, _), v)| 0.5 * m * dot(*v, *v))
-            .sum()
+            .fold(0.0, |sum, e| sum + e) // +0 when every vertex is pinned (`sum` starts at −0)
     }
 
     /// Elastic energy ½ Σ k (l − L)². O(springs).

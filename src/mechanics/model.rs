@@ -1101,7 +1101,7 @@ impl Embedded<3, Mechanics> {
                 let v = self.map().vertex_id(d);
                 0.5 * m.vertex_mass[v] * dot(m.velocity[v], m.velocity[v])
             })
-            .sum()
+            .fold(0.0, |sum, e| sum + e) // +0 for a body without vertices (`sum` starts at −0)
     }
 }
 

@@ -218,6 +218,28 @@ fn a_missing_file_is_named() {
     assert!(err.contains("cannot read"), "{err}");
 }
 
+/// A device that never ends is refused before anything is read, by every command that reads a
+/// file (before, `info /dev/zero` read until the memory ran out; under a 4 GB limit it failed
+/// with "out of memory", without one it took the machine's memory). Pipes are still read.
+#[cfg(unix)]
+#[test]
+fn a_device_is_refused_before_it_is_read() {
+    for args in [vec!["info", "/dev/zero"], vec!["check", "/dev/zero"], vec!["conformance", "check", "/dev/zero"]] {
+        let out = run(&args);
+        let err = stderr(&out) + &stdout(&out); // conformance check reports on stdout
+        assert!(matches!(out.status.code(), Some(1 | 2)), "{args:?}: {err}");
+        assert!(err.contains("/dev/zero: ") && err.contains("a device or socket, not a file"), "{args:?}: {err}");
+        assert_eq!(err.matches("/dev/zero").count(), 1, "the file is named once: {err}");
+    }
+    let piped = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!("\"{BIN}\" info --json /dev/stdin < \"{BUILTIN}\""))
+        .output()
+        .unwrap();
+    assert!(piped.status.success(), "{}", stderr(&piped));
+    assert!(stdout(&piped).contains("\"volumes\":1852"), "{}", stdout(&piped));
+}
+
 #[test]
 fn a_garbage_file_is_an_unknown_format() {
     let path = scratch("garbage.msh", b"hello, this is not a mesh\n\x00\xff\xfe");

@@ -37,7 +37,7 @@ pub fn run(args: CheckArgs) -> Result<(), CliError> {
     let doc = match store::read_document(&args.file) {
         Ok(doc) => doc,
         Err(e) => {
-            let _ = writeln!(std::io::stderr(), "topomech: error: {}: {e}", args.file.display());
+            let _ = writeln!(std::io::stderr(), "topomech: error: {}", super::named(&args.file, e.to_string()));
             std::process::exit(2);
         }
     };

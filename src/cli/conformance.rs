@@ -99,7 +99,7 @@ fn check(path: &Path, root: &Path) -> Result<(), CliError> {
             Err(e) => {
                 worst = worst.max(status(&e));
                 failed += 1;
-                writeln!(out, "FAIL  {}: {e}", file.display())?;
+                writeln!(out, "FAIL  {}", super::named(file, e.to_string()))?;
             }
         }
     }

@@ -270,8 +270,10 @@ impl Vector {
     /// assert!(Vector::read(&path).is_err()); // gone: an I/O error naming the path
     /// ```
     pub fn read(path: &Path) -> Result<Vector, ConformanceError> {
-        let text =
-            std::fs::read_to_string(path).map_err(|source| ConformanceError::Io { path: path.into(), source })?;
+        let io = |source| ConformanceError::Io { path: path.into(), source };
+        let bytes = crate::io::read_whole(path).map_err(io)?;
+        let text = String::from_utf8(bytes)
+            .map_err(|e| io(std::io::Error::new(std::io::ErrorKind::InvalidData, e.utf8_error())))?;
         Vector::from_json(&text, &path.display().to_string())
     }
 

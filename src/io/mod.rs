@@ -298,7 +298,26 @@ pub(crate) fn shorten(s: &str) -> String {
 }
 
 fn read_file(path: &Path) -> Result<Vec<u8>, ReadError> {
-    std::fs::read(path).map_err(|source| ReadError::Io { path: path.to_path_buf(), source })
+    read_whole(path).map_err(|source| ReadError::Io { path: path.to_path_buf(), source })
+}
+
+/// The bytes of the file at `path`: a regular file or a pipe (`<(zcat mesh.msh.gz)`). A
+/// character or block device or a socket is refused with [`std::io::ErrorKind::InvalidInput`]
+/// before anything is read: `/dev/zero` or `/dev/urandom` never end, and reading one would fill
+/// the memory before failing. O(file).
+pub(crate) fn read_whole(path: &Path) -> std::io::Result<Vec<u8>> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        let kind = std::fs::metadata(path)?.file_type();
+        if kind.is_char_device() || kind.is_block_device() || kind.is_socket() {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                "a device or socket, not a file (reading it might never end)",
+            ));
+        }
+    }
+    std::fs::read(path)
 }
 
 fn extension(path: &Path) -> String {

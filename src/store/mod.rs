@@ -574,7 +574,7 @@ pub fn decode(bytes: &[u8]) -> Result<Document, StoreError> {
 /// assert!(matches!(store::read_document(&path), Err(store::StoreError::Io { .. })));
 /// ```
 pub fn read_document(path: &Path) -> Result<Document, StoreError> {
-    let bytes = std::fs::read(path).map_err(|source| StoreError::Io { path: path.to_path_buf(), source })?;
+    let bytes = crate::io::read_whole(path).map_err(|source| StoreError::Io { path: path.to_path_buf(), source })?;
     decode(&bytes)
 }
 

@@ -313,6 +313,19 @@ fn the_refine_command_reports_the_conforming_closure_and_the_cut_error() {
     assert!(num("cut_faces_after") > num("cut_faces_before"));
     assert!(num("cut_error_max_after") < num("cut_error_max_before"));
     assert!(num("cut_error_mean_after") < num("cut_error_mean_before"));
+    // A single tet whose centroid-side rule cuts no face unrefined: no error to measure before,
+    // so those keys are absent and the text says "none" (before, 0/0 printed NaN and JSON null).
+    let tet = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/single_tet.msh");
+    let args = ["refine", tet, "--around", "0,0,0", "--radius", "10", "--levels", "2", "--cut", "0.1,0.1,0.1,1,0,0"];
+    let out = Command::new(BIN).args(args).arg("--json").output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["cut_zone_faces_before"], 0, "{v}");
+    assert!(v.get("cut_error_max_before").is_none() && v.get("cut_error_mean_before").is_none(), "{v}");
+    assert!(v["cut_error_max_after"].as_f64().is_some_and(|x| x > 0.0), "{v}");
+    let text = String::from_utf8_lossy(&Command::new(BIN).args(args).output().unwrap().stdout).into_owned();
+    let line = text.lines().find(|l| l.contains("cut error in the zone")).expect("the cut error line");
+    assert!(line.contains("max none -> 0.") && !line.contains("NaN"), "{line}");
     // Without the options the new keys are absent and the documented ones unchanged.
     let out = Command::new(BIN)
         .args(["refine", &liver_path(), "--around", "-2.2,3.2,0.6", "--radius", "0.5", "--conforming", "--json"])

@@ -249,8 +249,6 @@ pub(crate) fn check_ids(flag: &str, (one, many): (&str, &str), ids: &[u32], n: u
     }
 }
 
-/// One number of a command-line value: NaN and ±∞ are refused with the value named (they
-/// would run silently or blow up far from the argument that caused it).
 /// `message` prefixed with `path`, unless it starts with it already (I/O errors name their file):
 /// one mention of the file per line. O(message).
 pub(crate) fn named(path: &Path, message: String) -> String {
@@ -262,6 +260,8 @@ pub(crate) fn named(path: &Path, message: String) -> String {
     }
 }
 
+/// One number of a command-line value: NaN and ±∞ are refused with the value named (they
+/// would run silently or blow up far from the argument that caused it).
 pub(crate) fn parse_finite(t: &str) -> Result<f64, String> {
     match t.trim().parse::<f64>() {
         Ok(v) if v.is_finite() => Ok(v),

@@ -104,7 +104,8 @@ pub struct RefineJson {
     /// Cut faces with their centroid in the zone, refined body (`--cut`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cut_zone_faces_after: Option<usize>,
-    /// Largest distance to the plane of a vertex of a cut face in the zone, unrefined (`--cut`).
+    /// Largest distance to the plane of a vertex of a cut face in the zone, unrefined (`--cut`;
+    /// absent when no face in the zone was cut, as are the other three error figures).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cut_error_max_before: Option<f64>,
     /// The same on the refined body (`--cut`).
@@ -298,10 +299,12 @@ fn fill_cut(r: &mut RefineJson, before: &CutSurfaceError, after: &CutSurfaceErro
     r.cut_faces_after = Some(after.faces);
     r.cut_zone_faces_before = Some(before.measured);
     r.cut_zone_faces_after = Some(after.measured);
-    r.cut_error_max_before = Some(before.max);
-    r.cut_error_max_after = Some(after.max);
-    r.cut_error_mean_before = Some(before.mean);
-    r.cut_error_mean_after = Some(after.mean);
+    // No cut face in the zone: no error to measure (the figures would be 0/0).
+    let measured = |s: &CutSurfaceError, x: f64| (s.measured > 0).then_some(x);
+    r.cut_error_max_before = measured(before, before.max);
+    r.cut_error_max_after = measured(after, after.max);
+    r.cut_error_mean_before = measured(before, before.mean);
+    r.cut_error_mean_after = measured(after, after.mean);
 }
 
 fn report(
@@ -366,10 +369,10 @@ fn write_table(out: &mut dyn Write, r: &RefineJson) -> std::io::Result<()> {
     if let (Some(fb), Some(fa)) = (r.cut_faces_before, r.cut_faces_after) {
         let (zb, za) = (r.cut_zone_faces_before.unwrap_or(0), r.cut_zone_faces_after.unwrap_or(0));
         writeln!(out, "  {:<26}{fb} -> {fa} (in the zone {zb} -> {za})", "cut faces")?;
-        let f = |x: Option<f64>| x.unwrap_or(f64::NAN);
+        let f = |x: Option<f64>| x.map_or("none".to_string(), |v| format!("{v:.6}"));
         writeln!(
             out,
-            "  {:<26}max {:.6} -> {:.6}, mean {:.6} -> {:.6}",
+            "  {:<26}max {} -> {}, mean {} -> {}",
             "cut error in the zone",
             f(r.cut_error_max_before),
             f(r.cut_error_max_after),

@@ -297,6 +297,38 @@ fn a_stale_projection_refuses_to_step() {
     sim.step(&mut body).unwrap();
 }
 
+/// A simulation runs only the body it was built for. Before, stepping a larger body with the
+/// simulation of a smaller one returned Ok and moved the first vertices by the other body's
+/// springs, the reverse panicked on a slice bound, and `update` took the touched cells of
+/// another body; a clone (same version) was taken for the original.
+#[test]
+fn a_simulation_refuses_a_body_it_was_not_built_for() {
+    let body = |k: usize| Body::from_tets(&kuhn_cube(k).0, &kuhn_cube(k).1, material()).unwrap().0;
+    let config = StepConfig::new(Integrator::Rk4, 1e-4);
+    let (mut small, mut big) = (body(1), body(2));
+    let mut copy = small.clone();
+    let mut sim = Simulation::new(&mut small, G, config).unwrap();
+    for other in [&mut big, &mut copy] {
+        let before = other.attrs().position.as_slice().to_vec();
+        match sim.step(other) {
+            Err(e @ SimError::OtherBody { built_for, given }) => {
+                assert_eq!((built_for, given), (small.identity(), other.identity()));
+                assert!(e.to_string().contains("rebuild it for this body"), "{e}");
+            }
+            r => panic!("expected OtherBody, got {r:?}"),
+        }
+        assert_eq!(other.attrs().position.as_slice(), &before[..], "nothing moved");
+    }
+    let mut sim_big = Simulation::new(&mut big, G, config).unwrap();
+    assert!(matches!(sim_big.step(&mut small), Err(SimError::OtherBody { .. })), "the reverse panicked");
+    let d = copy.map().darts().find(|&d| !copy.map().is_free(3, d)).unwrap();
+    let touched = topomech::cut::dissociate_face(&mut copy, d).unwrap().touched;
+    assert!(matches!(sim.update(&mut copy, &touched), Err(SimError::OtherBody { .. })));
+    sim.step(&mut small).unwrap(); // its own body still runs
+    sim_big.rebuild(&mut small).unwrap(); // and a rebuild adopts a body
+    sim_big.step(&mut small).unwrap();
+}
+
 #[test]
 fn unsew3_of_a_boundary_dart_is_refused_and_changes_nothing() {
     let (points, tets) = kuhn_cube(1);

@@ -95,7 +95,8 @@ pub struct TearStep {
 }
 
 /// σ_v's principal pair for every vertex slot of `sim`'s projection, from `body`'s current
-/// positions. O(springs + slots).
+/// positions. O(springs + slots). Empty when `sim` was not built for `body`
+/// ([`crate::mechanics::Projection::is_for`]): its slots and springs are another body's.
 ///
 /// # Examples
 ///
@@ -111,8 +112,12 @@ pub struct TearStep {
 /// body.attrs_mut().position.as_mut_slice()[7][2] += 0.5; // pull the top corner up
 /// let stress = principal_stress(&body, &sim);
 /// assert!(stress[7].magnitude > 0.0 && stress[7].direction[2].abs() > 0.5);
+/// assert!(principal_stress(&body.clone(), &sim).is_empty()); // another body
 /// ```
 pub fn principal_stress(body: &Body, sim: &Simulation) -> Vec<Stress> {
+    if !sim.projection.is_for(body) {
+        return Vec::new();
+    }
     let sys = &sim.projection.system;
     let x = body.attrs().position.as_slice();
     let mut sigma = vec![[[0.0f64; 3]; 3]; sys.slots()];
@@ -163,7 +168,7 @@ fn largest_eigenpair(m: &[[f64; 3]; 3]) -> Stress {
 
 /// One dart per face of the fan around the vertex of `d0`, starting with `d0`'s face, in walk
 /// order (module docs). Faces met twice are listed once. Every walk is bounded by the dart count.
-/// O(fan).
+/// O(fan). Empty when `d0` is not a live dart.
 ///
 /// # Examples
 ///
@@ -178,8 +183,12 @@ fn largest_eigenpair(m: &[[f64; 3]; 3]) -> Stress {
 /// let fan = fan_darts(&map, d);
 /// assert_eq!(fan[0], d);
 /// assert!(fan.len() > 2 && fan.iter().all(|&e| map.vertex_id(e).0 == 13));
+/// assert!(fan_darts(&map, topomech::DartId(u32::MAX)).is_empty()); // no such dart: no fan
 /// ```
 pub fn fan_darts(map: &GMap<3>, d0: DartId) -> Vec<DartId> {
+    if !map.contains(d0) {
+        return Vec::new();
+    }
     let mut faces: Vec<CellId> = Vec::with_capacity(16);
     let mut out = Vec::with_capacity(16);
     let mut push = |d: DartId, out: &mut Vec<DartId>| {
@@ -345,15 +354,17 @@ pub fn tear_vertex(body: &mut Body, v: CellId, direction: Vec3, hint: Option<Dar
 /// Cost: O(springs + slots) for the stresses, plus the tears and the update.
 ///
 /// # Errors
-/// [`CutError::BadThreshold`] for a NaN, infinite or negative threshold (nothing done);
-/// [`CutError::Body`] or [`CutError::Sim`] (bugs or a bad time step).
+/// [`CutError::BadThreshold`] for a NaN, infinite or negative threshold, and
+/// [`CutError::Sim`] with [`crate::mechanics::SimError::OtherBody`] when `sim` was built for
+/// another body (nothing done either way); [`CutError::Body`] or [`CutError::Sim`] (bugs or a
+/// bad time step).
 ///
 /// # Examples
 ///
 /// ```
 /// use topomech::cut::{tear_step, CutError};
 /// use topomech::generate::kuhn_cube;
-/// use topomech::mechanics::{Body, Integrator, Material, Simulation, StepConfig};
+/// use topomech::mechanics::{Body, Integrator, Material, SimError, Simulation, StepConfig};
 ///
 /// let (points, tets) = kuhn_cube(2);
 /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
@@ -364,6 +375,8 @@ pub fn tear_vertex(body: &mut Body, v: CellId, direction: Vec3, hint: Option<Dar
 /// assert_eq!(step.tears.len(), 1);
 /// sim.step(&mut body).unwrap(); // the simulation followed the change
 /// assert!(matches!(tear_step(&mut body, &mut sim, f64::NAN, 1), Err(CutError::BadThreshold(_))));
+/// let mut copy = body.clone(); // another body: refused before anything tears
+/// assert!(matches!(tear_step(&mut copy, &mut sim, 0.0, 1), Err(CutError::Sim(SimError::OtherBody { .. }))));
 /// ```
 pub fn tear_step(
     body: &mut Body,
@@ -373,6 +386,10 @@ pub fn tear_step(
 ) -> Result<TearStep, CutError> {
     if !(threshold.is_finite() && threshold >= 0.0) {
         return Err(CutError::BadThreshold(threshold));
+    }
+    if !sim.projection.is_for(body) {
+        let (built_for, given) = (sim.projection.body_identity(), body.identity());
+        return Err(CutError::Sim(crate::mechanics::SimError::OtherBody { built_for, given }));
     }
     let stress = principal_stress(body, sim);
     let mut order: Vec<usize> = (0..stress.len()).filter(|&v| stress[v].magnitude > threshold).collect();

@@ -367,11 +367,26 @@ pub enum EmbedError<E: std::error::Error + 'static> {
 /// assert!(body.map().is_free(3, d));
 /// assert!(body.check().is_ok());
 /// ```
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub struct Embedded<const N: usize, E> {
     map: GMap<N>,
     attrs: E,
     version: u64,
+    identity: u64,
+}
+
+/// A number no earlier call returned in this process (1, 2, 3, …). O(1).
+fn next_identity() -> u64 {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+    NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+}
+
+/// A clone is another body: same map, attributes and version, its own [`Embedded::identity`]
+/// (so what was built for the original does not run on the copy unnoticed).
+impl<const N: usize, E: Clone> Clone for Embedded<N, E> {
+    fn clone(&self) -> Self {
+        Embedded { map: self.map.clone(), attrs: self.attrs.clone(), version: self.version, identity: next_identity() }
+    }
 }
 
 impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
@@ -392,7 +407,7 @@ impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
     /// ```
     pub fn new(map: GMap<N>, mut attrs: E) -> Self {
         attrs.grow_to(&map);
-        Embedded { map, attrs, version: 0 }
+        Embedded { map, attrs, version: 0, identity: next_identity() }
     }
 
     /// The map (read-only). O(1).
@@ -447,6 +462,26 @@ impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
     /// ```
     pub fn attrs_mut(&mut self) -> &mut E {
         &mut self.attrs
+    }
+
+    /// A number that names this body among all bodies of the process: set by
+    /// [`Embedded::new`], different for a clone. Projections and simulations remember it and
+    /// refuse another body. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let copy = body.clone();
+    /// assert_ne!(copy.identity(), body.identity());
+    /// assert_eq!((copy.version(), copy.map().dart_count()), (body.version(), body.map().dart_count()));
+    /// ```
+    pub fn identity(&self) -> u64 {
+        self.identity
     }
 
     /// Number of topological operations applied so far. O(1).

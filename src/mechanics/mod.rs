@@ -56,6 +56,15 @@ pub enum SimError {
     /// A gravity vector with a NaN or infinite component.
     #[error("gravity {0:?} must be finite")]
     BadGravity(Vec3),
+    /// The simulation was built for another body ([`crate::mechanics::Body::identity`]): its
+    /// arrays describe that body's vertices and springs. Rebuild it for this one.
+    #[error("the simulation was built for body {built_for}, not for body {given}: rebuild it for this body")]
+    OtherBody {
+        /// The identity of the body it was built for.
+        built_for: u64,
+        /// The identity of the body given.
+        given: u64,
+    },
     /// The body changed topologically since the projection was built.
     #[error("the projection was built at body version {built} but the body is at version {now}: rebuild it")]
     StaleProjection {
@@ -181,9 +190,18 @@ impl Simulation {
         Ok(Simulation { projection, stepper })
     }
 
+    /// [`SimError::OtherBody`] unless the simulation was built for `body`. O(1).
+    fn check_body(&self, body: &Body) -> Result<(), SimError> {
+        match self.projection.is_for(body) {
+            true => Ok(()),
+            false => Err(SimError::OtherBody { built_for: self.projection.body_identity(), given: body.identity() }),
+        }
+    }
+
     /// One step on the body's positions and velocities. O(springs + vertex ids).
     ///
     /// # Errors
+    /// [`SimError::OtherBody`] if the simulation was built for another body (nothing moves);
     /// [`SimError::StaleProjection`] if the body changed topologically (call
     /// [`Simulation::rebuild`]); [`SimError::Step`] on blow-up (the slot is the vertex id).
     ///
@@ -207,6 +225,7 @@ impl Simulation {
     /// assert!(sim.kinetic_energy(&body) > 0.0 && sim.max_displacement(&body) > 0.0);
     /// ```
     pub fn step(&mut self, body: &mut Body) -> Result<(), SimError> {
+        self.check_body(body)?;
         if !self.projection.is_current(body) {
             return Err(SimError::StaleProjection { built: self.projection.version(), now: body.version() });
         }
@@ -222,7 +241,8 @@ impl Simulation {
     /// step count's configuration. O(darts + E log E).
     ///
     /// # Errors
-    /// As [`Simulation::new`].
+    /// [`SimError::OtherBody`] if the simulation was built for another body (nothing changes);
+    /// otherwise as [`Simulation::new`].
     ///
     /// # Examples
     ///
@@ -273,6 +293,7 @@ impl Simulation {
     /// sim.step(&mut body).unwrap();
     /// ```
     pub fn update(&mut self, body: &mut Body, touched: &TouchedCells) -> Result<(), SimError> {
+        self.check_body(body)?;
         self.projection.update(body, touched);
         let config = *self.stepper.config();
         let slots = self.projection.system.slots();

@@ -14,9 +14,10 @@
 //! locality; `spring_edge[s]` / `spring_dart[s]` give the edge and a dart of spring s, and
 //! [`Projection::spring_of_edge`] the way back. Spring parameters and per-vertex masses are
 //! copied in; they change only through topological operations, after which the projection is
-//! stale ([`Projection::is_current`] compares the body's version) and must be rebuilt. An
-//! incremental update (next issue) only has to touch the slots and springs named by the
-//! operation's `CellChanges`, through these maps.
+//! stale ([`Projection::is_current`] compares the body's version, and its identity: a
+//! projection of another body, or of a clone, is never current) and must be rebuilt or updated:
+//! [`Projection::update`] touches only the slots and springs named by the operation's
+//! `TouchedCells`, through these maps.
 //!
 //! # Incremental update
 //! [`Projection::update`] applies a topological operation's [`TouchedCells`] (the vertex and edge
@@ -65,6 +66,8 @@ pub struct Projection {
     edge_spring: Vec<u32>,
     vertex_dart: Vec<Option<DartId>>,
     version: u64,
+    /// The [`Body::identity`] of the body it was built from.
+    body: u64,
     /// The lists of [`Resolved::of`], kept between updates.
     scratch: Resolved,
 }
@@ -118,6 +121,7 @@ impl Projection {
             edge_spring,
             vertex_dart,
             version: body.version(),
+            body: body.identity(),
             scratch: Resolved::default(),
         }
     }
@@ -163,7 +167,43 @@ impl Projection {
     /// assert!(p.is_current(&body));
     /// ```
     pub fn is_current(&self, body: &Body) -> bool {
-        self.version == body.version()
+        self.is_for(body) && self.version == body.version()
+    }
+
+    /// Whether the projection was built from `body` (and not from another body, or a clone of
+    /// it: [`Body::identity`]). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, Projection};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let p = Projection::build(&body, [0.0; 3]);
+    /// assert!(p.is_for(&body) && p.is_current(&body));
+    /// let copy = body.clone();
+    /// assert!(!p.is_for(&copy) && !p.is_current(&copy)); // same version, another body
+    /// ```
+    pub fn is_for(&self, body: &Body) -> bool {
+        self.body == body.identity()
+    }
+
+    /// The [`Body::identity`] of the body the projection was built from. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, Projection};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// assert_eq!(Projection::build(&body, [0.0; 3]).body_identity(), body.identity());
+    /// ```
+    pub fn body_identity(&self) -> u64 {
+        self.body
     }
 
     /// The body version the projection was built from. O(1).
@@ -189,7 +229,8 @@ impl Projection {
     /// update"): afterwards the projection is [`Projection::equivalent`] to a fresh
     /// [`Projection::build`] of `body` and [`Projection::is_current`] holds.
     /// Cost: O(touched cells · degree + new ids) amortised (see [`SpringSystem`]'s incidence
-    /// lists); nothing proportional to the mesh.
+    /// lists); nothing proportional to the mesh. A projection built from another body
+    /// ([`Projection::is_for`] false) is rebuilt from `body` instead, O(darts + E log E).
     ///
     /// # Examples
     ///
@@ -208,6 +249,10 @@ impl Projection {
     /// assert_eq!(p.system.slots(), body.map().cell_id_bound(0)); // new vertex ids got slots
     /// ```
     pub fn update(&mut self, body: &Body, touched: &TouchedCells) {
+        if !self.is_for(body) {
+            // Built from another body: its records say nothing about this one.
+            return self.rebuild(body);
+        }
         let map = body.map();
         let mech = body.attrs();
         let n = map.cell_id_bound(0);

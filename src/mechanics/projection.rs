@@ -15,9 +15,8 @@
 //! [`Projection::spring_of_edge`] the way back. Spring parameters and per-vertex masses are
 //! copied in; they change only through topological operations, after which the projection is
 //! stale ([`Projection::is_current`] compares the body's version, and its identity: a
-//! projection of another body, or of a clone, is never current) and must be rebuilt or updated:
-//! [`Projection::update`] touches only the slots and springs named by the operation's
-//! `TouchedCells`, through these maps.
+//! projection of another body, or of a clone, is never current) and must be rebuilt or updated
+//! (below).
 //!
 //! # Incremental update
 //! [`Projection::update`] applies a topological operation's [`TouchedCells`] (the vertex and edge

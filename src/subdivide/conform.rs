@@ -178,7 +178,9 @@ impl LeveledMap<3> {
     /// Errors: [`SubdivideError::OpenEdge`] if a face is not closed, the errors of
     /// [`Self::tet_vertices`] for a closed volume that is not a tet at its level,
     /// [`SubdivideError::DegenerateFace`] if a face polygon cannot be triangulated (zero area,
-    /// reflex corner) or a cone tet would have a non-positive volume.
+    /// reflex corner) or a cone tet would have a non-positive volume;
+    /// [`SubdivideError::NoPosition`] first if a live vertex has no position (it was read as the
+    /// origin, and the error then blamed a degenerate face).
     ///
     /// ```
     /// use topomech::generate::kuhn_cube;
@@ -197,8 +199,16 @@ impl LeveledMap<3> {
     ///     topomech::mesh::signed_volume(p[0], p[1], p[2], p[3])
     /// }).sum();
     /// assert!((v - 8.0).abs() < 1e-12);
+    /// let short = LeveledMap::new(m.map().clone(), vec![[0.0; 3]; 5]);
+    /// assert!(matches!(short.conforming_tets(), Err(topomech::subdivide::SubdivideError::NoPosition { vertex: 5, .. })));
     /// ```
     pub fn conforming_tets(&self) -> Result<ConformingMesh, SubdivideError> {
+        if let Some(d) =
+            self.map.one_dart_per_cell(0).into_iter().find(|&d| self.map.vertex_id(d).index() >= self.points.len())
+        {
+            let vertex = self.map.vertex_id(d).0;
+            return Err(SubdivideError::NoPosition { vertex, points: self.points.len() });
+        }
         let mut out = ConformingMesh { points: self.points.clone(), ..ConformingMesh::default() };
         let mut face_tris: FxHashMap<u32, Vec<[u32; 3]>> = FxHashMap::default();
         for d in self.map.one_dart_per_cell(3) {

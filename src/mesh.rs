@@ -395,6 +395,18 @@ fn unreferenced<const N: usize>(point_count: usize, cells: &[[u32; N]]) -> Vec<u
 impl TetMesh {
     /// The file's node tags of `points`, when the mesh knows a tag for each (error messages name
     /// points by them: they survive the reorderings, point indices do not). O(points).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mesh::TetMesh;
+    ///
+    /// let mut mesh = TetMesh { points: vec![[0.0; 3]; 3], ..TetMesh::default() };
+    /// assert_eq!(mesh.file_tags(&[0, 2]), None); // no tags read (a generated mesh)
+    /// mesh.node_tags = vec![10, 20, 30];
+    /// assert_eq!(mesh.file_tags(&[2, 0]), Some(vec![30, 10]));
+    /// assert_eq!((mesh.file_tags(&[5]), mesh.file_tags(&[])), (None, None)); // no such point, nothing asked
+    /// ```
     pub fn file_tags(&self, points: &[u32]) -> Option<Vec<u64>> {
         points
             .iter()

@@ -12,6 +12,7 @@ use topomech::ambiguity::catalogue::{campaign_vectors, catalogue, symptom_name, 
 use topomech::ambiguity::mixed::{campaign_mixed, MixedError, MixedRun, MixedStats};
 use topomech::ambiguity::vector::Vector;
 use topomech::generate::{kuhn_cube, SplitMix64};
+use topomech::mesh::TetMesh;
 
 use super::{other, print_report, CliError};
 
@@ -145,26 +146,27 @@ pub struct CatalogueJson {
 /// [`CliError::Load`] when the mesh cannot be read or built; [`CliError::Other`] when a cut fails
 /// (a bug) or the vectors cannot be written; [`CliError::Output`] / [`CliError::Json`] on output.
 pub fn run(args: AmbiguityArgs) -> Result<(), CliError> {
-    let (name, positions, tets, node_tags) = load_mesh(args.mesh.as_deref())?;
+    let (name, mesh) = load_mesh(args.mesh.as_deref())?;
+    let (positions, tets) = (&mesh.points, &mesh.tets);
     let points = positions.len();
     let mut rng = SplitMix64(args.seed);
     let mut per_k = Vec::new();
     let mut firsts: Vec<(usize, Run)> = Vec::new();
     for &k in &args.cuts {
-        let (stats, runs) = campaign_k(points, &tets, k, args.sequences, &mut rng).map_err(other)?;
+        let (stats, runs) = campaign_k(points, tets, k, args.sequences, &mut rng).map_err(other)?;
         per_k.push(stats);
         firsts.extend(runs.into_iter().map(|r| (k, r)));
     }
     let subdivide = match args.subdivide {
         Some(p) => Some(
-            mixed_campaign(&positions, &tets, &args.cuts, p, args.sequences, args.seed)
-                .map_err(|e| mixed_error(&name, &tets, &node_tags, e))?,
+            mixed_campaign(positions, tets, &args.cuts, p, args.sequences, args.seed)
+                .map_err(|e| mixed_error(&name, &mesh, e))?,
         ),
         None => None,
     };
     let cat = args.catalogue.then(|| catalogue(Bounds::CATALOGUE));
     if let Some(dir) = &args.write_vectors {
-        write_vectors(dir, points, &tets, &firsts, cat.as_ref(), args.shrink_budget)?;
+        write_vectors(dir, points, tets, &firsts, cat.as_ref(), args.shrink_budget)?;
     }
     let report = AmbiguityJson {
         pairs_found: per_k.iter().map(|s| count(s, "skeleton_unchanged")).sum(),
@@ -187,11 +189,9 @@ pub fn run(args: AmbiguityArgs) -> Result<(), CliError> {
 
 /// A mixed campaign's error as the CLI reports it: a degenerate tet is named in the mesh's own
 /// terms (the mesh name and the file's node tags of its corners, when the file had tags).
-fn mixed_error(name: &str, tets: &[[u32; 4]], node_tags: &[u64], e: MixedError) -> CliError {
+fn mixed_error(name: &str, mesh: &TetMesh, e: MixedError) -> CliError {
     let tags = match &e {
-        MixedError::Degenerate { tet, .. } => tets
-            .get(*tet)
-            .and_then(|t| t.iter().map(|&v| node_tags.get(v as usize).copied()).collect::<Option<Vec<u64>>>()),
+        MixedError::Degenerate { tet, .. } => mesh.tets.get(*tet).and_then(|t| mesh.file_tags(t)),
         _ => None,
     };
     let at = tags.map_or(String::new(), |t| format!(" (file node tags {t:?})"));
@@ -232,8 +232,8 @@ fn count(s: &KStats, symptom: &str) -> usize {
     s.symptoms.iter().filter(|(x, _)| symptom_name(*x) == symptom).map(|x| x.1).sum()
 }
 
-/// A mesh for the campaigns: (name, point positions, tets, the file's node tags or none).
-type NamedMesh = (String, Vec<[f64; 3]>, Vec<[u32; 4]>, Vec<u64>);
+/// A mesh for the campaigns and its name (a Kuhn cube has no file node tags).
+type NamedMesh = (String, TetMesh);
 
 /// The mesh: the file given, `kuhn:K`, or the built-in liver.
 fn load_mesh(path: Option<&Path>) -> Result<NamedMesh, CliError> {
@@ -241,7 +241,7 @@ fn load_mesh(path: Option<&Path>) -> Result<NamedMesh, CliError> {
     match (path, kuhn) {
         (_, Some(Ok(k))) if (1..=16).contains(&k) => {
             let (points, tets) = kuhn_cube(k);
-            Ok((format!("kuhn:{k}"), points, tets, Vec::new()))
+            Ok((format!("kuhn:{k}"), TetMesh { points, tets, ..TetMesh::default() }))
         }
         (_, Some(_)) => Err(CliError::Other("kuhn:K needs K in 1..=16".into())),
         (Some(p), None) => from_loaded(topomech::load::load_tet_map(p)?),
@@ -250,8 +250,7 @@ fn load_mesh(path: Option<&Path>) -> Result<NamedMesh, CliError> {
 }
 
 fn from_loaded(loaded: topomech::load::Loaded) -> Result<NamedMesh, CliError> {
-    let mesh = loaded.mesh;
-    Ok((loaded.path.display().to_string(), mesh.points, mesh.tets, mesh.node_tags))
+    Ok((loaded.path.display().to_string(), loaded.mesh))
 }
 
 /// A run as a finding (shrinking is `--write-vectors`'s job).

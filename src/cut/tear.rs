@@ -387,10 +387,7 @@ pub fn tear_step(
     if !(threshold.is_finite() && threshold >= 0.0) {
         return Err(CutError::BadThreshold(threshold));
     }
-    if !sim.projection.is_for(body) {
-        let (built_for, given) = (sim.projection.body_identity(), body.identity());
-        return Err(CutError::Sim(crate::mechanics::SimError::OtherBody { built_for, given }));
-    }
+    sim.check_body(body)?;
     let stress = principal_stress(body, sim);
     let mut order: Vec<usize> = (0..stress.len()).filter(|&v| stress[v].magnitude > threshold).collect();
     order.sort_by(|&a, &b| stress[b].magnitude.total_cmp(&stress[a].magnitude).then(a.cmp(&b)));

@@ -191,7 +191,7 @@ impl Simulation {
     }
 
     /// [`SimError::OtherBody`] unless the simulation was built for `body`. O(1).
-    fn check_body(&self, body: &Body) -> Result<(), SimError> {
+    pub(crate) fn check_body(&self, body: &Body) -> Result<(), SimError> {
         match self.projection.is_for(body) {
             true => Ok(()),
             false => Err(SimError::OtherBody { built_for: self.projection.body_identity(), given: body.identity() }),

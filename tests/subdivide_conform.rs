@@ -19,7 +19,7 @@ use std::collections::HashMap;
 use std::process::Command;
 
 use proptest::prelude::*;
-use topomech::cut::{incise_plane, Plane};
+use topomech::cut::{incise_plane, CutError, Plane};
 use topomech::generate::kuhn_cube;
 use topomech::load;
 use topomech::mechanics::{check_conservation, Body, Material};
@@ -272,7 +272,7 @@ fn the_refined_liver_closes_and_cuts_closer_to_the_plane() {
         let (mut b, mut a) = (before.clone(), after.clone());
         let eb = cut_error(&mut b, &plane, Some(ZONE)).unwrap();
         let incision = incise_plane(&mut a, &plane).unwrap();
-        let ea = measure_cut(&a, &incision, &plane, Some(ZONE));
+        let ea = measure_cut(&a, &incision, &plane, Some(ZONE)).unwrap();
         assert!(eb.measured > 0 && ea.measured > eb.measured, "{eb:?} {ea:?}");
         assert!(ea.max < eb.max && ea.mean < eb.mean, "normal {normal:?}: before {eb:?}, after {ea:?}");
         for body in [&b, &a] {
@@ -282,7 +282,7 @@ fn the_refined_liver_closes_and_cuts_closer_to_the_plane() {
             assert!((mass - RHO * volume).abs() <= 1e-12 * RHO * volume);
         }
         // Without a zone every cut face is measured, and the zone's faces are among them.
-        let all = measure_cut(&a, &incision, &plane, None);
+        let all = measure_cut(&a, &incision, &plane, None).unwrap();
         assert_eq!((all.measured, all.faces), (ea.faces, ea.faces));
         assert!(all.max >= ea.max);
     }
@@ -290,6 +290,16 @@ fn the_refined_liver_closes_and_cuts_closer_to_the_plane() {
     let darts = before.map().dart_count();
     assert!(cut_error(&mut before, &Plane { point: ZONE.0, normal: [0.0; 3] }, None).is_err());
     assert_eq!(before.map().dart_count(), darts);
+    // So is a bad zone (a NaN radius would have measured every face as inside it), before the
+    // incision: nothing is dissociated.
+    let plane = Plane { point: ZONE.0, normal: [1.0, 0.3, 0.2] };
+    let boundary_before = before.map().boundary_darts().count();
+    for zone in [(ZONE.0, f64::NAN), (ZONE.0, -1.0), ([f64::INFINITY, 0.0, 0.0], 1.0), (ZONE.0, f64::INFINITY)] {
+        let e = cut_error(&mut before, &plane, Some(zone)).unwrap_err();
+        assert!(matches!(e, CutError::BadZone { .. }), "{zone:?}: {e}");
+        assert_eq!(before.map().dart_count(), darts);
+        assert_eq!(before.map().boundary_darts().count(), boundary_before);
+    }
     after.map().validate().unwrap();
 }
 

@@ -6,7 +6,7 @@ use proptest::prelude::*;
 use topomech::generate::kuhn_cube;
 use topomech::mechanics::{Integrator, Material, SpringSystem, StepConfig, Stepper, Vec3};
 use topomech::subdivide::fuzz::{decode, Op, MAX_DARTS, MAX_FUZZ_LEVEL};
-use topomech::subdivide::{CouplingError, EdgeKey, LeveledMap, LeveledMechanics, SpringLawError};
+use topomech::subdivide::{CouplingError, EdgeKey, LeveledMap, LeveledMechanics, SpringLawError, SubdivideError};
 use topomech::{DartId, GMap};
 
 mod subdivide_common;
@@ -626,4 +626,94 @@ fn a_ball_holding_everything_takes_the_bulk_path_with_the_per_tet_springs() {
     }
     let (tb, tp) = (mb.masses.total(&bulk), mp.masses.total(&perop));
     assert!((tb - tp).abs() <= 1e-12 * tp, "Σ tet mass {tb} vs {tp}");
+}
+
+/// Finding 23 (docs/VERIFICATION.md): the coupling refuses what a `Body` refuses (a bad material,
+/// a zero-volume or non-finite tet) and a map it was not built for, before the map changes; the
+/// leveled map refuses a partial geometry and a dart past its end instead of panicking or
+/// making up positions.
+#[test]
+fn the_coupling_and_the_leveled_map_refuse_bad_input_before_changing_anything() {
+    let single = || GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap().0;
+    let m = LeveledMap::new(single(), TET.to_vec());
+    // Materials: each bad constant is named, as by Body::from_tets.
+    for (name, bad) in [
+        ("density", Material { density: 0.0, ..material() }),
+        ("young", Material { young: f64::NAN, ..material() }),
+        ("young", Material { young: -1.0, ..material() }),
+        ("damping", Material { damping: f64::INFINITY, ..material() }),
+        ("viscosity", Material { viscosity: -3.0, ..material() }),
+    ] {
+        let e = LeveledMechanics::new(&m, bad).unwrap_err();
+        assert!(
+            matches!(e, CouplingError::Material(topomech::mechanics::ModelError::BadMaterial { name: n, .. }) if n == name)
+                || (name == "density" && matches!(e, CouplingError::Subdivide(SubdivideError::BadDensity(_)))),
+            "{name}: {e}"
+        );
+        let given = topomech::subdivide::TetMasses { mass: vec![1.0] };
+        assert!(LeveledMechanics::with_masses(&m, bad, given).is_err(), "with_masses, {name}");
+    }
+    // Geometry: a flat tet, coincident corners, a NaN corner.
+    let mut flat = TET.to_vec();
+    flat[3] = [0.5, 0.5, 0.0];
+    flat[0] = [0.0, 0.0, 0.0];
+    flat[1] = [1.0, 0.0, 0.0];
+    flat[2] = [0.0, 1.0, 0.0];
+    let mut same = TET.to_vec();
+    same[1] = same[0];
+    for pts in [flat, same] {
+        let e = LeveledMechanics::new(&LeveledMap::new(single(), pts), material()).unwrap_err();
+        assert!(matches!(e, CouplingError::DegenerateTet { volume: 0, .. }), "{e}");
+    }
+    let mut nan = TET.to_vec();
+    nan[2][1] = f64::NAN;
+    let e = LeveledMechanics::new(&LeveledMap::new(single(), nan), material()).unwrap_err();
+    assert!(matches!(e, CouplingError::Subdivide(SubdivideError::NonFinitePosition { vertex: 2, .. })), "{e}");
+
+    // Another map's coupling: refused with the map unchanged (it was subdivided, then the
+    // coupling failed with NoSpring and the pair was out of step).
+    let mech = LeveledMechanics::new(&m, material()).unwrap();
+    let (points, tets) = kuhn_cube(2);
+    let mut big = LeveledMap::new(GMap::<3>::from_tets(points.len(), &tets).unwrap().0, points);
+    let d = big.map().darts().nth(100).unwrap();
+    let (darts, log) = (big.map().dart_count(), big.split_log().len());
+    let mut other = mech.clone();
+    let e = other.subdivide_tet(&mut big, d, 1).unwrap_err();
+    assert_eq!(e, CouplingError::StateCount { states: 4, vertices: 27 });
+    assert!(other.split_edge(&mut big, d, 1).is_err() && other.subdivide_triangle(&mut big, d, 1).is_err());
+    assert!(other.refine_around(&mut big, [1.0; 3], 10.0, 1).is_err());
+    assert_eq!((big.map().dart_count(), big.split_log().len()), (darts, log));
+    assert_eq!(other, mech);
+    // Resized state vectors are seen too.
+    let mut own = LeveledMap::new(single(), TET.to_vec());
+    let mut shrunk = mech.clone();
+    shrunk.velocity.pop();
+    assert!(matches!(
+        shrunk.subdivide_tet(&mut own, DartId(0), 1),
+        Err(CouplingError::StateCount { states: 3, vertices: 4 })
+    ));
+    assert_eq!(own.map().dart_count(), 24);
+
+    // The leveled map alone: a dart past the end, points that stop before a vertex.
+    let mut masses = topomech::subdivide::TetMasses::from_density(&m, 1.0).unwrap();
+    let mut alone = LeveledMap::new(single(), TET.to_vec());
+    let e = alone.subdivide_tet_with_mass(DartId(9999), 1, &mut masses).unwrap_err();
+    assert_eq!(e, SubdivideError::NoSuchDart(DartId(9999)));
+    let mut partial = LeveledMap::new(single(), TET[..3].to_vec());
+    let refusals = [
+        partial.clone().subdivide_tet(DartId(0), 1).map(|_| ()),
+        partial.clone().subdivide_tet_with_mass(DartId(0), 1, &mut masses).map(|_| ()),
+        partial.clone().split_edge(DartId(0), 1).map(|_| ()),
+        partial.clone().subdivide_triangle(DartId(0), 1).map(|_| ()),
+        partial.clone().refine_uniform(1, &mut masses).map(|_| ()),
+        partial.refine_around([0.1; 3], 10.0, 1, &mut masses).map(|_| ()),
+    ];
+    for (k, r) in refusals.into_iter().enumerate() {
+        assert_eq!(r, Err(SubdivideError::NoPosition { vertex: 3, points: 3 }), "operation {k}");
+    }
+    assert_eq!((partial.map().dart_count(), partial.points().len()), (24, 3));
+    assert_eq!(masses.mass.len(), 1);
+    // A map without any geometry still refines (its new vertices get the origin).
+    let mut bare = LeveledMap::new(single(), vec![]);
+    assert!(bare.subdivide_tet(DartId(0), 1).is_ok() && bare.points().is_empty());
 }

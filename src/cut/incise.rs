@@ -43,7 +43,8 @@ impl Plane {
         (0..3).map(|k| (x[k] - self.point[k]) * self.normal[k]).sum::<f64>() > 0.0
     }
 
-    fn check(&self) -> Result<(), CutError> {
+    /// [`CutError::BadPlane`] unless the point and normal are finite and the normal is not zero.
+    pub(crate) fn check(&self) -> Result<(), CutError> {
         let finite = self.point.iter().chain(&self.normal).all(|c| c.is_finite());
         if !finite || self.normal.iter().all(|&c| c == 0.0) {
             return Err(CutError::BadPlane { point: self.point, normal: self.normal });

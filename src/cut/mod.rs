@@ -100,6 +100,15 @@ pub enum CutError {
         /// Normal.
         normal: [f64; 3],
     },
+    /// A measuring zone (ball) whose centre is not finite or whose radius is not a finite
+    /// number ≥ 0 (with NaN every face would compare inside it).
+    #[error("measuring zone centre {center:?} / radius {radius} is not finite (or the radius is negative)")]
+    BadZone {
+        /// The centre given.
+        center: [f64; 3],
+        /// The radius given.
+        radius: f64,
+    },
     /// A tearing threshold that is NaN, infinite or negative (with NaN no vertex would ever
     /// compare above it: tearing would silently never happen).
     #[error("tear threshold {0} must be a finite number ≥ 0")]

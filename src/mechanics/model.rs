@@ -952,7 +952,7 @@ impl ModelTotals {
     }
 }
 
-fn check_material(m: &Material) -> Result<(), ModelError> {
+pub(crate) fn check_material(m: &Material) -> Result<(), ModelError> {
     let bad = |name, value: f64, rule| ModelError::BadMaterial { name, value, rule };
     if !(m.density.is_finite() && m.density > 0.0) {
         return Err(bad("density", m.density, "> 0"));

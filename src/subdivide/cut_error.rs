@@ -49,25 +49,48 @@ pub struct CutSurfaceError {
 /// faces whose centroid lies in the ball `zone = (centre, radius)` when given (module docs).
 /// O(cut faces).
 ///
+/// # Errors
+/// [`CutError::BadPlane`], [`CutError::BadZone`] (non-finite centre, radius not finite and ≥ 0),
+/// [`CutError::NoSuchDart`] for a dissociation whose dart is not live in `body` (an incision of
+/// another body).
+///
 /// # Examples
 ///
 /// ```
-/// use topomech::cut::{incise_plane, Plane};
+/// use topomech::cut::{incise_plane, CutError, Plane};
 /// use topomech::mechanics::{Body, Material};
 /// use topomech::subdivide::measure_cut;
 /// let (points, tets) = topomech::generate::kuhn_cube(2);
 /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
 /// let plane = Plane { point: [1.0, 0.0, 0.0], normal: [1.0, 0.0, 0.0] };
 /// let inc = incise_plane(&mut body, &plane).unwrap();
-/// let all = measure_cut(&body, &inc, &plane, None);
+/// let all = measure_cut(&body, &inc, &plane, None).unwrap();
 /// assert!(all.measured == all.faces && all.faces > 0 && all.max < 1e-12);
-/// let none = measure_cut(&body, &inc, &plane, Some(([9.0; 3], 0.1)));
+/// let none = measure_cut(&body, &inc, &plane, Some(([9.0; 3], 0.1))).unwrap();
 /// assert!(none.measured == 0 && none.max.is_nan());
+/// let nan = measure_cut(&body, &inc, &plane, Some(([1.0; 3], f64::NAN)));
+/// assert!(matches!(nan, Err(CutError::BadZone { .. }))); // not "every face is inside"
 /// ```
-pub fn measure_cut(body: &Body, incision: &Incision, plane: &Plane, zone: Option<([f64; 3], f64)>) -> CutSurfaceError {
+pub fn measure_cut(
+    body: &Body,
+    incision: &Incision,
+    plane: &Plane,
+    zone: Option<([f64; 3], f64)>,
+) -> Result<CutSurfaceError, CutError> {
+    plane.check()?;
+    if let Some((center, radius)) = zone {
+        check_zone(center, radius)?;
+    }
     let (map, mech) = (body.map(), body.attrs());
-    let len = plane.normal.iter().map(|c| c * c).sum::<f64>().sqrt();
-    let dist = |x: [f64; 3]| ((0..3).map(|k| (x[k] - plane.point[k]) * plane.normal[k]).sum::<f64>() / len).abs();
+    if let Some(dis) = incision.dissociations.iter().find(|dis| !map.contains(dis.dart)) {
+        return Err(CutError::NoSuchDart(dis.dart));
+    }
+    // The normal scaled by its largest component, so that a tiny (or huge) normal does not
+    // underflow (overflow) in its squared length.
+    let scale = plane.normal.iter().fold(0.0f64, |m, c| m.max(c.abs()));
+    let unit = plane.normal.map(|c| c / scale);
+    let len = unit.iter().map(|c| c * c).sum::<f64>().sqrt();
+    let dist = |x: [f64; 3]| ((0..3).map(|k| (x[k] - plane.point[k]) * unit[k]).sum::<f64>() / len).abs();
     let (mut measured, mut max, mut sum) = (0usize, 0.0f64, 0.0);
     for dis in &incision.dissociations {
         let mut ids: Vec<_> =
@@ -87,14 +110,23 @@ pub fn measure_cut(body: &Body, incision: &Incision, plane: &Plane, zone: Option
         sum += d.iter().sum::<f64>() / d.len() as f64;
     }
     let (max, mean) = if measured == 0 { (f64::NAN, f64::NAN) } else { (max, sum / measured as f64) };
-    CutSurfaceError { faces: incision.cut_faces(), measured, max, mean }
+    Ok(CutSurfaceError { faces: incision.cut_faces(), measured, max, mean })
+}
+
+/// [`CutError::BadZone`] unless the centre is finite and the radius a finite number ≥ 0. O(1).
+fn check_zone(center: [f64; 3], radius: f64) -> Result<(), CutError> {
+    if center.iter().all(|c| c.is_finite()) && radius.is_finite() && radius >= 0.0 {
+        return Ok(());
+    }
+    Err(CutError::BadZone { center, radius })
 }
 
 /// Incises `body` along `plane` ([`incise_plane`]) and measures the cut surface
 /// ([`measure_cut`]). O(darts + cut faces · dissociation).
 ///
 /// # Errors
-/// Those of [`incise_plane`] (a bad plane leaves the body unchanged).
+/// [`CutError::BadZone`] and those of [`incise_plane`] (a bad plane or zone leaves the body
+/// unchanged).
 ///
 /// ```
 /// use topomech::cut::Plane;
@@ -109,6 +141,9 @@ pub fn measure_cut(body: &Body, incision: &Incision, plane: &Plane, zone: Option
 /// assert!(e.faces > 0 && e.max < 1e-12);
 /// ```
 pub fn cut_error(body: &mut Body, plane: &Plane, zone: Option<([f64; 3], f64)>) -> Result<CutSurfaceError, CutError> {
+    if let Some((center, radius)) = zone {
+        check_zone(center, radius)?;
+    }
     let incision = incise_plane(body, plane)?;
-    Ok(measure_cut(body, &incision, plane, zone))
+    measure_cut(body, &incision, plane, zone)
 }

@@ -234,13 +234,25 @@ pub enum SubdivideError {
         radius: f64,
     },
     /// A geometric query (a volume, a distance to a ball, a mass from a density) reached a vertex
-    /// without a position: the points given to [`LeveledMap::new`] stop before its id.
+    /// without a position: the points given to [`LeveledMap::new`] stop before its id. Every
+    /// subdivision operation refuses such a partial geometry before it changes anything (it
+    /// would take the origin for that vertex); a map given no points at all is accepted.
     #[error("vertex {vertex} has no position (the map was given {points} points)")]
     NoPosition {
         /// The vertex id.
         vertex: u32,
         /// How many positions the map has.
         points: usize,
+    },
+    /// A geometric query reached a vertex whose position is NaN or infinite (the points given to
+    /// [`LeveledMap::new`] are not checked there; a volume, distance or mass from them would be
+    /// NaN and compare false everywhere).
+    #[error("vertex {vertex} has a non-finite position {position:?}")]
+    NonFinitePosition {
+        /// The vertex id.
+        vertex: u32,
+        /// Its stored position.
+        position: [f64; 3],
     },
     /// A density for [`TetMasses::from_density`] that is not a finite number > 0.
     #[error("density {0} must be a finite number > 0")]
@@ -389,7 +401,9 @@ impl<const N: usize> LeveledMap<N> {
     /// Wraps a G-map as level 0: every dart gets level 0 and μ = 0. `points[v]` is the position of
     /// the vertex with id v (may be empty when geometry is not needed; new vertices then get the
     /// origin). The geometric queries (volumes, balls, masses from a density) refuse a vertex
-    /// past the end of `points` with [`SubdivideError::NoPosition`]. O(capacity).
+    /// past the end of `points` with [`SubdivideError::NoPosition`] and a NaN or infinite
+    /// position with [`SubdivideError::NonFinitePosition`]; the operations refuse points that stop
+    /// before a live vertex (but not an empty list). O(capacity).
     ///
     /// # Examples
     ///
@@ -398,10 +412,15 @@ impl<const N: usize> LeveledMap<N> {
     /// # use topomech::GMap;
     /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
     /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-    /// let m = LeveledMap::new(map, pts);
+    /// let m = LeveledMap::new(map.clone(), pts.clone());
     /// let d = m.map().darts().next().unwrap();
     /// assert_eq!((m.max_level(), m.darts_at_level(0)), (0, 24));
     /// assert_eq!(m.mu(d), topomech::subdivide::Mu::default());
+    /// // Points that stop before vertex 3: refused, not filled in with the origin.
+    /// let mut partial = LeveledMap::new(map, pts[..3].to_vec());
+    /// let e = partial.subdivide_tet(d, 1).unwrap_err();
+    /// assert_eq!(e, topomech::subdivide::SubdivideError::NoPosition { vertex: 3, points: 3 });
+    /// assert_eq!((partial.map().dart_count(), partial.points().len()), (24, 3));
     /// ```
     pub fn new(map: GMap<N>, points: Vec<[f64; 3]>) -> Self {
         let cap = map.capacity();
@@ -643,6 +662,8 @@ impl<const N: usize> LeveledMap<N> {
     }
 
     /// αj^i(d): the image of d by αj at level i (the paper's α0^i for j = 0). O(changes of d).
+    /// `d` must be a live dart and j ≤ n, as for [`GMap::alpha_dyn`] (panics otherwise; a dart
+    /// from outside is checked first with `self.map().contains(d)`).
     ///
     /// # Examples
     ///

@@ -85,7 +85,9 @@ pub(super) struct OpLog {
 }
 
 impl<const N: usize> LeveledMap<N> {
-    /// Checks the level of a new operation: at most [`MAX_LEVEL`], at least the maximum level.
+    /// Checks a new operation before it changes anything: its level is at most [`MAX_LEVEL`]
+    /// and at least the maximum level, and the map's points cover its vertices
+    /// ([`Self::check_points_cover`]).
     pub(super) fn check_op_level(&self, level: u8) -> Result<(), SubdivideError> {
         if level > MAX_LEVEL {
             return Err(SubdivideError::LevelTooHigh(level));
@@ -93,7 +95,20 @@ impl<const N: usize> LeveledMap<N> {
         if level < self.max_level {
             return Err(SubdivideError::LevelBelowMax { level, max_level: self.max_level });
         }
-        Ok(())
+        self.check_points_cover()
+    }
+
+    /// Refuses to operate on a partial geometry: points given, but none for some live vertex (the
+    /// operation would take the origin for it, store a made-up midpoint and fill the gap with the
+    /// origin). A map without points (no geometry) is accepted.
+    /// O(1) when the points reach every vertex id; O(darts) otherwise.
+    pub(super) fn check_points_cover(&self) -> Result<(), SubdivideError> {
+        let points = self.points.len();
+        if points == 0 || points >= self.map.cell_id_bound(0) {
+            return Ok(());
+        }
+        let uncovered = self.map.darts().map(|d| self.map.vertex_id(d).0).filter(|&v| v as usize >= points).min();
+        uncovered.map_or(Ok(()), |vertex| Err(SubdivideError::NoPosition { vertex, points }))
     }
 
     /// Opens the log of an operation of level `level` (already checked).

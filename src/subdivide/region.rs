@@ -261,7 +261,8 @@ impl LeveledMap<3> {
         Ok(crate::mesh::signed_volume(p[0], p[1], p[2], p[3]))
     }
 
-    /// The positions of the corners `t`; [`SubdivideError::NoPosition`] for one without. O(1).
+    /// The positions of the corners `t`; [`SubdivideError::NoPosition`] for one without,
+    /// [`SubdivideError::NonFinitePosition`] for one that is NaN or infinite. O(1).
     fn corner_positions(&self, t: [u32; 4]) -> Result<[[f64; 3]; 4], SubdivideError> {
         let mut p = [[0.0; 3]; 4];
         for (k, &v) in t.iter().enumerate() {
@@ -269,6 +270,9 @@ impl LeveledMap<3> {
                 .points
                 .get(v as usize)
                 .ok_or(SubdivideError::NoPosition { vertex: v, points: self.points.len() })?;
+            if !p[k].iter().all(|c| c.is_finite()) {
+                return Err(SubdivideError::NonFinitePosition { vertex: v, position: p[k] });
+            }
         }
         Ok(p)
     }
@@ -300,17 +304,25 @@ impl LeveledMap<3> {
     /// Subdivides the tet of `d` 1→8 at `level` (see [`Self::subdivide_tet`]) and shares its mass
     /// among the children in proportion to their rest volumes (module docs). O(volume + touched).
     ///
-    /// Errors: those of [`Self::subdivide_tet`]; the map and the masses are unchanged on error.
+    /// Errors: those of [`Self::tet_volume`] for the tet of `d` (no such dart, a corner without a
+    /// finite position: the volumes are needed) and of [`Self::subdivide_tet`]; the map and the
+    /// masses are unchanged on error.
     ///
     /// # Examples
     ///
     /// ```
-    /// # use topomech::subdivide::LeveledMap;
-    /// # use topomech::GMap;
+    /// # use topomech::subdivide::{LeveledMap, SubdivideError};
+    /// # use topomech::{DartId, GMap};
     /// # use topomech::subdivide::TetMasses;
     /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
     /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mut bare = LeveledMap::new(map.clone(), vec![]); // no geometry: no volumes to share by
+    /// let mut masses = TetMasses { mass: vec![1.0] };
+    /// let e = bare.subdivide_tet_with_mass(DartId(0), 1, &mut masses).unwrap_err();
+    /// assert!(matches!(e, SubdivideError::NoPosition { points: 0, .. }));
+    /// assert_eq!(bare.map().dart_count(), 24); // refused before any change
     /// let mut m = LeveledMap::new(map, pts);
+    /// assert!(matches!(m.subdivide_tet_with_mass(DartId(9999), 1, &mut masses), Err(SubdivideError::NoSuchDart(_))));
     /// let d = m.map().darts().next().unwrap();
     /// let mut masses = TetMasses::from_density(&m, 6.0).unwrap();
     /// let children = m.subdivide_tet_with_mass(d, 1, &mut masses).unwrap();
@@ -324,6 +336,10 @@ impl LeveledMap<3> {
         level: u8,
         masses: &mut TetMasses,
     ) -> Result<[DartId; 8], SubdivideError> {
+        // The parent's volume first: a dead dart, a corner without a (finite) position or a
+        // volume that is no tet is refused here, before the map changes (the children's corners
+        // are the parent's and midpoints of its edges).
+        self.tet_volume(d)?;
         let parent = masses.mass.get(self.map.cell_id(3, d).index()).copied().unwrap_or(0.0);
         let children = self.subdivide_tet(d, level)?;
         let volumes: Vec<f64> = children.iter().map(|&c| self.tet_volume(c).map(f64::abs)).collect::<Result<_, _>>()?;

@@ -207,6 +207,31 @@ pub enum CouplingError {
     /// The map split an edge cell that has no spring (a bug, or a tampered coupling).
     #[error("{0} was split but has no spring")]
     NoSpring(EdgeKey),
+    /// The coupling holds a state (position, velocity) for another number of vertex ids than the
+    /// map has: it was built for another map, the map changed behind its back (a cut), or its
+    /// state vectors were resized. Refused before the map changes.
+    #[error(
+        "the coupling holds {states} vertex states but the map has {vertices} vertex ids: not this map's coupling"
+    )]
+    StateCount {
+        /// Entries of [`LeveledMechanics::position`] / [`LeveledMechanics::velocity`] (the fewer).
+        states: usize,
+        /// The map's vertex id bound.
+        vertices: usize,
+    },
+    /// A material constant is refused ([`crate::mechanics::ModelError::BadMaterial`], as for a
+    /// [`crate::mechanics::Body`]).
+    #[error(transparent)]
+    Material(crate::mechanics::ModelError),
+    /// A level-0 tet has zero volume: it would get no mass and no stiffness (a
+    /// [`crate::mechanics::Body`] refuses it too).
+    #[error("volume {volume} (dart {dart}) has zero volume")]
+    DegenerateTet {
+        /// The volume cell id.
+        volume: u32,
+        /// A dart of it.
+        dart: DartId,
+    },
 }
 
 /// A level-0 tet: its corner vertex ids (increasing) and the keys of its six edges in [`PAIRS`]
@@ -277,7 +302,9 @@ impl LeveledMechanics {
     /// with zero velocity. Two edge cells joining the same vertices get a spring each, from their own
     /// tets. O(darts + E log E).
     ///
-    /// Errors: [`CouplingError::NotLevelZero`], [`CouplingError::NoGeometry`], and the errors of
+    /// Errors: [`CouplingError::NotLevelZero`], [`CouplingError::NoGeometry`],
+    /// [`CouplingError::Material`] (a material a [`crate::mechanics::Body`] refuses too),
+    /// [`CouplingError::DegenerateTet`], [`SubdivideError::NonFinitePosition`], and the errors of
     /// [`LeveledMap::tet_vertices`] for a volume that is not a tet.
     ///
     /// # Examples
@@ -334,7 +361,14 @@ impl LeveledMechanics {
 
     /// The coupling of a checked level-0 map with these masses.
     fn build(m: &LeveledMap<3>, material: Material, masses: TetMasses) -> Result<Self, CouplingError> {
+        crate::mechanics::model::check_material(&material).map_err(CouplingError::Material)?;
         let nv = m.map().cell_id_bound(0);
+        for d in m.map().one_dart_per_cell(3) {
+            // Finite positions and a non-zero volume (NoPosition was settled by check_start).
+            if m.tet_volume(d)? == 0.0 {
+                return Err(CouplingError::DegenerateTet { volume: m.map().cell_id(3, d).0, dart: d });
+            }
+        }
         let tets0 = m.map().one_dart_per_cell(3).into_iter().map(|d| tet_edges(m, d)).collect::<Result<Vec<_>, _>>()?;
         let mut mech = LeveledMechanics {
             material,
@@ -577,11 +611,16 @@ impl LeveledMechanics {
         }
     }
 
-    /// Errors unless every vertex insertion of the map was followed.
+    /// Errors unless every vertex insertion of the map was followed and the coupling holds one
+    /// state per vertex id of the map. O(1).
     fn in_sync(&self, m: &LeveledMap<3>) -> Result<(), CouplingError> {
         let logged = m.edge_split_log().len();
         if logged != self.applied {
             return Err(CouplingError::OutOfSync { applied: self.applied, logged });
+        }
+        let (vertices, states) = (m.map().cell_id_bound(0), self.position.len().min(self.velocity.len()));
+        if states != vertices || self.position.len() != self.velocity.len() {
+            return Err(CouplingError::StateCount { states, vertices });
         }
         Ok(())
     }
@@ -602,8 +641,9 @@ impl LeveledMechanics {
     /// [`LeveledMap::split_edge`] with the series rule on the edge's spring and the new vertex
     /// interpolated (module docs). Returns the map's result. O(edge · n + log E).
     ///
-    /// Errors: [`CouplingError::OutOfSync`], the map's refusals (both unchanged), or
-    /// [`CouplingError::NoSpring`] (the map changed; a tampered coupling).
+    /// Errors: [`CouplingError::OutOfSync`], [`CouplingError::StateCount`] (another map's
+    /// coupling), the map's refusals (all three: both unchanged), or [`CouplingError::NoSpring`]
+    /// (the map changed; a tampered coupling).
     ///
     /// # Examples
     ///
@@ -734,6 +774,7 @@ impl LeveledMechanics {
     ) -> Result<Refinement, CouplingError> {
         m.check_op_level(levels)?;
         LeveledMap::check_ball(center, radius)?;
+        self.in_sync(m)?;
         let before = self.masses.total(m);
         let mut per_level = vec![0; levels as usize + 1];
         for level in m.max_level().max(1)..=levels {

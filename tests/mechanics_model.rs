@@ -481,3 +481,36 @@ fn a_model_whose_totals_overflow_is_refused_naming_the_tet_and_quantity() {
     let total: f64 = flat.system.mass.iter().sum();
     assert!(rel_close(total, body.attrs().total_vertex_mass(body.map()), 1e-12) && total.is_finite());
 }
+
+/// Finding 24 (docs/VERIFICATION.md): `Body::new` wrapped any map with any attributes, and every
+/// operation then ran on a body that broke the conservation laws from the start. Parts from
+/// outside are now checked; refused parts come back unchanged.
+#[test]
+fn a_body_from_parts_that_disagree_is_refused_and_the_parts_come_back() {
+    let build = |k: usize| {
+        let (points, tets) = kuhn_cube(k);
+        Body::from_tets(&points, &tets, material()).unwrap().0
+    };
+    // Each way round: a larger map with smaller attributes, and the reverse.
+    for (map_from, attrs_from) in [(2, 1), (1, 2)] {
+        let (map, _) = build(map_from).into_parts();
+        let (_, mech) = build(attrs_from).into_parts();
+        let (darts, rest) = (map.dart_count(), mech.rest_position.as_slice().to_vec());
+        let refused = Body::new(map, mech).unwrap_err();
+        assert!(refused.to_string().starts_with("the attributes do not agree with the map"), "{refused}");
+        assert_eq!(refused.map.dart_count(), darts);
+        assert_eq!(&refused.attrs.rest_position.as_slice()[..rest.len()], &rest[..]);
+    }
+    // A lawful body after cuts goes apart and back together.
+    let mut body = build(2);
+    let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+    body.unsew3(d).unwrap();
+    let (map, mech) = body.into_parts();
+    let again = Body::new(map, mech).unwrap();
+    assert!(again.check().is_ok() && again.map().is_free(3, d));
+    // One moved rest position is enough to refuse (the rest lengths no longer match it).
+    let (map, mut mech) = again.into_parts();
+    mech.rest_position[CellId(0)][0] += 0.25;
+    let refused = Body::new(map, mech).unwrap_err();
+    assert!(matches!(refused.error, ConservationError::RestLength { .. }), "{refused}");
+}

@@ -209,7 +209,7 @@ impl<T> std::ops::IndexMut<CellId> for CellArray<T> {
 /// }
 /// let (map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
 /// let d = map.darts().find(|&d| !map.is_free(3, d)).unwrap();
-/// let mut e = Embedded::new(map, SplitCount(0));
+/// let mut e = Embedded::new(map, SplitCount(0)).unwrap();
 /// let changes = e.unsew(3, d).unwrap();
 /// assert_eq!(e.attrs().0, changes.changes.len());
 /// ```
@@ -281,7 +281,7 @@ pub trait CellRules<const N: usize> {
 /// }
 /// let (map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
 /// let d = map.darts().find(|&d| !map.is_free(3, d)).unwrap();
-/// let mut e = Embedded::new(map, SideCheck(0));
+/// let mut e = Embedded::new(map, SideCheck(0)).unwrap();
 /// e.unsew(3, d).unwrap();
 /// assert_eq!(e.attrs().0, 7); // 3 vertices, 3 edges and the face
 /// ```
@@ -389,8 +389,43 @@ impl<const N: usize, E: Clone> Clone for Embedded<N, E> {
     }
 }
 
+/// Parts that [`Embedded::new`] refused: the reason ([`CellRules::check`]'s error) and the map
+/// and attributes given back unchanged (after [`CellRules::grow_to`]), so nothing is lost.
+pub struct RefusedParts<const N: usize, E: CellRules<N>> {
+    /// What the check found.
+    pub error: E::Error,
+    /// The map given.
+    pub map: GMap<N>,
+    /// The attributes given.
+    pub attrs: E,
+}
+
+impl<const N: usize, E: CellRules<N>> std::fmt::Debug for RefusedParts<N, E> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RefusedParts").field("error", &self.error).field("darts", &self.map.dart_count()).finish()
+    }
+}
+
+impl<const N: usize, E: CellRules<N>> std::fmt::Display for RefusedParts<N, E> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "the attributes do not agree with the map: {}", self.error)
+    }
+}
+
+impl<const N: usize, E: CellRules<N>> std::error::Error for RefusedParts<N, E> {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        Some(&self.error)
+    }
+}
+
 impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
-    /// Wraps a map and attributes that already agree with it. O(1) (plus [`CellRules::grow_to`]).
+    /// Wraps a map and attributes, which must agree: [`CellRules::check`] runs first (for the
+    /// mechanical model, every conservation law), since parts from outside are the one way in
+    /// that no rule has vetted. O(check) (plus [`CellRules::grow_to`]).
+    ///
+    /// # Errors
+    /// [`RefusedParts`] (boxed: it holds the whole map): the check's error, with both parts given
+    /// back.
     ///
     /// # Examples
     ///
@@ -401,11 +436,28 @@ impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
     /// let (points, tets) = kuhn_cube(1);
     /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
     /// let (map, mech) = body.into_parts();
-    /// let rebuilt = Body::new(map.clone(), mech);
+    /// let rebuilt = Body::new(map.clone(), mech.clone()).unwrap();
     /// assert_eq!(rebuilt.version(), 0);
     /// assert!(rebuilt.map().is_isomorphic(&map));
+    /// // The attributes of another body do not agree with this map: refused, parts given back.
+    /// let (points, tets) = kuhn_cube(2);
+    /// let (other, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let refused = Body::new(other.into_parts().0, mech).unwrap_err();
+    /// assert!(refused.to_string().starts_with("the attributes do not agree with the map"));
+    /// assert_eq!(refused.map.dart_count(), 1152);
     /// ```
-    pub fn new(map: GMap<N>, mut attrs: E) -> Self {
+    pub fn new(map: GMap<N>, mut attrs: E) -> Result<Self, Box<RefusedParts<N, E>>> {
+        attrs.grow_to(&map);
+        if let Err(error) = attrs.check(&map) {
+            return Err(Box::new(RefusedParts { error, map, attrs }));
+        }
+        Ok(Embedded { map, attrs, version: 0, identity: next_identity() })
+    }
+
+    /// [`Embedded::new`] without the check, for parts this crate has just built or checked
+    /// itself (the model builder, the store after its own conservation check). O(1) (plus
+    /// [`CellRules::grow_to`]).
+    pub(crate) fn from_checked_parts(map: GMap<N>, mut attrs: E) -> Self {
         attrs.grow_to(&map);
         Embedded { map, attrs, version: 0, identity: next_identity() }
     }
@@ -637,7 +689,7 @@ impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
     /// let (points, tets) = kuhn_cube(1);
     /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
     /// let (map, mech) = body.into_parts();
-    /// let again = Body::new(map, mech); // back together, attributes unchanged
+    /// let again = Body::new(map, mech).unwrap(); // back together, attributes unchanged
     /// assert!(again.check().is_ok());
     /// assert_eq!(again.map().dart_count(), 144);
     /// ```

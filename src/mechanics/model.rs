@@ -1021,7 +1021,7 @@ impl Embedded<3, Mechanics> {
         }
         mech.position = mech.rest_position.clone();
         mech.init_from_map(&map);
-        Ok((Embedded::new(map, mech), report))
+        Ok((Embedded::from_checked_parts(map, mech), report))
     }
 
     /// Dissociates the face of `d` from its neighbour: 3-unsews it and applies the split rules

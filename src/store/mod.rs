@@ -476,7 +476,7 @@ impl Document {
         map.validate()?;
         let mech = raw_mech.to_mechanics();
         crate::mechanics::check_conservation(&map, &mech)?;
-        Ok(Body::new(map, mech))
+        Ok(Body::from_checked_parts(map, mech))
     }
 }
 

@@ -335,3 +335,67 @@ fn a_kinetic_energy_at_the_runaway_limit_is_not_a_blow_up() {
         }
     }
 }
+
+/// A chain of `n` unit masses on springs, the first pinned, hanging under gravity.
+fn chain(n: usize) -> (SpringSystem, Vec<[f64; 3]>, Vec<[f64; 3]>) {
+    let mut sys = SpringSystem::default();
+    sys.gravity = [0.0, 0.0, -10.0];
+    for i in 0..n {
+        sys.push_slot(1.0, i == 0, 0.1);
+    }
+    for i in 1..n {
+        sys.push_spring([(i - 1) as u32, i as u32], 1.0, 100.0, 0.1);
+    }
+    let x = (0..n).map(|i| [0.0, 0.0, -(i as f64)]).collect();
+    (sys, x, vec![[0.0; 3]; n])
+}
+
+/// Finding 25 (docs/VERIFICATION.md): a stepper given a system of another shape panicked on its
+/// buffer sizes, and NaN or negative parameters were only found as a blow-up after the first
+/// step (or, for the implicit scheme with a NaN mass, not at all).
+#[test]
+fn a_stepper_refuses_another_system_and_input_it_cannot_step() {
+    for integrator in [Integrator::Euler, Integrator::Symplectic, Integrator::Rk4, Integrator::Implicit] {
+        for parallel in [false, true] {
+            let config = StepConfig { parallel, ..StepConfig::new(integrator, 1e-3) };
+            let (sys, x, v) = chain(4);
+            let mut stepper = Stepper::new(config, &sys, &x, &v).unwrap();
+            for n in [2, 10] {
+                let (other, mut x2, mut v2) = chain(n);
+                let before = x2.clone();
+                let e = stepper.step(&other, &mut x2, &mut v2).unwrap_err();
+                let expected = StepError::OtherSystem { slots: 4, springs: 3, got_slots: n, got_springs: n - 1 };
+                assert_eq!(e, expected, "{integrator:?} parallel {parallel}");
+                assert_eq!(x2, before);
+            }
+            let (mut x, mut v) = (x, v);
+            stepper.step(&sys, &mut x, &mut v).unwrap(); // its own system still steps
+        }
+    }
+    type Tamper = fn(&mut SpringSystem, &mut Vec<[f64; 3]>, &mut Vec<[f64; 3]>);
+    let cases: [(Tamper, &str); 13] = [
+        (|s, _, _| s.mass[1] = f64::NAN, "mass of slot 1 is NaN"),
+        (|s, _, _| s.mass[2] = -1.0, "mass of slot 2 is -1"),
+        (|s, _, _| s.inv_mass[3] = f64::INFINITY, "inverse mass of slot 3 is inf"),
+        (|s, _, _| s.viscosity[0] = -0.5, "viscosity of slot 0 is -0.5"),
+        (|s, _, _| s.rest[0] = f64::NAN, "rest length of spring 0 is NaN"),
+        (|s, _, _| s.stiffness[2] = f64::NAN, "stiffness of spring 2 is NaN"),
+        (|s, _, _| s.damping[1] = -2.0, "damping of spring 1 is -2"),
+        (|s, _, _| s.gravity[1] = f64::NAN, "gravity [0.0, NaN, -10.0] is not finite"),
+        (|s, _, _| s.ends[1] = [1, 9], "spring 1 joins slots [1, 9]"),
+        (|s, _, _| s.ends[2] = [3, 3], "spring 2 joins slots [3, 3]"),
+        (|s, _, _| s.damping.truncate(2), "damping has 2 entries for 3 springs"),
+        (|_, x, _| x[1][2] = f64::NEG_INFINITY, "start position of slot 1"),
+        (|_, _, v| v[3][0] = f64::NAN, "start velocity of slot 3"),
+    ];
+    for (tamper, expected) in cases {
+        let (mut sys, mut x, mut v) = chain(4);
+        tamper(&mut sys, &mut x, &mut v);
+        for integrator in [Integrator::Euler, Integrator::Rk4, Integrator::Implicit] {
+            match Stepper::new(StepConfig::new(integrator, 1e-3), &sys, &x, &v) {
+                Err(StepError::BadInput(text)) => assert!(text.starts_with(expected), "{expected}: {text}"),
+                other => panic!("{expected}: {other:?}"),
+            }
+        }
+    }
+}

@@ -157,6 +157,25 @@ pub enum StepError {
         /// Length of the state given.
         got: usize,
     },
+    /// [`Stepper::step`] was given a system of another shape than the one the stepper was made
+    /// for (its buffers are sized by it): make a new stepper for the new system.
+    #[error("this stepper was made for {slots} slots and {springs} springs, the system given has {got_slots} and {got_springs}")]
+    OtherSystem {
+        /// Slots of the system at [`Stepper::new`].
+        slots: usize,
+        /// Springs of the system at [`Stepper::new`].
+        springs: usize,
+        /// Slots of the system given.
+        got_slots: usize,
+        /// Springs of the system given.
+        got_springs: usize,
+    },
+    /// [`Stepper::new`] was given a system or a start state it cannot step, named in the text:
+    /// a mass, inverse mass, viscosity, rest length, stiffness or damping that is NaN, infinite
+    /// or negative, a non-finite gravity, per-slot or per-spring arrays of the wrong length, a
+    /// spring whose ends are equal or not slots, a non-finite start position or velocity.
+    #[error("cannot step this input: {0}")]
+    BadInput(String),
 }
 
 /// Parameters of the stepping.
@@ -273,7 +292,8 @@ impl Stepper {
     /// test. O(slots + springs).
     ///
     /// # Errors
-    /// [`StepError::BadTimeStep`], [`StepError::SizeMismatch`].
+    /// [`StepError::BadTimeStep`], [`StepError::BadParameter`], [`StepError::SizeMismatch`],
+    /// [`StepError::BadInput`] (a system or start state it cannot step).
     ///
     /// # Examples
     ///
@@ -287,6 +307,9 @@ impl Stepper {
     /// assert_eq!((stepper.steps_done(), stepper.config().dt), (0, 0.01));
     /// let bad = Stepper::new(StepConfig::new(Integrator::Implicit, 0.01), &sys, &[], &v);
     /// assert!(matches!(bad, Err(StepError::SizeMismatch { .. })));
+    /// sys.viscosity[0] = f64::NAN; // a parameter the stepping cannot use
+    /// let bad = Stepper::new(StepConfig::new(Integrator::Implicit, 0.01), &sys, &x, &v).unwrap_err();
+    /// assert_eq!(bad.to_string(), "cannot step this input: viscosity of slot 0 is NaN (must be finite and >= 0)");
     /// ```
     pub fn new(config: StepConfig, sys: &SpringSystem, x: &[Vec3], v: &[Vec3]) -> Result<Self, StepError> {
         if !(config.dt.is_finite() && config.dt > 0.0) {
@@ -299,6 +322,8 @@ impl Stepper {
         }
         check_len(sys, x)?;
         check_len(sys, v)?;
+        check_system(sys).map_err(StepError::BadInput)?;
+        check_start(x, v).map_err(StepError::BadInput)?;
         let (n, s) = (sys.slots(), sys.springs());
         let z = |len| vec![[0.0; 3]; len];
         Ok(Stepper {
@@ -452,8 +477,10 @@ impl Stepper {
     /// O(slots + springs) (times the CG iterations for the implicit scheme).
     ///
     /// # Errors
-    /// [`StepError::BlowUp`], [`StepError::SolverFailed`], [`StepError::SizeMismatch`]. After an
-    /// error the state holds the bad values (for inspection); do not continue.
+    /// [`StepError::BlowUp`], [`StepError::SolverFailed`] (after either, the state holds the bad
+    /// values, for inspection; do not continue), [`StepError::SizeMismatch`] and
+    /// [`StepError::OtherSystem`] (a system of another shape than at [`Stepper::new`]; nothing
+    /// moved).
     ///
     /// # Examples
     ///
@@ -471,8 +498,23 @@ impl Stepper {
     /// (0..100).for_each(|_| stepper.step(&sys, &mut x, &mut v).unwrap());
     /// assert_eq!(stepper.steps_done(), 100);
     /// assert!(x[0] == [0.0; 3] && x[1][2] < -1.0); // the anchor stays, the mass falls
+    /// // Another system's shape is refused, not stepped with buffers of the wrong size.
+    /// let mut bigger = sys.clone();
+    /// bigger.push_slot(1.0, false, 0.0);
+    /// let (mut x3, mut v3) = (vec![[0.0; 3]; 3], vec![[0.0; 3]; 3]);
+    /// let e = stepper.step(&bigger, &mut x3, &mut v3).unwrap_err();
+    /// assert!(matches!(e, topomech::mechanics::StepError::OtherSystem { slots: 2, got_slots: 3, .. }));
     /// ```
     pub fn step(&mut self, sys: &SpringSystem, x: &mut [Vec3], v: &mut [Vec3]) -> Result<(), StepError> {
+        if (sys.slots(), sys.springs()) != (self.ys.len(), self.sf.len()) {
+            let (got_slots, got_springs) = (sys.slots(), sys.springs());
+            return Err(StepError::OtherSystem {
+                slots: self.ys.len(),
+                springs: self.sf.len(),
+                got_slots,
+                got_springs,
+            });
+        }
         check_len(sys, x)?;
         check_len(sys, v)?;
         match self.config.integrator {
@@ -726,6 +768,44 @@ fn stage_slots(
         }
     }
     probe
+}
+
+/// What makes `sys` unsteppable (see [`StepError::BadInput`]), if anything. O(slots + springs),
+/// no allocation unless it fails.
+fn check_system(sys: &SpringSystem) -> Result<(), String> {
+    let (n, s) = (sys.slots(), sys.springs());
+    let per_slot = [("inverse mass", &sys.inv_mass), ("viscosity", &sys.viscosity)];
+    let per_spring = [("rest length", &sys.rest), ("stiffness", &sys.stiffness), ("damping", &sys.damping)];
+    for (name, values, len, of) in
+        per_slot.map(|(a, b)| (a, b, n, "slots")).into_iter().chain(per_spring.map(|(a, b)| (a, b, s, "springs")))
+    {
+        if values.len() != len {
+            return Err(format!("{name} has {} entries for {len} {of}", values.len()));
+        }
+    }
+    let all = [("mass", &sys.mass, "slot")].into_iter().chain(per_slot.map(|(a, b)| (a, b, "slot")));
+    for (name, values, of) in all.chain(per_spring.map(|(a, b)| (a, b, "spring"))) {
+        if let Some((i, x)) = values.iter().enumerate().find(|(_, x)| !(x.is_finite() && **x >= 0.0)) {
+            return Err(format!("{name} of {of} {i} is {x} (must be finite and >= 0)"));
+        }
+    }
+    if !sys.gravity.iter().all(|g| g.is_finite()) {
+        return Err(format!("gravity {:?} is not finite", sys.gravity));
+    }
+    match sys.ends.iter().enumerate().find(|(_, e)| e[0] == e[1] || e[0].max(e[1]) as usize >= n) {
+        Some((i, e)) => Err(format!("spring {i} joins slots {e:?} (must be two different slots of {n})")),
+        None => Ok(()),
+    }
+}
+
+/// What makes the start state unsteppable: a non-finite position or velocity. O(slots).
+fn check_start(x: &[Vec3], v: &[Vec3]) -> Result<(), String> {
+    for (name, values) in [("position", x), ("velocity", v)] {
+        if let Some((i, p)) = values.iter().enumerate().find(|(_, p)| !p.iter().all(|c| c.is_finite())) {
+            return Err(format!("start {name} of slot {i} is {p:?} (must be finite)"));
+        }
+    }
+    Ok(())
 }
 
 fn check_len(sys: &SpringSystem, x: &[Vec3]) -> Result<(), StepError> {

@@ -123,7 +123,7 @@ fn undo(f: &mut Fixture, dissociations: &[cut::Dissociation]) {
     let mut touched = TouchedCells::default();
     for dis in dissociations.iter().rev() {
         let changes = f.body.sew3(dis.dart, dis.opposite).expect("sew back");
-        touched.record(f.body.map(), &changes);
+        touched.record_change(&f.body, &changes);
     }
     f.projection.update(&f.body, &touched);
 }

@@ -60,7 +60,7 @@ fn main() {
             }
             let changes = body.sew3(dis.dart, dis.opposite).expect("sew back");
             let mut touched = TouchedCells::default();
-            touched.record(body.map(), &changes);
+            touched.record_change(&body, &changes);
             projection.update(&body, &touched);
         }
     }

@@ -37,7 +37,7 @@ impl Probe {
         let mut touched = TouchedCells::default();
         for dis in dissociations.iter().rev() {
             let changes = self.body.sew3(dis.dart, dis.opposite).expect("sew back");
-            touched.record(self.body.map(), &changes);
+            touched.record_change(&self.body, &changes);
         }
         self.projection.update(&self.body, &touched);
     }

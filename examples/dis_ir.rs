@@ -84,7 +84,7 @@ fn tears(body: &mut Body, projection: &mut Projection, vertices: &[DartId], pass
 fn undo(body: &mut Body, projection: &mut Projection, dis: &cut::Dissociation) {
     let mut touched = TouchedCells::default();
     let changes = body.sew3(dis.dart, dis.opposite).expect("sew back");
-    touched.record(body.map(), &changes);
+    touched.record_change(body, &changes);
     projection.update(body, &touched);
 }
 

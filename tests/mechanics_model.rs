@@ -514,3 +514,70 @@ fn a_body_from_parts_that_disagree_is_refused_and_the_parts_come_back() {
     let refused = Body::new(map, mech).unwrap_err();
     assert!(matches!(refused.error, ConservationError::RestLength { .. }), "{refused}");
 }
+
+/// Finding 26 (docs/VERIFICATION.md): `Projection::update` trusted its touched list. A vertex id
+/// past the map panicked; a missed, repeated or hand-made list left a projection that said it
+/// was current but was not a fresh build. Only lists that take the projection to the body's
+/// version are applied incrementally now; anything else rebuilds.
+#[test]
+fn a_projection_update_takes_only_lists_that_bring_it_up_to_date() {
+    use topomech::cut::dissociate_face;
+    use topomech::mechanics::TouchedCells;
+    let fresh = |b: &Body| Projection::build(b, G);
+    let inner = |b: &Body, k: usize| b.map().darts().filter(|&d| !b.map().is_free(3, d)).nth(k).unwrap();
+    let (points, tets) = kuhn_cube(2);
+    let base = Body::from_tets(&points, &tets, material()).unwrap().0;
+
+    // Hand-made lists: an id past the map, a dart past the map. Rebuilt, no panic.
+    let mut hand = TouchedCells::default();
+    hand.vertices.push((CellId(9999), None));
+    hand.edges.push((CellId(5000), Some(DartId(88888))));
+    let mut p = fresh(&base);
+    assert!(!p.update(&base, &hand));
+    assert!(p.is_current(&base) && p.equivalent(&fresh(&base)).is_ok());
+
+    // Two cuts; a projection from before them.
+    let mut body = base.clone();
+    let before = fresh(&body);
+    let d = inner(&body, 0);
+    let first = dissociate_face(&mut body, d).unwrap();
+    let d = inner(&body, 200);
+    let second = dissociate_face(&mut body, d).unwrap();
+    assert!(before.equivalent(&fresh(&body)).is_err(), "the cuts must need an update");
+    for (name, list) in [("empty", TouchedCells::default()), ("first cut only", first.touched.clone())] {
+        let mut p = before.clone();
+        assert!(!p.update(&body, &list), "{name}");
+        assert!(p.is_current(&body) && p.equivalent(&fresh(&body)).is_ok(), "{name}: not a fresh build");
+    }
+    // Both lists in order: incremental. Out of order: rebuilt.
+    let mut both = first.touched.clone();
+    both.extend(&second.touched);
+    let mut reversed = second.touched.clone();
+    reversed.extend(&first.touched);
+    assert_eq!(both.versions(&body), Some((0, 2)));
+    assert_eq!(reversed.versions(&body), None);
+    let mut p = before.clone();
+    assert!(!p.update(&body, &reversed));
+    assert!(p.equivalent(&fresh(&body)).is_ok());
+    let mut p = before.clone();
+    assert!(p.update(&body, &both), "the operations' lists in order are incremental");
+    assert!(p.equivalent(&fresh(&body)).is_ok());
+    // Sewing both back, each change recorded: incremental too.
+    let mut back = TouchedCells::default();
+    for dis in [&second, &first] {
+        let changes = body.sew3(dis.dart, dis.opposite).unwrap();
+        back.record_change(&body, &changes);
+    }
+    assert_eq!(back.versions(&body), Some((2, 4)));
+    assert!(p.update(&body, &back), "recorded changes in order are incremental");
+    assert!(p.equivalent(&fresh(&body)).is_ok());
+    assert!(!p.update(&body, &back), "the same list again is refused and rebuilt");
+    assert!(p.equivalent(&fresh(&body)).is_ok());
+    let d = inner(&body, 0);
+    let again = dissociate_face(&mut body, d).unwrap();
+    let mut by_hand = TouchedCells::default();
+    by_hand.vertices = again.touched.vertices.clone();
+    by_hand.edges = again.touched.edges.clone();
+    assert!(!p.update(&body, &by_hand), "a copy by hand has no version stamp");
+    assert!(p.equivalent(&fresh(&body)).is_ok());
+}

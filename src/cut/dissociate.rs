@@ -106,9 +106,11 @@ pub fn dissociate_face(body: &mut Body, d: DartId) -> Result<Dissociation, CutEr
     if map.is_free(3, d) {
         return Err(CutError::BoundaryFace { face: map.cell_id(2, d), dart: d });
     }
-    let opposite = map.alpha::<3>(d);
+    let (opposite, from) = (map.alpha::<3>(d), body.version());
     let changes = body.unsew3(d)?;
-    Ok(report(body, d, opposite, &changes))
+    let mut dis = report(body, d, opposite, &changes);
+    dis.touched.cover(body, from);
+    Ok(dis)
 }
 
 /// [`dissociate_face`] of the face with id `f`. O(darts) to find a dart of it ([`face_dart`]),

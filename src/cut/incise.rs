@@ -181,11 +181,13 @@ pub fn incise_plane(body: &mut Body, plane: &Plane) -> Result<Incision, CutError
 /// tail of the incisions. O(Σ dissociation costs).
 pub(crate) fn dissociate_all(body: &mut Body, faces: Vec<DartId>) -> Result<Incision, CutError> {
     let mut out = Incision { dissociations: Vec::with_capacity(faces.len()), touched: TouchedCells::default() };
+    let from = body.version();
     for d in faces {
         let dis = dissociate_face(body, d)?;
         out.touched.extend(&dis.touched);
         out.dissociations.push(dis);
     }
+    out.touched.cover(body, from);
     Ok(out)
 }
 

@@ -560,7 +560,11 @@ impl Harness {
                 touched.extend(&tear.touched);
             }
         }
-        self.projection.update(&self.body, &touched);
+        // The operations' own lists must always be taken incrementally: a rebuild here would
+        // make the "incremental ≡ fresh" law of `check` hold trivially.
+        if !self.projection.update(&self.body, &touched) {
+            return Err(format!("{op:?}: the operation's touched cells were not taken incrementally"));
+        }
         Ok(())
     }
 

@@ -101,6 +101,7 @@ pub fn remove_volume(body: &mut Body, t: CellId) -> Result<Removal, CutError> {
         return Err(CutError::NotATet { volume: t, dart: d, darts: darts.len() });
     }
     let (removed_mass, removed_stiffness) = mass_and_stiffness(body, t, &darts);
+    let from = body.version();
     let mut touched = TouchedCells::default();
     let mut dissociations = Vec::new();
     for x in one_dart_per_face(body.map(), &darts) {
@@ -116,6 +117,7 @@ pub fn remove_volume(body: &mut Body, t: CellId) -> Result<Removal, CutError> {
         touched.edges.push((map.cell_id(1, x), None));
     }
     delete_isolated(body, &darts)?;
+    touched.cover(body, from);
     Ok(Removal { volume: t, removed_mass, removed_stiffness, dissociations, touched })
 }
 

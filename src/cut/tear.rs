@@ -332,6 +332,8 @@ pub fn tear_vertex(body: &mut Body, v: CellId, direction: Vec3, hint: Option<Dar
     let best = start_face(body, start, direction);
     let mut tear =
         Tear { vertex: v, fan: Vec::new(), dissociations: Vec::new(), split: false, touched: TouchedCells::default() };
+    let from = body.version();
+    tear.touched.cover(body, from);
     let Some(d0) = best else { return Ok(tear) };
     tear.fan = fan_darts(body.map(), d0);
     tear.dissociations.reserve(tear.fan.len());
@@ -341,9 +343,10 @@ pub fn tear_vertex(body: &mut Body, v: CellId, direction: Vec3, hint: Option<Dar
         }
         let dis = dissociate_face(body, d)?;
         tear.split |= dis.vertices.iter().any(|s| s.kept == v);
-        append(&mut tear.touched, &dis.touched);
+        tear.touched.extend(&dis.touched);
         tear.dissociations.push(dis);
     }
+    tear.touched.cover(body, from);
     Ok(tear)
 }
 
@@ -400,19 +403,13 @@ pub fn tear_step(
             continue;
         }
         let tear = tear_vertex(body, id, stress[v].direction, Some(hint))?;
-        append(&mut touched, &tear.touched);
+        touched.extend(&tear.touched);
         out.tears.push(tear);
     }
     if !touched.is_empty() {
         sim.update(body, &touched)?;
     }
     Ok(out)
-}
-
-/// Appends `more`'s records to `into`, in order, without cloning `more`. O(records).
-fn append(into: &mut TouchedCells, more: &TouchedCells) {
-    into.vertices.extend_from_slice(&more.vertices);
-    into.edges.extend_from_slice(&more.edges);
 }
 
 fn mul(m: &[[f64; 3]; 3], v: Vec3) -> Vec3 {

@@ -30,6 +30,13 @@
 //! Spring order differs from a fresh build (appended, not sorted), so the two are compared with
 //! [`Projection::equivalent`], cell by cell.
 //!
+//! The lists are stamped with the versions of the body they cover (the operations of
+//! `crate::cut` do it, [`TouchedCells::extend`] joins consecutive ones,
+//! [`TouchedCells::record_change`] stamps one sew or unsew of [`Body`]), and an update applies
+//! them only when they take the projection from its version to the body's; a missed, repeated,
+//! reordered or hand-made list makes it rebuild instead, so a projection that says it is
+//! current always is.
+//!
 //! [`forces_by_coverage`] computes the same forces the paper's first way, by covering the
 //! map's edges and vertices with a dart set: the reference the projection is tested against.
 
@@ -228,8 +235,15 @@ impl Projection {
     /// update"): afterwards the projection is [`Projection::equivalent`] to a fresh
     /// [`Projection::build`] of `body` and [`Projection::is_current`] holds.
     /// Cost: O(touched cells · degree + new ids) amortised (see [`SpringSystem`]'s incidence
-    /// lists); nothing proportional to the mesh. A projection built from another body
-    /// ([`Projection::is_for`] false) is rebuilt from `body` instead, O(darts + E log E).
+    /// lists); nothing proportional to the mesh. Returns `true` for this incremental update.
+    ///
+    /// `touched` must bring this projection to the body's version: the lists an operation of
+    /// `crate::cut` returned, or several of them merged in order with [`TouchedCells::extend`]
+    /// ([`TouchedCells::versions`] = (this projection's version, the body's version)). Anything
+    /// else — a projection of another body ([`Projection::is_for`] false), a missed or repeated
+    /// operation, lists filled by hand or by [`TouchedCells::record`] — cannot be trusted, and
+    /// the projection is rebuilt from `body` instead (O(darts + E log E)); the result is `false`.
+    /// Either way the projection ends current and equal to a fresh build.
     ///
     /// # Examples
     ///
@@ -242,15 +256,24 @@ impl Projection {
     /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
     /// let mut p = Projection::build(&body, [0.0, 0.0, -9.81]);
     /// let cut = incise_plane(&mut body, &Plane { point: [1.0; 3], normal: [1.0, 0.0, 0.0] }).unwrap();
-    /// p.update(&body, &cut.touched);
+    /// assert!(p.update(&body, &cut.touched)); // incremental
     /// assert!(p.is_current(&body));
     /// assert!(p.equivalent(&Projection::build(&body, [0.0, 0.0, -9.81])).is_ok());
     /// assert_eq!(p.system.slots(), body.map().cell_id_bound(0)); // new vertex ids got slots
     /// ```
-    pub fn update(&mut self, body: &Body, touched: &TouchedCells) {
-        if !self.is_for(body) {
-            // Built from another body: its records say nothing about this one.
-            return self.rebuild(body);
+    pub fn update(&mut self, body: &Body, touched: &TouchedCells) -> bool {
+        let brings_up_to_date = match touched.span {
+            Span::Versions { body: id, from, to } => {
+                id == body.identity() && from == self.version && to == body.version()
+            }
+            Span::Nothing => touched.is_empty() && self.version == body.version(),
+            Span::Unknown => false,
+        };
+        if !self.is_for(body) || !brings_up_to_date {
+            // Built from another body, or records that do not take this projection to the body's
+            // version (missed, repeated, hand-made): they cannot be trusted.
+            self.rebuild(body);
+            return false;
         }
         let map = body.map();
         let mech = body.attrs();
@@ -277,6 +300,7 @@ impl Projection {
         }
         self.scratch = resolved;
         self.version = body.version();
+        true
     }
 
     /// Writes (or appends) the spring of live edge `e`, a dart of which is `d`. O(degree of its
@@ -519,9 +543,75 @@ pub struct TouchedCells {
     pub vertices: Vec<(CellId, Option<DartId>)>,
     /// Edge ids and a dart of each.
     pub edges: Vec<(CellId, Option<DartId>)>,
+    /// Which changes of which body the lists hold (stamped by the operations).
+    span: Span,
+}
+
+/// Which topological changes a [`TouchedCells`] holds, so that [`Projection::update`] applies
+/// it only to a projection it brings up to date.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+enum Span {
+    /// Nothing recorded.
+    #[default]
+    Nothing,
+    /// Every change of body `body` ([`crate::embedding::Embedded::identity`]) from version
+    /// `from` to version `to`, as the operations of `crate::cut` report them.
+    Versions { body: u64, from: u64, to: u64 },
+    /// Records of unknown coverage: filled by hand or by [`TouchedCells::record`], or merged
+    /// from operations that do not follow each other.
+    Unknown,
+}
+
+impl Span {
+    /// The span of lists `a` followed by lists `b` (each with whether its lists are empty):
+    /// an empty unstamped side adds nothing; two stamped spans of one body join when `b` starts
+    /// where `a` ends; anything else is unknown. O(1).
+    fn joined((a, a_empty): (Span, bool), (b, b_empty): (Span, bool)) -> Span {
+        match (a, b) {
+            (Span::Nothing, span) if a_empty => span,
+            (span, Span::Nothing) if b_empty => span,
+            (Span::Versions { body, from, to }, Span::Versions { body: id, from: f, to: t })
+                if body == id && to == f =>
+            {
+                Span::Versions { body, from, to: t }
+            }
+            _ => Span::Unknown,
+        }
+    }
 }
 
 impl TouchedCells {
+    /// Stamps the lists as every change of `body` since its version `from` (the operation that
+    /// filled them started there and `body` is now where it ended). O(1).
+    pub(crate) fn cover(&mut self, body: &Body, from: u64) {
+        self.span = Span::Versions { body: body.identity(), from, to: body.version() };
+    }
+
+    /// The versions of `body` the lists bring a projection from and to, when an operation of
+    /// `crate::cut` (or an in-order [`Self::extend`] of theirs) filled them; `None` for lists of
+    /// unknown coverage (filled by hand or by [`Self::record`]) or of another body. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::dissociate_face;
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, TouchedCells};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+    /// let cut = dissociate_face(&mut body, d).unwrap();
+    /// assert_eq!(cut.touched.versions(&body), Some((0, 1)));
+    /// assert_eq!(TouchedCells::default().versions(&body), None);
+    /// ```
+    pub fn versions(&self, body: &Body) -> Option<(u64, u64)> {
+        match self.span {
+            Span::Versions { body: id, from, to } if id == body.identity() => Some((from, to)),
+            _ => None,
+        }
+    }
+
     /// Records what `changes` (already applied to `map`) did to vertices and edges: both sides of
     /// every split, the survivor and the absorbed id of every merge, and every edge around a
     /// vertex that got a new id (its spring's ends changed). O(changes + stars of renamed
@@ -543,6 +633,8 @@ impl TouchedCells {
     /// assert!(!touched.is_empty() && !touched.vertices.is_empty());
     /// ```
     pub fn record(&mut self, map: &GMap<3>, changes: &CellChanges) {
+        // A map has no version: what these records cover is unknown until an operation stamps them.
+        self.span = Span::Unknown;
         self.record_with(map, changes, |t, d, side| match side {
             Some(side) => t.edges_around(map, side.iter().copied()),
             None => t.edges_around(map, map.cell_darts(0, d)),
@@ -615,7 +707,10 @@ impl TouchedCells {
     /// larger one only grows the list).
     const STAR_RESERVE: usize = 24;
 
-    /// Appends the records of `other` (a later operation of the same batch). O(|other|).
+    /// Appends the records of `other` (a later operation of the same batch). When both lists
+    /// were stamped by operations on one body and `other` starts where `self` ends, the result
+    /// covers both ([`Self::versions`]); otherwise its coverage is unknown and
+    /// [`Projection::update`] rebuilds from it. O(|other|).
     ///
     /// # Examples
     ///
@@ -636,8 +731,42 @@ impl TouchedCells {
     /// }
     /// ```
     pub fn extend(&mut self, other: &TouchedCells) {
+        self.span = Span::joined((self.span, self.is_empty()), (other.span, other.is_empty()));
         self.vertices.extend_from_slice(&other.vertices);
         self.edges.extend_from_slice(&other.edges);
+    }
+
+    /// [`Self::record`] of the `changes` that the last sew or unsew of `body` returned
+    /// ([`crate::mechanics::Body::sew3`], [`crate::mechanics::Body::unsew3`], …), called right
+    /// after it: the records are stamped as that one change (versions `body.version() − 1` to
+    /// `body.version()`), so that [`Projection::update`] can take them incrementally, alone or
+    /// after the lists of the operations before it. O(changes + stars of renamed vertices).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::dissociate_face;
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, Projection, TouchedCells};
+    ///
+    /// let (points, tets) = kuhn_cube(2);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let mut p = Projection::build(&body, [0.0; 3]);
+    /// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+    /// let cut = dissociate_face(&mut body, d).unwrap();
+    /// let mut touched = TouchedCells::default();
+    /// touched.extend(&cut.touched);
+    /// let changes = body.sew3(cut.dart, cut.opposite).unwrap(); // sew it back
+    /// touched.record_change(&body, &changes);
+    /// assert_eq!(touched.versions(&body), Some((0, 2)));
+    /// assert!(p.update(&body, &touched)); // incremental, both changes at once
+    /// assert!(p.equivalent(&Projection::build(&body, [0.0; 3])).is_ok());
+    /// ```
+    pub fn record_change(&mut self, body: &Body, changes: &CellChanges) {
+        let before = (self.span, self.is_empty());
+        self.record(body.map(), changes);
+        let step = Span::Versions { body: body.identity(), from: body.version().saturating_sub(1), to: body.version() };
+        self.span = Span::joined(before, (step, false));
     }
 
     /// Whether nothing was recorded. O(1).
@@ -867,7 +996,7 @@ mod tests {
                 };
                 vertex_splits += changes.splits(0).count();
                 vertex_merges += changes.merges(0).count();
-                fast.record(body.map(), &changes);
+                fast.record_change(&body, &changes);
                 record_per_dart(&mut reference, body.map(), &changes);
             }
             let map = body.map();
@@ -879,7 +1008,7 @@ mod tests {
                 assert_eq!(resolve(map, dim, &f), resolve_by_hash(map, dim, &f));
                 assert_eq!(resolve(map, dim, &r), resolve_by_hash(map, dim, &r));
             }
-            projection.update(&body, &fast);
+            assert!(projection.update(&body, &fast), "the recorded changes are taken incrementally");
             projection.equivalent(&Projection::build(&body, [0.0, 0.0, -1.0])).unwrap();
         }
         assert!(vertex_splits > 10 && vertex_merges > 10, "splits {vertex_splits}, merges {vertex_merges}");

@@ -581,3 +581,63 @@ fn a_projection_update_takes_only_lists_that_bring_it_up_to_date() {
     assert!(!p.update(&body, &by_hand), "a copy by hand has no version stamp");
     assert!(p.equivalent(&fresh(&body)).is_ok());
 }
+
+/// The laws are checked where the docs say: `Body::check` reports a broken law (here a moved
+/// rest position), and with `expensive-checks` a sew or unsew whose rules leave the attributes
+/// broken returns `EmbedError::Check` (a rule that breaks its law on every split, below).
+/// Found missing by the twenty-fourth mutation sample (docs/VERIFICATION.md).
+#[test]
+fn check_reports_a_broken_law_and_the_layer_checks_after_each_operation() {
+    let (points, tets) = kuhn_cube(1);
+    let (mut body, _) = Body::from_tets(&points, &tets, material()).unwrap();
+    assert!(body.check().is_ok());
+    body.attrs_mut().rest_position[CellId(0)][0] += 0.25;
+    assert!(matches!(body.check(), Err(ConservationError::RestLength { .. })));
+
+    /// Counts splits and calls its own law broken once any happened.
+    struct SplitsBreak(usize);
+    #[derive(Debug, thiserror::Error)]
+    #[error("{0} splits")]
+    struct Broken(usize);
+    impl CellRules<3> for SplitsBreak {
+        type Error = Broken;
+        fn grow_to(&mut self, _: &topomech::GMap<3>) {}
+        fn on_split(&mut self, _: &topomech::GMap<3>, _: &topomech::embedding::Split<'_>) {
+            self.0 += 1;
+        }
+        fn on_merge(&mut self, _: &topomech::GMap<3>, _: usize, _: CellId, _: CellId) {}
+        fn check(&self, _: &topomech::GMap<3>) -> Result<(), Broken> {
+            if self.0 == 0 {
+                Ok(())
+            } else {
+                Err(Broken(self.0))
+            }
+        }
+    }
+    let (map, _) = topomech::GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [0, 1, 2, 4]]).unwrap();
+    let d = map.darts().find(|&d| !map.is_free(3, d)).unwrap();
+    let mut e = topomech::embedding::Embedded::new(map, SplitsBreak(0)).unwrap();
+    let result = e.unsew(3, d);
+    assert!(e.map().is_free(3, d), "the unsew itself is done");
+    if cfg!(feature = "expensive-checks") {
+        assert!(matches!(result, Err(topomech::embedding::EmbedError::Check { op: "unsew", .. })), "{result:?}");
+    } else {
+        assert!(result.is_ok());
+    }
+    assert!(e.check().is_err());
+}
+
+/// Removing a tet counts as a topological change even when no face had to be dissociated first
+/// (a lone tet): the version moves on and a projection built before is stale. Found missing by
+/// the twenty-fourth mutation sample (the version bump of the crate-private bypass).
+#[test]
+fn removing_a_lone_tet_moves_the_version_on() {
+    let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    let (mut body, _) = Body::from_tets(&points, &[[0, 1, 2, 3]], material()).unwrap();
+    let projection = Projection::build(&body, G);
+    let removal = topomech::cut::remove_volume(&mut body, CellId(0)).unwrap();
+    assert!(removal.dissociations.is_empty());
+    assert_eq!(body.version(), 1);
+    assert!(!projection.is_current(&body));
+    assert_eq!(removal.touched.versions(&body), Some((0, 1)));
+}

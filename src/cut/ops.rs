@@ -377,7 +377,7 @@ pub enum Op {
 /// assert!(h.removed_mass > 0.0 && h.removed_mass < h.mass);
 /// assert!(h.check().is_ok());
 /// ```
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub struct Harness {
     /// The body under test.
     pub body: Body,
@@ -393,6 +393,28 @@ pub struct Harness {
     pub removed_mass: f64,
     /// Σ of the removed tets' stiffness contributions.
     pub removed_stiffness: f64,
+}
+
+/// A copy whose projection follows the copied body ([`Projection::for_clone`]), so that it is
+/// still only ever updated incrementally (a plain clone of the projection would be for the
+/// original body, and its first update a rebuild).
+impl Clone for Harness {
+    fn clone(&self) -> Self {
+        let body = self.body.clone();
+        let projection = match self.projection.for_clone(&self.body, &body) {
+            Some(p) => p,
+            None => Projection::build(&body, self.projection.system.gravity),
+        };
+        Harness {
+            body,
+            projection,
+            oracle: self.oracle.clone(),
+            mass: self.mass,
+            stiffness: self.stiffness,
+            removed_mass: self.removed_mass,
+            removed_stiffness: self.removed_stiffness,
+        }
+    }
 }
 
 /// Σ k_e over the live edges of `body`. O(darts).

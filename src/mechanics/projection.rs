@@ -212,6 +212,34 @@ impl Projection {
         self.body
     }
 
+    /// A copy of this projection for `copy`, a clone of `original` taken while this projection
+    /// was current for it (same map, attributes and version): the copy's arrays are the same,
+    /// only the body it answers for changes. `None` unless the projection is current for
+    /// `original` and `copy` is at the same version. O(slots + springs) (the copy).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, Projection};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let p = Projection::build(&body, [0.0; 3]);
+    /// let copy = body.clone();
+    /// let q = p.for_clone(&body, &copy).unwrap();
+    /// assert!(q.is_current(&copy) && !q.is_for(&body));
+    /// assert!(p.for_clone(&copy, &body).is_none()); // p is not current for `copy`
+    /// ```
+    pub fn for_clone(&self, original: &Body, copy: &Body) -> Option<Projection> {
+        if !self.is_current(original) || copy.version() != original.version() {
+            return None;
+        }
+        let mut out = self.clone();
+        out.body = copy.identity();
+        Some(out)
+    }
+
     /// The body version the projection was built from. O(1).
     ///
     /// # Examples

@@ -202,3 +202,28 @@ fn a_point_count_past_the_vertex_ids_is_refused() {
     let bad_index = [[0, 1, 2, u32::MAX]];
     assert!(matches!(GMap::<3>::from_tets(max, &bad_index), Err(BuildError::IndexOutOfRange { index: u32::MAX, .. })));
 }
+
+/// Finding 27 (docs/VERIFICATION.md): the kernel's queries answer for a dart that is not live or
+/// a dimension past n instead of panicking on a slice index or a shift, and `try_alpha` names a
+/// bad index as such (it reported the live dart as missing).
+#[test]
+fn kernel_queries_answer_for_dead_darts_and_dimensions_past_n() {
+    use topomech::gmap::DartError;
+    use topomech::{CellId, DartId};
+    let (map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [1, 2, 3, 4]]).unwrap();
+    let (live, dead) = (DartId(0), DartId(9999));
+    assert_eq!(map.try_alpha(9, live), Err(DartError::BadIndex { i: 9, n: 3 }));
+    assert_eq!(map.try_alpha(0, dead), Err(DartError::NoSuchDart(dead)));
+    assert!(map.orbit(dead, AlphaMask::of(&[0, 1])).is_empty());
+    assert!(map.cell_darts(0, dead).is_empty() && map.cell_darts(5, live).is_empty());
+    assert!(!map.same_orbit(live, dead, AlphaMask::all(3)) && !map.same_orbit(dead, dead, AlphaMask::all(3)));
+    assert!(map.one_dart_per_cell(4).is_empty());
+    assert!(map.incident_cells(live, 9, 0).is_empty() && map.incident_cells(live, 0, 9).is_empty());
+    assert!(map.incident_cells(dead, 2, 0).is_empty());
+    assert_eq!(map.cell_id_bound(9), 0);
+    assert!(!map.is_live_cell(8, CellId(0)));
+    // The answers for live darts and dimensions ≤ n are unchanged.
+    assert_eq!(map.cell_darts(3, live).len(), 24);
+    assert_eq!(map.one_dart_per_cell(3).len(), 2);
+    assert!(map.same_orbit(live, map.alpha::<1>(live), AlphaMask::cell(3, 0)));
+}

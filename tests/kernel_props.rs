@@ -180,7 +180,12 @@ proptest! {
                     }
                     Err(e) => {
                         prop_assert!(i > 3 || !map.contains(d), "try_alpha({i}, {d:?}) refused: {e}");
-                        prop_assert_eq!(e, topomech::gmap::DartError::NoSuchDart(d));
+                        let expected = if i > 3 {
+                            topomech::gmap::DartError::BadIndex { i, n: 3 }
+                        } else {
+                            topomech::gmap::DartError::NoSuchDart(d)
+                        };
+                        prop_assert_eq!(e, expected);
                     }
                 }
             }

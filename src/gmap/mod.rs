@@ -104,6 +104,14 @@ pub enum DartError {
     /// The map has 2^32 − 1 darts already.
     #[error("the map is full: {0} darts")]
     Full(usize),
+    /// An involution index past the dimension: α{i} of an n-map with n = {n}.
+    #[error("alpha index {i} out of range for a {n}-map")]
+    BadIndex {
+        /// The index given.
+        i: usize,
+        /// The map's dimension.
+        n: usize,
+    },
 }
 
 /// An n-dimensional generalized map with exact cell ids. See the [module docs](self).
@@ -322,11 +330,14 @@ impl<const N: usize> GMap<N> {
     ///
     /// let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
     /// assert_eq!(map.try_alpha(2, DartId(0)), Ok(DartId(0))); // a lone triangle is 2-free
-    /// assert_eq!(map.try_alpha(3, DartId(0)), Err(DartError::NoSuchDart(DartId(0))));
+    /// assert_eq!(map.try_alpha(3, DartId(0)), Err(DartError::BadIndex { i: 3, n: 2 }));
     /// assert_eq!(map.try_alpha(1, DartId(6)), Err(DartError::NoSuchDart(DartId(6))));
     /// ```
     pub fn try_alpha(&self, i: usize, d: DartId) -> Result<DartId, DartError> {
-        if i > N || !self.contains(d) {
+        if i > N {
+            return Err(DartError::BadIndex { i, n: N });
+        }
+        if !self.contains(d) {
             return Err(DartError::NoSuchDart(d));
         }
         Ok(self.alpha_dyn(i, d))
@@ -427,7 +438,8 @@ impl<const N: usize> GMap<N> {
         self.cell_id(0, d)
     }
 
-    /// One past the largest live i-cell id: the length an array keyed by i-cell id needs. O(1).
+    /// One past the largest live i-cell id: the length an array keyed by i-cell id needs (0 for
+    /// i > n: there are no such cells). O(1).
     ///
     /// # Examples
     ///
@@ -441,10 +453,10 @@ impl<const N: usize> GMap<N> {
     /// assert_eq!(map.count_cells().0[0], 4);
     /// ```
     pub fn cell_id_bound(&self, i: usize) -> usize {
-        self.ids[i].next as usize
+        self.ids.get(i).map_or(0, |ids| ids.next as usize)
     }
 
-    /// Whether `id` is a live i-cell id. O(free ids of dimension i).
+    /// Whether `id` is a live i-cell id (false for i > n). O(free ids of dimension i).
     ///
     /// # Examples
     ///
@@ -457,7 +469,7 @@ impl<const N: usize> GMap<N> {
     /// assert!(!map.is_live_cell(3, CellId(1))); // only one volume
     /// ```
     pub fn is_live_cell(&self, i: usize, id: CellId) -> bool {
-        id.0 < self.ids[i].next && !self.ids[i].free.contains(&id.0)
+        self.ids.get(i).is_some_and(|ids| id.0 < ids.next && !ids.free.contains(&id.0))
     }
 
     /// Creates an isolated dart (free for every αi), reusing a freed slot if any. It is its own

@@ -112,7 +112,8 @@ pub(crate) fn generators(n: usize, mask: AlphaMask) -> ([usize; 8], usize) {
 }
 
 impl<const N: usize> GMap<N> {
-    /// The darts of ⟨mask⟩(d) in breadth-first order, d first. O(orbit · n).
+    /// The darts of ⟨mask⟩(d) in breadth-first order, d first; empty when d is not a live dart.
+    /// O(orbit · n).
     ///
     /// # Examples
     ///
@@ -126,8 +127,12 @@ impl<const N: usize> GMap<N> {
     /// assert_eq!(face[0], d);
     /// assert_eq!(map.orbit(d, AlphaMask::all(3)).len(), 24);
     /// assert_eq!(map.orbit(d, AlphaMask::EMPTY), vec![d]);
+    /// assert!(map.orbit(topomech::DartId(999), AlphaMask::all(3)).is_empty()); // no such dart
     /// ```
     pub fn orbit(&self, d: DartId, mask: AlphaMask) -> Vec<DartId> {
+        if !self.contains(d) {
+            return Vec::new();
+        }
         let (gens, len) = generators(N, mask);
         let gens = &gens[..len];
         let mut out = vec![d];
@@ -173,7 +178,8 @@ impl<const N: usize> GMap<N> {
         })
     }
 
-    /// The darts of the i-cell of d, ⟨⟩N−{i}(d). O(cell · n).
+    /// The darts of the i-cell of d, ⟨⟩N−{i}(d); empty for i > n or a dart that is not live.
+    /// O(cell · n).
     ///
     /// # Examples
     ///
@@ -185,14 +191,18 @@ impl<const N: usize> GMap<N> {
     /// let sizes: Vec<usize> = (0..=3).map(|i| map.cell_darts(i, d).len()).collect();
     /// assert_eq!(sizes, vec![6, 4, 6, 24]); // corner, edge, face, volume of one tet
     /// assert!(map.cell_darts(0, d).iter().all(|&e| map.vertex_id(e) == map.vertex_id(d)));
+    /// assert!(map.cell_darts(5, d).is_empty()); // no 5-cells in a 3-map
     /// ```
     pub fn cell_darts(&self, i: usize, d: DartId) -> Vec<DartId> {
+        if i > N {
+            return Vec::new();
+        }
         self.orbit(d, AlphaMask::cell(N, i))
     }
 
-    /// Whether b lies in ⟨mask⟩(a). Walks from a and b at once and stops as soon as the walks
-    /// meet or one of them is exhausted, so the cost is O(min(|orbit(a)|, |orbit(b)|) · n) when
-    /// the orbits differ.
+    /// Whether b lies in ⟨mask⟩(a) (false when either is not a live dart). Walks from a and b
+    /// at once and stops as soon as the walks meet or one of them is exhausted, so the cost is
+    /// O(min(|orbit(a)|, |orbit(b)|) · n) when the orbits differ.
     ///
     /// # Examples
     ///
@@ -204,9 +214,10 @@ impl<const N: usize> GMap<N> {
     /// let e = map.alpha::<0>(d);
     /// assert!(map.same_orbit(d, e, AlphaMask::cell(3, 1))); // same edge
     /// assert!(!map.same_orbit(d, e, AlphaMask::cell(3, 0))); // different vertices
+    /// assert!(!map.same_orbit(d, topomech::DartId(999), AlphaMask::all(3))); // no such dart
     /// ```
     pub fn same_orbit(&self, a: DartId, b: DartId, mask: AlphaMask) -> bool {
-        self.split_side(a, b, mask).is_none()
+        self.contains(a) && self.contains(b) && self.split_side(a, b, mask).is_none()
     }
 
     /// Walks ⟨mask⟩(a) and ⟨mask⟩(b) in lockstep. `None` if they are one orbit; otherwise the
@@ -244,7 +255,8 @@ impl<const N: usize> GMap<N> {
         }
     }
 
-    /// One dart per i-cell: for each live i-cell id, the smallest dart carrying it. O(capacity).
+    /// One dart per i-cell: for each live i-cell id, the smallest dart carrying it (none for
+    /// i > n). O(capacity).
     ///
     /// # Examples
     ///
@@ -260,6 +272,9 @@ impl<const N: usize> GMap<N> {
     /// }
     /// ```
     pub fn one_dart_per_cell(&self, i: usize) -> Vec<DartId> {
+        if i > N {
+            return Vec::new();
+        }
         let mut first = vec![u32::MAX; self.cell_id_bound(i)];
         for d in self.darts() {
             let id = self.cell_id(i, d).index();
@@ -424,7 +439,8 @@ impl<const N: usize> GMap<N> {
         count
     }
 
-    /// The ids of the i-cells incident to d's j-cell, each once. O(j-cell · n).
+    /// The ids of the i-cells incident to d's j-cell, each once; empty for i or j > n or a dart
+    /// that is not live. O(j-cell · n).
     ///
     /// # Examples
     ///
@@ -436,8 +452,12 @@ impl<const N: usize> GMap<N> {
     /// assert_eq!(map.incident_cells(d, 2, 0).len(), 3); // its corners
     /// assert_eq!(map.incident_cells(d, 2, 3).len(), 2); // the two tets around it
     /// assert_eq!(map.incident_cells(d, 0, 3).len(), 2);
+    /// assert!(map.incident_cells(d, 9, 0).is_empty() && map.incident_cells(d, 0, 9).is_empty());
     /// ```
     pub fn incident_cells(&self, d: DartId, j: usize, i: usize) -> Vec<CellId> {
+        if i > N {
+            return Vec::new();
+        }
         let mut ids: Vec<CellId> = self.cell_darts(j, d).into_iter().map(|e| self.cell_id(i, e)).collect();
         ids.sort_unstable();
         ids.dedup();

@@ -333,8 +333,10 @@ pub fn tear_vertex(body: &mut Body, v: CellId, direction: Vec3, hint: Option<Dar
     let mut tear =
         Tear { vertex: v, fan: Vec::new(), dissociations: Vec::new(), split: false, touched: TouchedCells::default() };
     let from = body.version();
-    tear.touched.cover(body, from);
-    let Some(d0) = best else { return Ok(tear) };
+    let Some(d0) = best else {
+        tear.touched.cover(body, from);
+        return Ok(tear);
+    };
     tear.fan = fan_darts(body.map(), d0);
     tear.dissociations.reserve(tear.fan.len());
     for &d in &tear.fan {

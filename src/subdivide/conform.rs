@@ -203,12 +203,7 @@ impl LeveledMap<3> {
     /// assert!(matches!(short.conforming_tets(), Err(topomech::subdivide::SubdivideError::NoPosition { vertex: 5, .. })));
     /// ```
     pub fn conforming_tets(&self) -> Result<ConformingMesh, SubdivideError> {
-        if let Some(d) =
-            self.map.one_dart_per_cell(0).into_iter().find(|&d| self.map.vertex_id(d).index() >= self.points.len())
-        {
-            let vertex = self.map.vertex_id(d).0;
-            return Err(SubdivideError::NoPosition { vertex, points: self.points.len() });
-        }
+        self.check_positions_given()?;
         let mut out = ConformingMesh { points: self.points.clone(), ..ConformingMesh::default() };
         let mut face_tris: FxHashMap<u32, Vec<[u32; 3]>> = FxHashMap::default();
         for d in self.map.one_dart_per_cell(3) {

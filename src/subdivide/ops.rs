@@ -103,8 +103,17 @@ impl<const N: usize> LeveledMap<N> {
     /// origin). A map without points (no geometry) is accepted.
     /// O(1) when the points reach every vertex id; O(darts) otherwise.
     pub(super) fn check_points_cover(&self) -> Result<(), SubdivideError> {
+        if self.points.is_empty() {
+            return Ok(());
+        }
+        self.check_positions_given()
+    }
+
+    /// [`SubdivideError::NoPosition`] for the smallest live vertex id past the end of the points.
+    /// O(1) when the points reach every vertex id; O(darts) otherwise.
+    pub(super) fn check_positions_given(&self) -> Result<(), SubdivideError> {
         let points = self.points.len();
-        if points == 0 || points >= self.map.cell_id_bound(0) {
+        if points >= self.map.cell_id_bound(0) {
             return Ok(());
         }
         let uncovered = self.map.darts().map(|d| self.map.vertex_id(d).0).filter(|&v| v as usize >= points).min();

@@ -363,13 +363,14 @@ impl LeveledMechanics {
     fn build(m: &LeveledMap<3>, material: Material, masses: TetMasses) -> Result<Self, CouplingError> {
         crate::mechanics::model::check_material(&material).map_err(CouplingError::Material)?;
         let nv = m.map().cell_id_bound(0);
-        for d in m.map().one_dart_per_cell(3) {
+        let level0_tet = |d: DartId| {
             // Finite positions and a non-zero volume (NoPosition was settled by check_start).
             if m.tet_volume(d)? == 0.0 {
                 return Err(CouplingError::DegenerateTet { volume: m.map().cell_id(3, d).0, dart: d });
             }
-        }
-        let tets0 = m.map().one_dart_per_cell(3).into_iter().map(|d| tet_edges(m, d)).collect::<Result<Vec<_>, _>>()?;
+            Ok(tet_edges(m, d)?)
+        };
+        let tets0 = m.map().one_dart_per_cell(3).into_iter().map(level0_tet).collect::<Result<Vec<_>, _>>()?;
         let mut mech = LeveledMechanics {
             material,
             total_mass: masses.total(m),

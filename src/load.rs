@@ -164,7 +164,7 @@ pub fn load_tet_map_from_msh_bytes(bytes: &[u8], name: &Path) -> Result<Loaded, 
 /// assert_eq!(liver.map.count_cells().0[1], 2833); // edges
 /// assert_eq!(liver.map.boundary_cell_count(), 870);
 /// assert_eq!(liver.map.euler_characteristic(), 1); // one solid ball
-/// assert!((liver.mesh.total_volume() - 38.17).abs() < 0.01);
+/// assert!((liver.mesh.total_volume().unwrap() - 38.17).abs() < 0.01);
 /// ```
 pub fn load_builtin() -> Result<Loaded, LoadError> {
     load_tet_map_from_msh_bytes(BUILTIN_MESH, Path::new(BUILTIN_NAME))

@@ -44,7 +44,7 @@ pub const DEGENERACY_TOLERANCE: f64 = 1e-12;
 /// assert!(mesh.tets.iter().flatten().all(|&i| (i as usize) < mesh.points.len()));
 /// let report = mesh.check().unwrap();
 /// assert!(report.zero_volume_tets.is_empty() && report.unreferenced_points.is_empty());
-/// assert!((mesh.total_volume() - 1.0).abs() < 1e-12);
+/// assert!((mesh.total_volume().unwrap() - 1.0).abs() < 1e-12);
 /// ```
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct TetMesh {
@@ -72,7 +72,7 @@ pub struct TetMesh {
 /// let mesh = TriMesh { points, triangles };
 /// assert_eq!((mesh.points.len(), mesh.triangles.len()), (4, 2)); // a unit square, two halves
 /// assert!(mesh.check().unwrap().is_clean());
-/// assert!((mesh.total_area() - 1.0).abs() < 1e-12);
+/// assert!((mesh.total_area().unwrap() - 1.0).abs() < 1e-12);
 /// ```
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct TriMesh {
@@ -340,6 +340,16 @@ fn sorted3(mut f: [u32; 3]) -> [u32; 3] {
 fn edge_key(a: u32, b: u32) -> u64 {
     let (lo, hi) = if a < b { (a, b) } else { (b, a) };
     (u64::from(lo) << 32) | u64::from(hi)
+}
+
+/// [`MeshError::IndexOutOfRange`] for the first corner of `cells` not below `point_count`. O(cells).
+fn check_in_range<const N: usize>(kind: CellKind, cells: &[[u32; N]], point_count: usize) -> Result<(), MeshError> {
+    for (cell, corners) in cells.iter().enumerate() {
+        if let Some((corner, &value)) = corners.iter().enumerate().find(|(_, &v)| v as usize >= point_count) {
+            return Err(MeshError::IndexOutOfRange { kind, cell, corner, value, point_count });
+        }
+    }
+    Ok(())
 }
 
 /// Checks that every index in `cells` is below `point_count` and no cell repeats a point.
@@ -620,7 +630,9 @@ impl TetMesh {
     /// Sum of the absolute tet volumes `sum |signed_volume|`. O(T).
     ///
     /// Equals the enclosed volume for a valid mesh; inverted tets count positively.
-    /// Panics if an index is out of range (call [`TetMesh::check`] first).
+    ///
+    /// # Errors
+    /// [`MeshError::IndexOutOfRange`] naming the first tet corner past the points.
     ///
     /// # Examples
     ///
@@ -630,17 +642,18 @@ impl TetMesh {
     /// let unit = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
     /// let mesh = TetMesh { points: unit, tets: vec![[0, 1, 2, 3]], ..Default::default() };
     /// assert!(mesh.check().unwrap().is_clean());
-    /// assert!((mesh.total_volume() - 1.0 / 6.0).abs() < 1e-15);
+    /// assert!((mesh.total_volume().unwrap() - 1.0 / 6.0).abs() < 1e-15);
     /// assert_eq!((mesh.edge_count(), mesh.boundary_face_count()), (6, 4));
+    /// let bad = TetMesh { tets: vec![[0, 1, 2, 4]], ..mesh };
+    /// assert!(bad.total_volume().is_err()); // corner 3 names point 4 of 4
     /// ```
-    pub fn total_volume(&self) -> f64 {
-        self.tets
-            .iter()
-            .map(|t| {
-                let c = t.map(|v| self.points[v as usize]);
-                signed_volume(c[0], c[1], c[2], c[3]).abs()
-            })
-            .sum()
+    pub fn total_volume(&self) -> Result<f64, MeshError> {
+        check_in_range(CellKind::Tet, &self.tets, self.points.len())?;
+        let volume = |t: &[u32; 4]| {
+            let c = t.map(|v| self.points[v as usize]);
+            signed_volume(c[0], c[1], c[2], c[3]).abs()
+        };
+        Ok(self.tets.iter().map(volume).sum())
     }
 
     /// The distinct edges of the tets, each as `[lo, hi]` with `lo < hi`, sorted. O(T log T).
@@ -771,8 +784,11 @@ impl TetMesh {
     ///
     /// Returns the new mesh and the map `old index -> new index` (`u32::MAX` for a dropped
     /// point). `node_tags` follow their points; a boundary triangle with a dropped corner is
-    /// dropped. O(P + T + B). Panics if an index is out of range (call [`TetMesh::check`]
-    /// first).
+    /// dropped. O(P + T + B).
+    ///
+    /// # Errors
+    /// [`MeshError::IndexOutOfRange`] naming the first tet or boundary-triangle corner past the
+    /// points.
     ///
     /// # Examples
     ///
@@ -781,12 +797,14 @@ impl TetMesh {
     ///
     /// let points = vec![[9.0; 3], [0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
     /// let mesh = TetMesh { points, tets: vec![[1, 2, 3, 4]], ..Default::default() };
-    /// let (small, old_to_new) = mesh.compact();
+    /// let (small, old_to_new) = mesh.compact().unwrap();
     /// assert_eq!(small.tets, vec![[0, 1, 2, 3]]);
     /// assert_eq!(old_to_new, vec![u32::MAX, 0, 1, 2, 3]);
     /// assert_eq!(small.total_volume(), mesh.total_volume());
     /// ```
-    pub fn compact(&self) -> (TetMesh, Vec<u32>) {
+    pub fn compact(&self) -> Result<(TetMesh, Vec<u32>), MeshError> {
+        check_in_range(CellKind::Tet, &self.tets, self.points.len())?;
+        check_in_range(CellKind::BoundaryTriangle, &self.boundary_triangles, self.points.len())?;
         let mut used = vec![false; self.points.len()];
         for t in &self.tets {
             for &v in t {
@@ -813,7 +831,7 @@ impl TetMesh {
             .filter(|t| !t.contains(&u32::MAX))
             .collect();
         let mesh = TetMesh { points, tets, boundary_triangles, node_tags };
-        (mesh, map)
+        Ok((mesh, map))
     }
 }
 
@@ -858,8 +876,10 @@ impl TriMesh {
         Ok(report)
     }
 
-    /// Sum of the triangle areas. O(T). Panics if an index is out of range (call
-    /// [`TriMesh::check`] first).
+    /// Sum of the triangle areas. O(T).
+    ///
+    /// # Errors
+    /// [`MeshError::IndexOutOfRange`] naming the first corner past the points.
     ///
     /// # Examples
     ///
@@ -869,16 +889,15 @@ impl TriMesh {
     /// let points = vec![[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0], [2.0, 2.0, 0.0]];
     /// let mesh = TriMesh { points, triangles: vec![[0, 1, 2], [1, 3, 2]] };
     /// assert!(mesh.check().unwrap().is_clean());
-    /// assert!((mesh.total_area() - 4.0).abs() < 1e-12);
+    /// assert!((mesh.total_area().unwrap() - 4.0).abs() < 1e-12);
     /// ```
-    pub fn total_area(&self) -> f64 {
-        self.triangles
-            .iter()
-            .map(|t| {
-                let c = t.map(|v| self.points[v as usize]);
-                triangle_area(c[0], c[1], c[2])
-            })
-            .sum()
+    pub fn total_area(&self) -> Result<f64, MeshError> {
+        check_in_range(CellKind::Triangle, &self.triangles, self.points.len())?;
+        let area = |t: &[u32; 3]| {
+            let c = t.map(|v| self.points[v as usize]);
+            triangle_area(c[0], c[1], c[2])
+        };
+        Ok(self.triangles.iter().map(area).sum())
     }
 }
 
@@ -977,7 +996,7 @@ mod tests {
     #[test]
     fn unit_tet_volume_edges_faces() {
         let m = unit_tet();
-        assert!((m.total_volume() - 1.0 / 6.0).abs() < 1e-15);
+        assert!((m.total_volume().unwrap() - 1.0 / 6.0).abs() < 1e-15);
         assert_eq!(m.edge_count(), 6);
         assert_eq!(m.boundary_face_count(), 4);
         assert!(m.check().unwrap().is_clean());
@@ -1030,7 +1049,7 @@ mod tests {
         m.node_tags.insert(0, 99);
         m.tets[0] = [1, 2, 3, 4];
         assert_eq!(m.check().unwrap().unreferenced_points, vec![0]);
-        let (c, map) = m.compact();
+        let (c, map) = m.compact().unwrap();
         assert_eq!(map, vec![u32::MAX, 0, 1, 2, 3]);
         assert_eq!(c, unit_tet());
     }
@@ -1052,7 +1071,7 @@ mod tests {
         };
         let r = m.check().unwrap();
         assert_eq!(r.unreferenced_points, vec![3]);
-        assert!((m.total_area() - 0.5).abs() < 1e-15);
+        assert!((m.total_area().unwrap() - 0.5).abs() < 1e-15);
         m.triangles.push([0, 1, 3]);
         assert_eq!(m.check().unwrap().zero_area_triangles, vec![1]);
         m.triangles.push([0, 0, 3]);

@@ -260,7 +260,7 @@ fn reference_meshes_match_readme_counts() {
         assert_eq!(m.edge_count(), edges, "{file} edges");
         assert_eq!(m.boundary_face_count(), faces, "{file} boundary faces");
         assert_eq!(m.boundary_triangles_of_tets().len(), faces, "{file}");
-        let v = m.total_volume();
+        let v = m.total_volume().unwrap();
         assert!((v - volume).abs() < 1e-2, "{file} volume {v}");
         // README: no inverted tet; the file's triangles (if any) are exactly the boundary.
         let report = m.check().unwrap();
@@ -339,7 +339,7 @@ fn single_tet_with_sparse_tags() {
     let m = io::read_mesh(&fixture("single_tet.msh")).unwrap();
     assert_eq!(m.node_tags, vec![10, 20, 30, 40]);
     assert_eq!(m.tets, vec![[0, 1, 2, 3]]);
-    assert!((m.total_volume() - 1.0 / 6.0).abs() < 1e-15);
+    assert!((m.total_volume().unwrap() - 1.0 / 6.0).abs() < 1e-15);
     assert!(m.check().unwrap().is_clean());
 }
 
@@ -351,7 +351,7 @@ fn two_tets_sharing_a_face() {
     assert_eq!(m.tets.len(), 2);
     assert_eq!(m.edge_count(), 9);
     assert_eq!(m.boundary_face_count(), 6);
-    assert!((m.total_volume() - 0.5).abs() < 1e-15);
+    assert!((m.total_volume().unwrap() - 0.5).abs() < 1e-15);
     // The point and line elements are skipped; the six triangles are the boundary.
     assert_eq!(m.boundary_triangles.len(), 6);
     assert!(m.check().unwrap().is_clean());
@@ -365,7 +365,7 @@ fn check_cube5(m: &TetMesh, name: &str) {
     assert_eq!(m.tets.len(), 5, "{name}");
     assert_eq!(m.edge_count(), 18, "{name}");
     assert_eq!(m.boundary_face_count(), 12, "{name}");
-    assert!((m.total_volume() - 1.0).abs() < 1e-14, "{name}");
+    assert!((m.total_volume().unwrap() - 1.0).abs() < 1e-14, "{name}");
     let r = m.check().unwrap();
     assert!(r.zero_volume_tets.is_empty() && r.inverted_tets.is_empty(), "{name}");
 }
@@ -493,7 +493,7 @@ fn tri_meshes_obj_and_msh() {
     for m in [&obj, &msh] {
         assert_eq!(m.points.len(), 8);
         assert_eq!(m.triangles.len(), 12);
-        assert!((m.total_area() - 6.0).abs() < 1e-14);
+        assert!((m.total_area().unwrap() - 6.0).abs() < 1e-14);
         assert!(m.check().unwrap().is_clean());
     }
     assert_eq!(obj.triangles, msh.triangles);
@@ -938,5 +938,37 @@ proptest! {
             apply(&mut bytes, m);
         }
         run_all_readers(&bytes);
+    }
+}
+
+/// Finding 29 (docs/VERIFICATION.md): `TetMesh::total_volume`, `TetMesh::compact` and
+/// `TriMesh::total_area` panicked on a corner past the points (the fields are public, so such a
+/// mesh is easy to make), and `graph::incidences(map, k)` panicked for k ≥ n. The measures now
+/// name the corner; there are no incidences with (n+1)-cells.
+#[test]
+fn mesh_measures_name_a_corner_past_the_points_and_no_cell_is_incident_past_n() {
+    use topomech::mesh::{CellKind, MeshError, TriMesh};
+    let unit = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    let out =
+        |kind, cell, corner, value| Some(MeshError::IndexOutOfRange { kind, cell, corner, value, point_count: 4 });
+    let good = TetMesh { points: unit.clone(), tets: vec![[0, 1, 2, 3]], ..Default::default() };
+    let bad = TetMesh { tets: vec![[0, 1, 2, 3], [0, 1, 7, 3]], ..good.clone() };
+    assert_eq!(bad.total_volume().err(), out(CellKind::Tet, 1, 2, 7));
+    assert_eq!(bad.compact().err(), out(CellKind::Tet, 1, 2, 7));
+    let bad_triangle = TetMesh { boundary_triangles: vec![[0, 1, 2], [1, 2, 9]], ..good.clone() };
+    assert_eq!(bad_triangle.compact().err(), out(CellKind::BoundaryTriangle, 1, 2, 9));
+    assert!((good.total_volume().unwrap() - 1.0 / 6.0).abs() < 1e-15);
+    assert_eq!(good.compact().unwrap().0, good);
+    let tri = TriMesh { points: unit, triangles: vec![[0, 1, 2], [4, 1, 2]] };
+    assert_eq!(tri.total_area().err(), out(CellKind::Triangle, 1, 0, 4));
+    let tri = TriMesh { triangles: vec![[0, 1, 2]], ..tri };
+    assert_eq!(tri.total_area(), Ok(0.5));
+
+    let (map, _) = topomech::GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    for k in 0..3 {
+        assert!(!topomech::graph::incidences(&map, k).is_empty(), "k = {k}");
+    }
+    for k in [3, 4, 99] {
+        assert!(topomech::graph::incidences(&map, k).is_empty(), "k = {k}");
     }
 }

@@ -6,7 +6,7 @@
 use topomech::load::load_builtin;
 use topomech::mechanics::force::PARALLEL_CHUNK;
 use topomech::mechanics::{
-    FlatModel, Integrator, Kernel, Material, SpringSystem, StepConfig, StepError, Stepper, Vec3,
+    FlatModel, Integrator, Kernel, Material, SpringSystem, StepConfig, StepError, Stepper, SystemError, Vec3,
 };
 
 /// A small deterministic generator (64-bit LCG, top bits): uniform in [0, 1).
@@ -51,7 +51,7 @@ fn random_system(seed: u64, slots: usize, springs: usize) -> Case {
     let mut x: Vec<Vec3> = (0..slots).map(|_| rng.vec(10.0)).collect();
     let v: Vec<Vec3> = (0..slots).map(|_| rng.vec(2.0)).collect();
     for _ in 0..slots {
-        sys.push_slot(0.1 + rng.next(), rng.next() < 0.1, 0.5 * rng.next());
+        sys.push_slot(0.1 + rng.next(), rng.next() < 0.1, 0.5 * rng.next()).unwrap();
     }
     for s in 0..springs {
         let a = rng.below(slots);
@@ -61,7 +61,7 @@ fn random_system(seed: u64, slots: usize, springs: usize) -> Case {
         }
         let k = if s % 13 == 0 { 0.0 } else { 100.0 * rng.next() };
         let c = if s % 7 == 0 { 0.0 } else { rng.next() };
-        sys.push_spring([a as u32, b as u32], 2.0 * rng.next(), k, c);
+        sys.push_spring([a as u32, b as u32], 2.0 * rng.next(), k, c).unwrap();
     }
     (sys, x, v)
 }
@@ -90,7 +90,8 @@ fn sorted_system(seed: u64, slots: usize, springs: usize) -> Case {
         &fixed,
         random.viscosity.clone(),
         random.gravity,
-    );
+    )
+    .unwrap();
     x[sys.ends[0][1] as usize] = x[sys.ends[0][0] as usize]; // a zero-length spring in the sorted order too
     (sys, x, v)
 }
@@ -149,9 +150,9 @@ fn spring_sums_and_the_gather_step_the_same_bits_on_every_kernel_and_thread_coun
     // A mutator leaves the order of the packed lists: the stepper falls back to the gather.
     let (mut sys, _, _) = sorted_system(19, 50, 200);
     let (rest, k, c) = (sys.rest[0], sys.stiffness[0], sys.damping[0]);
-    sys.set_spring(0, sys.ends[0], rest, 2.0 * k, c);
+    sys.set_spring(0, sys.ends[0], rest, 2.0 * k, c).unwrap();
     assert!(sys.sorted_by_first_end(), "same ends: the lists are untouched");
-    sys.swap_remove_spring(0);
+    sys.swap_remove_spring(0).unwrap();
     assert!(!sys.sorted_by_first_end());
 }
 
@@ -161,7 +162,7 @@ fn every_kernel_gives_the_portable_forces_bit_for_bit() {
     for (name, (sys, x, v)) in systems() {
         let eval = |kernel, parallel| {
             let (mut sf, mut acc) = (vec![[0.0; 3]; sys.springs()], vec![[0.0; 3]; sys.slots()]);
-            sys.accelerations_with(kernel, &x, &v, &mut sf, &mut acc, parallel);
+            sys.accelerations_with(kernel, &x, &v, &mut sf, &mut acc, parallel).unwrap();
             (bits(&sf), bits(&acc))
         };
         let reference = eval(Kernel::portable(), false);
@@ -194,12 +195,12 @@ fn textbook_rk4(sys: &SpringSystem, h: f64, x: &mut [Vec3], v: &mut [Vec3]) {
     let n = x.len();
     let mut sf = vec![[0.0; 3]; sys.springs()];
     let mut a = vec![[0.0; 3]; n];
-    sys.accelerations_with(Kernel::portable(), x, v, &mut sf, &mut a, false);
+    sys.accelerations_with(Kernel::portable(), x, v, &mut sf, &mut a, false).unwrap();
     let (mut ax, mut av) = (v.to_vec(), a.clone());
     let mut xs: Vec<Vec3> = (0..n).map(|i| madd(x[i], 0.5 * h, v[i])).collect();
     let mut vs: Vec<Vec3> = (0..n).map(|i| madd(v[i], 0.5 * h, a[i])).collect();
     for c in [0.5 * h, h] {
-        sys.accelerations_with(Kernel::portable(), &xs, &vs, &mut sf, &mut a, false);
+        sys.accelerations_with(Kernel::portable(), &xs, &vs, &mut sf, &mut a, false).unwrap();
         for i in 0..n {
             ax[i] = madd(ax[i], 2.0, vs[i]);
             av[i] = madd(av[i], 2.0, a[i]);
@@ -207,7 +208,7 @@ fn textbook_rk4(sys: &SpringSystem, h: f64, x: &mut [Vec3], v: &mut [Vec3]) {
             vs[i] = madd(v[i], c, a[i]);
         }
     }
-    sys.accelerations_with(Kernel::portable(), &xs, &vs, &mut sf, &mut a, false);
+    sys.accelerations_with(Kernel::portable(), &xs, &vs, &mut sf, &mut a, false).unwrap();
     for i in 0..n {
         x[i] = madd(x[i], h / 6.0, add(ax[i], vs[i]));
         v[i] = madd(v[i], h / 6.0, add(av[i], a[i]));
@@ -310,11 +311,11 @@ fn a_kinetic_energy_at_the_runaway_limit_is_not_a_blow_up() {
     let mut sys = SpringSystem::default();
     sys.gravity = [0.0; 3];
     for _ in 0..2 {
-        sys.push_slot(2.0, false, 0.0);
+        sys.push_slot(2.0, false, 0.0).unwrap();
     }
     let x0: Vec<Vec3> = vec![[0.0; 3], [1.0, 0.0, 0.0]];
     let v0: Vec<Vec3> = vec![[1.0, 0.0, 0.0], [0.0, -1.0, 0.0]];
-    assert_eq!(sys.kinetic_energy(&v0), 2.0);
+    assert_eq!(sys.kinetic_energy(&v0), Ok(2.0));
     let schemes = [Integrator::Euler, Integrator::Symplectic, Integrator::Rk4, Integrator::Implicit];
     for (integrator, kernel) in schemes.into_iter().flat_map(|s| Kernel::available().into_iter().map(move |k| (s, k))) {
         let run = |factor: f64| {
@@ -341,10 +342,10 @@ fn chain(n: usize) -> (SpringSystem, Vec<[f64; 3]>, Vec<[f64; 3]>) {
     let mut sys = SpringSystem::default();
     sys.gravity = [0.0, 0.0, -10.0];
     for i in 0..n {
-        sys.push_slot(1.0, i == 0, 0.1);
+        sys.push_slot(1.0, i == 0, 0.1).unwrap();
     }
     for i in 1..n {
-        sys.push_spring([(i - 1) as u32, i as u32], 1.0, 100.0, 0.1);
+        sys.push_spring([(i - 1) as u32, i as u32], 1.0, 100.0, 0.1).unwrap();
     }
     let x = (0..n).map(|i| [0.0, 0.0, -(i as f64)]).collect();
     (sys, x, vec![[0.0; 3]; n])
@@ -398,4 +399,87 @@ fn a_stepper_refuses_another_system_and_input_it_cannot_step() {
             }
         }
     }
+}
+
+/// Finding 28 (docs/VERIFICATION.md): `SpringSystem`'s constructor and mutators panicked on an
+/// array of the wrong length, a spring end past the slots, a spring from a slot to itself or an
+/// index past the last slot or spring, and took a NaN mass; its force and energy passes panicked
+/// on a short position array, and `kinetic_energy` of a short velocity array silently summed a
+/// prefix. Each now returns a `SystemError` naming the array, spring or slot, and changes nothing.
+#[test]
+fn a_spring_system_refuses_bad_arrays_indices_and_values_and_changes_nothing() {
+    let new = |ends: Vec<[u32; 2]>, rest: Vec<f64>, mass: Vec<f64>, fixed: &[bool]| {
+        let (s, n) = (ends.len(), mass.len());
+        SpringSystem::new(ends, rest, vec![1.0; s], vec![0.0; s], mass, fixed, vec![0.0; n], [0.0; 3])
+    };
+    fn length<T>(array: &'static str, len: usize, expected: usize, of: &'static str) -> Result<T, SystemError> {
+        Err(SystemError::Length { array, len, expected, of })
+    }
+    assert_eq!(new(vec![[0, 1]], vec![], vec![1.0; 2], &[false; 2]), length("rest length", 0, 1, "springs"));
+    assert_eq!(new(vec![[0, 1]], vec![1.0], vec![1.0; 2], &[false; 3]), length("fixed", 3, 2, "slots"));
+    assert_eq!(
+        new(vec![[0, 1], [1, 5]], vec![1.0; 2], vec![1.0; 2], &[false; 2]),
+        Err(SystemError::BadEnds { spring: 1, ends: [1, 5], slots: 2 })
+    );
+    assert_eq!(
+        new(vec![[1, 1]], vec![1.0], vec![1.0; 2], &[false; 2]),
+        Err(SystemError::BadEnds { spring: 0, ends: [1, 1], slots: 2 })
+    );
+    let bad_mass = new(vec![[0, 1]], vec![1.0], vec![1.0, f64::NAN], &[false; 2]);
+    assert!(
+        matches!(bad_mass, Err(SystemError::BadValue { quantity: "mass", of: "slot", index: 1, .. })),
+        "{bad_mass:?}"
+    );
+    let bad_rest = new(vec![[0, 1]], vec![-1.0], vec![1.0; 2], &[false; 2]);
+    assert!(matches!(bad_rest, Err(SystemError::BadValue { quantity: "rest length", index: 0, .. })), "{bad_rest:?}");
+
+    // The mutators: each refusal leaves the system as it was.
+    let mut sys = new(vec![[0, 1], [1, 2]], vec![1.0; 2], vec![1.0; 3], &[false; 3]).unwrap();
+    let before = sys.clone();
+    assert_eq!(sys.push_spring([0, 3], 1.0, 1.0, 0.0), Err(SystemError::BadEnds { spring: 2, ends: [0, 3], slots: 3 }));
+    assert_eq!(sys.push_spring([2, 2], 1.0, 1.0, 0.0), Err(SystemError::BadEnds { spring: 2, ends: [2, 2], slots: 3 }));
+    assert!(sys.push_spring([0, 2], 1.0, f64::INFINITY, 0.0).is_err());
+    assert_eq!(sys.set_slot(3, 1.0, false, 0.0), Err(SystemError::NoSuchSlot { slot: 3, slots: 3 }));
+    assert!(sys.set_slot(0, -1.0, false, 0.0).is_err());
+    assert_eq!(sys.set_spring(2, [0, 1], 1.0, 1.0, 0.0), Err(SystemError::NoSuchSpring { spring: 2, springs: 2 }));
+    assert!(sys.set_spring(0, [0, 9], 1.0, 1.0, 0.0).is_err());
+    assert_eq!(sys.swap_remove_spring(2), Err(SystemError::NoSuchSpring { spring: 2, springs: 2 }));
+    assert!(sys.push_slot(f64::NAN, false, 0.0).is_err());
+    assert!(sys.push_slot(1.0, false, -0.5).is_err());
+    assert_eq!(sys, before);
+    sys.check_incidence().unwrap();
+
+    // The passes: a state of the wrong length is named and nothing is written.
+    let (x, v) = (vec![[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [2.0, 3.0, 0.0]], vec![[1.0, 0.0, 0.0]; 3]);
+    let (mut sf, mut out) = (vec![[7.0; 3]; 2], vec![[7.0; 3]; 3]);
+    assert_eq!(sys.spring_forces(&x[..2], &v, &mut sf, false), length("positions", 2, 3, "slots"));
+    assert_eq!(sys.forces(&x, &v[..1], &mut sf, &mut out, false), length("velocities", 1, 3, "slots"));
+    assert_eq!(sys.forces(&x, &v, &mut sf[..1], &mut out, false), length("spring forces", 1, 2, "springs"));
+    assert_eq!(sys.forces(&x, &v, &mut sf, &mut out[..2], false), length("forces", 2, 3, "slots"));
+    assert_eq!(sys.accelerations(&x, &v, &mut sf, &mut out[..1], false), length("accelerations", 1, 3, "slots"));
+    assert!((sf.clone(), out.clone()) == (vec![[7.0; 3]; 2], vec![[7.0; 3]; 3]), "a refused pass wrote");
+    assert_eq!(sys.kinetic_energy(&v[..2]), length("velocities", 2, 3, "slots"));
+    assert_eq!(sys.kinetic_energy(&v), Ok(1.5)); // ½ · 1 · 1² over three free slots
+    assert_eq!(sys.elastic_energy(&x[..1]), length("positions", 1, 3, "slots"));
+    assert_eq!(sys.gravity_energy(&x[..1]), length("positions", 1, 3, "slots"));
+    assert_eq!(sys.vertex_force(3, &v, &sf), Err(SystemError::NoSuchSlot { slot: 3, slots: 3 }));
+    assert_eq!(sys.incident(3).count(), 0);
+    sys.forces(&x, &v, &mut sf, &mut out, false).unwrap();
+    assert_eq!(sf[0], [1.0, 0.0, 0.0]); // stretched from 1 to 2 with k = 1: pulled towards b
+    assert_eq!(sys.vertex_force(1, &v, &sf), Ok(out[1]));
+
+    // The arrays are public: a spring end written past the slots is found, not indexed.
+    let mut broken = sys.clone();
+    broken.ends[1] = [1, 8];
+    assert_eq!(
+        broken.forces(&x, &v, &mut sf, &mut out, false),
+        Err(SystemError::BadEnds { spring: 1, ends: [1, 8], slots: 3 })
+    );
+    assert_eq!(broken.elastic_energy(&x), Err(SystemError::BadEnds { spring: 1, ends: [1, 8], slots: 3 }));
+    broken.viscosity.pop();
+    assert_eq!(broken.check(), length("viscosity", 2, 3, "slots"));
+    let mut nan = sys.clone();
+    nan.damping[1] = f64::NAN;
+    assert!(matches!(nan.check(), Err(SystemError::BadValue { quantity: "damping", of: "spring", index: 1, .. })));
+    assert_eq!(sys.check(), Ok(()));
 }

@@ -146,7 +146,7 @@ pub enum Multiplicity {
 
 /// The incidences between k-cells and (k+1)-cells of `map`: ((k-cell id, (k+1)-cell id) →
 /// multiplicity), i.e. the number of orbits ⟨αj : j ∉ {k, k+1}⟩ carrying both ids. O(darts · n).
-/// Panics if k ≥ n (there is no (k+1)-cell).
+/// Empty for k ≥ n: there is no (k+1)-cell to be incident to.
 ///
 /// # Examples
 ///
@@ -159,9 +159,12 @@ pub enum Multiplicity {
 /// assert_eq!(vertex_edge.len(), 12); // 6 edges × 2 ends
 /// assert!(vertex_edge.values().all(|&m| m == 1));
 /// assert_eq!(incidences(&map, 2).len(), 4); // 4 faces on the one volume
+/// assert!(incidences(&map, 3).is_empty()); // no 4-cells
 /// ```
 pub fn incidences<const N: usize>(map: &GMap<N>, k: usize) -> BTreeMap<(u32, u32), u32> {
-    assert!(k < N, "incidences({k}) of a {N}-map: there are no {}-cells", k + 1);
+    if k >= N {
+        return BTreeMap::new();
+    }
     let mask = AlphaMask(AlphaMask::all(N).0 & !(1 << k) & !(1 << (k + 1)));
     let mut seen = DartSet::with_capacity(map.capacity());
     let mut out = BTreeMap::new();

@@ -463,7 +463,7 @@ fn parse_msh_records(bytes: &[u8], path: &Path) -> Result<MeshBuilder, ReadError
 /// let mesh = parse_msh(msh.as_bytes(), Path::new("one.msh")).unwrap();
 /// assert_eq!(mesh.tets, vec![[0, 1, 2, 3]]); // node tags 1..4 become indices 0..3
 /// assert_eq!(mesh.boundary_triangles, vec![[0, 1, 2]]);
-/// assert!((mesh.total_volume() - 1.0 / 6.0).abs() < 1e-15);
+/// assert!((mesh.total_volume().unwrap() - 1.0 / 6.0).abs() < 1e-15);
 /// ```
 pub fn parse_msh(bytes: &[u8], path: &Path) -> Result<TetMesh, ReadError> {
     parse_msh_records(bytes, path)?.into_tet_mesh(path)
@@ -485,7 +485,7 @@ pub fn parse_msh(bytes: &[u8], path: &Path) -> Result<TetMesh, ReadError> {
 ///            $EndNodes\n$Elements\n1\n1 2 2 0 1 1 2 3\n$EndElements\n";
 /// let mesh = parse_msh_tri(msh.as_bytes(), Path::new("tri.msh")).unwrap();
 /// assert_eq!(mesh.triangles, vec![[0, 1, 2]]);
-/// assert_eq!(mesh.total_area(), 2.0);
+/// assert_eq!(mesh.total_area(), Ok(2.0));
 /// ```
 pub fn parse_msh_tri(bytes: &[u8], path: &Path) -> Result<TriMesh, ReadError> {
     parse_msh_records(bytes, path)?.into_tri_mesh(path)
@@ -531,7 +531,7 @@ pub fn parse_tetgen(node: &[u8], node_path: &Path, ele: &[u8], ele_path: &Path) 
 /// let obj = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1/1 3/3 -1\n"; // -1: the last vertex so far
 /// let mesh = parse_obj(obj.as_bytes(), Path::new("quad.obj")).unwrap();
 /// assert_eq!(mesh.triangles, vec![[0, 1, 2], [0, 2, 3]]);
-/// assert_eq!(mesh.total_area(), 1.0);
+/// assert_eq!(mesh.total_area(), Ok(1.0));
 /// assert!(parse_obj(b"v 0 0 0\nf 1 2 3\n", Path::new("x.obj")).is_err()); // vertices 2, 3 missing
 /// ```
 pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<TriMesh, ReadError> {

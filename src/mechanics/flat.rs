@@ -102,7 +102,7 @@ impl FlatModel {
         let damping = stiffness.iter().map(|k| material.damping * k).collect();
         let viscosity = mass.iter().map(|m| material.viscosity * m).collect();
         let fixed: Vec<bool> = (0..n).map(|i| pinned.get(i).copied().unwrap_or(false)).collect();
-        let system = SpringSystem::new(ends, rest, stiffness, damping, mass, &fixed, viscosity, gravity);
+        let system = SpringSystem::from_arrays(ends, rest, stiffness, damping, mass, &fixed, viscosity, gravity);
         Ok(FlatModel { system, rest_position: points.to_vec(), position: points.to_vec(), velocity: vec![[0.0; 3]; n] })
     }
 }

@@ -63,8 +63,8 @@ pub const PARALLEL_CHUNK: usize = 4096;
 /// use topomech::mechanics::SpringSystem;
 ///
 /// let mut sys = SpringSystem::default();
-/// let (a, b) = (sys.push_slot(2.0, false, 0.0), sys.push_slot(1.0, true, 0.0));
-/// let s = sys.push_spring([a as u32, b as u32], 1.0, 50.0, 0.1);
+/// let (a, b) = (sys.push_slot(2.0, false, 0.0).unwrap(), sys.push_slot(1.0, true, 0.0).unwrap());
+/// let s = sys.push_spring([a as u32, b as u32], 1.0, 50.0, 0.1).unwrap();
 /// assert_eq!((sys.slots(), sys.springs()), (2, 1));
 /// assert_eq!((sys.inv_mass[a], sys.inv_mass[b]), (0.5, 0.0)); // slot b is fixed
 /// assert_eq!(sys.incident(a).map(|(spring, _)| spring).collect::<Vec<_>>(), vec![s]);
@@ -96,21 +96,31 @@ pub struct SpringSystem {
 impl SpringSystem {
     /// A system from its arrays; builds the incidence lists packed (module docs). O(slots + springs).
     ///
-    /// Panics if the arrays disagree in length or an end is out of range (a bug of the builder).
+    /// `inv_mass` is derived: 0 on a fixed slot or one of mass 0, else 1/mass.
+    ///
+    /// # Errors
+    /// What [`SpringSystem::check`] refuses, before anything is built: arrays that disagree in
+    /// length ([`SystemError::Length`]), a spring whose ends are not two different slots
+    /// ([`SystemError::BadEnds`]), a mass, viscosity, rest length, stiffness or damping that is
+    /// negative or not finite ([`SystemError::BadValue`]), a non-finite gravity.
     ///
     /// # Examples
     ///
     /// ```
-    /// use topomech::mechanics::SpringSystem;
+    /// use topomech::mechanics::{SpringSystem, SystemError};
     ///
     /// let sys = SpringSystem::new(
     ///     vec![[0, 1]], vec![1.0], vec![10.0], vec![0.0], // ends, rest length, stiffness, damping
     ///     vec![1.0, 2.0], &[false, true], vec![0.0; 2], [0.0; 3], // mass, fixed, viscosity, gravity
-    /// );
+    /// )
+    /// .unwrap();
     /// assert_eq!(sys.inv_mass, vec![1.0, 0.0]); // slot 1 is fixed
     /// assert_eq!((sys.slots(), sys.springs()), (2, 1));
     /// assert_eq!(sys.incident(1).collect::<Vec<_>>(), vec![(0, -1.0)]); // end b of spring 0
     /// sys.check_incidence().unwrap();
+    /// // A spring to a slot that does not exist is named, not a panic.
+    /// let bad = SpringSystem::new(vec![[0, 5]], vec![1.0], vec![1.0], vec![0.0], vec![1.0; 2], &[false; 2], vec![0.0; 2], [0.0; 3]);
+    /// assert_eq!(bad, Err(SystemError::BadEnds { spring: 0, ends: [0, 5], slots: 2 }));
     /// ```
     #[allow(clippy::too_many_arguments)]
     pub fn new(
@@ -122,17 +132,129 @@ impl SpringSystem {
         fixed: &[bool],
         viscosity: Vec<f64>,
         gravity: Vec3,
-    ) -> Self {
-        let n = mass.len();
-        assert!(rest.len() == ends.len() && stiffness.len() == ends.len() && damping.len() == ends.len());
-        assert!(fixed.len() == n && viscosity.len() == n);
-        let inv_mass = mass.iter().zip(fixed).map(|(&m, &f)| if f || m <= 0.0 { 0.0 } else { 1.0 / m }).collect();
-        let inc = Incidence::packed(n, &ends);
-        SpringSystem { ends, rest, stiffness, damping, mass, inv_mass, viscosity, gravity, inc }
+    ) -> Result<Self, SystemError> {
+        if fixed.len() != mass.len() {
+            return Err(SystemError::Length { array: "fixed", len: fixed.len(), expected: mass.len(), of: "slots" });
+        }
+        let inv_mass = mass.iter().zip(fixed).map(|(&m, &f)| inverse_mass(m, f)).collect();
+        let mut sys = SpringSystem {
+            ends,
+            rest,
+            stiffness,
+            damping,
+            mass,
+            inv_mass,
+            viscosity,
+            gravity,
+            inc: Incidence::default(),
+        };
+        sys.check()?;
+        sys.inc = Incidence::packed(sys.slots(), &sys.ends);
+        Ok(sys)
     }
 
-    /// Appends a slot with mass `mass` (fixed when `fixed` or `mass <= 0`) and viscosity
+    /// [`SpringSystem::new`] for the crate's builders, whose arrays are right by construction
+    /// (checked in debug builds). O(slots + springs).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn from_arrays(
+        ends: Vec<[u32; 2]>,
+        rest: Vec<f64>,
+        stiffness: Vec<f64>,
+        damping: Vec<f64>,
+        mass: Vec<f64>,
+        fixed: &[bool],
+        viscosity: Vec<f64>,
+        gravity: Vec3,
+    ) -> Self {
+        let inv_mass = mass.iter().zip(fixed).map(|(&m, &f)| inverse_mass(m, f)).collect();
+        let inc = Incidence::packed(mass.len(), &ends);
+        let sys = SpringSystem { ends, rest, stiffness, damping, mass, inv_mass, viscosity, gravity, inc };
+        debug_assert_eq!(sys.check_shape(), Ok(()));
+        sys
+    }
+
+    /// Whether the system can be stepped: every array has one entry per slot or per spring,
+    /// every spring joins two different slots, every mass, inverse mass, viscosity, rest length,
+    /// stiffness and damping is finite and ≥ 0, gravity is finite. O(slots + springs).
+    ///
+    /// The public arrays can be written directly; this is the check to run after doing so.
+    ///
+    /// # Errors
+    /// The first fault found, as a [`SystemError`] naming the array, spring or slot.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::{SpringSystem, SystemError};
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// sys.push_slot(1.0, false, 0.0).unwrap();
+    /// assert_eq!(sys.check(), Ok(()));
+    /// sys.viscosity[0] = f64::NAN;
+    /// assert!(matches!(sys.check(), Err(SystemError::BadValue { quantity: "viscosity", index: 0, .. })));
+    /// ```
+    pub fn check(&self) -> Result<(), SystemError> {
+        self.check_shape()?;
+        let per_slot = [("mass", &self.mass), ("inverse mass", &self.inv_mass), ("viscosity", &self.viscosity)];
+        let per_spring = [("rest length", &self.rest), ("stiffness", &self.stiffness), ("damping", &self.damping)];
+        let all = per_slot.map(|(q, a)| (q, a, "slot")).into_iter().chain(per_spring.map(|(q, a)| (q, a, "spring")));
+        for (quantity, values, of) in all {
+            if let Some((index, &value)) = values.iter().enumerate().find(|(_, &x)| !is_amount(x)) {
+                return Err(SystemError::BadValue { quantity, of, index, value });
+            }
+        }
+        match self.gravity.iter().all(|g| g.is_finite()) {
+            true => Ok(()),
+            false => Err(SystemError::BadGravity(self.gravity)),
+        }
+    }
+
+    /// The structural part of [`SpringSystem::check`]: array lengths and spring ends (what the
+    /// force and energy passes index by). O(springs).
+    fn check_shape(&self) -> Result<(), SystemError> {
+        let (n, s) = (self.slots(), self.springs());
+        let per_slot = [("inverse mass", self.inv_mass.len()), ("viscosity", self.viscosity.len())];
+        let per_spring =
+            [("rest length", self.rest.len()), ("stiffness", self.stiffness.len()), ("damping", self.damping.len())];
+        let all =
+            per_slot.map(|(a, l)| (a, l, n, "slots")).into_iter().chain(per_spring.map(|(a, l)| (a, l, s, "springs")));
+        for (array, len, expected, of) in all {
+            if len != expected {
+                return Err(SystemError::Length { array, len, expected, of });
+            }
+        }
+        match self.ends.iter().position(|&e| !ends_ok(e, n)) {
+            Some(spring) => Err(SystemError::BadEnds { spring, ends: self.ends[spring], slots: n }),
+            None => Ok(()),
+        }
+    }
+
+    /// [`SpringSystem::check_shape`] and one entry per slot in each of `per_slot`, one per
+    /// spring in each of `per_spring` (name, length). O(springs).
+    fn check_state(
+        &self,
+        per_slot: &[(&'static str, usize)],
+        per_spring: &[(&'static str, usize)],
+    ) -> Result<(), SystemError> {
+        let (n, s) = (self.slots(), self.springs());
+        let all = per_slot
+            .iter()
+            .map(|&(a, l)| (a, l, n, "slots"))
+            .chain(per_spring.iter().map(|&(a, l)| (a, l, s, "springs")));
+        for (array, len, expected, of) in all {
+            if len != expected {
+                return Err(SystemError::Length { array, len, expected, of });
+            }
+        }
+        self.check_shape()
+    }
+
+    /// Appends a slot with mass `mass` (fixed when `fixed` or `mass == 0`) and viscosity
     /// `viscosity`, with no spring; returns its index. O(1) amortised.
+    ///
+    /// # Errors
+    /// [`SystemError::BadValue`] (with the index the slot would have had) for a mass or
+    /// viscosity that is negative or not finite; nothing is appended.
     ///
     /// # Examples
     ///
@@ -140,60 +262,97 @@ impl SpringSystem {
     /// use topomech::mechanics::SpringSystem;
     ///
     /// let mut sys = SpringSystem::default();
-    /// assert_eq!(sys.push_slot(2.0, false, 0.1), 0);
-    /// assert_eq!(sys.push_slot(3.0, true, 0.0), 1); // fixed: infinite inertia
+    /// assert_eq!(sys.push_slot(2.0, false, 0.1), Ok(0));
+    /// assert_eq!(sys.push_slot(3.0, true, 0.0), Ok(1)); // fixed: infinite inertia
     /// assert_eq!(sys.inv_mass, vec![0.5, 0.0]);
     /// assert_eq!(sys.incident(1).count(), 0); // no spring yet
+    /// assert!(sys.push_slot(f64::NAN, false, 0.0).is_err());
+    /// assert_eq!(sys.slots(), 2);
     /// ```
-    pub fn push_slot(&mut self, mass: f64, fixed: bool, viscosity: f64) -> usize {
+    pub fn push_slot(&mut self, mass: f64, fixed: bool, viscosity: f64) -> Result<usize, SystemError> {
+        check_slot_values(self.slots(), mass, viscosity)?;
+        Ok(self.push_slot_raw(mass, fixed, viscosity))
+    }
+
+    /// [`SpringSystem::push_slot`] without the value check (the crate's builders). O(1) amortised.
+    pub(crate) fn push_slot_raw(&mut self, mass: f64, fixed: bool, viscosity: f64) -> usize {
         self.mass.push(0.0);
         self.inv_mass.push(0.0);
         self.viscosity.push(0.0);
         self.inc.push_slot();
         let v = self.mass.len() - 1;
-        self.set_slot(v, mass, fixed, viscosity);
+        self.set_slot_raw(v, mass, fixed, viscosity);
         v
     }
 
-    /// Sets slot v's mass, fixedness and viscosity (`inv_mass` = 0 when fixed or `mass <= 0`,
-    /// else 1/mass). O(1). Panics if v is not a slot.
+    /// Sets slot v's mass, fixedness and viscosity (`inv_mass` = 0 when fixed or `mass == 0`,
+    /// else 1/mass). O(1).
+    ///
+    /// # Errors
+    /// [`SystemError::NoSuchSlot`], [`SystemError::BadValue`]; nothing changes.
     ///
     /// # Examples
     ///
     /// ```
-    /// use topomech::mechanics::SpringSystem;
+    /// use topomech::mechanics::{SpringSystem, SystemError};
     ///
     /// let mut sys = SpringSystem::default();
-    /// let v = sys.push_slot(1.0, false, 0.0);
-    /// sys.set_slot(v, 4.0, false, 0.5);
+    /// let v = sys.push_slot(1.0, false, 0.0).unwrap();
+    /// sys.set_slot(v, 4.0, false, 0.5).unwrap();
     /// assert_eq!((sys.mass[v], sys.inv_mass[v], sys.viscosity[v]), (4.0, 0.25, 0.5));
-    /// sys.set_slot(v, 4.0, true, 0.5); // pin it
+    /// sys.set_slot(v, 4.0, true, 0.5).unwrap(); // pin it
     /// assert_eq!(sys.inv_mass[v], 0.0);
+    /// assert_eq!(sys.set_slot(7, 1.0, false, 0.0), Err(SystemError::NoSuchSlot { slot: 7, slots: 1 }));
     /// ```
-    pub fn set_slot(&mut self, v: usize, mass: f64, fixed: bool, viscosity: f64) {
+    pub fn set_slot(&mut self, v: usize, mass: f64, fixed: bool, viscosity: f64) -> Result<(), SystemError> {
+        self.check_slot(v)?;
+        check_slot_values(v, mass, viscosity)?;
+        self.set_slot_raw(v, mass, fixed, viscosity);
+        Ok(())
+    }
+
+    /// [`SpringSystem::set_slot`] without the checks (v must be a slot). O(1).
+    pub(crate) fn set_slot_raw(&mut self, v: usize, mass: f64, fixed: bool, viscosity: f64) {
         self.mass[v] = mass;
         self.viscosity[v] = viscosity;
-        self.inv_mass[v] = if fixed || mass <= 0.0 { 0.0 } else { 1.0 / mass };
+        self.inv_mass[v] = inverse_mass(mass, fixed);
     }
 
     /// Appends spring `ends` = (a, b) with rest length, stiffness and damping; returns its index.
-    /// O(degree of a and b) amortised. Panics if an end is not a slot or a = b.
+    /// O(degree of a and b) amortised.
+    ///
+    /// # Errors
+    /// [`SystemError::BadEnds`] unless a and b are two different slots, [`SystemError::BadValue`]
+    /// for a negative or non-finite rest length, stiffness or damping; nothing is appended.
     ///
     /// # Examples
     ///
     /// ```
-    /// use topomech::mechanics::SpringSystem;
+    /// use topomech::mechanics::{SpringSystem, SystemError};
     ///
     /// let mut sys = SpringSystem::default();
-    /// let (a, b) = (sys.push_slot(1.0, false, 0.0), sys.push_slot(0.0, false, 0.0));
+    /// let (a, b) = (sys.push_slot(1.0, false, 0.0).unwrap(), sys.push_slot(0.0, false, 0.0).unwrap());
     /// assert_eq!(sys.inv_mass, vec![1.0, 0.0]); // a massless slot does not move
-    /// let s = sys.push_spring([a as u32, b as u32], 1.0, 3.0, 0.0);
+    /// let s = sys.push_spring([a as u32, b as u32], 1.0, 3.0, 0.0).unwrap();
     /// assert_eq!((s, sys.springs()), (0, 1));
     /// assert_eq!(sys.incident(a).collect::<Vec<_>>(), vec![(s, 1.0)]);
+    /// assert_eq!(sys.push_spring([1, 1], 1.0, 3.0, 0.0), Err(SystemError::BadEnds { spring: 1, ends: [1, 1], slots: 2 }));
     /// sys.check_incidence().unwrap();
     /// ```
-    pub fn push_spring(&mut self, ends: [u32; 2], rest: f64, stiffness: f64, damping: f64) -> usize {
-        assert!(ends[0] != ends[1] && (ends[0].max(ends[1]) as usize) < self.slots(), "bad spring ends {ends:?}");
+    pub fn push_spring(
+        &mut self,
+        ends: [u32; 2],
+        rest: f64,
+        stiffness: f64,
+        damping: f64,
+    ) -> Result<usize, SystemError> {
+        self.check_spring_values(self.springs(), ends, rest, stiffness, damping)?;
+        Ok(self.push_spring_raw(ends, rest, stiffness, damping))
+    }
+
+    /// [`SpringSystem::push_spring`] without the checks (the ends must be two different slots).
+    pub(crate) fn push_spring_raw(&mut self, ends: [u32; 2], rest: f64, stiffness: f64, damping: f64) -> usize {
+        debug_assert!(ends_ok(ends, self.slots()), "bad spring ends {ends:?}");
         let s = self.ends.len();
         self.ends.push(ends);
         self.rest.push(rest);
@@ -205,24 +364,43 @@ impl SpringSystem {
     }
 
     /// Rewrites spring s: its ends (moving it between incidence lists when they change), rest
-    /// length, stiffness and damping. O(degree of the old and new ends) amortised. Panics if s is
-    /// not a spring, an end is not a slot or a = b.
+    /// length, stiffness and damping. O(degree of the old and new ends) amortised.
+    ///
+    /// # Errors
+    /// [`SystemError::NoSuchSpring`], and what [`SpringSystem::push_spring`] refuses; nothing
+    /// changes.
     ///
     /// # Examples
     ///
     /// ```
-    /// use topomech::mechanics::SpringSystem;
+    /// use topomech::mechanics::{SpringSystem, SystemError};
     ///
     /// let mut sys = SpringSystem::default();
     /// (0..3).for_each(|_| drop(sys.push_slot(1.0, false, 0.0)));
-    /// sys.push_spring([0, 1], 1.0, 1.0, 0.0);
-    /// sys.set_spring(0, [0, 2], 2.0, 5.0, 0.1); // re-attach end b to slot 2
+    /// sys.push_spring([0, 1], 1.0, 1.0, 0.0).unwrap();
+    /// sys.set_spring(0, [0, 2], 2.0, 5.0, 0.1).unwrap(); // re-attach end b to slot 2
     /// assert_eq!((sys.incident(1).count(), sys.incident(2).count()), (0, 1));
     /// assert_eq!((sys.rest[0], sys.stiffness[0], sys.damping[0]), (2.0, 5.0, 0.1));
+    /// assert_eq!(sys.set_spring(3, [0, 1], 1.0, 1.0, 0.0), Err(SystemError::NoSuchSpring { spring: 3, springs: 1 }));
     /// sys.check_incidence().unwrap();
     /// ```
-    pub fn set_spring(&mut self, s: usize, ends: [u32; 2], rest: f64, stiffness: f64, damping: f64) {
-        assert!(ends[0] != ends[1] && (ends[0].max(ends[1]) as usize) < self.slots(), "bad spring ends {ends:?}");
+    pub fn set_spring(
+        &mut self,
+        s: usize,
+        ends: [u32; 2],
+        rest: f64,
+        stiffness: f64,
+        damping: f64,
+    ) -> Result<(), SystemError> {
+        self.check_spring(s)?;
+        self.check_spring_values(s, ends, rest, stiffness, damping)?;
+        self.set_spring_raw(s, ends, rest, stiffness, damping);
+        Ok(())
+    }
+
+    /// [`SpringSystem::set_spring`] without the checks.
+    pub(crate) fn set_spring_raw(&mut self, s: usize, ends: [u32; 2], rest: f64, stiffness: f64, damping: f64) {
+        debug_assert!(ends_ok(ends, self.slots()), "bad spring ends {ends:?}");
         let old = self.ends[s];
         if old != ends {
             self.inc.remove(old[0] as usize, true, s as u32);
@@ -238,7 +416,10 @@ impl SpringSystem {
 
     /// Removes spring s; the last spring takes its index (its incidence entries are renamed).
     /// Returns the former index of the moved spring, `None` if s was last. O(degree of the ends
-    /// of both springs). Panics if s is not a spring.
+    /// of both springs).
+    ///
+    /// # Errors
+    /// [`SystemError::NoSuchSpring`]; nothing changes.
     ///
     /// # Examples
     ///
@@ -247,14 +428,21 @@ impl SpringSystem {
     ///
     /// let mut sys = SpringSystem::default();
     /// (0..3).for_each(|_| drop(sys.push_slot(1.0, false, 0.0)));
-    /// sys.push_spring([0, 1], 1.0, 1.0, 0.0);
-    /// sys.push_spring([1, 2], 1.0, 1.0, 0.0);
-    /// assert_eq!(sys.swap_remove_spring(0), Some(1)); // spring 1 moved into index 0
+    /// sys.push_spring([0, 1], 1.0, 1.0, 0.0).unwrap();
+    /// sys.push_spring([1, 2], 1.0, 1.0, 0.0).unwrap();
+    /// assert_eq!(sys.swap_remove_spring(0), Ok(Some(1))); // spring 1 moved into index 0
     /// assert_eq!((sys.springs(), sys.ends[0]), (1, [1, 2]));
     /// assert_eq!(sys.incident(0).count(), 0);
+    /// assert!(sys.swap_remove_spring(1).is_err()); // only spring 0 is left
     /// sys.check_incidence().unwrap();
     /// ```
-    pub fn swap_remove_spring(&mut self, s: usize) -> Option<usize> {
+    pub fn swap_remove_spring(&mut self, s: usize) -> Result<Option<usize>, SystemError> {
+        self.check_spring(s)?;
+        Ok(self.swap_remove_spring_raw(s))
+    }
+
+    /// [`SpringSystem::swap_remove_spring`] without the check (s must be a spring).
+    pub(crate) fn swap_remove_spring_raw(&mut self, s: usize) -> Option<usize> {
         let [a, b] = self.ends[s];
         self.inc.remove(a as usize, true, s as u32);
         self.inc.remove(b as usize, false, s as u32);
@@ -272,6 +460,35 @@ impl SpringSystem {
         moved
     }
 
+    /// [`SystemError::NoSuchSlot`] unless v is a slot. O(1).
+    fn check_slot(&self, v: usize) -> Result<(), SystemError> {
+        match v < self.slots() {
+            true => Ok(()),
+            false => Err(SystemError::NoSuchSlot { slot: v, slots: self.slots() }),
+        }
+    }
+
+    /// [`SystemError::NoSuchSpring`] unless s is a spring. O(1).
+    fn check_spring(&self, s: usize) -> Result<(), SystemError> {
+        match s < self.springs() {
+            true => Ok(()),
+            false => Err(SystemError::NoSuchSpring { spring: s, springs: self.springs() }),
+        }
+    }
+
+    /// The checks of a spring about to be written at index s. O(1).
+    fn check_spring_values(&self, s: usize, ends: [u32; 2], rest: f64, k: f64, c: f64) -> Result<(), SystemError> {
+        if !ends_ok(ends, self.slots()) {
+            return Err(SystemError::BadEnds { spring: s, ends, slots: self.slots() });
+        }
+        for (quantity, value) in [("rest length", rest), ("stiffness", k), ("damping", c)] {
+            if !is_amount(value) {
+                return Err(SystemError::BadValue { quantity, of: "spring", index: s, value });
+            }
+        }
+        Ok(())
+    }
+
     /// Whether the incidence lists hold exactly the springs of `ends`: spring s once in the head
     /// list of `ends[s][0]` and once in the tail list of `ends[s][1]`, nothing else, segments
     /// inside `adj` and disjoint. O(slots + springs).
@@ -286,9 +503,9 @@ impl SpringSystem {
     ///
     /// let mut sys = SpringSystem::default();
     /// (0..3).for_each(|_| drop(sys.push_slot(1.0, false, 0.0)));
-    /// sys.push_spring([0, 1], 1.0, 1.0, 0.0);
-    /// sys.push_spring([1, 2], 1.0, 1.0, 0.0);
-    /// sys.swap_remove_spring(0);
+    /// sys.push_spring([0, 1], 1.0, 1.0, 0.0).unwrap();
+    /// sys.push_spring([1, 2], 1.0, 1.0, 0.0).unwrap();
+    /// sys.swap_remove_spring(0).unwrap();
     /// assert!(sys.check_incidence().is_ok());
     /// assert_eq!(sys.incident(0).count(), 0);
     /// ```
@@ -323,7 +540,7 @@ impl SpringSystem {
     /// let mut sys = SpringSystem::default();
     /// (0..3).for_each(|_| drop(sys.push_slot(1.0, false, 0.0)));
     /// assert_eq!(sys.springs(), 0);
-    /// sys.push_spring([0, 2], 1.0, 1.0, 0.0);
+    /// sys.push_spring([0, 2], 1.0, 1.0, 0.0).unwrap();
     /// assert_eq!((sys.springs(), sys.slots()), (1, 3));
     /// ```
     pub fn springs(&self) -> usize {
@@ -331,6 +548,11 @@ impl SpringSystem {
     }
 
     /// Pass 1: F_s (force on end a) of every spring into `sf`. O(springs).
+    ///
+    /// # Errors
+    /// [`SystemError::Length`] unless `x` and `v` hold one entry per slot and `sf` one per
+    /// spring, and what the structural part of [`SpringSystem::check`] refuses; `sf` is then
+    /// left as it was.
     ///
     /// # Examples
     ///
@@ -340,20 +562,24 @@ impl SpringSystem {
     /// // Three slots on a line, springs of rest length 1: the first compressed, the second stretched.
     /// let mut sys = SpringSystem::default();
     /// (0..3).for_each(|_| drop(sys.push_slot(1.0, false, 0.0)));
-    /// sys.push_spring([0, 1], 1.0, 2.0, 0.0);
-    /// sys.push_spring([1, 2], 1.0, 2.0, 0.0);
+    /// sys.push_spring([0, 1], 1.0, 2.0, 0.0).unwrap();
+    /// sys.push_spring([1, 2], 1.0, 2.0, 0.0).unwrap();
     /// let (x, v) = ([[0.0; 3], [0.5, 0.0, 0.0], [2.5, 0.0, 0.0]], [[0.0; 3]; 3]);
     /// let mut sf = vec![[0.0; 3]; 2];
-    /// sys.spring_forces(&x, &v, &mut sf, false);
+    /// sys.spring_forces(&x, &v, &mut sf, false).unwrap();
     /// assert_eq!(sf, vec![[-1.0, 0.0, 0.0], [2.0, 0.0, 0.0]]); // F on end a: pushed away, pulled along
-    /// assert_eq!(sys.vertex_force(1, &v, &sf), [1.0 + 2.0, 0.0, 0.0]); // −F₀ + F₁ on the middle slot
+    /// assert_eq!(sys.vertex_force(1, &v, &sf), Ok([1.0 + 2.0, 0.0, 0.0])); // −F₀ + F₁ on the middle slot
+    /// assert!(sys.spring_forces(&x[..2], &v, &mut sf, false).is_err()); // two positions for three slots
     /// ```
-    pub fn spring_forces(&self, x: &[Vec3], v: &[Vec3], sf: &mut [Vec3], parallel: bool) {
-        self.spring_forces_with(Kernel::detect(), x, v, sf, parallel);
+    pub fn spring_forces(&self, x: &[Vec3], v: &[Vec3], sf: &mut [Vec3], parallel: bool) -> Result<(), SystemError> {
+        self.spring_forces_with(Kernel::detect(), x, v, sf, parallel)
     }
 
     /// [`SpringSystem::spring_forces`] run with `kernel`: the same bits for every kernel
     /// ([`Kernel`]). O(springs).
+    ///
+    /// # Errors
+    /// As [`SpringSystem::spring_forces`].
     ///
     /// # Examples
     ///
@@ -362,17 +588,32 @@ impl SpringSystem {
     ///
     /// let mut sys = SpringSystem::default();
     /// (0..2).for_each(|_| drop(sys.push_slot(1.0, false, 0.0)));
-    /// sys.push_spring([0, 1], 1.0, 2.0, 0.5);
+    /// sys.push_spring([0, 1], 1.0, 2.0, 0.5).unwrap();
     /// let (x, v) = ([[0.0; 3], [0.3, 0.4, 1.2]], [[0.1, 0.0, 0.0], [0.0, -0.2, 0.0]]);
     /// let mut reference = vec![[0.0; 3]];
-    /// sys.spring_forces_with(Kernel::portable(), &x, &v, &mut reference, false);
+    /// sys.spring_forces_with(Kernel::portable(), &x, &v, &mut reference, false).unwrap();
     /// for kernel in Kernel::available() {
     ///     let mut sf = vec![[0.0; 3]];
-    ///     sys.spring_forces_with(kernel, &x, &v, &mut sf, false);
+    ///     sys.spring_forces_with(kernel, &x, &v, &mut sf, false).unwrap();
     ///     assert_eq!(sf, reference); // bit for bit
     /// }
     /// ```
-    pub fn spring_forces_with(&self, kernel: Kernel, x: &[Vec3], v: &[Vec3], sf: &mut [Vec3], parallel: bool) {
+    pub fn spring_forces_with(
+        &self,
+        kernel: Kernel,
+        x: &[Vec3],
+        v: &[Vec3],
+        sf: &mut [Vec3],
+        parallel: bool,
+    ) -> Result<(), SystemError> {
+        self.check_state(&[("positions", x.len()), ("velocities", v.len())], &[("spring forces", sf.len())])?;
+        self.spring_forces_raw(kernel, x, v, sf, parallel);
+        Ok(())
+    }
+
+    /// [`SpringSystem::spring_forces_with`] on arrays of the right lengths (the steppers check
+    /// them once). O(springs).
+    pub(crate) fn spring_forces_raw(&self, kernel: Kernel, x: &[Vec3], v: &[Vec3], sf: &mut [Vec3], parallel: bool) {
         self.by_spring_chunks(sf, parallel, |springs, out| spring_pass(kernel, springs, x, v, out));
     }
 
@@ -443,6 +684,10 @@ impl SpringSystem {
 
     /// Total force on slot i from gravity, viscosity and the springs (given F_s in `sf`). O(degree).
     ///
+    /// # Errors
+    /// [`SystemError::NoSuchSlot`], or [`SystemError::Length`] unless `v` holds one entry per
+    /// slot and `sf` one per spring.
+    ///
     /// # Examples
     ///
     /// ```
@@ -450,12 +695,20 @@ impl SpringSystem {
     ///
     /// let mut sys = SpringSystem::default();
     /// sys.gravity = [0.0, 0.0, -10.0];
-    /// sys.push_slot(2.0, false, 0.5); // mass 2, viscosity 0.5, no spring
+    /// sys.push_slot(2.0, false, 0.5).unwrap(); // mass 2, viscosity 0.5, no spring
     /// let (v, sf) = ([[1.0, 0.0, 0.0]], []);
-    /// assert_eq!(sys.vertex_force(0, &v, &sf), [-0.5, 0.0, -20.0]); // m·g − γ·v
+    /// assert_eq!(sys.vertex_force(0, &v, &sf), Ok([-0.5, 0.0, -20.0])); // m·g − γ·v
+    /// assert!(sys.vertex_force(1, &v, &sf).is_err()); // there is one slot
     /// ```
+    pub fn vertex_force(&self, i: usize, v: &[Vec3], sf: &[Vec3]) -> Result<Vec3, SystemError> {
+        self.check_slot(i)?;
+        self.check_state(&[("velocities", v.len())], &[("spring forces", sf.len())])?;
+        Ok(self.vertex_force_raw(i, v, sf))
+    }
+
+    /// [`SpringSystem::vertex_force`] on a slot and arrays of the right lengths. O(degree).
     #[inline(always)]
-    pub fn vertex_force(&self, i: usize, v: &[Vec3], sf: &[Vec3]) -> Vec3 {
+    fn vertex_force_raw(&self, i: usize, v: &[Vec3], sf: &[Vec3]) -> Vec3 {
         let s = self.gather(i, sf);
         let (m, g, vi) = (self.mass[i], self.viscosity[i], v[i]);
         [
@@ -467,6 +720,10 @@ impl SpringSystem {
 
     /// Forces on every slot (pinned ones included) into `out`. O(slots + springs).
     ///
+    /// # Errors
+    /// As [`SpringSystem::spring_forces`], and [`SystemError::Length`] unless `out` holds one
+    /// entry per slot; nothing is written then.
+    ///
     /// # Examples
     ///
     /// ```
@@ -474,21 +731,40 @@ impl SpringSystem {
     ///
     /// // One spring of rest length 1 and stiffness 10, stretched to length 2 along x.
     /// let mut sys = SpringSystem::default();
-    /// let (a, b) = (sys.push_slot(1.0, false, 0.0), sys.push_slot(1.0, false, 0.0));
-    /// sys.push_spring([a as u32, b as u32], 1.0, 10.0, 0.0);
+    /// let (a, b) = (sys.push_slot(1.0, false, 0.0).unwrap(), sys.push_slot(1.0, false, 0.0).unwrap());
+    /// sys.push_spring([a as u32, b as u32], 1.0, 10.0, 0.0).unwrap();
     /// let (x, v) = ([[0.0; 3], [2.0, 0.0, 0.0]], [[0.0; 3]; 2]);
     /// let (mut sf, mut out) = (vec![[0.0; 3]; 1], vec![[0.0; 3]; 2]);
-    /// sys.forces(&x, &v, &mut sf, &mut out, false);
+    /// sys.forces(&x, &v, &mut sf, &mut out, false).unwrap();
     /// assert_eq!(out, vec![[10.0, 0.0, 0.0], [-10.0, 0.0, 0.0]]); // equal and opposite
-    /// assert_eq!(sys.elastic_energy(&x), 5.0); // ½ k (l − L)²
+    /// assert_eq!(sys.elastic_energy(&x), Ok(5.0)); // ½ k (l − L)²
+    /// assert!(sys.forces(&x, &v, &mut sf, &mut out[..1], false).is_err()); // one output for two slots
     /// sys.check_incidence().unwrap();
     /// ```
-    pub fn forces(&self, x: &[Vec3], v: &[Vec3], sf: &mut [Vec3], out: &mut [Vec3], parallel: bool) {
-        self.spring_forces(x, v, sf, parallel);
-        self.per_slot(out, parallel, |i| self.vertex_force(i, v, sf));
+    pub fn forces(
+        &self,
+        x: &[Vec3],
+        v: &[Vec3],
+        sf: &mut [Vec3],
+        out: &mut [Vec3],
+        parallel: bool,
+    ) -> Result<(), SystemError> {
+        let per_slot = [("positions", x.len()), ("velocities", v.len()), ("forces", out.len())];
+        self.check_state(&per_slot, &[("spring forces", sf.len())])?;
+        self.forces_raw(x, v, sf, out, parallel);
+        Ok(())
+    }
+
+    /// [`SpringSystem::forces`] on arrays of the right lengths. O(slots + springs).
+    pub(crate) fn forces_raw(&self, x: &[Vec3], v: &[Vec3], sf: &mut [Vec3], out: &mut [Vec3], parallel: bool) {
+        self.spring_forces_raw(Kernel::detect(), x, v, sf, parallel);
+        self.per_slot(out, parallel, |i| self.vertex_force_raw(i, v, sf));
     }
 
     /// Accelerations f_i / m_i (zero on fixed slots) into `acc`. O(slots + springs).
+    ///
+    /// # Errors
+    /// As [`SpringSystem::forces`], with `acc` for `out`.
     ///
     /// # Examples
     ///
@@ -498,18 +774,28 @@ impl SpringSystem {
     /// // No springs: a free slot falls with g, a fixed one does not move.
     /// let mut sys = SpringSystem::default();
     /// sys.gravity = [0.0, 0.0, -9.81];
-    /// sys.push_slot(2.0, false, 0.0);
-    /// sys.push_slot(2.0, true, 0.0);
+    /// sys.push_slot(2.0, false, 0.0).unwrap();
+    /// sys.push_slot(2.0, true, 0.0).unwrap();
     /// let (x, v, mut acc) = ([[0.0; 3]; 2], [[0.0; 3]; 2], [[1.0; 3]; 2]);
-    /// sys.accelerations(&x, &v, &mut [], &mut acc, false);
+    /// sys.accelerations(&x, &v, &mut [], &mut acc, false).unwrap();
     /// assert_eq!(acc, [[0.0, 0.0, -9.81], [0.0; 3]]);
     /// ```
-    pub fn accelerations(&self, x: &[Vec3], v: &[Vec3], sf: &mut [Vec3], acc: &mut [Vec3], parallel: bool) {
-        self.accelerations_with(Kernel::detect(), x, v, sf, acc, parallel);
+    pub fn accelerations(
+        &self,
+        x: &[Vec3],
+        v: &[Vec3],
+        sf: &mut [Vec3],
+        acc: &mut [Vec3],
+        parallel: bool,
+    ) -> Result<(), SystemError> {
+        self.accelerations_with(Kernel::detect(), x, v, sf, acc, parallel)
     }
 
     /// [`SpringSystem::accelerations`] run with `kernel`: the same bits for every kernel
     /// ([`Kernel`]). O(slots + springs).
+    ///
+    /// # Errors
+    /// As [`SpringSystem::accelerations`].
     ///
     /// # Examples
     ///
@@ -519,15 +805,15 @@ impl SpringSystem {
     /// let mut sys = SpringSystem::default();
     /// sys.gravity = [0.0, 0.0, -9.81];
     /// (0..3).for_each(|i| drop(sys.push_slot(1.0 + i as f64, i == 0, 0.1)));
-    /// sys.push_spring([0, 1], 1.0, 30.0, 0.2);
-    /// sys.push_spring([1, 2], 1.0, 20.0, 0.2);
+    /// sys.push_spring([0, 1], 1.0, 30.0, 0.2).unwrap();
+    /// sys.push_spring([1, 2], 1.0, 20.0, 0.2).unwrap();
     /// let x = [[0.0; 3], [0.0, 0.0, -1.1], [0.1, 0.0, -2.3]];
     /// let v = [[0.0; 3], [0.0, 0.3, 0.0], [0.2, 0.0, -0.1]];
     /// let (mut sf, mut reference) = (vec![[0.0; 3]; 2], vec![[0.0; 3]; 3]);
-    /// sys.accelerations_with(Kernel::portable(), &x, &v, &mut sf, &mut reference, false);
+    /// sys.accelerations_with(Kernel::portable(), &x, &v, &mut sf, &mut reference, false).unwrap();
     /// for kernel in Kernel::available() {
     ///     let mut acc = vec![[0.0; 3]; 3];
-    ///     sys.accelerations_with(kernel, &x, &v, &mut sf, &mut acc, false);
+    ///     sys.accelerations_with(kernel, &x, &v, &mut sf, &mut acc, false).unwrap();
     ///     assert_eq!(acc, reference); // bit for bit
     /// }
     /// ```
@@ -539,8 +825,24 @@ impl SpringSystem {
         sf: &mut [Vec3],
         acc: &mut [Vec3],
         parallel: bool,
+    ) -> Result<(), SystemError> {
+        let per_slot = [("positions", x.len()), ("velocities", v.len()), ("accelerations", acc.len())];
+        self.check_state(&per_slot, &[("spring forces", sf.len())])?;
+        self.accelerations_raw(kernel, x, v, sf, acc, parallel);
+        Ok(())
+    }
+
+    /// [`SpringSystem::accelerations_with`] on arrays of the right lengths. O(slots + springs).
+    pub(crate) fn accelerations_raw(
+        &self,
+        kernel: Kernel,
+        x: &[Vec3],
+        v: &[Vec3],
+        sf: &mut [Vec3],
+        acc: &mut [Vec3],
+        parallel: bool,
     ) {
-        self.spring_forces_with(kernel, x, v, sf, parallel);
+        self.spring_forces_raw(kernel, x, v, sf, parallel);
         let sf: &[Vec3] = sf;
         if parallel && acc.len() > PARALLEL_CHUNK {
             acc.par_chunks_mut(PARALLEL_CHUNK).enumerate().for_each(|(c, chunk)| {
@@ -587,7 +889,8 @@ impl SpringSystem {
         }
     }
 
-    /// The springs incident to slot i as (spring, sign): +1 where i is end a. O(degree).
+    /// The springs incident to slot i as (spring, sign): +1 where i is end a; none if i is not
+    /// a slot. O(degree).
     ///
     /// # Examples
     ///
@@ -596,18 +899,23 @@ impl SpringSystem {
     ///
     /// let mut sys = SpringSystem::default();
     /// (0..3).for_each(|_| drop(sys.push_slot(1.0, false, 0.0)));
-    /// sys.push_spring([0, 1], 1.0, 1.0, 0.0);
-    /// sys.push_spring([1, 2], 1.0, 1.0, 0.0);
+    /// sys.push_spring([0, 1], 1.0, 1.0, 0.0).unwrap();
+    /// sys.push_spring([1, 2], 1.0, 1.0, 0.0).unwrap();
     /// let mut at_1: Vec<_> = sys.incident(1).collect();
     /// at_1.sort_by(|a, b| a.partial_cmp(b).unwrap());
     /// assert_eq!(at_1, vec![(0, -1.0), (1, 1.0)]); // end b of spring 0, end a of spring 1
+    /// assert_eq!(sys.incident(9).count(), 0); // no slot 9
     /// ```
     pub fn incident(&self, i: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
-        let (heads, tails) = self.inc.lists(i);
+        let (heads, tails) = if i < self.slots() { self.inc.lists(i) } else { (&[][..], &[][..]) };
         heads.iter().map(|&s| (s as usize, 1.0)).chain(tails.iter().map(|&s| (s as usize, -1.0)))
     }
 
     /// Kinetic energy ½ Σ m |v|² over free slots. O(slots).
+    ///
+    /// # Errors
+    /// [`SystemError::Length`] unless `v` holds one entry per slot (and per mass and inverse
+    /// mass).
     ///
     /// # Examples
     ///
@@ -615,11 +923,18 @@ impl SpringSystem {
     /// use topomech::mechanics::SpringSystem;
     ///
     /// let mut sys = SpringSystem::default();
-    /// sys.push_slot(2.0, false, 0.0);
-    /// sys.push_slot(2.0, true, 0.0); // fixed slots do not count
-    /// assert_eq!(sys.kinetic_energy(&[[3.0, 0.0, 4.0], [9.0; 3]]), 25.0); // ½ · 2 · 5²
+    /// sys.push_slot(2.0, false, 0.0).unwrap();
+    /// sys.push_slot(2.0, true, 0.0).unwrap(); // fixed slots do not count
+    /// assert_eq!(sys.kinetic_energy(&[[3.0, 0.0, 4.0], [9.0; 3]]), Ok(25.0)); // ½ · 2 · 5²
+    /// assert!(sys.kinetic_energy(&[[3.0, 0.0, 4.0]]).is_err()); // not a sum over a prefix
     /// ```
-    pub fn kinetic_energy(&self, v: &[Vec3]) -> f64 {
+    pub fn kinetic_energy(&self, v: &[Vec3]) -> Result<f64, SystemError> {
+        self.check_state(&[("velocities", v.len())], &[])?;
+        Ok(self.kinetic_energy_raw(v))
+    }
+
+    /// [`SpringSystem::kinetic_energy`] of a `v` of the right length. O(slots).
+    pub(crate) fn kinetic_energy_raw(&self, v: &[Vec3]) -> f64 {
         self.mass
             .iter()
             .zip(&self.inv_mass)
@@ -631,6 +946,10 @@ impl SpringSystem {
 
     /// Elastic energy ½ Σ k (l − L)². O(springs).
     ///
+    /// # Errors
+    /// [`SystemError::Length`] unless `x` holds one entry per slot, and the structural faults
+    /// of [`SpringSystem::check`].
+    ///
     /// # Examples
     ///
     /// ```
@@ -638,11 +957,17 @@ impl SpringSystem {
     ///
     /// let mut sys = SpringSystem::default();
     /// (0..2).for_each(|_| drop(sys.push_slot(1.0, false, 0.0)));
-    /// sys.push_spring([0, 1], 2.0, 8.0, 0.0);
-    /// assert_eq!(sys.elastic_energy(&[[0.0; 3], [0.0, 2.0, 0.0]]), 0.0); // at rest length
-    /// assert_eq!(sys.elastic_energy(&[[0.0; 3], [0.0, 1.5, 0.0]]), 1.0); // ½ · 8 · 0.5²
+    /// sys.push_spring([0, 1], 2.0, 8.0, 0.0).unwrap();
+    /// assert_eq!(sys.elastic_energy(&[[0.0; 3], [0.0, 2.0, 0.0]]), Ok(0.0)); // at rest length
+    /// assert_eq!(sys.elastic_energy(&[[0.0; 3], [0.0, 1.5, 0.0]]), Ok(1.0)); // ½ · 8 · 0.5²
     /// ```
-    pub fn elastic_energy(&self, x: &[Vec3]) -> f64 {
+    pub fn elastic_energy(&self, x: &[Vec3]) -> Result<f64, SystemError> {
+        self.check_state(&[("positions", x.len())], &[])?;
+        Ok(self.elastic_energy_raw(x))
+    }
+
+    /// [`SpringSystem::elastic_energy`] of an `x` of the right length. O(springs).
+    pub(crate) fn elastic_energy_raw(&self, x: &[Vec3]) -> f64 {
         (0..self.springs())
             .map(|s| {
                 let [a, b] = self.ends[s];
@@ -654,6 +979,9 @@ impl SpringSystem {
 
     /// Gravitational potential −Σ m g·x over free slots. O(slots).
     ///
+    /// # Errors
+    /// [`SystemError::Length`] unless `x` holds one entry per slot.
+    ///
     /// # Examples
     ///
     /// ```
@@ -661,19 +989,15 @@ impl SpringSystem {
     ///
     /// let mut sys = SpringSystem::default();
     /// sys.gravity = [0.0, 0.0, -10.0];
-    /// sys.push_slot(2.0, false, 0.0);
-    /// assert_eq!(sys.gravity_energy(&[[0.0, 0.0, 3.0]]), 60.0); // m g h
-    /// assert_eq!(sys.kinetic_energy(&[[0.0, 4.0, 0.0]]), 16.0); // ½ m v²
+    /// sys.push_slot(2.0, false, 0.0).unwrap();
+    /// assert_eq!(sys.gravity_energy(&[[0.0, 0.0, 3.0]]), Ok(60.0)); // m g h
+    /// assert_eq!(sys.kinetic_energy(&[[0.0, 4.0, 0.0]]), Ok(16.0)); // ½ m v²
     /// ```
-    pub fn gravity_energy(&self, x: &[Vec3]) -> f64 {
+    pub fn gravity_energy(&self, x: &[Vec3]) -> Result<f64, SystemError> {
+        self.check_state(&[("positions", x.len())], &[])?;
         let g = self.gravity;
-        self.mass
-            .iter()
-            .zip(&self.inv_mass)
-            .zip(x)
-            .filter(|((_, &w), _)| w > 0.0)
-            .map(|((&m, _), x)| -m * dot(g, *x))
-            .sum()
+        let free = self.mass.iter().zip(&self.inv_mass).zip(x).filter(|((_, &w), _)| w > 0.0);
+        Ok(free.map(|((&m, _), x)| -m * dot(g, *x)).sum())
     }
 
     /// A bound on the largest angular frequency, ω_max² ≤ max_v Σ_{s ∋ v} 2 k_s / m_v
@@ -685,9 +1009,9 @@ impl SpringSystem {
     /// use topomech::mechanics::SpringSystem;
     ///
     /// let mut sys = SpringSystem::default();
-    /// sys.push_slot(2.0, true, 0.0); // fixed: does not count
-    /// sys.push_slot(0.5, false, 0.0);
-    /// sys.push_spring([0, 1], 1.0, 4.0, 0.0);
+    /// sys.push_slot(2.0, true, 0.0).unwrap(); // fixed: does not count
+    /// sys.push_slot(0.5, false, 0.0).unwrap();
+    /// sys.push_spring([0, 1], 1.0, 4.0, 0.0).unwrap();
     /// assert_eq!(sys.omega_max(), 4.0); // √(2k / m)
     /// ```
     pub fn omega_max(&self) -> f64 {
@@ -700,6 +1024,105 @@ impl SpringSystem {
         }
         w2.sqrt()
     }
+}
+
+/// A fault of a [`SpringSystem`] or of the arrays given to it, naming the array, spring or slot.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mechanics::{SpringSystem, SystemError};
+///
+/// let mut sys = SpringSystem::default();
+/// sys.push_slot(1.0, false, 0.0).unwrap();
+/// let e = sys.push_spring([0, 1], 1.0, 1.0, 0.0).unwrap_err();
+/// assert_eq!(e, SystemError::BadEnds { spring: 0, ends: [0, 1], slots: 1 });
+/// assert_eq!(e.to_string(), "spring 0 joins slots [0, 1] (must be two different slots of 1)");
+/// ```
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SystemError {
+    /// An array has the wrong number of entries.
+    #[error("{array} has {len} entries for {expected} {of}")]
+    Length {
+        /// Which array (e.g. "positions", "rest length").
+        array: &'static str,
+        /// Its length.
+        len: usize,
+        /// The length it must have.
+        expected: usize,
+        /// What it must have one entry per ("slots" or "springs").
+        of: &'static str,
+    },
+    /// A spring whose ends are not two different slots.
+    #[error("spring {spring} joins slots {ends:?} (must be two different slots of {slots})")]
+    BadEnds {
+        /// The spring's index.
+        spring: usize,
+        /// Its ends.
+        ends: [u32; 2],
+        /// The number of slots.
+        slots: usize,
+    },
+    /// A spring index past the last spring.
+    #[error("no spring {spring} (the system has {springs})")]
+    NoSuchSpring {
+        /// The index given.
+        spring: usize,
+        /// The number of springs.
+        springs: usize,
+    },
+    /// A slot index past the last slot.
+    #[error("no slot {slot} (the system has {slots})")]
+    NoSuchSlot {
+        /// The index given.
+        slot: usize,
+        /// The number of slots.
+        slots: usize,
+    },
+    /// A mass, viscosity, rest length, stiffness or damping that is negative or not finite.
+    #[error("{quantity} of {of} {index} is {value} (must be finite and >= 0)")]
+    BadValue {
+        /// Which quantity.
+        quantity: &'static str,
+        /// "slot" or "spring".
+        of: &'static str,
+        /// The slot's or spring's index.
+        index: usize,
+        /// The value.
+        value: f64,
+    },
+    /// A gravity with a non-finite component.
+    #[error("gravity {0:?} is not finite")]
+    BadGravity(Vec3),
+}
+
+/// 1/m for a free slot of mass m > 0, else 0 (fixed or massless). O(1).
+fn inverse_mass(m: f64, fixed: bool) -> f64 {
+    if fixed || m <= 0.0 {
+        0.0
+    } else {
+        1.0 / m
+    }
+}
+
+/// A physical amount: finite and ≥ 0. O(1).
+fn is_amount(x: f64) -> bool {
+    x.is_finite() && x >= 0.0
+}
+
+/// Whether `ends` are two different slots of `slots`. O(1).
+fn ends_ok(ends: [u32; 2], slots: usize) -> bool {
+    ends[0] != ends[1] && (ends[0].max(ends[1]) as usize) < slots
+}
+
+/// The value checks of a slot at index v. O(1).
+fn check_slot_values(v: usize, mass: f64, viscosity: f64) -> Result<(), SystemError> {
+    for (quantity, value) in [("mass", mass), ("viscosity", viscosity)] {
+        if !is_amount(value) {
+            return Err(SystemError::BadValue { quantity, of: "slot", index: v, value });
+        }
+    }
+    Ok(())
 }
 
 /// Springs per block of the vectorised spring pass.
@@ -944,13 +1367,13 @@ impl SpringSystem {
     /// let sorted = |ends: Vec<[u32; 2]>| {
     ///     let n = ends.len();
     ///     let sys = SpringSystem::new(ends, vec![1.0; n], vec![1.0; n], vec![0.0; n], vec![1.0; 3], &[false; 3], vec![0.0; 3], [0.0; 3]);
-    ///     sys.sorted_by_first_end()
+    ///     sys.unwrap().sorted_by_first_end()
     /// };
     /// assert!(sorted(vec![[0, 1], [0, 2], [1, 2]]));
     /// assert!(!sorted(vec![[1, 2], [0, 1]])); // not by first end
     /// assert!(!sorted(vec![[1, 0]])); // a > b
-    /// let mut sys = SpringSystem::new(vec![[0, 1]], vec![1.0], vec![1.0], vec![0.0], vec![1.0; 3], &[false; 3], vec![0.0; 3], [0.0; 3]);
-    /// sys.push_spring([0, 2], 1.0, 1.0, 0.0); // a mutator: the lists are no longer the packed ones
+    /// let mut sys = SpringSystem::new(vec![[0, 1]], vec![1.0], vec![1.0], vec![0.0], vec![1.0; 3], &[false; 3], vec![0.0; 3], [0.0; 3]).unwrap();
+    /// sys.push_spring([0, 2], 1.0, 1.0, 0.0).unwrap(); // a mutator: the lists are no longer the packed ones
     /// assert!(!sys.sorted_by_first_end());
     /// ```
     pub fn sorted_by_first_end(&self) -> bool {
@@ -1100,7 +1523,7 @@ fn spring_scale_padded(
 ///
 /// let mut sys = SpringSystem::default();
 /// (0..3).for_each(|_| drop(sys.push_slot(1.0, false, 0.0)));
-/// sys.push_spring([0, 1], 1.0, 1.0, 0.0);
+/// sys.push_spring([0, 1], 1.0, 1.0, 0.0).unwrap();
 /// sys.ends[0] = [0, 2]; // bypasses the mutators: the incidence lists are now stale
 /// assert!(matches!(sys.check_incidence(), Err(IncidenceError::Lists { .. })));
 /// ```

@@ -108,7 +108,7 @@ impl FromStr for Integrator {
 /// use topomech::mechanics::{Integrator, SpringSystem, StepConfig, StepError, Stepper};
 ///
 /// let mut sys = SpringSystem::default();
-/// sys.push_slot(1.0, false, 0.0);
+/// sys.push_slot(1.0, false, 0.0).unwrap();
 /// let (x, v) = (vec![[0.0; 3]], vec![[0.0; 3]]);
 /// let nan = Stepper::new(StepConfig::new(Integrator::Rk4, f64::NAN), &sys, &x, &v);
 /// assert!(matches!(nan, Err(StepError::BadTimeStep(dt)) if dt.is_nan()));
@@ -188,7 +188,7 @@ pub enum StepError {
 /// let config = StepConfig { cg_tolerance: 1e-6, cg_max_iterations: 50, ..StepConfig::new(Integrator::Implicit, 0.01) };
 /// assert_eq!((config.integrator, config.dt, config.parallel), (Integrator::Implicit, 0.01, false));
 /// let mut sys = SpringSystem::default();
-/// sys.push_slot(1.0, false, 0.0);
+/// sys.push_slot(1.0, false, 0.0).unwrap();
 /// let stepper = Stepper::new(config, &sys, &[[0.0; 3]], &[[0.0; 3]]).unwrap();
 /// assert_eq!(stepper.config().cg_max_iterations, 50);
 /// ```
@@ -244,7 +244,7 @@ impl StepConfig {
 ///
 /// let mut sys = SpringSystem::default();
 /// sys.gravity = [0.0, 0.0, -10.0];
-/// sys.push_slot(1.0, false, 0.0);
+/// sys.push_slot(1.0, false, 0.0).unwrap();
 /// let (mut x, mut v) = (vec![[0.0; 3]], vec![[0.0; 3]]);
 /// let mut stepper = Stepper::new(StepConfig::new(Integrator::Symplectic, 0.1), &sys, &x, &v).unwrap();
 /// (0..10).for_each(|_| stepper.step(&sys, &mut x, &mut v).unwrap());
@@ -301,7 +301,7 @@ impl Stepper {
     /// use topomech::mechanics::{Integrator, SpringSystem, StepConfig, StepError, Stepper};
     ///
     /// let mut sys = SpringSystem::default();
-    /// sys.push_slot(1.0, false, 0.0);
+    /// sys.push_slot(1.0, false, 0.0).unwrap();
     /// let (x, v) = (vec![[0.0; 3]], vec![[0.0; 3]]);
     /// let stepper = Stepper::new(StepConfig::new(Integrator::Implicit, 0.01), &sys, &x, &v).unwrap();
     /// assert_eq!((stepper.steps_done(), stepper.config().dt), (0, 0.01));
@@ -353,7 +353,7 @@ impl Stepper {
     /// use topomech::mechanics::{Integrator, SpringSystem, StepConfig, Stepper};
     ///
     /// let mut sys = SpringSystem::default();
-    /// sys.push_slot(1.0, false, 0.0);
+    /// sys.push_slot(1.0, false, 0.0).unwrap();
     /// let config = StepConfig { parallel: true, ..StepConfig::new(Integrator::Symplectic, 0.002) };
     /// let stepper = Stepper::new(config, &sys, &[[0.0; 3]], &[[0.0; 3]]).unwrap();
     /// assert_eq!(stepper.config(), &config);
@@ -370,7 +370,7 @@ impl Stepper {
     /// use topomech::mechanics::{Integrator, SpringSystem, StepConfig, Stepper};
     ///
     /// let mut sys = SpringSystem::default();
-    /// sys.push_slot(1.0, false, 0.0);
+    /// sys.push_slot(1.0, false, 0.0).unwrap();
     /// let (mut x, mut v) = (vec![[0.0; 3]], vec![[1.0, 0.0, 0.0]]);
     /// let mut stepper = Stepper::new(StepConfig::new(Integrator::Euler, 0.5), &sys, &x, &v).unwrap();
     /// for _ in 0..4 {
@@ -391,7 +391,7 @@ impl Stepper {
     /// use topomech::mechanics::{Integrator, Kernel, SpringSystem, StepConfig, Stepper};
     ///
     /// let mut sys = SpringSystem::default();
-    /// sys.push_slot(1.0, false, 0.0);
+    /// sys.push_slot(1.0, false, 0.0).unwrap();
     /// let stepper = Stepper::new(StepConfig::new(Integrator::Rk4, 0.1), &sys, &[[0.0; 3]], &[[0.0; 3]]).unwrap();
     /// assert_eq!(stepper.kernel(), Kernel::detect());
     /// ```
@@ -408,7 +408,7 @@ impl Stepper {
     ///
     /// let mut sys = SpringSystem::default();
     /// sys.gravity = [0.0, 0.0, -9.81];
-    /// sys.push_slot(1.0, false, 0.3);
+    /// sys.push_slot(1.0, false, 0.3).unwrap();
     /// let run = |kernel| {
     ///     let (mut x, mut v) = (vec![[0.0; 3]], vec![[1.0, 0.0, 0.0]]);
     ///     let mut stepper = Stepper::new(StepConfig::new(Integrator::Rk4, 0.01), &sys, &x, &v).unwrap();
@@ -490,9 +490,9 @@ impl Stepper {
     /// // A unit mass hanging from a fixed point on a spring, released at the spring's rest length.
     /// let mut sys = SpringSystem::default();
     /// sys.gravity = [0.0, 0.0, -10.0];
-    /// sys.push_slot(1.0, true, 0.0);
-    /// sys.push_slot(1.0, false, 0.0);
-    /// sys.push_spring([0, 1], 1.0, 100.0, 0.0);
+    /// sys.push_slot(1.0, true, 0.0).unwrap();
+    /// sys.push_slot(1.0, false, 0.0).unwrap();
+    /// sys.push_spring([0, 1], 1.0, 100.0, 0.0).unwrap();
     /// let (mut x, mut v) = (vec![[0.0; 3], [0.0, 0.0, -1.0]], vec![[0.0; 3]; 2]);
     /// let mut stepper = Stepper::new(StepConfig::new(Integrator::Symplectic, 1e-3), &sys, &x, &v).unwrap();
     /// (0..100).for_each(|_| stepper.step(&sys, &mut x, &mut v).unwrap());
@@ -500,7 +500,7 @@ impl Stepper {
     /// assert!(x[0] == [0.0; 3] && x[1][2] < -1.0); // the anchor stays, the mass falls
     /// // Another system's shape is refused, not stepped with buffers of the wrong size.
     /// let mut bigger = sys.clone();
-    /// bigger.push_slot(1.0, false, 0.0);
+    /// bigger.push_slot(1.0, false, 0.0).unwrap();
     /// let (mut x3, mut v3) = (vec![[0.0; 3]; 3], vec![[0.0; 3]; 3]);
     /// let e = stepper.step(&bigger, &mut x3, &mut v3).unwrap_err();
     /// assert!(matches!(e, topomech::mechanics::StepError::OtherSystem { slots: 2, got_slots: 3, .. }));
@@ -536,14 +536,14 @@ impl Stepper {
 
     fn euler(&mut self, sys: &SpringSystem, x: &mut [Vec3], v: &mut [Vec3]) {
         let (h, par) = (self.config.dt, self.config.parallel);
-        sys.accelerations_with(self.kernel, x, v, &mut self.sf, &mut self.acc, par);
+        sys.accelerations_raw(self.kernel, x, v, &mut self.sf, &mut self.acc, par);
         axpy(x, h, v);
         axpy(v, h, &self.acc);
     }
 
     fn symplectic(&mut self, sys: &SpringSystem, x: &mut [Vec3], v: &mut [Vec3]) {
         let (h, par) = (self.config.dt, self.config.parallel);
-        sys.accelerations_with(self.kernel, x, v, &mut self.sf, &mut self.acc, par);
+        sys.accelerations_raw(self.kernel, x, v, &mut self.sf, &mut self.acc, par);
         axpy(v, h, &self.acc);
         axpy(x, h, v);
     }
@@ -773,29 +773,7 @@ fn stage_slots(
 /// What makes `sys` unsteppable (see [`StepError::BadInput`]), if anything. O(slots + springs),
 /// no allocation unless it fails.
 fn check_system(sys: &SpringSystem) -> Result<(), String> {
-    let (n, s) = (sys.slots(), sys.springs());
-    let per_slot = [("inverse mass", &sys.inv_mass), ("viscosity", &sys.viscosity)];
-    let per_spring = [("rest length", &sys.rest), ("stiffness", &sys.stiffness), ("damping", &sys.damping)];
-    for (name, values, len, of) in
-        per_slot.map(|(a, b)| (a, b, n, "slots")).into_iter().chain(per_spring.map(|(a, b)| (a, b, s, "springs")))
-    {
-        if values.len() != len {
-            return Err(format!("{name} has {} entries for {len} {of}", values.len()));
-        }
-    }
-    let all = [("mass", &sys.mass, "slot")].into_iter().chain(per_slot.map(|(a, b)| (a, b, "slot")));
-    for (name, values, of) in all.chain(per_spring.map(|(a, b)| (a, b, "spring"))) {
-        if let Some((i, x)) = values.iter().enumerate().find(|(_, x)| !(x.is_finite() && **x >= 0.0)) {
-            return Err(format!("{name} of {of} {i} is {x} (must be finite and >= 0)"));
-        }
-    }
-    if !sys.gravity.iter().all(|g| g.is_finite()) {
-        return Err(format!("gravity {:?} is not finite", sys.gravity));
-    }
-    match sys.ends.iter().enumerate().find(|(_, e)| e[0] == e[1] || e[0].max(e[1]) as usize >= n) {
-        Some((i, e)) => Err(format!("spring {i} joins slots {e:?} (must be two different slots of {n})")),
-        None => Ok(()),
-    }
+    sys.check().map_err(|e| e.to_string())
 }
 
 /// What makes the start state unsteppable: a non-finite position or velocity. O(slots).
@@ -827,7 +805,7 @@ fn energy_scale(sys: &SpringSystem, x: &[Vec3], v: &[Vec3]) -> f64 {
     }
     let diag = if x.is_empty() { 0.0 } else { norm(sub(hi, lo)) };
     let total_mass: f64 = sys.mass.iter().sum();
-    sys.kinetic_energy(v) + sys.elastic_energy(x) + total_mass * norm(sys.gravity) * diag
+    sys.kinetic_energy_raw(v) + sys.elastic_energy_raw(x) + total_mass * norm(sys.gravity) * diag
 }
 
 #[inline(always)]
@@ -872,7 +850,7 @@ impl Stepper {
         cg.coef.resize(sys.springs(), [0.0; 3]);
         linearise(sys, x, &mut cg.dir, &mut cg.coef);
         // b = h f0 + h² K-gather(v0)  (K v0 enters with a minus: −h² K v0, K = −∂f/∂x ⇒ + gather).
-        sys.forces(x, v, &mut self.sf, &mut self.acc, par);
+        sys.forces_raw(x, v, &mut self.sf, &mut self.acc, par);
         spring_products(sys, &cg.dir, &cg.coef, v, 0.0, 1.0, &mut self.sf);
         let sf: &[Vec3] = &self.sf;
         let f0: &[Vec3] = &self.acc;

@@ -26,7 +26,7 @@ pub mod simd;
 
 pub use conservation::{check_conservation, conservation_violations, ConservationError};
 pub use flat::FlatModel;
-pub use force::{IncidenceError, SpringSystem};
+pub use force::{IncidenceError, SpringSystem, SystemError};
 pub use geom::Vec3;
 pub use integrate::{Integrator, StepConfig, StepError, Stepper};
 pub use model::{Body, BodyError, Material, Mechanics, ModelError};
@@ -325,7 +325,7 @@ impl Simulation {
     /// ```
     pub fn kinetic_energy(&self, body: &Body) -> f64 {
         let slots = self.projection.system.slots();
-        self.projection.system.kinetic_energy(&body.attrs().velocity.as_slice()[..slots])
+        self.projection.system.kinetic_energy_raw(&body.attrs().velocity.as_slice()[..slots])
     }
 
     /// Largest distance of a live vertex from its rest position. O(vertex ids).

@@ -307,7 +307,7 @@ impl Projection {
         let mech = body.attrs();
         let n = map.cell_id_bound(0);
         while self.system.slots() < n {
-            self.system.push_slot(0.0, true, 0.0);
+            self.system.push_slot_raw(0.0, true, 0.0);
             self.vertex_dart.push(None);
         }
         if self.edge_spring.len() < map.cell_id_bound(1) {
@@ -318,7 +318,7 @@ impl Projection {
             self.vertex_dart[v.index()] = d;
             let (m, g) = if d.is_some() { (mech.vertex_mass(v), mech.vertex_viscosity(v)) } else { (0.0, 0.0) };
             let fixed = d.is_none() || mech.pinned[v];
-            self.system.set_slot(v.index(), m, fixed, g);
+            self.system.set_slot_raw(v.index(), m, fixed, g);
         }
         for &(e, d) in resolved.of(map, 1, &touched.edges) {
             match d {
@@ -339,11 +339,11 @@ impl Projection {
         let (rest, k, c) = (mech.edge_rest_length(e), mech.edge_stiffness(e), mech.edge_damping(e));
         match self.spring_of_edge(e) {
             Some(s) => {
-                self.system.set_spring(s, ends, rest, k, c);
+                self.system.set_spring_raw(s, ends, rest, k, c);
                 self.spring_dart[s] = d;
             }
             None => {
-                let s = self.system.push_spring(ends, rest, k, c);
+                let s = self.system.push_spring_raw(ends, rest, k, c);
                 self.spring_edge.push(e);
                 self.spring_dart.push(d);
                 self.edge_spring[e.index()] = s as u32;
@@ -354,7 +354,7 @@ impl Projection {
     /// Swap-removes the spring of the dead edge `e`, if any. O(degree of the two springs' ends).
     fn remove_spring(&mut self, e: CellId) {
         let Some(s) = self.spring_of_edge(e) else { return };
-        self.system.swap_remove_spring(s);
+        self.system.swap_remove_spring_raw(s);
         self.spring_dart.swap_remove(s);
         self.spring_edge.swap_remove(s);
         self.edge_spring[e.index()] = u32::MAX;
@@ -916,7 +916,7 @@ fn system_of(
     let mass = (0..n).map(|v| if live(v) { mech.vertex_mass(CellId(v as u32)) } else { 0.0 }).collect();
     let visc = (0..n).map(|v| if live(v) { mech.vertex_viscosity(CellId(v as u32)) } else { 0.0 }).collect();
     let fixed: Vec<bool> = (0..n).map(|v| !live(v) || mech.pinned[CellId(v as u32)]).collect();
-    SpringSystem::new(ends, rest, stiffness, damping, mass, &fixed, visc, gravity)
+    SpringSystem::from_arrays(ends, rest, stiffness, damping, mass, &fixed, visc, gravity)
 }
 
 /// Forces on every vertex id computed by covering the map (seed §4.2), without the projection:

@@ -949,7 +949,7 @@ impl LeveledMechanics {
         let rest = self.springs.values().map(|s| s.rest).collect();
         let stiffness = self.springs.values().map(|s| s.stiffness).collect();
         let damping = self.springs.values().map(|s| s.damping).collect();
-        SpringSystem::new(ends, rest, stiffness, damping, mass, &pinned, viscosity, gravity)
+        SpringSystem::from_arrays(ends, rest, stiffness, damping, mass, &pinned, viscosity, gravity)
     }
 }
 

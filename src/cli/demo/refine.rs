@@ -20,7 +20,7 @@
 use std::time::Instant;
 
 use indicatif::ProgressBar;
-use topomech::mechanics::{Body, Integrator, StepConfig, Stepper, Vec3};
+use topomech::mechanics::{Body, Integrator, StepConfig, StepError, Stepper, Vec3};
 use topomech::subdivide::{EdgeKey, LeveledMap, LeveledMechanics, TetMasses};
 use topomech::surface::Surface;
 use topomech::{AlphaMask, CellId, DartId, GMap};
@@ -175,6 +175,9 @@ pub fn simulate_refined(
     if let Some(&(vertex, at)) = held.iter().find(|&&(v, p)| mech.position[v] != p) {
         return Err(DemoError::RefinedPin { vertex, at, now: mech.position[vertex] });
     }
+    let kinetic_energy = sys
+        .kinetic_energy(&mech.velocity)
+        .map_err(|e| DemoError::RefinedStep { step: steps, source: StepError::BadInput(e.to_string()) })?;
     let max_displacement = (0..sys.slots().min(rest.len()))
         .filter(|&v| sys.mass[v] > 0.0)
         .map(|v| dist(mech.position[v], rest[v]))
@@ -186,7 +189,7 @@ pub fn simulate_refined(
         pinned: fixed.iter().filter(|&&f| f).count(),
         step_us_median: crate::cli::simulate::median(&mut times),
         max_displacement,
-        kinetic_energy: sys.kinetic_energy(&mech.velocity),
+        kinetic_energy,
         checks: SIM_CHECKS,
     })
 }

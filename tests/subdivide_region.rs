@@ -260,3 +260,62 @@ fn the_refine_command_rejects_bad_arguments_with_a_message() {
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("/no/such.msh"));
 }
+
+/// Finding 30 (docs/VERIFICATION.md): masses without an entry for some live volume (made for a
+/// smaller map, or missing the volumes of a plain `subdivide_tet`) were taken as 0: a
+/// refinement of the cube with the masses of one tet reported equal totals before and after
+/// while five of its six tets weighed nothing, and a NaN mass was shared as NaN. Each
+/// operation that shares masses now refuses them before any change.
+#[test]
+fn masses_that_miss_a_volume_or_are_not_finite_are_refused_before_any_change() {
+    use topomech::generate::kuhn_cube;
+    let leveled = |points: Vec<[f64; 3]>, tets: &[[u32; 4]]| {
+        let (map, _) = GMap::<3>::from_tets(points.len(), tets).unwrap();
+        LeveledMap::new(map, points)
+    };
+    let one = leveled(vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], &[[0, 1, 2, 3]]);
+    let (points, tets) = kuhn_cube(1);
+    let cube = leveled(points, &tets);
+    let small = TetMasses::from_density(&one, 1.0).unwrap();
+    let no_mass = Err(SubdivideError::NoMass { volume: 1, masses: 1 });
+    let last = cube.map().darts().last().unwrap(); // a dart of the last volume
+    let unchanged = |m: &LeveledMap<3>, masses: &TetMasses| {
+        assert_eq!((m.map().dart_count(), m.max_level()), (144, 0));
+        assert_eq!(masses, &small);
+    };
+    let (mut m, mut masses) = (cube.clone(), small.clone());
+    assert_eq!(m.subdivide_tet_with_mass(last, 1, &mut masses).map(|_| ()), no_mass);
+    unchanged(&m, &masses);
+    assert_eq!(m.refine_uniform(1, &mut masses).map(|_| ()), no_mass);
+    unchanged(&m, &masses);
+    assert_eq!(m.refine_around([0.5; 3], 2.0, 1, &mut masses).map(|_| ()), no_mass);
+    unchanged(&m, &masses);
+    assert_eq!(m.refine_around_per_op([0.5; 3], 2.0, 1, &mut masses).map(|_| ()), no_mass);
+    unchanged(&m, &masses);
+    assert_eq!(masses.vertex_masses(&m).map(|_| ()), no_mass);
+
+    // Volumes made by an operation without masses have none to share.
+    let mut full = TetMasses::from_density(&m, 1.0).unwrap();
+    let first = m.map().darts().next().unwrap();
+    let children = m.subdivide_tet(first, 1).unwrap();
+    let e = m.subdivide_tet_with_mass(last, 1, &mut full).unwrap_err();
+    let SubdivideError::NoMass { volume, masses: 6 } = e else { panic!("{e:?}") };
+    assert!(volume >= 6 && children.iter().any(|&c| m.map().cell_id(3, c).0 == volume), "{volume}");
+
+    // A non-finite or negative mass.
+    let (mut m, mut masses) = (cube.clone(), TetMasses::from_density(&cube, 1.0).unwrap());
+    let t = m.map().cell_id(3, last);
+    masses.mass[t.index()] = f64::NAN;
+    let e = m.subdivide_tet_with_mass(last, 1, &mut masses).unwrap_err();
+    assert!(matches!(e, SubdivideError::BadMass { volume, .. } if volume == t.0), "{e:?}");
+    masses.mass[t.index()] = -1.0;
+    assert!(matches!(m.refine_uniform(1, &mut masses), Err(SubdivideError::BadMass { mass, .. }) if mass == -1.0));
+    assert_eq!(m.map().dart_count(), 144);
+
+    // Masses that cover the map still refine and conserve.
+    let mut masses = TetMasses::from_density(&cube, 1.0).unwrap();
+    let mut m = cube.clone();
+    let r = m.refine_around([0.5; 3], 2.0, 1, &mut masses).unwrap();
+    assert_eq!(r.subdivided_per_level, vec![0, 6]);
+    assert!((r.total_mass_after - 1.0).abs() < 1e-12 && (r.total_mass_before - 1.0).abs() < 1e-12);
+}

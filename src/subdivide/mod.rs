@@ -254,6 +254,24 @@ pub enum SubdivideError {
         /// Its stored position.
         position: [f64; 3],
     },
+    /// A live volume has no entry in the [`TetMasses`] given (masses made for another, smaller
+    /// map, or the volume was made by an operation without masses): sharing its mass would
+    /// take it as 0 and lose the parent's. Refused before any change.
+    #[error("volume {volume} has no mass (the masses hold {masses} entries): masses of another map, or a volume made without them")]
+    NoMass {
+        /// The volume id.
+        volume: u32,
+        /// How many entries the masses hold.
+        masses: usize,
+    },
+    /// A live volume's entry in the [`TetMasses`] given is negative or not finite.
+    #[error("volume {volume} has mass {mass} (must be finite and >= 0)")]
+    BadMass {
+        /// The volume id.
+        volume: u32,
+        /// Its mass.
+        mass: f64,
+    },
     /// A density for [`TetMasses::from_density`] that is not a finite number > 0.
     #[error("density {0} must be a finite number > 0")]
     BadDensity(f64),

@@ -38,9 +38,11 @@ use crate::mechanics::geom::{cross, dot, sub};
 /// ```
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TetMasses {
-    /// `mass[t]`: the mass of volume t (0 for ids no volume uses). An id past the end has mass
-    /// 0 too, in every function of this module (e.g. a volume created by an operation without
-    /// masses, or masses made for a smaller map).
+    /// `mass[t]`: the mass of volume t (0 for ids no volume uses). The operations that share
+    /// masses and [`TetMasses::vertex_masses`] refuse masses without an entry for some live
+    /// volume ([`SubdivideError::NoMass`]: masses made for a smaller map, or a volume created
+    /// by an operation without masses) or with a negative or non-finite one
+    /// ([`SubdivideError::BadMass`]); [`TetMasses::total`] counts a missing entry as 0.
     pub mass: Vec<f64>,
 }
 
@@ -130,6 +132,51 @@ impl TetMasses {
         self.mass.get(t.index()).copied().unwrap_or(0.0)
     }
 
+    /// [`SubdivideError::NoMass`] unless every live volume of `m` has an entry: O(1) when the
+    /// entries reach the map's volume id bound, else O(darts).
+    pub(crate) fn check_cover(&self, m: &LeveledMap<3>) -> Result<(), SubdivideError> {
+        let map = m.map();
+        if self.mass.len() >= map.cell_id_bound(3) {
+            return Ok(());
+        }
+        match map.one_dart_per_cell(3).into_iter().map(|d| map.cell_id(3, d)).find(|t| t.index() >= self.mass.len()) {
+            Some(t) => Err(SubdivideError::NoMass { volume: t.0, masses: self.mass.len() }),
+            None => Ok(()),
+        }
+    }
+
+    /// [`TetMasses::check_cover`] and every live volume's mass finite and ≥ 0
+    /// ([`SubdivideError::BadMass`]). O(darts).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::subdivide::{LeveledMap, SubdivideError, TetMasses};
+    /// # use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [1, 2, 3, 4]]).unwrap();
+    /// let m = LeveledMap::new(map, vec![]);
+    /// assert_eq!(TetMasses { mass: vec![1.0, 2.0] }.check(&m), Ok(()));
+    /// assert_eq!(TetMasses { mass: vec![1.0] }.check(&m), Err(SubdivideError::NoMass { volume: 1, masses: 1 }));
+    /// assert!(matches!(TetMasses { mass: vec![1.0, f64::NAN] }.check(&m), Err(SubdivideError::BadMass { volume: 1, .. })));
+    /// ```
+    pub fn check(&self, m: &LeveledMap<3>) -> Result<(), SubdivideError> {
+        self.check_cover(m)?;
+        let map = m.map();
+        for t in map.one_dart_per_cell(3).into_iter().map(|d| map.cell_id(3, d)) {
+            self.check_mass(t)?;
+        }
+        Ok(())
+    }
+
+    /// [`SubdivideError::BadMass`] unless the entry of volume t (which must exist) is finite
+    /// and ≥ 0. O(1).
+    fn check_mass(&self, t: CellId) -> Result<f64, SubdivideError> {
+        match self.mass[t.index()] {
+            mass if mass.is_finite() && mass >= 0.0 => Ok(mass),
+            mass => Err(SubdivideError::BadMass { volume: t.0, mass }),
+        }
+    }
+
     /// Vertex masses m_v = Σ_{t ∋ v} m_t / 4, indexed by vertex id. O(darts).
     ///
     /// # Examples
@@ -144,9 +191,10 @@ impl TetMasses {
     /// let masses = TetMasses::from_density(&m, 6.0).unwrap();
     /// let v = masses.vertex_masses(&m).unwrap();
     /// assert!(v.iter().all(|&x| (x - 0.25).abs() < 1e-12));
-    /// assert!(TetMasses::default().vertex_masses(&m).unwrap().iter().all(|&x| x == 0.0));
+    /// assert!(TetMasses::default().vertex_masses(&m).is_err()); // no mass for volume 0
     /// ```
     pub fn vertex_masses(&self, m: &LeveledMap<3>) -> Result<Vec<f64>, SubdivideError> {
+        self.check(m)?;
         let map = m.map();
         let mut out = vec![0.0; map.cell_id_bound(0)];
         for d in map.one_dart_per_cell(3) {
@@ -305,8 +353,10 @@ impl LeveledMap<3> {
     /// among the children in proportion to their rest volumes (module docs). O(volume + touched).
     ///
     /// Errors: those of [`Self::tet_volume`] for the tet of `d` (no such dart, a corner without a
-    /// finite position: the volumes are needed) and of [`Self::subdivide_tet`]; the map and the
-    /// masses are unchanged on error.
+    /// finite position: the volumes are needed), [`SubdivideError::NoMass`] when some live
+    /// volume has no entry in `masses` (O(1) when they reach the volume id bound),
+    /// [`SubdivideError::BadMass`] for the parent's, and those of [`Self::subdivide_tet`]; the
+    /// map and the masses are unchanged on error.
     ///
     /// # Examples
     ///
@@ -340,7 +390,8 @@ impl LeveledMap<3> {
         // volume that is no tet is refused here, before the map changes (the children's corners
         // are the parent's and midpoints of its edges).
         self.tet_volume(d)?;
-        let parent = masses.mass.get(self.map.cell_id(3, d).index()).copied().unwrap_or(0.0);
+        masses.check_cover(self)?;
+        let parent = masses.check_mass(self.map.cell_id(3, d))?;
         let children = self.subdivide_tet(d, level)?;
         let volumes: Vec<f64> = children.iter().map(|&c| self.tet_volume(c).map(f64::abs)).collect::<Result<_, _>>()?;
         let total: f64 = volumes.iter().sum();
@@ -369,6 +420,7 @@ impl LeveledMap<3> {
     /// O(Σ_L (volumes + refined · touched)); O(darts) per bulk level.
     ///
     /// Errors: those of [`Self::subdivide_tet`] (the map keeps the operations done before it);
+    /// those of [`TetMasses::check`] before any change;
     /// [`SubdivideError::LevelTooHigh`] for `levels` above [`super::MAX_LEVEL`];
     /// [`SubdivideError::BadBall`] for a non-finite centre or radius or a negative radius and
     /// [`SubdivideError::DartLimit`] for a level over the dart limit (both before any change at
@@ -432,6 +484,7 @@ impl LeveledMap<3> {
     ) -> Result<Refinement, SubdivideError> {
         self.check_op_level(levels)?;
         Self::check_ball(center, radius)?;
+        masses.check(self)?;
         // Mass totals: a bulk level reports them (Σ over every volume), so O(darts) sweeps are
         // only made around per-op levels.
         let (mut before, mut after) = (None, None);

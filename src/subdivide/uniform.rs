@@ -766,7 +766,8 @@ impl LeveledMap<3> {
     /// [`SubdivideError::NotUniform`] (a dart off the common level m, or an inserted vertex);
     /// [`SubdivideError::AlreadyAtLevel`] (m ≥ `level`); [`SubdivideError::OpenEdge`] (an α0-,
     /// α1- or α2-free dart); [`SubdivideError::NotATetrahedron`] (a volume that is not a tet of
-    /// 24 darts with four distinct corner vertices).
+    /// 24 darts with four distinct corner vertices); those of [`TetMasses::check`] (a live
+    /// volume without a finite mass ≥ 0 in `masses`).
     ///
     /// # Examples
     ///
@@ -785,6 +786,7 @@ impl LeveledMap<3> {
     /// ```
     pub fn refine_uniform(&mut self, level: u8, masses: &mut TetMasses) -> Result<Refinement, SubdivideError> {
         self.uniform_level(level)?;
+        masses.check(self)?;
         let tpl = templates(3);
         let lab = self.label_parents(&tpl)?;
         let parents = lab.template.len();

@@ -181,10 +181,10 @@ fn split_edges_interpolated_after_deformation_are_in_equilibrium_with_the_coarse
     for (v, &p) in TET.iter().enumerate() {
         mech.position[v] = deformed(p, v);
     }
-    let coarse = mech.spring_system(&m, [0.0; 3], &[true; 4]);
+    let coarse = mech.spring_system(&m, [0.0; 3], &[true; 4]).unwrap();
     let f_coarse = spring_forces(&coarse, &mech.position);
     split_all_edges(&mut mech, &mut m, 3);
-    let fine = mech.spring_system(&m, [0.0; 3], &[true; 4]);
+    let fine = mech.spring_system(&m, [0.0; 3], &[true; 4]).unwrap();
     assert_eq!(fine.springs(), 6 * 8);
     let f_fine = spring_forces(&fine, &mech.position);
     let scale = f_coarse.iter().flatten().fold(0.0f64, |a, &b| a.max(b.abs()));
@@ -216,9 +216,11 @@ fn a_relaxed_refined_chain_network_has_the_coarse_static_response() {
     let coarse = LeveledMechanics::new(&tet_mesh(TET.to_vec(), &[[0, 1, 2, 3]]), heavy).unwrap();
     let mut x_coarse = coarse.position.clone();
     (0..4).for_each(|v| x_coarse[v] = mech.position[v]);
-    let f_coarse =
-        spring_forces(&coarse.spring_system(&tet_mesh(TET.to_vec(), &[[0, 1, 2, 3]]), [0.0; 3], &[]), &x_coarse);
-    let sys = mech.spring_system(&m, [0.0; 3], &[true; 4]);
+    let f_coarse = spring_forces(
+        &coarse.spring_system(&tet_mesh(TET.to_vec(), &[[0, 1, 2, 3]]), [0.0; 3], &[]).unwrap(),
+        &x_coarse,
+    );
+    let sys = mech.spring_system(&m, [0.0; 3], &[true; 4]).unwrap();
     let mut stepper =
         Stepper::new(StepConfig::new(Integrator::Implicit, 1e-2), &sys, &mech.position, &mech.velocity).unwrap();
     for _ in 0..3000 {
@@ -244,18 +246,18 @@ fn refinement_never_softens_and_chains_alone_keep_the_coarse_energy() {
     let (points, tets) = kuhn_cube(1);
     let mut m = tet_mesh(points.clone(), &tets);
     let mech0 = LeveledMechanics::new(&m, material()).unwrap();
-    let e_coarse = mech0.spring_system(&m, [0.0; 3], &[]).elastic_energy(&affine(m.points())).unwrap();
+    let e_coarse = mech0.spring_system(&m, [0.0; 3], &[]).unwrap().elastic_energy(&affine(m.points())).unwrap();
     // Edge splits only: the network is the coarse one in series, same energy under affine motion.
     let mut mech = mech0.clone();
     split_all_edges(&mut mech, &mut m, 2);
-    let e_chains = mech.spring_system(&m, [0.0; 3], &[]).elastic_energy(&affine(m.points())).unwrap();
+    let e_chains = mech.spring_system(&m, [0.0; 3], &[]).unwrap().elastic_energy(&affine(m.points())).unwrap();
     assert!((e_chains - e_coarse).abs() < 1e-12 * e_coarse, "{e_chains} vs {e_coarse}");
     // 1→8 adds inner springs: at least as stiff.
     let mut m2 = tet_mesh(points, &tets);
     let mut mech2 = LeveledMechanics::new(&m2, material()).unwrap();
     mech2.refine_around(&mut m2, [0.5; 3], 10.0, 2).unwrap();
     mech2.check(&m2).unwrap();
-    let e_fine = mech2.spring_system(&m2, [0.0; 3], &[]).elastic_energy(&affine(m2.points())).unwrap();
+    let e_fine = mech2.spring_system(&m2, [0.0; 3], &[]).unwrap().elastic_energy(&affine(m2.points())).unwrap();
     assert!(e_fine > e_coarse * (1.0 + 1e-6), "{e_fine} vs {e_coarse}");
 }
 
@@ -268,10 +270,10 @@ fn masses_are_conserved_exactly_and_every_vertex_has_mass() {
     assert!(r.subdivided_per_level[1] > 0 && r.subdivided_per_level[2] > 0);
     mech.check(&m).unwrap();
     let total = 2.0 * 8.0; // ρ · volume of [0, 2]³
-    let vm = mech.vertex_masses(&m);
+    let vm = mech.vertex_masses(&m).unwrap();
     assert!((vm.iter().sum::<f64>() - total).abs() < 1e-12 * total);
     assert!(vm.iter().all(|&x| x > 0.0), "a vertex without mass would be pinned by the projection");
-    let sys = mech.spring_system(&m, [0.0; 3], &[]);
+    let sys = mech.spring_system(&m, [0.0; 3], &[]).unwrap();
     assert!((sys.mass.iter().sum::<f64>() - total).abs() < 1e-12 * total);
     assert_eq!(sys.springs(), m.map().count_cells().0[1]);
 }
@@ -283,7 +285,7 @@ fn a_refined_zone_simulates_from_the_projection_without_a_tet_list() {
     let mut mech = LeveledMechanics::new(&m, Material::default()).unwrap();
     mech.refine_around(&mut m, [1.0, 1.0, 2.0], 0.4, 2).unwrap();
     let fixed: Vec<bool> = m.points().iter().map(|p| p[2] == 0.0).collect();
-    let sys = mech.spring_system(&m, [0.0, 0.0, -9.81], &fixed);
+    let sys = mech.spring_system(&m, [0.0, 0.0, -9.81], &fixed).unwrap();
     let mut stepper =
         Stepper::new(StepConfig::new(Integrator::Implicit, 1e-3), &sys, &mech.position, &mech.velocity).unwrap();
     for _ in 0..200 {
@@ -493,7 +495,7 @@ fn a_cut_edge_whose_ends_stay_joined_carries_two_springs_through_refinement() {
         assert!((compliance * root.stiffness - 1.0).abs() < 1e-12);
     }
     assert!(c0.iter().all(|h| !c1.contains(h)), "two chains, no link shared");
-    let sys = mech.spring_system(&m, [0.0; 3], &[]);
+    let sys = mech.spring_system(&m, [0.0; 3], &[]).unwrap();
     assert_eq!(sys.springs(), m.map().count_cells().0[1], "one spring per edge cell");
     let mut ends: Vec<[u32; 2]> = sys.ends.clone();
     ends.sort_unstable();
@@ -501,7 +503,7 @@ fn a_cut_edge_whose_ends_stay_joined_carries_two_springs_through_refinement() {
     let doubled: usize = doubled_pairs(m.map()).values().map(|n| n - 1).sum();
     assert_eq!(repeated, doubled, "the spring system repeats exactly the doubled vertex pairs");
     let total = body.attrs().total_tet_mass(body.map()); // ρ · 27, cut or not
-    let vm: f64 = mech.vertex_masses(&m).iter().sum();
+    let vm: f64 = mech.vertex_masses(&m).unwrap().iter().sum();
     assert!((vm - total).abs() < 1e-12 * total, "{vm} vs {total}");
 }
 
@@ -543,7 +545,7 @@ fn run_cut(rings: &[(u8, u8, u8)], faces: &[u16], ops: &[u8]) -> Result<usize, S
             return Err(format!("vertices ({a}, {b}): {n} edge cells, {found} springs"));
         }
     }
-    let sys = mech.spring_system(&m, [0.0; 3], &[]);
+    let sys = mech.spring_system(&m, [0.0; 3], &[]).unwrap();
     if sys.springs() != m.map().count_cells().0[1] {
         return Err(format!("{} springs for {} edge cells", sys.springs(), m.map().count_cells().0[1]));
     }
@@ -716,4 +718,30 @@ fn the_coupling_and_the_leveled_map_refuse_bad_input_before_changing_anything() 
     // A map without any geometry still refines (its new vertices get the origin).
     let mut bare = LeveledMap::new(single(), vec![]);
     assert!(bare.subdivide_tet(DartId(0), 1).is_ok() && bare.points().is_empty());
+}
+
+/// Finding 31 (docs/VERIFICATION.md): `LeveledMechanics::spring_system` and `vertex_masses`
+/// did not check that the map given is the one the coupling follows. A coupling of one tet
+/// given a six-tet cube returned a system with the cube's masses and the tet's springs; a
+/// coupling of the cube given one tet had springs whose ends reach past the tet's vertex ids
+/// and panicked building the incidence lists. Both are refused as every coupling operation
+/// refuses another map (`CouplingError::StateCount`).
+#[test]
+fn the_coupling_projects_only_the_map_it_follows() {
+    let (points, tets) = kuhn_cube(1);
+    let cube = tet_mesh(points, &tets);
+    let one = tet_mesh(TET.to_vec(), &[[0, 1, 2, 3]]);
+    let (small, big) = (
+        LeveledMechanics::new(&one, Material::default()).unwrap(),
+        LeveledMechanics::new(&cube, Material::default()).unwrap(),
+    );
+    let count = |states, vertices| Err(CouplingError::StateCount { states, vertices });
+    assert_eq!(small.spring_system(&cube, [0.0; 3], &[]).map(|s| s.slots()), count(4, 8));
+    assert_eq!(big.spring_system(&one, [0.0; 3], &[]).map(|s| s.slots()), count(8, 4));
+    assert_eq!(small.vertex_masses(&cube).map(|v| v.len()), count(4, 8));
+    assert_eq!(big.vertex_masses(&one).map(|v| v.len()), count(8, 4));
+    let sys = big.spring_system(&cube, [0.0; 3], &[]).unwrap();
+    assert_eq!((sys.slots(), sys.springs()), (8, 19));
+    let total: f64 = big.vertex_masses(&cube).unwrap().iter().sum();
+    assert!((total - 1.0).abs() < 1e-12, "{total}");
 }

@@ -888,6 +888,10 @@ impl LeveledMechanics {
     /// Vertex masses m_v = Σ_{volumes t ∋ v} m_t / n_t (n_t: vertices of t in the finest map), by
     /// vertex id: a scatter from the volumes. Σ_v m_v = Σ_t m_t. O(darts).
     ///
+    /// # Errors
+    /// [`CouplingError::OutOfSync`] or [`CouplingError::StateCount`] when `m` is not the map this
+    /// coupling follows (checked as every coupling operation does).
+    ///
     /// # Examples
     ///
     /// ```
@@ -900,9 +904,16 @@ impl LeveledMechanics {
     /// let mut mech = LeveledMechanics::new(&m, Material { density: 6.0, ..Material::default() }).unwrap();
     /// let d = m.map().darts().next().unwrap();
     /// mech.split_edge(&mut m, d, 1).unwrap(); // one tet with 5 vertices: 1/5 each
-    /// assert!(mech.vertex_masses(&m).iter().all(|&x| (x - 0.2).abs() < 1e-12));
+    /// assert!(mech.vertex_masses(&m).unwrap().iter().all(|&x| (x - 0.2).abs() < 1e-12));
     /// ```
-    pub fn vertex_masses(&self, m: &LeveledMap<3>) -> Vec<f64> {
+    pub fn vertex_masses(&self, m: &LeveledMap<3>) -> Result<Vec<f64>, CouplingError> {
+        self.in_sync(m)?;
+        Ok(self.vertex_masses_raw(m))
+    }
+
+    /// [`Self::vertex_masses`] without the check (the law checks and the spring system, which
+    /// have made it). O(darts).
+    pub(super) fn vertex_masses_raw(&self, m: &LeveledMap<3>) -> Vec<f64> {
         let map = m.map();
         let mut out = vec![0.0; map.cell_id_bound(0)];
         for t in map.one_dart_per_cell(3) {
@@ -921,6 +932,10 @@ impl LeveledMechanics {
     /// [`Self::vertex_masses`], viscosity ν·m_v, `fixed[v]` pinning vertex v (missing entries:
     /// free). No tet list is rebuilt. O(darts + E).
     ///
+    /// # Errors
+    /// As [`Self::vertex_masses`]: a coupling given another map (whose spring ends could reach
+    /// past its vertex ids) is refused.
+    ///
     /// # Examples
     ///
     /// ```
@@ -933,15 +948,21 @@ impl LeveledMechanics {
     /// let mut mech = LeveledMechanics::new(&m, Material::default()).unwrap();
     /// let d = m.map().darts().next().unwrap();
     /// mech.subdivide_tet(&mut m, d, 1).unwrap();
-    /// let sys = mech.spring_system(&m, [0.0, 0.0, -9.81], &[true, true, true]);
+    /// let sys = mech.spring_system(&m, [0.0, 0.0, -9.81], &[true, true, true]).unwrap();
     /// assert_eq!((sys.slots(), sys.springs()), (10, 25));
     /// let mut stepper = Stepper::new(StepConfig::new(Integrator::Symplectic, 1e-4), &sys, &mech.position, &mech.velocity).unwrap();
     /// let (x, v) = (&mut mech.position, &mut mech.velocity);
     /// stepper.step(&sys, x, v).unwrap();
     /// assert!(mech.position[3][2] < 1.0 && mech.position[0] == [0.0; 3]); // falls, pinned stays
     /// ```
-    pub fn spring_system(&self, m: &LeveledMap<3>, gravity: Vec3, fixed: &[bool]) -> SpringSystem {
-        let mass = self.vertex_masses(m);
+    pub fn spring_system(
+        &self,
+        m: &LeveledMap<3>,
+        gravity: Vec3,
+        fixed: &[bool],
+    ) -> Result<SpringSystem, CouplingError> {
+        self.in_sync(m)?;
+        let mass = self.vertex_masses_raw(m);
         let n = mass.len();
         let pinned: Vec<bool> = (0..n).map(|v| fixed.get(v).copied().unwrap_or(false)).collect();
         let viscosity = mass.iter().map(|x| self.material.viscosity * x).collect();
@@ -949,7 +970,7 @@ impl LeveledMechanics {
         let rest = self.springs.values().map(|s| s.rest).collect();
         let stiffness = self.springs.values().map(|s| s.stiffness).collect();
         let damping = self.springs.values().map(|s| s.damping).collect();
-        SpringSystem::from_arrays(ends, rest, stiffness, damping, mass, &pinned, viscosity, gravity)
+        Ok(SpringSystem::from_arrays(ends, rest, stiffness, damping, mass, &pinned, viscosity, gravity))
     }
 }
 

@@ -320,7 +320,7 @@ impl LeveledMechanics {
         if !close(after, self.total_mass) {
             return Err(SpringLawError::TotalMass { before: self.total_mass, after });
         }
-        let scattered = self.vertex_masses(m);
+        let scattered = self.vertex_masses_raw(m);
         for d in map.one_dart_per_cell(0) {
             let mut volumes: Vec<_> =
                 map.orbit(d, AlphaMask::cell(3, 0)).iter().map(|&x| (map.cell_id(3, x), x)).collect();

@@ -95,7 +95,8 @@ pub fn refine(body: &Body, tets: &[CellId], run: &mut StageRun, bar: &ProgressBa
         return Err(DemoError::Balance { stage: "refinement", step: 0, quantity: "mass", residual });
     }
     mech.check(&lm).map_err(DemoError::SpringLaws)?;
-    let projected = mech.spring_system(&lm, [0.0; 3], &[]).springs();
+    let projected =
+        mech.spring_system(&lm, [0.0; 3], &[]).map_err(|source| DemoError::Coupling { tet: None, source })?.springs();
     let edges = lm.map().count_cells().0[1];
     if projected != edges {
         return Err(DemoError::SpringCount { springs: projected, edges });
@@ -152,7 +153,8 @@ pub fn simulate_refined(
             pins.get(v).copied().unwrap_or_else(|| rest.get(v).is_some_and(|p| p[config.long_axis] <= config.pin_limit))
         })
         .collect();
-    let sys = mech.spring_system(lm, config.gravity, &fixed);
+    let sys =
+        mech.spring_system(lm, config.gravity, &fixed).map_err(|source| DemoError::Coupling { tet: None, source })?;
     let (slot_mass, tet_mass) = (sys.mass.iter().sum::<f64>(), mech.masses.total(lm));
     let residual = (slot_mass - tet_mass) / tet_mass;
     if residual.is_nan() || residual.abs() > super::checks::TOLERANCE {

@@ -343,7 +343,7 @@ impl LeveledMechanics {
     /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
     /// let m = LeveledMap::new(map, pts);
     /// let mech = LeveledMechanics::with_masses(&m, Material::default(), TetMasses { mass: vec![2.0] }).unwrap();
-    /// assert!((mech.vertex_masses(&m)[3] - 0.5).abs() < 1e-15);
+    /// assert!((mech.vertex_masses(&m).unwrap()[3] - 0.5).abs() < 1e-15);
     /// let e = LeveledMechanics::with_masses(&m, Material::default(), TetMasses { mass: vec![] }).unwrap_err();
     /// assert_eq!(e, CouplingError::BadMass { volume: 0, given: None });
     /// ```

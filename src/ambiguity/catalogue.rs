@@ -299,4 +299,15 @@ mod tests {
         }
         assert!(cat.counts.iter().all(|c| c.ambiguous_classes >= 2 * c.groups));
     }
+
+    /// Every pair's description names both constructions, that of `a` then that of `b`.
+    #[test]
+    fn every_catalogue_description_names_both_constructions() {
+        let pairs = catalogue(Bounds::SMALL).pairs;
+        assert!(!pairs.is_empty());
+        for p in pairs {
+            let (a, b) = (origin_text(&p.a.origin), origin_text(&p.b.origin));
+            assert_eq!(p.description, format!("{a} vs {b}"), "{}", p.name);
+        }
+    }
 }

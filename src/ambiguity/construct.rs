@@ -533,6 +533,28 @@ mod tests {
         assert_eq!(gluings(2, 2).len(), 7);
     }
 
+    /// `combinations4(n)` lists the C(n, 4) strictly increasing quadruples of 0..n, in
+    /// lexicographic order (hence each once).
+    #[test]
+    fn combinations4_lists_each_increasing_quadruple_once() {
+        for n in 0..9u32 {
+            let all = combinations4(n);
+            let choose4 = (0..4).map(|i| n.saturating_sub(i)).product::<u32>() / 24;
+            assert_eq!(all.len() as u32, choose4, "n = {n}");
+            assert!(all.iter().all(|q| q.windows(2).all(|w| w[0] < w[1]) && q[3] < n), "n = {n}");
+            assert!(all.windows(2).all(|w| w[0] < w[1]), "n = {n}");
+        }
+    }
+
+    /// A glued pair matches two triangles in one of six ways, k in 0..6: k = 6 is refused even
+    /// when both faces exist (rather than sewing a dart of another face).
+    #[test]
+    fn a_face_gluing_way_out_of_range_is_refused() {
+        assert!(FaceGluing { tets: 2, pairs: vec![[0, 4, 5]] }.build().is_ok());
+        let bad = FaceGluing { tets: 2, pairs: vec![[0, 4, 6]] };
+        assert!(matches!(bad.build(), Err(ConstructError::BadSide { .. })));
+    }
+
     #[test]
     fn a_cut_complex_dissociates_the_named_face() {
         let c = CutComplex { points: 5, tets: vec![[0, 1, 2, 3], [1, 2, 3, 4]], cuts: vec![[0, 1]] };

@@ -324,6 +324,16 @@ mod tests {
         assert_eq!(r.cuts, 4);
     }
 
+    /// Invariant 1 rejects a map that breaks a law: here α3 is no longer an involution.
+    #[test]
+    fn check_valid_rejects_a_broken_involution() {
+        let (mut map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [1, 2, 3, 4]]).expect("builds");
+        assert_eq!(check_valid(&map, 0), Ok(()));
+        let glued = map.darts().find(|&d| !map.is_free(3, d)).expect("a glued face");
+        map.set_alpha_raw(3, glued, glued); // its partner still points to it
+        assert!(matches!(check_valid(&map, 7), Err(FuzzFailure::Invalid { cut: 7, .. })));
+    }
+
     #[test]
     fn mixed_inputs_decode_to_ops_and_back() {
         let ops = [Op::Cut(5), Op::Subdivide(3), Op::Cut(191), Op::Subdivide(63)];

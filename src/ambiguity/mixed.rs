@@ -31,7 +31,7 @@ use crate::ambiguity::refine::RefinedModel;
 use crate::generate::SplitMix64;
 use crate::gmap::{AlphaMask, DartId, GMap};
 use crate::graph::{graph_of, graphs_isomorphic, GraphInvariant, GraphKind, Multiplicity};
-use crate::subdivide::{LeveledMap, SubdivideError};
+use crate::subdivide::{LevelView, LeveledMap, SubdivideError};
 use crate::BuildError;
 
 /// Graphs with more nodes than this are not compared by VF2 (the pair is then *undecided*).
@@ -306,11 +306,7 @@ pub fn run_ops(points: &[[f64; 3]], tets: &[[u32; 4]], ops: &[Op]) -> Result<Mix
         for (k, d) in view.darts.iter().enumerate() {
             index.insert(d.0, DartId(k as u32));
         }
-        run.level_law &= view.map.dart_count() == snap.map.dart_count()
-            && view.map.components().iter().all(|&r| {
-                let size = view.map.orbit(r, AlphaMask::all(3)).len();
-                view.map.isomorphism_from(r, &snap.map, view.darts[r.index()]).is_some_and(|p| p.len() == size)
-            });
+        run.level_law &= level_matches(&view, &snap.map);
         let vol: Option<Vec<DartId>> = snap.vol_dart.iter().map(|d| index.get(&d.0).copied()).collect();
         let vol = vol.ok_or_else(|| MixedError::Level(level, "a paired dart is not in B_i".into()))?;
         let mut c = compare(&view.map, &vol, &snap.model)?;
@@ -320,6 +316,17 @@ pub fn run_ops(points: &[[f64; 3]], tets: &[[u32; 4]], ops: &[Op]) -> Result<Mix
     run.finest = compare(s.lm.map(), &s.vol_dart, &s.model)?;
     run.finest.level = s.lm.max_level();
     Ok(run)
+}
+
+/// Whether G_i (`view`) is `snap`, the finest map as it was when level i ended: as many darts,
+/// and every component of G_i isomorphic to its image through the dart identity (dart k of
+/// `view.map` is dart `view.darts[k]` of `snap`). O(darts · n).
+fn level_matches(view: &LevelView<3>, snap: &GMap<3>) -> bool {
+    view.map.dart_count() == snap.dart_count()
+        && view.map.components().iter().all(|&r| {
+            let size = view.map.orbit(r, AlphaMask::all(3)).len();
+            view.map.isomorphism_from(r, snap, view.darts[r.index()]).is_some_and(|p| p.len() == size)
+        })
 }
 
 /// The first tet of zero or non-finite signed volume, as [`MixedError::Degenerate`]. O(tets).
@@ -720,6 +727,52 @@ mod tests {
         let e = run_ops(&nan, &t, &ops).unwrap_err();
         assert!(e.to_string().contains("a corner that is not finite"), "{e}");
         assert!(run_ops(&p, &t, &ops).is_ok(), "the cube itself runs");
+    }
+
+    /// Each of the five symptoms alone makes the tet list fail to represent the g-map.
+    #[test]
+    fn each_symptom_alone_makes_a_comparison_ambiguous() {
+        let same = Compare { gmap_vertices: 8, indexed_vertices: 8, ..Compare::default() };
+        assert!(!same.ambiguous());
+        let alone = [
+            Compare { hanging_edges: 1, ..same.clone() },
+            Compare { pinched_points: 1, ..same.clone() },
+            Compare { non_manifold_edges: 1, ..same.clone() },
+            Compare { indexed_vertices: 9, ..same.clone() },
+            Compare { map_differs: true, ..same },
+        ];
+        for c in alone {
+            assert!(c.ambiguous(), "{c:?}");
+        }
+    }
+
+    /// `hanging` counts the sequences that end with hanging edges, and only those: of no op, one
+    /// subdivision next to unrefined neighbours (T-junctions) and one cut (no midpoint at all),
+    /// only the subdivision hangs.
+    #[test]
+    fn the_statistics_count_the_sequences_ending_with_hanging_edges() {
+        let (p, t) = cube();
+        let mut stats = MixedStats::default();
+        for ops in [&[][..], &[Op::Subdivide(0)], &[Op::Cut(0)]] {
+            stats.add(&run_ops(&p, &t, ops).expect("runs"));
+        }
+        assert_eq!((stats.sequences, stats.hanging), (3, 1), "{stats:?}");
+    }
+
+    /// The level law holds only for the map the level was: the cube against itself, not against
+    /// the cube with one face cut (as many darts, another gluing).
+    #[test]
+    fn a_level_matches_its_own_map_and_not_a_cut_one() {
+        let (p, t) = cube();
+        let (map, _) = GMap::<3>::from_tets(p.len(), &t).expect("builds");
+        let lm = LeveledMap::new(map.clone(), p);
+        let view = lm.level(0).expect("level 0");
+        assert!(level_matches(&view, &map));
+        let mut cut = map;
+        let d = cut.darts().find(|&d| !cut.is_free(3, d)).expect("a glued face");
+        cut.unsew::<3>(d).expect("unsews");
+        assert_eq!(cut.dart_count(), view.map.dart_count());
+        assert!(!level_matches(&view, &cut));
     }
 
     #[test]

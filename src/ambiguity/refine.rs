@@ -207,6 +207,27 @@ mod tests {
         assert_eq!(r.hanging_edges(), 0);
     }
 
+    /// The diagonal hint is an unordered pair of positions: its ends in either order split the
+    /// octahedron the same way, whatever the hint (here every ordered pair of the ten points).
+    #[test]
+    fn the_diagonal_hint_does_not_depend_on_the_order_of_its_ends() {
+        let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        let fresh = RefinedModel::new(&points, &[[0, 1, 2, 3]]).unwrap();
+        let mut probe = fresh.clone();
+        probe.subdivide(0, None).unwrap();
+        let ten: Vec<[f64; 3]> = (0..10).map(|p| probe.position(p)).collect();
+        let split = |hint| {
+            let mut r = fresh.clone();
+            r.subdivide(0, Some(hint)).unwrap();
+            r.model.tets
+        };
+        for &u in &ten {
+            for &v in &ten {
+                assert_eq!(split([u, v]), split([v, u]), "hint {u:?} {v:?}");
+            }
+        }
+    }
+
     #[test]
     fn a_refined_neighbour_leaves_hanging_edges_until_the_other_refines() {
         let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 1.0]];

@@ -546,6 +546,15 @@ mod tests {
         GMap::<2>::from_triangles(4, &[[0, 1, 2], [0, 2, 3]]).expect("valid triangles").0
     }
 
+    /// `name` is the snake-case name used in JSON and by `Display`.
+    #[test]
+    fn each_kind_is_named_as_in_json() {
+        for k in GraphKind::ALL {
+            assert_eq!(serde_json::to_string(&k).expect("serialises"), format!("\"{}\"", k.name()));
+            assert_eq!(k.to_string(), k.name());
+        }
+    }
+
     #[test]
     fn square_of_two_triangles_has_the_expected_graphs() {
         let map = two_triangles();

@@ -446,7 +446,7 @@ fn simulate_writes_a_series_and_a_summary_that_follow_from_the_scene() {
     let (body, _) =
         topomech::mechanics::Body::from_tets(&mesh.points, &mesh.tets, topomech::mechanics::Material::default())
             .unwrap();
-    let mass = body.attrs().total_vertex_mass(body.map());
+    let mass = body.total_vertex_mass();
     assert!((s["total_mass"].as_f64().unwrap() - mass).abs() <= 1e-12 * mass, "{s:?} vs {mass}");
     // Gravity moved the free vertices from rest.
     let (ke, disp) = (s["kinetic_energy"].as_f64().unwrap(), s["max_displacement"].as_f64().unwrap());

@@ -42,12 +42,12 @@ fn oracle_cut_count(points: &[Vec3], tets: &[[u32; 4]], surface: &PolylineSweep)
 /// Cuts `body` along `surface` and checks the laws: valid map, conservation, unchanged mass,
 /// two new boundary faces per cut face, and the oracle's count. Returns the cut face count.
 fn cut_and_check(points: &[Vec3], tets: &[[u32; 4]], body: &mut Body, surface: &PolylineSweep) -> usize {
-    let (mass, boundary) = (body.attrs().total_vertex_mass(body.map()), body.map().boundary_cell_count());
+    let (mass, boundary) = (body.total_vertex_mass(), body.map().boundary_cell_count());
     let cut = incise_sweep(body, surface).unwrap();
     let map = body.map();
     map.validate().unwrap();
     check_conservation(map, body.attrs()).unwrap();
-    let after = body.attrs().total_vertex_mass(map);
+    let after = body.total_vertex_mass();
     assert!((after - mass).abs() <= 1e-12 * mass, "mass {mass} -> {after}");
     assert_eq!(map.boundary_cell_count(), boundary + 2 * cut.cut_faces());
     assert_eq!(cut.cut_faces(), oracle_cut_count(points, tets, surface), "cut faces vs the tet-list oracle");
@@ -120,7 +120,7 @@ fn a_slit_cuts_part_of_the_plane_and_keeps_one_piece() {
 #[test]
 fn an_l_shaped_wall_cuts_a_block_off() {
     let (points, tets, mut body) = cube(4);
-    let total = body.attrs().total_vertex_mass(body.map());
+    let total = body.total_vertex_mass();
     // x = 2 for y ≤ 2, then y = 2 for x ≥ 2, through the whole height: frees the block x > 2, y < 2.
     let wall =
         PolylineSweep { points: vec![[2.0, -1.0, -1.0], [2.0, 2.0, -1.0], [5.0, 2.0, -1.0]], sweep: [0.0, 0.0, 6.0] };
@@ -205,7 +205,7 @@ proptest! {
         let surface = PolylineSweep { points: pts, sweep };
         prop_assume!(surface.check().is_ok());
         let (points, tets, mut body) = cube(3);
-        let total = body.attrs().total_vertex_mass(body.map());
+        let total = body.total_vertex_mass();
         cut_and_check(&points, &tets, &mut body, &surface);
         let sum: f64 = components(&body).iter().map(|p| p.mass).sum();
         prop_assert!((sum - total).abs() <= 1e-12 * total);

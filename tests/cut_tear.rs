@@ -30,7 +30,7 @@ fn stretched_cube(stretch: f64) -> (Body, Simulation) {
 }
 
 fn total_mass(body: &Body) -> f64 {
-    body.attrs().total_vertex_mass(body.map())
+    body.total_vertex_mass()
 }
 
 fn check(body: &Body, sim: &Simulation, mass: f64) {

@@ -62,8 +62,8 @@ fn laws_hold_on_a_fresh_body_and_match_the_flat_baseline() {
             topomech::mesh::signed_volume(c[0], c[1], c[2], c[3]).abs()
         })
         .sum();
-    assert!(rel_close(mech.total_vertex_mass(body.map()), 2.5 * volume, 1e-12));
-    assert!(rel_close(mech.total_tet_mass(body.map()), 2.5 * volume, 1e-12));
+    assert!(rel_close(mech.total_vertex_mass(body.map()).unwrap(), 2.5 * volume, 1e-12));
+    assert!(rel_close(mech.total_tet_mass(body.map()).unwrap(), 2.5 * volume, 1e-12));
     // Every vertex mass and spring stiffness equals the flat baseline's (built with no map).
     let flat = FlatModel::from_tets(&points, &tets, material(), G, &[]).unwrap();
     for (v, &m) in flat.system.mass.iter().enumerate() {
@@ -96,7 +96,7 @@ fn unsew3_along_a_plane_splits_masses_and_stiffnesses_conservatively() {
     let (points, tets) = kuhn_cube(2);
     let (mut body, _) = Body::from_tets(&points, &tets, material()).unwrap();
     let before = body.clone();
-    let total = body.attrs().total_vertex_mass(body.map());
+    let total = body.total_vertex_mass();
     let faces = faces_in_plane(&body, &points, 1.0);
     assert_eq!(faces.len(), 8, "the plane x = 1 of a 2-cube holds 8 triangles");
     let mut vertex_splits = Vec::new();
@@ -125,7 +125,7 @@ fn unsew3_along_a_plane_splits_masses_and_stiffnesses_conservatively() {
         assert!(rel_close(sum, m0.edge_stiffness(kept), 1e-12), "k = k1 + k2 at {kept:?}");
         assert!(rel_close(m.edge_damping(kept) + m.edge_damping(new), m0.edge_damping(kept), 1e-12));
     }
-    assert!(rel_close(m.total_vertex_mass(body.map()), total, 1e-12));
+    assert!(rel_close(m.total_vertex_mass(body.map()).unwrap(), total, 1e-12));
     // The body is now two halves: it must equal the flat model of the two halves, built apart.
     let (half_points, half_tets) = split_at_plane(&points, &tets, 1.0);
     let flat = FlatModel::from_tets(&half_points, &half_tets, material(), G, &[]).unwrap();
@@ -479,7 +479,7 @@ fn a_model_whose_totals_overflow_is_refused_naming_the_tet_and_quantity() {
     check_conservation(body.map(), body.attrs()).unwrap();
     let flat = FlatModel::from_tets(&scaled(1e50), &tets, with(1.0, 1.0, 1.0), G, &[]).unwrap();
     let total: f64 = flat.system.mass.iter().sum();
-    assert!(rel_close(total, body.attrs().total_vertex_mass(body.map()), 1e-12) && total.is_finite());
+    assert!(rel_close(total, body.total_vertex_mass(), 1e-12) && total.is_finite());
 }
 
 /// Finding 24 (docs/VERIFICATION.md): `Body::new` wrapped any map with any attributes, and every
@@ -640,4 +640,42 @@ fn removing_a_lone_tet_moves_the_version_on() {
     assert_eq!(body.version(), 1);
     assert!(!projection.is_current(&body));
     assert_eq!(removal.touched.versions(&body), Some((0, 1)));
+}
+
+/// Finding 32 (docs/VERIFICATION.md): the `Mechanics` functions that take the map beside the
+/// attributes (`total_vertex_mass`, `total_tet_mass`, `vertex_mass_from_map`,
+/// `edge_stiffness_from_map`, `update_normals`) panicked on an index when given another body's
+/// map or a dart that is not live. They now return `ConservationError::MissingAttributes` or
+/// `NoSuchDart`, as `check_conservation` does for such a pair, and change nothing.
+#[test]
+fn attributes_given_another_bodys_map_or_a_dead_dart_are_refused() {
+    use topomech::mechanics::ConservationError;
+    let body = |k| {
+        let (points, tets) = kuhn_cube(k);
+        Body::from_tets(&points, &tets, Material::default()).unwrap().0
+    };
+    let (small, big) = (body(1), body(2));
+    let missing = Err(ConservationError::MissingAttributes { dim: 0, len: 8, bound: 27 });
+    let m = small.attrs();
+    assert_eq!(m.total_vertex_mass(big.map()), missing);
+    assert_eq!(m.total_tet_mass(big.map()), missing);
+    let far = big.map().darts().last().unwrap();
+    assert_eq!(m.vertex_mass_from_map(big.map(), far), missing);
+    assert_eq!(m.edge_stiffness_from_map(big.map(), far), missing);
+    let mut copy = m.clone();
+    assert_eq!(copy.update_normals(big.map()), missing.map(|_: f64| ()));
+    assert_eq!(format!("{copy:?}"), format!("{m:?}"), "a refused update changed the attributes");
+    let dead = DartId(small.map().capacity() as u32 + 5);
+    assert_eq!(m.vertex_mass_from_map(small.map(), dead), Err(ConservationError::NoSuchDart(dead)));
+    assert_eq!(m.edge_stiffness_from_map(small.map(), dead), Err(ConservationError::NoSuchDart(dead)));
+    // The body's own pair: the laws as before.
+    assert!((m.total_vertex_mass(small.map()).unwrap() - 1.0).abs() < 1e-12);
+    assert_eq!(m.total_tet_mass(small.map()).unwrap(), small.total_tet_mass());
+    let d = small.map().darts().next().unwrap();
+    assert_eq!(m.vertex_mass_from_map(small.map(), d), Ok(m.vertex_mass(small.map().vertex_id(d))));
+    assert!(
+        (m.edge_stiffness_from_map(small.map(), d).unwrap() / m.edge_stiffness(small.map().cell_id(1, d)) - 1.0).abs()
+            < 1e-12
+    );
+    assert_eq!(copy.update_normals(small.map()), Ok(()));
 }

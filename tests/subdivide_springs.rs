@@ -502,7 +502,7 @@ fn a_cut_edge_whose_ends_stay_joined_carries_two_springs_through_refinement() {
     let repeated = ends.windows(2).filter(|w| w[0] == w[1]).count();
     let doubled: usize = doubled_pairs(m.map()).values().map(|n| n - 1).sum();
     assert_eq!(repeated, doubled, "the spring system repeats exactly the doubled vertex pairs");
-    let total = body.attrs().total_tet_mass(body.map()); // ρ · 27, cut or not
+    let total = body.total_tet_mass(); // ρ · 27, cut or not
     let vm: f64 = mech.vertex_masses(&m).unwrap().iter().sum();
     assert!((vm - total).abs() < 1e-12 * total, "{vm} vs {total}");
 }

@@ -127,7 +127,7 @@ pub fn stats(body: &Body, removed_mass: f64) -> BodyStats {
     let mech = body.attrs();
     BodyStats {
         cells: CellCensus::of(map),
-        total_mass: mech.total_vertex_mass(map),
+        total_mass: body.total_vertex_mass(),
         removed_mass,
         stiffness_sum: map.one_dart_per_cell(1).into_iter().map(|d| mech.edge_stiffness(map.cell_id(1, d))).sum(),
         valid: map.validate().is_ok(),

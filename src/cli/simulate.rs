@@ -178,7 +178,7 @@ fn simulate(args: &SimulateArgs, parallel: bool) -> Result<(), CliError> {
         dt: args.dt,
         integrator: args.integrator.name(),
         step_us_median: median(&mut times),
-        total_mass: body.attrs().total_vertex_mass(body.map()),
+        total_mass: body.total_vertex_mass(),
         kinetic_energy: sim.kinetic_energy(&body),
         max_displacement: sim.max_displacement(&body),
     };

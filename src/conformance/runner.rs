@@ -570,7 +570,7 @@ impl Runner {
             components: parts.len(),
             euler: counts.euler_characteristic(),
             // `+ 0.0` turns the −0.0 of an empty sum into 0.0.
-            total_mass: self.body.attrs().total_vertex_mass(map) + 0.0,
+            total_mass: self.body.total_vertex_mass() + 0.0,
             total_stiffness: shared::total_stiffness(&self.body) + 0.0,
             component_masses: masses,
         }

@@ -459,7 +459,7 @@ impl Harness {
     pub fn new(points: Vec<Vec3>, tets: Vec<[u32; 4]>) -> Result<Self, crate::mechanics::ModelError> {
         let (body, _) = Body::from_tets(&points, &tets, material())?;
         let projection = Projection::build(&body, G);
-        let mass = body.attrs().total_vertex_mass(body.map());
+        let mass = body.total_vertex_mass();
         let stiffness = total_stiffness(&body);
         let oracle = Oracle::new(points, tets);
         Ok(Harness { body, projection, oracle, mass, stiffness, removed_mass: 0.0, removed_stiffness: 0.0 })
@@ -629,7 +629,7 @@ impl Harness {
         if parts.len() != comps {
             return Err(format!("components {} vs oracle {comps}", parts.len()));
         }
-        let mass = self.body.attrs().total_vertex_mass(map);
+        let mass = self.body.total_vertex_mass();
         if !rel_close(mass, self.mass - self.removed_mass) {
             return Err(format!("mass {mass} != {} - {}", self.mass, self.removed_mass));
         }

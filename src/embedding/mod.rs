@@ -489,7 +489,7 @@ impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
     ///
     /// let (points, tets) = kuhn_cube(1);
     /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
-    /// let total = body.attrs().total_vertex_mass(body.map());
+    /// let total = body.total_vertex_mass();
     /// assert!((total - Material::default().density).abs() < 1e-12); // the unit cube
     /// ```
     pub fn attrs(&self) -> &E {

@@ -102,6 +102,9 @@ pub enum ConservationError {
         /// The recomputed value.
         expected: f64,
     },
+    /// A dart given to a recomputation from the map is not live in that map.
+    #[error("{0} is not a live dart of the map")]
+    NoSuchDart(DartId),
     /// The attribute arrays of a dimension are shorter than the map's cell ids (the map changed
     /// without the embedding layer).
     #[error("{dim}-cell attributes cover {len} ids but the map uses {bound}")]

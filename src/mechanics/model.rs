@@ -55,7 +55,7 @@ use super::geom::{add, cross, dot, norm, scale, sub, tet_volume, Vec3};
 /// let (points, tets) = kuhn_cube(1); // the unit cube
 /// let dense = Material { density: 2.5, ..Material::default() };
 /// let (body, _) = Body::from_tets(&points, &tets, dense).unwrap();
-/// assert!((body.attrs().total_tet_mass(body.map()) - 2.5).abs() < 1e-12); // ρ · volume
+/// assert!((body.total_tet_mass() - 2.5).abs() < 1e-12); // ρ · volume
 /// let bad = Material { young: -1.0, ..Material::default() };
 /// assert!(matches!(Body::from_tets(&points, &tets, bad), Err(ModelError::BadMaterial { name: "young", .. })));
 /// ```
@@ -153,7 +153,7 @@ pub enum ModelError {
 /// assert_eq!(m.position.as_slice(), m.rest_position.as_slice()); // built at rest
 /// assert!(m.velocity.as_slice().iter().all(|v| *v == [0.0; 3]));
 /// assert!(!m.pinned.as_slice().iter().any(|&p| p));
-/// assert!((m.total_tet_mass(body.map()) - 1.0).abs() < 1e-12); // density 1, unit cube
+/// assert!((m.total_tet_mass(body.map()).unwrap() - 1.0).abs() < 1e-12); // density 1, unit cube
 /// ```
 #[derive(Clone, Debug)]
 pub struct Mechanics {
@@ -472,10 +472,47 @@ impl Mechanics {
     /// let faces: Vec<_> = map.one_dart_per_cell(2).into_iter().map(|d| map.cell_id(2, d)).collect();
     /// let top = *faces.iter().find(|&&f| body.attrs().face_normal(f) == [0.0, 0.0, 1.0]).unwrap();
     /// body.attrs_mut().position.as_mut_slice().iter_mut().for_each(|p| p[2] = -p[2]); // mirror in z
-    /// body.attrs_mut().update_normals(&map);
+    /// body.attrs_mut().update_normals(&map).unwrap();
     /// assert_eq!(body.attrs().face_normal(top), [0.0, 0.0, -1.0]); // the top face now faces down
     /// ```
-    pub fn update_normals(&mut self, map: &GMap<3>) {
+    pub fn update_normals(&mut self, map: &GMap<3>) -> Result<(), ConservationError> {
+        self.check_covers(map)?;
+        self.update_normals_raw(map);
+        Ok(())
+    }
+
+    /// Whether the attribute arrays hold an entry for every cell id of `map`, in every
+    /// dimension: what every function taking the map beside the attributes needs (a map and
+    /// attributes from two different bodies are refused here). O(1).
+    ///
+    /// # Errors
+    /// [`ConservationError::MissingAttributes`] for the first dimension whose arrays are short.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, ConservationError, Material};
+    ///
+    /// let body = |k| Body::from_tets(&kuhn_cube(k).0, &kuhn_cube(k).1, Material::default()).unwrap().0;
+    /// let (small, big) = (body(1), body(2));
+    /// assert!(small.attrs().check_covers(small.map()).is_ok());
+    /// let e = small.attrs().check_covers(big.map()).unwrap_err();
+    /// assert_eq!(e, ConservationError::MissingAttributes { dim: 0, len: 8, bound: 27 });
+    /// assert!(small.attrs().total_vertex_mass(big.map()).is_err());
+    /// ```
+    pub fn check_covers(&self, map: &GMap<3>) -> Result<(), ConservationError> {
+        for dim in 0..=3 {
+            let (len, bound) = (self.attribute_len(dim), map.cell_id_bound(dim));
+            if len < bound {
+                return Err(ConservationError::MissingAttributes { dim, len, bound });
+            }
+        }
+        Ok(())
+    }
+
+    /// [`Mechanics::update_normals`] for a map the attributes cover. O(darts).
+    pub(crate) fn update_normals_raw(&mut self, map: &GMap<3>) {
         for d in map.one_dart_per_cell(2) {
             let f = map.cell_id(2, d);
             self.face_boundary[f] = map.is_free(3, d);
@@ -527,7 +564,12 @@ impl Mechanics {
         scale(n, sign / len)
     }
 
-    /// Total mass Σ_v m_v over the live vertices of `map`. O(darts).
+    /// Total mass Σ_v m_v over the live vertices of `map`. O(darts). [`Body::total_vertex_mass`]
+    /// is the same for a body's own pair.
+    ///
+    /// # Errors
+    /// [`ConservationError::MissingAttributes`] for a map the attributes do not cover
+    /// ([`Mechanics::check_covers`]).
     ///
     /// # Examples
     ///
@@ -539,14 +581,24 @@ impl Mechanics {
     /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
     /// let (map, m) = (body.map(), body.attrs());
     /// // Law 1 summed over the body: each tet gives a quarter of its mass to each corner.
-    /// assert!((m.total_vertex_mass(map) - m.total_tet_mass(map)).abs() < 1e-12);
-    /// assert!((m.total_tet_mass(map) - 8.0).abs() < 1e-12); // density 1, volume 2³
+    /// assert!((m.total_vertex_mass(map).unwrap() - m.total_tet_mass(map).unwrap()).abs() < 1e-12);
+    /// assert!((m.total_tet_mass(map).unwrap() - 8.0).abs() < 1e-12); // density 1, volume 2³
     /// ```
-    pub fn total_vertex_mass(&self, map: &GMap<3>) -> f64 {
+    pub fn total_vertex_mass(&self, map: &GMap<3>) -> Result<f64, ConservationError> {
+        self.check_covers(map)?;
+        Ok(self.total_vertex_mass_raw(map))
+    }
+
+    /// [`Mechanics::total_vertex_mass`] for a map the attributes cover. O(darts).
+    pub(crate) fn total_vertex_mass_raw(&self, map: &GMap<3>) -> f64 {
         map.one_dart_per_cell(0).into_iter().map(|d| self.vertex_mass[map.vertex_id(d)]).sum()
     }
 
-    /// Total mass Σ_t m_t over the live volumes of `map`. O(darts).
+    /// Total mass Σ_t m_t over the live volumes of `map`. O(darts). [`Body::total_tet_mass`] is
+    /// the same for a body's own pair.
+    ///
+    /// # Errors
+    /// As [`Mechanics::total_vertex_mass`].
     ///
     /// # Examples
     ///
@@ -560,14 +612,24 @@ impl Mechanics {
     /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
     /// let gone = remove_volume(&mut body, CellId(2)).unwrap().removed_mass;
     /// let m = body.attrs();
-    /// assert!((m.total_tet_mass(body.map()) - (1.0 - gone)).abs() < 1e-12);
-    /// assert!((m.total_vertex_mass(body.map()) - m.total_tet_mass(body.map())).abs() < 1e-12);
+    /// assert!((body.total_tet_mass() - (1.0 - gone)).abs() < 1e-12);
+    /// assert!((m.total_vertex_mass(body.map()).unwrap() - m.total_tet_mass(body.map()).unwrap()).abs() < 1e-12);
     /// ```
-    pub fn total_tet_mass(&self, map: &GMap<3>) -> f64 {
+    pub fn total_tet_mass(&self, map: &GMap<3>) -> Result<f64, ConservationError> {
+        self.check_covers(map)?;
+        Ok(self.total_tet_mass_raw(map))
+    }
+
+    /// [`Mechanics::total_tet_mass`] for a map the attributes cover. O(darts).
+    pub(crate) fn total_tet_mass_raw(&self, map: &GMap<3>) -> f64 {
         map.one_dart_per_cell(3).into_iter().map(|d| self.tet_mass[map.cell_id(3, d)]).sum()
     }
 
     /// Law 1 at the vertex of `d`: Σ m_t/4 over the distinct volumes of its orbit. O(vertex).
+    ///
+    /// # Errors
+    /// [`ConservationError::NoSuchDart`] unless `d` is a live dart of `map`, and
+    /// [`ConservationError::MissingAttributes`] for a map the attributes do not cover.
     ///
     /// # Examples
     ///
@@ -579,16 +641,34 @@ impl Mechanics {
     /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
     /// let (map, m) = (body.map(), body.attrs());
     /// for d in map.darts() {
-    ///     assert!((m.vertex_mass_from_map(map, d) - m.vertex_mass(map.vertex_id(d))).abs() < 1e-15);
+    ///     assert!((m.vertex_mass_from_map(map, d).unwrap() - m.vertex_mass(map.vertex_id(d))).abs() < 1e-15);
     /// }
     /// ```
-    pub fn vertex_mass_from_map(&self, map: &GMap<3>, d: DartId) -> f64 {
+    pub fn vertex_mass_from_map(&self, map: &GMap<3>, d: DartId) -> Result<f64, ConservationError> {
+        self.check_dart_of(map, d)?;
+        Ok(self.vertex_mass_from_map_raw(map, d))
+    }
+
+    /// [`ConservationError::NoSuchDart`] unless `d` is live in `map`, then
+    /// [`Mechanics::check_covers`]. O(1).
+    fn check_dart_of(&self, map: &GMap<3>, d: DartId) -> Result<(), ConservationError> {
+        if !map.contains(d) {
+            return Err(ConservationError::NoSuchDart(d));
+        }
+        self.check_covers(map)
+    }
+
+    /// [`Mechanics::vertex_mass_from_map`] for a live dart of a covered map. O(vertex).
+    pub(crate) fn vertex_mass_from_map_raw(&self, map: &GMap<3>, d: DartId) -> f64 {
         let tets = map.vertex_volumes(d);
         tets.iter().map(|&t| self.tet_mass[t] / 4.0).sum()
     }
 
     /// Law 2 at the edge of `d`: Σ E_t·V_t/L_e² over the distinct volumes of its orbit, with L_e
     /// the edge's stored rest length. O(edge).
+    ///
+    /// # Errors
+    /// As [`Mechanics::vertex_mass_from_map`].
     ///
     /// # Examples
     ///
@@ -601,10 +681,16 @@ impl Mechanics {
     /// let (map, m) = (body.map(), body.attrs());
     /// for d in map.one_dart_per_cell(1) {
     ///     let stored = m.edge_stiffness(map.cell_id(1, d));
-    ///     assert!(stored > 0.0 && (m.edge_stiffness_from_map(map, d) - stored).abs() <= 1e-12 * stored);
+    ///     assert!(stored > 0.0 && (m.edge_stiffness_from_map(map, d).unwrap() - stored).abs() <= 1e-12 * stored);
     /// }
     /// ```
-    pub fn edge_stiffness_from_map(&self, map: &GMap<3>, d: DartId) -> f64 {
+    pub fn edge_stiffness_from_map(&self, map: &GMap<3>, d: DartId) -> Result<f64, ConservationError> {
+        self.check_dart_of(map, d)?;
+        Ok(self.edge_stiffness_from_map_raw(map, d))
+    }
+
+    /// [`Mechanics::edge_stiffness_from_map`] for a live dart of a covered map. O(edge).
+    pub(crate) fn edge_stiffness_from_map_raw(&self, map: &GMap<3>, d: DartId) -> f64 {
         let l = self.edge_rest_length[map.cell_id(1, d)];
         let k = |t: &CellId| stiffness_contribution(self.tet_young[*t], self.tet_rest_volume[*t], l);
         // α0 keeps the volume, so the volumes of the edge orbit ⟨α0, α2, α3⟩ are those of the ring
@@ -630,7 +716,7 @@ impl Mechanics {
 
     /// Sets the mass and viscosity of the vertex of `d` from law 1 and law 4.
     fn recompute_vertex(&mut self, map: &GMap<3>, d: DartId) {
-        let mass = self.vertex_mass_from_map(map, d);
+        let mass = self.vertex_mass_from_map_raw(map, d);
         self.set_vertex_mass(map.vertex_id(d), mass);
     }
 
@@ -669,7 +755,7 @@ impl Mechanics {
     /// Sets the stiffness and damping of the edge of `d` from laws 2 and 3.
     fn recompute_edge(&mut self, map: &GMap<3>, d: DartId) {
         let e = map.cell_id(1, d);
-        self.edge_stiffness[e] = self.edge_stiffness_from_map(map, d);
+        self.edge_stiffness[e] = self.edge_stiffness_from_map_raw(map, d);
         self.edge_damping[e] = self.material.damping * self.edge_stiffness[e];
     }
 
@@ -770,7 +856,7 @@ impl CellRules<3> for Mechanics {
                 self.recompute_vertex(map, dart_kept);
                 // The new side's darts are known: its volumes without walking it again.
                 let mass = if new_side.is_empty() {
-                    self.vertex_mass_from_map(map, dart_new)
+                    self.vertex_mass_from_map_raw(map, dart_new)
                 } else {
                     self.vertex_mass_of_darts(map, new_side)
                 };
@@ -1042,10 +1128,10 @@ impl Embedded<3, Mechanics> {
     /// let (points, tets) = kuhn_cube(1);
     /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
     /// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
-    /// let mass = body.attrs().total_vertex_mass(body.map());
+    /// let mass = body.total_vertex_mass();
     /// body.unsew3(d).unwrap();
     /// assert!(body.map().is_free(3, d));
-    /// assert!((body.attrs().total_vertex_mass(body.map()) - mass).abs() < 1e-12); // m = m1 + m2
+    /// assert!((body.total_vertex_mass() - mass).abs() < 1e-12); // m = m1 + m2
     /// check_conservation(body.map(), body.attrs()).unwrap();
     /// ```
     pub fn unsew3(&mut self, d: DartId) -> Result<CellChanges, BodyError> {
@@ -1090,10 +1176,37 @@ impl Embedded<3, Mechanics> {
     /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
     /// assert_eq!(body.kinetic_energy(), 0.0); // at rest
     /// body.attrs_mut().velocity.as_mut_slice().fill([2.0, 0.0, 0.0]);
-    /// let mass = body.attrs().total_vertex_mass(body.map());
+    /// let mass = body.total_vertex_mass();
     /// assert!((body.kinetic_energy() - 0.5 * mass * 4.0).abs() < 1e-12); // ½ m v²
     /// ```
     pub fn kinetic_energy(&self) -> f64 {
+        self.kinetic_energy_of_attrs()
+    }
+
+    /// Total vertex mass Σ_v m_v of the body ([`Mechanics::total_vertex_mass`] on its own map and
+    /// attributes, which always cover each other). O(darts).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// assert!((body.total_vertex_mass() - 1.0).abs() < 1e-12 && (body.total_tet_mass() - 1.0).abs() < 1e-12);
+    /// ```
+    pub fn total_vertex_mass(&self) -> f64 {
+        self.attrs().total_vertex_mass_raw(self.map())
+    }
+
+    /// Total tet mass Σ_t m_t of the body. O(darts).
+    pub fn total_tet_mass(&self) -> f64 {
+        self.attrs().total_tet_mass_raw(self.map())
+    }
+
+    /// ½ Σ m_v |v_v|² over the live vertices. O(darts).
+    fn kinetic_energy_of_attrs(&self) -> f64 {
         let m = self.attrs();
         let live = self.map().one_dart_per_cell(0);
         live.into_iter()
@@ -1138,7 +1251,7 @@ impl Mechanics {
         for d in map.one_dart_per_cell(0) {
             self.recompute_vertex(map, d);
         }
-        self.update_normals(map);
+        self.update_normals_raw(map);
     }
 
     /// Marks the live vertex ids of `map`: `live[v]` is true iff vertex id v has darts. O(capacity).
@@ -1219,10 +1332,10 @@ mod tests {
                     without += 1;
                 } else {
                     with_side += 1;
-                    assert_eq!(mech.vertex_mass_of_darts(map, side), mech.vertex_mass_from_map(map, dart_new));
+                    assert_eq!(mech.vertex_mass_of_darts(map, side), mech.vertex_mass_from_map_raw(map, dart_new));
                 }
-                assert_eq!(mech.vertex_mass(new), mech.vertex_mass_from_map(map, dart_new), "new side {new}");
-                assert_eq!(mech.vertex_mass(kept), mech.vertex_mass_from_map(map, dart_kept), "kept side {kept}");
+                assert_eq!(mech.vertex_mass(new), mech.vertex_mass_from_map_raw(map, dart_new), "new side {new}");
+                assert_eq!(mech.vertex_mass(kept), mech.vertex_mass_from_map_raw(map, dart_kept), "kept side {kept}");
             }
         }
         assert!(with_side > 10, "with a side {with_side}, without {without}");

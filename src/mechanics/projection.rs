@@ -935,7 +935,7 @@ fn system_of(
 /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
 /// let f = forces_by_coverage(&body, [0.0, 0.0, -9.81]);
 /// let total_z: f64 = f.iter().map(|f| f[2]).sum();
-/// assert!((total_z + 9.81 * body.attrs().total_vertex_mass(body.map())).abs() < 1e-12);
+/// assert!((total_z + 9.81 * body.total_vertex_mass()).abs() < 1e-12);
 /// assert!(f.iter().all(|f| f[0] == 0.0 && f[1] == 0.0));
 /// ```
 pub fn forces_by_coverage(body: &Body, gravity: Vec3) -> Vec<Vec3> {

@@ -52,7 +52,7 @@ pub struct Checker {
 
 /// Σ_v m_v over the live vertices. O(darts).
 pub fn total_mass(body: &Body) -> f64 {
-    body.attrs().total_vertex_mass(body.map())
+    body.total_vertex_mass()
 }
 
 /// Σ_e k_e over the live edges. O(darts).

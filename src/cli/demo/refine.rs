@@ -321,7 +321,7 @@ mod tests {
         let before = topomech::surface::boundary_surface(&body);
         let tets: Vec<CellId> = (0..12).map(CellId).collect();
         let mut run = StageRun::default();
-        let mass = body.attrs().total_tet_mass(body.map());
+        let mass = body.total_tet_mass();
         let r = refine(&body, &tets, &mut run, &ProgressBar::hidden()).unwrap();
         assert_eq!((run.operations, r.checks), (12, CHECKS));
         assert!((r.mech.masses.total(&r.lm) - mass).abs() < 1e-12 * mass, "the children share the parents' masses");

@@ -482,4 +482,12 @@ fn a_spring_system_refuses_bad_arrays_indices_and_values_and_changes_nothing() {
     nan.damping[1] = f64::NAN;
     assert!(matches!(nan.check(), Err(SystemError::BadValue { quantity: "damping", of: "spring", index: 1, .. })));
     assert_eq!(sys.check(), Ok(()));
+
+    // The energies count free slots only: a fixed slot has no kinetic or gravitational energy.
+    let mut held = sys.clone();
+    held.gravity = [0.0, 0.0, -10.0];
+    held.set_slot(2, 1.0, true, 0.0).unwrap();
+    let high = [[0.0, 0.0, 1.0], [0.0, 0.0, 2.0], [0.0, 0.0, 100.0]];
+    assert_eq!(held.gravity_energy(&high), Ok(10.0 * (1.0 + 2.0))); // m g h of slots 0 and 1
+    assert_eq!(held.kinetic_energy(&v), Ok(1.0)); // ½ · 1 · 1² for slots 0 and 1
 }

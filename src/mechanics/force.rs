@@ -212,41 +212,51 @@ impl SpringSystem {
     /// The structural part of [`SpringSystem::check`]: array lengths and spring ends (what the
     /// force and energy passes index by). O(springs).
     fn check_shape(&self) -> Result<(), SystemError> {
-        let (n, s) = (self.slots(), self.springs());
-        let per_slot = [("inverse mass", self.inv_mass.len()), ("viscosity", self.viscosity.len())];
-        let per_spring =
-            [("rest length", self.rest.len()), ("stiffness", self.stiffness.len()), ("damping", self.damping.len())];
-        let all =
-            per_slot.map(|(a, l)| (a, l, n, "slots")).into_iter().chain(per_spring.map(|(a, l)| (a, l, s, "springs")));
-        for (array, len, expected, of) in all {
-            if len != expected {
-                return Err(SystemError::Length { array, len, expected, of });
-            }
-        }
+        self.check_given(&[], &[])?;
+        self.check_ends()
+    }
+
+    /// [`SystemError::BadEnds`] for the first spring whose ends are not two different slots.
+    /// O(springs).
+    fn check_ends(&self) -> Result<(), SystemError> {
+        let n = self.slots();
         match self.ends.iter().position(|&e| !ends_ok(e, n)) {
             Some(spring) => Err(SystemError::BadEnds { spring, ends: self.ends[spring], slots: n }),
             None => Ok(()),
         }
     }
 
-    /// [`SpringSystem::check_shape`] and one entry per slot in each of `per_slot`, one per
-    /// spring in each of `per_spring` (name, length). O(springs).
-    fn check_state(
+    /// One entry per slot in the system's per-slot arrays and in each of `per_slot`, one per
+    /// spring in its per-spring arrays and in each of `per_spring` (name, length): what a pass
+    /// that does not follow the spring ends needs. O(1).
+    fn check_given(
         &self,
         per_slot: &[(&'static str, usize)],
         per_spring: &[(&'static str, usize)],
     ) -> Result<(), SystemError> {
         let (n, s) = (self.slots(), self.springs());
-        let all = per_slot
-            .iter()
-            .map(|&(a, l)| (a, l, n, "slots"))
-            .chain(per_spring.iter().map(|&(a, l)| (a, l, s, "springs")));
-        for (array, len, expected, of) in all {
+        let own_slot = [("inverse mass", self.inv_mass.len()), ("viscosity", self.viscosity.len())];
+        let own_spring =
+            [("rest length", self.rest.len()), ("stiffness", self.stiffness.len()), ("damping", self.damping.len())];
+        let slot_arrays = own_slot.iter().chain(per_slot).map(|&(a, l)| (a, l, n, "slots"));
+        let spring_arrays = own_spring.iter().chain(per_spring).map(|&(a, l)| (a, l, s, "springs"));
+        for (array, len, expected, of) in slot_arrays.chain(spring_arrays) {
             if len != expected {
                 return Err(SystemError::Length { array, len, expected, of });
             }
         }
-        self.check_shape()
+        Ok(())
+    }
+
+    /// [`SpringSystem::check_given`] and the spring ends: what a pass over the springs needs.
+    /// O(springs).
+    fn check_state(
+        &self,
+        per_slot: &[(&'static str, usize)],
+        per_spring: &[(&'static str, usize)],
+    ) -> Result<(), SystemError> {
+        self.check_given(per_slot, per_spring)?;
+        self.check_ends()
     }
 
     /// Appends a slot with mass `mass` (fixed when `fixed` or `mass == 0`) and viscosity
@@ -702,7 +712,7 @@ impl SpringSystem {
     /// ```
     pub fn vertex_force(&self, i: usize, v: &[Vec3], sf: &[Vec3]) -> Result<Vec3, SystemError> {
         self.check_slot(i)?;
-        self.check_state(&[("velocities", v.len())], &[("spring forces", sf.len())])?;
+        self.check_given(&[("velocities", v.len())], &[("spring forces", sf.len())])?;
         Ok(self.vertex_force_raw(i, v, sf))
     }
 
@@ -929,7 +939,7 @@ impl SpringSystem {
     /// assert!(sys.kinetic_energy(&[[3.0, 0.0, 4.0]]).is_err()); // not a sum over a prefix
     /// ```
     pub fn kinetic_energy(&self, v: &[Vec3]) -> Result<f64, SystemError> {
-        self.check_state(&[("velocities", v.len())], &[])?;
+        self.check_given(&[("velocities", v.len())], &[])?;
         Ok(self.kinetic_energy_raw(v))
     }
 
@@ -994,7 +1004,7 @@ impl SpringSystem {
     /// assert_eq!(sys.kinetic_energy(&[[0.0, 4.0, 0.0]]), Ok(16.0)); // ½ m v²
     /// ```
     pub fn gravity_energy(&self, x: &[Vec3]) -> Result<f64, SystemError> {
-        self.check_state(&[("positions", x.len())], &[])?;
+        self.check_given(&[("positions", x.len())], &[])?;
         let g = self.gravity;
         let free = self.mass.iter().zip(&self.inv_mass).zip(x).filter(|((_, &w), _)| w > 0.0);
         Ok(free.map(|((&m, _), x)| -m * dot(g, *x)).sum())

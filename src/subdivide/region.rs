@@ -145,7 +145,7 @@ impl TetMasses {
         }
     }
 
-    /// [`TetMasses::check_cover`] and every live volume's mass finite and ≥ 0
+    /// Every live volume of `m` has an entry ([`SubdivideError::NoMass`]) whose mass is finite and ≥ 0
     /// ([`SubdivideError::BadMass`]). O(darts).
     ///
     /// # Examples

@@ -203,12 +203,9 @@ pub fn check_conservation(map: &GMap<3>, mech: &Mechanics) -> Result<(), Conserv
 /// ```
 pub fn conservation_violations(map: &GMap<3>, mech: &Mechanics, limit: usize) -> Vec<ConservationError> {
     let mut sink = Sink { out: Vec::new(), limit };
-    for dim in 0..=3 {
-        let (len, bound) = (mech.attribute_len(dim), map.cell_id_bound(dim));
-        if len < bound {
-            sink.push(ConservationError::MissingAttributes { dim, len, bound });
-            return sink.out;
-        }
+    if let Err(e) = mech.check_covers(map) {
+        sink.push(e);
+        return sink.out;
     }
     let exp = scatter_from_volumes(map, mech, &mut sink);
     check_vertices(mech, &exp, &mut sink);

@@ -20,8 +20,8 @@ fn stretched_cube(stretch: f64) -> (Body, Simulation) {
     let k = K as f64;
     let mech = body.attrs_mut();
     mech.pin_where(|_, p| p[0] <= 0.0 || p[0] >= k);
-    let rest = mech.rest_position.as_slice().to_vec();
-    for (x, r) in mech.position.as_mut_slice().iter_mut().zip(&rest) {
+    let rest = mech.rest_position().as_slice().to_vec();
+    for (x, r) in mech.position_mut().as_mut_slice().iter_mut().zip(&rest) {
         // Affine stretch: every spring with an x component is tensed.
         x[0] = r[0] * (1.0 + stretch / k);
     }

@@ -187,7 +187,7 @@ fn a_liver_pinned_on_one_side_settles_under_gravity_with_its_mass_unchanged() {
     let (mut sf, mut f) = (vec![[0.0; 3]; sim.projection.system.springs()], vec![[0.0; 3]; n]);
     sim.projection
         .system
-        .forces(&m.position.as_slice()[..n], &m.velocity.as_slice()[..n], &mut sf, &mut f, false)
+        .forces(&m.position().as_slice()[..n], &m.velocity().as_slice()[..n], &mut sf, &mut f, false)
         .unwrap();
     for (v, fv) in f.iter().enumerate() {
         if sim.projection.system.inv_mass[v] > 0.0 {
@@ -239,7 +239,7 @@ fn implicit_euler_is_stable_where_explicit_euler_blows_up() {
         rsim.step(&mut reference).unwrap();
     }
     let (a, b) = (implicit.attrs(), reference.attrs());
-    let diff = error(a.position.as_slice(), b.position.as_slice());
+    let diff = error(a.position().as_slice(), b.position().as_slice());
     let sag = rsim.max_displacement(&reference);
     assert!(diff < 1e-3 * sag, "implicit equilibrium differs by {diff} (sag {sag})");
 }

@@ -254,7 +254,7 @@ fn failed_saves_leave_the_old_file_intact() {
 
     // An unrepresentable value: refused before anything is written.
     let mut nan = body.clone();
-    nan.attrs_mut().position.as_mut_slice()[0][0] = f64::NAN;
+    nan.attrs_mut().position_mut().as_mut_slice()[0][0] = f64::NAN;
     assert!(matches!(store::save_body(&nan, &path, Format::Text), Err(StoreError::Unrepresentable { .. })));
     assert_eq!(std::fs::read(&path).unwrap(), old);
 
@@ -273,7 +273,7 @@ fn failed_saves_leave_the_old_file_intact() {
     set_mode(&ro, 0o555);
     let probe_ok = std::fs::write(ro.join("probe"), b"x").is_ok();
     let mut moved = small_body();
-    moved.attrs_mut().position.as_mut_slice()[0][0] += 1.0;
+    moved.attrs_mut().position_mut().as_mut_slice()[0][0] += 1.0;
     let result = store::save_body(&moved, &ro_path, Format::Text);
     if !probe_ok {
         assert!(matches!(result, Err(StoreError::Io { .. })), "{result:?}");

@@ -72,9 +72,9 @@ fn assert_body_round_trips(body: &Body) {
         let again = store::encode(&Document::from_body(&back), Format::Binary).unwrap();
         assert!(again == reference, "{format:?}: attributes differ after the round trip");
         let (m0, m1) = (body.attrs(), back.attrs());
-        for v in 0..m0.position.len() {
+        for v in 0..m0.position().len() {
             let id = CellId(v as u32);
-            assert_eq!(m0.position[id].map(f64::to_bits), m1.position[id].map(f64::to_bits));
+            assert_eq!(m0.position()[id].map(f64::to_bits), m1.position()[id].map(f64::to_bits));
             assert_eq!(m0.vertex_mass(id).to_bits(), m1.vertex_mass(id).to_bits());
         }
         for e in 0..m0.attribute_len(1) {
@@ -89,11 +89,11 @@ fn assert_body_round_trips(body: &Body) {
 /// encoding is really exercised.
 fn disturb(body: &mut Body) {
     let m = body.attrs_mut();
-    for (k, p) in m.position.as_mut_slice().iter_mut().enumerate() {
+    for (k, p) in m.position_mut().as_mut_slice().iter_mut().enumerate() {
         p[0] += 0.1 * (k as f64).sin();
         p[1] += f64::MIN_POSITIVE / 3.0;
     }
-    for (k, v) in m.velocity.as_mut_slice().iter_mut().enumerate() {
+    for (k, v) in m.velocity_mut().as_mut_slice().iter_mut().enumerate() {
         *v = [1.0 / (k as f64 + 3.0), -0.0, 1e-300];
     }
 }

@@ -392,7 +392,7 @@ fn the_refine_command_reports_the_spring_coupling_with_springs() {
 /// The inner edges of a Kuhn cube of side 3 (both ends strictly inside), one dart each.
 fn inner_edges(body: &topomech::mechanics::Body) -> Vec<DartId> {
     let map = body.map();
-    let inner = |v: topomech::CellId| body.attrs().rest_position[v].iter().all(|&c| c > 0.5 && c < 2.5);
+    let inner = |v: topomech::CellId| body.attrs().rest_position()[v].iter().all(|&c| c > 0.5 && c < 2.5);
     map.one_dart_per_cell(1)
         .into_iter()
         .filter(|&d| inner(map.vertex_id(d)) && inner(map.vertex_id(map.alpha::<0>(d))))
@@ -435,7 +435,7 @@ fn doubled_pairs(map: &GMap<3>) -> std::collections::BTreeMap<(u32, u32), usize>
 
 /// A leveled map of the body's map at its rest positions.
 fn leveled_body(body: &topomech::mechanics::Body) -> LeveledMap<3> {
-    LeveledMap::new(body.map().clone(), body.attrs().rest_position.as_slice().to_vec())
+    LeveledMap::new(body.map().clone(), body.attrs().rest_position().as_slice().to_vec())
 }
 
 /// Law 2 per edge cell: two edge cells between the same vertices get a spring each, from the tets

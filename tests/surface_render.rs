@@ -110,10 +110,10 @@ fn body_and_tet_list_give_the_same_oriented_boundary() {
 fn surface_follows_the_current_positions() {
     let mut body = cube_body(2);
     let corner = boundary_surface(&body).vertex_ids[0];
-    body.attrs_mut().position.as_mut_slice()[corner as usize][2] += 0.25;
+    body.attrs_mut().position_mut().as_mut_slice()[corner as usize][2] += 0.25;
     let s = boundary_surface(&body);
     let i = s.vertex_ids.iter().position(|&v| v == corner).unwrap();
-    assert_eq!(s.positions[i], body.attrs().position.as_slice()[corner as usize]);
+    assert_eq!(s.positions[i], body.attrs().position().as_slice()[corner as usize]);
     // Orientation comes from the rest shape: still closed and outward.
     assert_closed_oriented(&s);
     assert!(s.enclosed_volume() > 0.0);

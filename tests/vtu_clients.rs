@@ -56,7 +56,7 @@ fn cut_liver() -> Mesh {
     let plane = Plane { point: [-1.5, 3.0, 0.6], normal: [1.0, 0.2, 0.1] };
     incise_plane(&mut body, &plane).unwrap();
     let n = body.map().cell_id_bound(0);
-    let points: Vec<[f64; 3]> = (0..n).map(|v| body.attrs().position[CellId(v as u32)]).collect();
+    let points: Vec<[f64; 3]> = (0..n).map(|v| body.attrs().position()[CellId(v as u32)]).collect();
     (points, body_tets(&body))
 }
 

@@ -202,7 +202,7 @@ pub fn run_remove(args: RemoveArgs) -> Result<(), CliError> {
 pub fn run_tear(args: TearArgs) -> Result<(), CliError> {
     let (mut body, load_us) = load_body(&args.common)?;
     let before = stats(&body, 0.0);
-    let rest = body.attrs().rest_position.as_slice().to_vec();
+    let rest = body.attrs().rest_position().as_slice().to_vec();
     let (lo, hi) = rest.iter().fold((f64::MAX, f64::MIN), |(lo, hi), p| (lo.min(p[2]), hi.max(p[2])));
     let pin_z = args.pin_z.unwrap_or(lo + 0.1 * (hi - lo));
     body.attrs_mut().pin_where(|_, p| p[2] <= pin_z);
@@ -235,7 +235,7 @@ fn load_body(common: &CommonArgs) -> Result<(Body, u64), CliError> {
 /// Tet (volume) ids whose centroid at rest is within distance r of c.
 fn tets_in_ball(body: &Body, c: Vec3, r: f64) -> Vec<u32> {
     let map = body.map();
-    let rest = &body.attrs().rest_position;
+    let rest = body.attrs().rest_position();
     let mut out = Vec::new();
     for d in map.one_dart_per_cell(3) {
         let mut ids: Vec<CellId> = map.cell_darts(3, d).into_iter().map(|x| map.vertex_id(x)).collect();
@@ -288,9 +288,9 @@ fn finish(
 fn write_vtu(body: &Body, path: &Path) -> Result<(), CliError> {
     let tets = body_tets(body);
     let frame = Frame {
-        points: body.attrs().position.as_slice(),
+        points: body.attrs().position().as_slice(),
         tets: &tets,
-        vectors: vec![("velocity", body.attrs().velocity.as_slice())],
+        vectors: vec![("velocity", body.attrs().velocity().as_slice())],
     };
     frame.write(path).map_err(other)
 }

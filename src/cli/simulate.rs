@@ -261,16 +261,16 @@ impl FrameWriter {
         }
         let m = body.attrs();
         let displacement: Vec<Vec3> = m
-            .position
+            .position()
             .as_slice()
             .iter()
-            .zip(m.rest_position.as_slice())
+            .zip(m.rest_position().as_slice())
             .map(|(p, r)| [p[0] - r[0], p[1] - r[1], p[2] - r[2]])
             .collect();
         let frame = Frame {
-            points: m.position.as_slice(),
+            points: m.position().as_slice(),
             tets: &self.tets,
-            vectors: vec![("velocity", m.velocity.as_slice()), ("displacement", &displacement)],
+            vectors: vec![("velocity", m.velocity().as_slice()), ("displacement", &displacement)],
         };
         series.push(step as f64 * self.dt, &frame).map_err(other)?;
         Ok(())

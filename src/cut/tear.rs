@@ -29,7 +29,7 @@ use super::{dissociate_face, CutError, Dissociation};
 /// let (points, tets) = kuhn_cube(1);
 /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
 /// let sim = Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Euler, 1e-3)).unwrap();
-/// body.attrs_mut().position.as_mut_slice()[7][0] += 0.5; // pull a corner along x
+/// body.attrs_mut().position_mut().as_mut_slice()[7][0] += 0.5; // pull a corner along x
 /// let s = principal_stress(&body, &sim)[7];
 /// let norm = s.direction.iter().map(|c| c * c).sum::<f64>().sqrt();
 /// assert!(s.magnitude > 0.0 && (norm - 1.0).abs() < 1e-9);
@@ -85,7 +85,7 @@ pub struct Tear {
 /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
 /// let mut sim = Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Euler, 1e-4)).unwrap();
 /// assert_eq!(tear_step(&mut body, &mut sim, 1.0, 4).unwrap(), TearStep::default()); // nothing at rest
-/// body.attrs_mut().position.as_mut_slice()[13][0] += 0.5;
+/// body.attrs_mut().position_mut().as_mut_slice()[13][0] += 0.5;
 /// assert_eq!(tear_step(&mut body, &mut sim, 1.0, 1).unwrap().tears[0].vertex.0, 13);
 /// ```
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -109,7 +109,7 @@ pub struct TearStep {
 /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
 /// let sim = Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Euler, 1e-3)).unwrap();
 /// assert!(principal_stress(&body, &sim).iter().all(|s| s.magnitude == 0.0)); // at rest
-/// body.attrs_mut().position.as_mut_slice()[7][2] += 0.5; // pull the top corner up
+/// body.attrs_mut().position_mut().as_mut_slice()[7][2] += 0.5; // pull the top corner up
 /// let stress = principal_stress(&body, &sim);
 /// assert!(stress[7].magnitude > 0.0 && stress[7].direction[2].abs() > 0.5);
 /// assert!(principal_stress(&body.clone(), &sim).is_empty()); // another body
@@ -375,7 +375,7 @@ pub fn tear_vertex(body: &mut Body, v: CellId, direction: Vec3, hint: Option<Dar
 /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
 /// let mut sim = Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Euler, 1e-4)).unwrap();
 /// assert!(tear_step(&mut body, &mut sim, 1.0, 4).unwrap().tears.is_empty()); // no tension at rest
-/// body.attrs_mut().position.as_mut_slice()[13][0] += 0.5; // stretch the centre vertex
+/// body.attrs_mut().position_mut().as_mut_slice()[13][0] += 0.5; // stretch the centre vertex
 /// let step = tear_step(&mut body, &mut sim, 1.0, 1).unwrap();
 /// assert_eq!(step.tears.len(), 1);
 /// sim.step(&mut body).unwrap(); // the simulation followed the change

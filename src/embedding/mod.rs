@@ -187,6 +187,152 @@ impl<T> std::ops::IndexMut<CellId> for CellArray<T> {
     }
 }
 
+/// A mutable view of the values of a [`CellArray`]: every slot can be read and written, none
+/// added or removed. Handed out where the values are free to change but the length is bound to
+/// the map (a body's positions, velocities, pins), so that no caller can shorten an array that
+/// later operations index by cell id.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::embedding::{CellArray, CellSliceMut};
+/// use topomech::CellId;
+///
+/// let mut speed = CellArray::filled(3, 1.0);
+/// let mut view = CellSliceMut::new(&mut speed);
+/// view[CellId(2)] = 4.0;
+/// view.as_mut_slice()[0] *= 2.0;
+/// assert_eq!((view.len(), view.get(CellId(3))), (3, None)); // past the end: no panic
+/// assert_eq!(speed.as_slice(), &[2.0, 1.0, 4.0]); // the length did not change
+/// ```
+#[derive(Debug)]
+pub struct CellSliceMut<'a, T> {
+    values: &'a mut [T],
+}
+
+impl<'a, T> CellSliceMut<'a, T> {
+    /// The view of every slot of `array`. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::embedding::{CellArray, CellSliceMut};
+    ///
+    /// let mut a = CellArray::from_vec(vec![1, 2]);
+    /// CellSliceMut::new(&mut a).as_mut_slice().swap(0, 1);
+    /// assert_eq!(a.as_slice(), &[2, 1]);
+    /// ```
+    pub fn new(array: &'a mut CellArray<T>) -> Self {
+        CellSliceMut { values: &mut array.values }
+    }
+
+    /// Number of slots. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::embedding::{CellArray, CellSliceMut};
+    ///
+    /// let mut a = CellArray::filled(4, 0u8);
+    /// assert_eq!(CellSliceMut::new(&mut a).len(), 4);
+    /// ```
+    pub fn len(&self) -> usize {
+        self.values.len()
+    }
+
+    /// Whether there is no slot. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::embedding::{CellArray, CellSliceMut};
+    ///
+    /// let mut a = CellArray::<u8>::default();
+    /// assert!(CellSliceMut::new(&mut a).is_empty());
+    /// ```
+    pub fn is_empty(&self) -> bool {
+        self.values.is_empty()
+    }
+
+    /// The value of `id`, or `None` past the end. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::embedding::{CellArray, CellSliceMut};
+    /// use topomech::CellId;
+    ///
+    /// let mut a = CellArray::from_vec(vec![5, 6]);
+    /// let view = CellSliceMut::new(&mut a);
+    /// assert_eq!((view.get(CellId(1)), view.get(CellId(2))), (Some(&6), None));
+    /// ```
+    pub fn get(&self, id: CellId) -> Option<&T> {
+        self.values.get(id.index())
+    }
+
+    /// The value of `id` for writing, or `None` past the end. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::embedding::{CellArray, CellSliceMut};
+    /// use topomech::CellId;
+    ///
+    /// let mut a = CellArray::from_vec(vec![5, 6]);
+    /// let mut view = CellSliceMut::new(&mut a);
+    /// *view.get_mut(CellId(0)).unwrap() = 7;
+    /// assert!(view.get_mut(CellId(2)).is_none());
+    /// assert_eq!(a.as_slice(), &[7, 6]);
+    /// ```
+    pub fn get_mut(&mut self, id: CellId) -> Option<&mut T> {
+        self.values.get_mut(id.index())
+    }
+
+    /// Every slot, read-only (slot i = cell id i). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::embedding::{CellArray, CellSliceMut};
+    ///
+    /// let mut a = CellArray::from_vec(vec![1.0, 2.0]);
+    /// assert_eq!(CellSliceMut::new(&mut a).as_slice().iter().sum::<f64>(), 3.0);
+    /// ```
+    pub fn as_slice(&self) -> &[T] {
+        self.values
+    }
+
+    /// Every slot, writable; a slice cannot change its length. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::embedding::{CellArray, CellSliceMut};
+    ///
+    /// let mut a = CellArray::filled(3, 1);
+    /// CellSliceMut::new(&mut a).as_mut_slice().fill(9);
+    /// assert_eq!(a.as_slice(), &[9, 9, 9]);
+    /// ```
+    pub fn as_mut_slice(&mut self) -> &mut [T] {
+        self.values
+    }
+}
+
+impl<T> std::ops::Index<CellId> for CellSliceMut<'_, T> {
+    type Output = T;
+    #[inline(always)]
+    fn index(&self, id: CellId) -> &T {
+        &self.values[id.index()]
+    }
+}
+
+impl<T> std::ops::IndexMut<CellId> for CellSliceMut<'_, T> {
+    #[inline(always)]
+    fn index_mut(&mut self, id: CellId) -> &mut T {
+        &mut self.values[id.index()]
+    }
+}
+
 /// Split and merge rules of a set of cell attributes: what the embedding layer does with the
 /// attributes when a sew merges cells or an unsew splits them.
 ///
@@ -508,8 +654,8 @@ impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
     ///
     /// let (points, tets) = kuhn_cube(1);
     /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
-    /// body.attrs_mut().position[CellId(0)] = [0.0, 0.0, -1.0];
-    /// assert_eq!(body.attrs().position[CellId(0)], [0.0, 0.0, -1.0]);
+    /// body.attrs_mut().position_mut()[CellId(0)] = [0.0, 0.0, -1.0];
+    /// assert_eq!(body.attrs().position()[CellId(0)], [0.0, 0.0, -1.0]);
     /// assert_eq!(body.version(), 0); // attributes are not topology
     /// ```
     pub fn attrs_mut(&mut self) -> &mut E {

@@ -26,13 +26,18 @@ pub const TOLERANCE: f64 = 1e-12;
 /// ```
 /// use topomech::generate::kuhn_cube;
 /// use topomech::mechanics::{check_conservation, Body, ConservationError, Material};
-/// use topomech::CellId;
 ///
 /// let (points, tets) = kuhn_cube(1);
-/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
-/// body.attrs_mut().rest_position[CellId(0)][0] += 0.1; // rest lengths at vertex 0 no longer match
-/// let err = check_conservation(body.map(), body.attrs()).unwrap_err();
-/// assert!(matches!(err, ConservationError::RestLength { .. }), "{err}");
+/// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// // The same cube with its points numbered from 1 on (the last is 0): lawful on its own map,
+/// // but its vertex i is another corner, so its masses do not fit the vertices of `body`'s map.
+/// let n = points.len();
+/// let shifted: Vec<_> = (0..n).map(|i| points[(i + n - 1) % n]).collect();
+/// let tets: Vec<[u32; 4]> = tets.iter().map(|t| t.map(|v| (v + 1) % n as u32)).collect();
+/// let (other, _) = Body::from_tets(&shifted, &tets, Material::default()).unwrap();
+/// let err = check_conservation(body.map(), other.attrs()).unwrap_err();
+/// assert!(matches!(err, ConservationError::VertexMass { .. }), "{err}");
+/// assert!(check_conservation(other.map(), other.attrs()).is_ok());
 /// ```
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ConservationError {
@@ -190,16 +195,18 @@ pub fn check_conservation(map: &GMap<3>, mech: &Mechanics) -> Result<(), Conserv
 /// ```
 /// use topomech::generate::kuhn_cube;
 /// use topomech::mechanics::{conservation_violations, Body, Material};
-/// use topomech::CellId;
 ///
 /// let (points, tets) = kuhn_cube(1);
-/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
 /// assert!(conservation_violations(body.map(), body.attrs(), usize::MAX).is_empty());
-/// // Moving a rest position breaks the rest length (and the stiffness) of every edge at vertex 0.
-/// body.attrs_mut().rest_position[CellId(0)][0] += 0.1;
-/// let all = conservation_violations(body.map(), body.attrs(), usize::MAX);
+/// // The attributes of the same cube with its points numbered from 1 on break many laws here.
+/// let n = points.len();
+/// let shifted: Vec<_> = (0..n).map(|i| points[(i + n - 1) % n]).collect();
+/// let tets: Vec<[u32; 4]> = tets.iter().map(|t| t.map(|v| (v + 1) % n as u32)).collect();
+/// let (other, _) = Body::from_tets(&shifted, &tets, Material::default()).unwrap();
+/// let all = conservation_violations(body.map(), other.attrs(), usize::MAX);
 /// assert!(all.len() > 3, "{all:?}");
-/// assert_eq!(conservation_violations(body.map(), body.attrs(), 3), all[..3].to_vec());
+/// assert_eq!(conservation_violations(body.map(), other.attrs(), 3), all[..3].to_vec());
 /// ```
 pub fn conservation_violations(map: &GMap<3>, mech: &Mechanics, limit: usize) -> Vec<ConservationError> {
     let mut sink = Sink { out: Vec::new(), limit };

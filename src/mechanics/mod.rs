@@ -136,7 +136,7 @@ impl PinSpec {
 /// (0..10).for_each(|_| sim.step(&mut body).unwrap());
 /// assert_eq!(sim.stepper.steps_done(), 10);
 /// assert!(sim.projection.is_current(&body));
-/// assert!(body.attrs().position.as_slice().iter().all(|p| p[2] < 1.0 + 1e-12)); // falling
+/// assert!(body.attrs().position().as_slice().iter().all(|p| p[2] < 1.0 + 1e-12)); // falling
 /// ```
 #[derive(Clone, Debug)]
 pub struct Simulation {
@@ -161,10 +161,10 @@ impl Simulation {
     ///
     /// let (points, tets) = kuhn_cube(1);
     /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
-    /// body.attrs_mut().velocity.as_mut_slice()[0] = [1.0, 0.0, 0.0];
-    /// body.attrs_mut().pinned.as_mut_slice()[0] = true;
+    /// body.attrs_mut().velocity_mut().as_mut_slice()[0] = [1.0, 0.0, 0.0];
+    /// body.attrs_mut().pinned_mut().as_mut_slice()[0] = true;
     /// let sim = Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Rk4, 1e-3)).unwrap();
-    /// assert_eq!(body.attrs().velocity.as_slice()[0], [0.0; 3]); // a pinned vertex starts still
+    /// assert_eq!(body.attrs().velocity().as_slice()[0], [0.0; 3]); // a pinned vertex starts still
     /// assert_eq!(sim.projection.system.springs(), 19); // one spring per edge
     /// assert!(Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Rk4, -1.0)).is_err());
     /// ```
@@ -220,7 +220,7 @@ impl Simulation {
     ///     sim.step(&mut body).unwrap();
     /// }
     /// let m = body.attrs();
-    /// let z = |v: usize| m.position.as_slice()[v][2];
+    /// let z = |v: usize| m.position().as_slice()[v][2];
     /// assert!(z(7) < 1.0 && z(0) == 0.0); // the top corner sags, the pinned one stays
     /// assert!(sim.kinetic_energy(&body) > 0.0 && sim.max_displacement(&body) > 0.0);
     /// ```
@@ -318,7 +318,7 @@ impl Simulation {
     ///
     /// let (points, tets) = kuhn_cube(1);
     /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
-    /// body.attrs_mut().velocity.as_mut_slice().fill([0.0, 3.0, 0.0]);
+    /// body.attrs_mut().velocity_mut().as_mut_slice().fill([0.0, 3.0, 0.0]);
     /// let sim = Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Euler, 1e-3)).unwrap();
     /// assert!((sim.kinetic_energy(&body) - 0.5 * 1.0 * 9.0).abs() < 1e-12); // ½ M v², M = 1
     /// assert!((sim.kinetic_energy(&body) - body.kinetic_energy()).abs() < 1e-12);
@@ -340,7 +340,7 @@ impl Simulation {
     /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
     /// let sim = Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Euler, 1e-3)).unwrap();
     /// assert_eq!(sim.max_displacement(&body), 0.0);
-    /// body.attrs_mut().position.as_mut_slice()[5] = [1.0, 0.0, 1.25]; // vertex 5 rests at (1, 0, 1)
+    /// body.attrs_mut().position_mut().as_mut_slice()[5] = [1.0, 0.0, 1.25]; // vertex 5 rests at (1, 0, 1)
     /// assert_eq!(sim.max_displacement(&body), 0.25);
     /// ```
     pub fn max_displacement(&self, body: &Body) -> f64 {

@@ -37,7 +37,7 @@
 //! - volume split (an unsew inside a tet) has no mechanical meaning: the new volume gets zero mass
 //!   and the conservation check reports it.
 
-use crate::embedding::{CellArray, CellRules, Embedded, Split};
+use crate::embedding::{CellArray, CellRules, CellSliceMut, Embedded, Split};
 use crate::gmap::CellChanges;
 use crate::{AlphaMask, BuildError, BuildReport, CellId, DartId, GMap};
 
@@ -137,9 +137,12 @@ pub enum ModelError {
 
 /// The mechanical attributes of a tetrahedral 3-G-map, all in arrays keyed by cell id.
 ///
-/// State variables (positions, velocities, forces, pins) are public fields: the simulation writes
-/// them every step. Parameters bound by the laws (masses, stiffnesses) are private and change only
-/// through the split/merge rules, so the laws cannot be broken from outside.
+/// State variables (positions, velocities, pins) are writable value by value through views that
+/// cannot change an array's length ([`Mechanics::position_mut`], [`Mechanics::velocity_mut`],
+/// [`Mechanics::pinned_mut`]): the simulation writes them every step, and every operation may
+/// index them by any vertex id of the map. Parameters bound by the laws (masses, stiffnesses, rest
+/// lengths and the rest positions they are measured on) are read-only and change only through
+/// the split/merge rules, so the laws cannot be broken from outside.
 ///
 /// # Examples
 ///
@@ -150,10 +153,35 @@ pub enum ModelError {
 /// let (points, tets) = kuhn_cube(1);
 /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
 /// let m = body.attrs();
-/// assert_eq!(m.position.as_slice(), m.rest_position.as_slice()); // built at rest
-/// assert!(m.velocity.as_slice().iter().all(|v| *v == [0.0; 3]));
-/// assert!(!m.pinned.as_slice().iter().any(|&p| p));
+/// assert_eq!(m.position().as_slice(), m.rest_position().as_slice()); // built at rest
+/// assert!(m.velocity().as_slice().iter().all(|v| *v == [0.0; 3]));
+/// assert!(!m.pinned().as_slice().iter().any(|&p| p));
 /// assert!((m.total_tet_mass(body.map()).unwrap() - 1.0).abs() < 1e-12); // density 1, unit cube
+/// ```
+///
+/// A state array cannot be replaced by one of another length (finding 33 in
+/// docs/VERIFICATION.md: a shorter one made later operations panic on an index):
+///
+/// ```compile_fail
+/// use topomech::embedding::CellArray;
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Material};
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// body.attrs_mut().position = CellArray::from_vec(vec![[0.0; 3]; 2]); // private field
+/// ```
+///
+/// nor a rest position moved from outside (it would break the rest-length law):
+///
+/// ```compile_fail
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Material};
+/// use topomech::CellId;
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// body.attrs_mut().rest_position()[CellId(0)][0] += 0.25; // read-only
 /// ```
 #[derive(Clone, Debug)]
 pub struct Mechanics {
@@ -172,16 +200,13 @@ pub struct Mechanics {
     // vertices
     pub(crate) vertex_mass: CellArray<f64>,
     pub(crate) vertex_viscosity: CellArray<f64>,
-    /// Rest (initial) position of each vertex; rest lengths and volumes are measured on it.
-    pub rest_position: CellArray<Vec3>,
-    /// Current position of each vertex.
-    pub position: CellArray<Vec3>,
-    /// Current velocity of each vertex.
-    pub velocity: CellArray<Vec3>,
-    /// Sum of the forces on each vertex at the last evaluation (seed §4.1 "for optimization").
-    pub force: CellArray<Vec3>,
-    /// Fixed vertices: their velocity stays zero.
-    pub pinned: CellArray<bool>,
+    // vertex state: private so that no caller can change an array's length (values change
+    // through the `*_mut` views); rest positions are bound by the laws and read-only
+    pub(crate) rest_position: CellArray<Vec3>,
+    pub(crate) position: CellArray<Vec3>,
+    pub(crate) velocity: CellArray<Vec3>,
+    pub(crate) force: CellArray<Vec3>,
+    pub(crate) pinned: CellArray<bool>,
 }
 
 /// A mechanical body: a 3-G-map whose sew/unsew keep the [`Mechanics`] attributes lawful.
@@ -433,6 +458,146 @@ impl Mechanics {
         self.face_normal[f]
     }
 
+    /// Rest (initial) position of each vertex, read-only: rest lengths and volumes are measured
+    /// on it, so it is bound by the laws and changes only through the operations. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    /// use topomech::CellId;
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// assert_eq!(body.attrs().rest_position().as_slice(), &points[..]); // vertex id i = point i
+    /// assert_eq!(body.attrs().rest_position()[CellId(7)], [1.0, 1.0, 1.0]);
+    /// ```
+    pub fn rest_position(&self) -> &CellArray<Vec3> {
+        &self.rest_position
+    }
+
+    /// Current position of each vertex. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// assert_eq!(body.attrs().position(), body.attrs().rest_position()); // built at rest
+    /// ```
+    pub fn position(&self) -> &CellArray<Vec3> {
+        &self.position
+    }
+
+    /// Current positions, writable value by value; the array keeps its length (one slot per
+    /// vertex id of the map), so no later operation can index past it. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    /// use topomech::CellId;
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// body.attrs_mut().position_mut()[CellId(0)] = [0.0, 0.0, -1.0];
+    /// assert_eq!(body.attrs().position()[CellId(0)], [0.0, 0.0, -1.0]);
+    /// assert_eq!(body.attrs().position().len(), 8);
+    /// ```
+    pub fn position_mut(&mut self) -> CellSliceMut<'_, Vec3> {
+        CellSliceMut::new(&mut self.position)
+    }
+
+    /// Current velocity of each vertex. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// assert!(body.attrs().velocity().as_slice().iter().all(|v| *v == [0.0; 3])); // at rest
+    /// ```
+    pub fn velocity(&self) -> &CellArray<Vec3> {
+        &self.velocity
+    }
+
+    /// Current velocities, writable value by value; the length stays bound to the map. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// body.attrs_mut().velocity_mut().as_mut_slice().fill([1.0, 0.0, 0.0]);
+    /// assert!((body.kinetic_energy() - 0.5).abs() < 1e-12); // ½ · 1 kg · (1 m/s)²
+    /// ```
+    pub fn velocity_mut(&mut self) -> CellSliceMut<'_, Vec3> {
+        CellSliceMut::new(&mut self.velocity)
+    }
+
+    /// Sum of the forces on each vertex at the last evaluation (seed §4.1 "for optimization"),
+    /// read-only: the simulation writes it. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// assert_eq!(body.attrs().force().len(), 8);
+    /// ```
+    pub fn force(&self) -> &CellArray<Vec3> {
+        &self.force
+    }
+
+    /// Which vertices are fixed (their velocity stays zero). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// assert!(!body.attrs().pinned().as_slice().contains(&true)); // nothing fixed at first
+    /// ```
+    pub fn pinned(&self) -> &CellArray<bool> {
+        &self.pinned
+    }
+
+    /// The pins, writable value by value ([`Mechanics::pin_where`] sets them by a predicate);
+    /// the length stays bound to the map. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    /// use topomech::CellId;
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// body.attrs_mut().pinned_mut()[CellId(3)] = true;
+    /// assert_eq!(body.attrs().pinned().as_slice().iter().filter(|&&p| p).count(), 1);
+    /// ```
+    pub fn pinned_mut(&mut self) -> CellSliceMut<'_, bool> {
+        CellSliceMut::new(&mut self.pinned)
+    }
+
     /// Number of attribute slots of `dim`-cells (≥ the map's `cell_id_bound(dim)` when in sync).
     /// O(1).
     ///
@@ -471,7 +636,7 @@ impl Mechanics {
     /// let map = body.map().clone();
     /// let faces: Vec<_> = map.one_dart_per_cell(2).into_iter().map(|d| map.cell_id(2, d)).collect();
     /// let top = *faces.iter().find(|&&f| body.attrs().face_normal(f) == [0.0, 0.0, 1.0]).unwrap();
-    /// body.attrs_mut().position.as_mut_slice().iter_mut().for_each(|p| p[2] = -p[2]); // mirror in z
+    /// body.attrs_mut().position_mut().as_mut_slice().iter_mut().for_each(|p| p[2] = -p[2]); // mirror in z
     /// body.attrs_mut().update_normals(&map).unwrap();
     /// assert_eq!(body.attrs().face_normal(top), [0.0, 0.0, -1.0]); // the top face now faces down
     /// ```
@@ -770,7 +935,7 @@ impl Mechanics {
     /// let (points, tets) = kuhn_cube(1);
     /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
     /// body.attrs_mut().pin_where(|_, rest| rest[2] == 0.0); // the bottom face
-    /// assert_eq!(body.attrs().pinned.as_slice().iter().filter(|&&p| p).count(), 4);
+    /// assert_eq!(body.attrs().pinned().as_slice().iter().filter(|&&p| p).count(), 4);
     /// ```
     pub fn pin_where(&mut self, mut pin: impl FnMut(CellId, Vec3) -> bool) {
         for (i, (p, r)) in self.pinned.as_mut_slice().iter_mut().zip(self.rest_position.as_slice()).enumerate() {
@@ -1075,8 +1240,8 @@ impl Embedded<3, Mechanics> {
     /// assert_eq!(body.map().count_cells().0, vec![8, 19, 18, 6]);
     /// assert!(report.pinched_vertices.is_empty());
     /// let m = body.attrs();
-    /// assert_eq!(m.rest_position.as_slice(), &points[..]); // vertex id = point index
-    /// assert_eq!(m.position.as_slice(), m.rest_position.as_slice()); // at rest
+    /// assert_eq!(m.rest_position().as_slice(), &points[..]); // vertex id = point index
+    /// assert_eq!(m.position().as_slice(), m.rest_position().as_slice()); // at rest
     /// check_conservation(body.map(), m).unwrap();
     /// ```
     pub fn from_tets(
@@ -1175,7 +1340,7 @@ impl Embedded<3, Mechanics> {
     /// let (points, tets) = kuhn_cube(1);
     /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
     /// assert_eq!(body.kinetic_energy(), 0.0); // at rest
-    /// body.attrs_mut().velocity.as_mut_slice().fill([2.0, 0.0, 0.0]);
+    /// body.attrs_mut().velocity_mut().as_mut_slice().fill([2.0, 0.0, 0.0]);
     /// let mass = body.total_vertex_mass();
     /// assert!((body.kinetic_energy() - 0.5 * mass * 4.0).abs() < 1e-12); // ½ m v²
     /// ```
@@ -1278,6 +1443,18 @@ impl Mechanics {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `Body::check` reports a broken law: one moved rest position (possible only inside the
+    /// crate since finding 33) no longer matches the rest lengths. Found missing by the
+    /// twenty-fourth mutation sample (docs/VERIFICATION.md).
+    #[test]
+    fn check_reports_a_moved_rest_position() {
+        let (points, tets) = crate::generate::kuhn_cube(1);
+        let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+        assert!(body.check().is_ok());
+        body.attrs_mut().rest_position[CellId(0)][0] += 0.25;
+        assert!(matches!(body.check(), Err(ConservationError::RestLength { .. })));
+    }
 
     /// The O(1) outward normal equals the orbit-based one, bit for bit, at every dart of a body
     /// with dissociated faces (tets as built: the five-load path), then with a tet opened inside

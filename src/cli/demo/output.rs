@@ -122,10 +122,10 @@ impl Output {
     pub fn frame(&mut self, scene: &Scene) -> Result<(), DemoError> {
         let body = &scene.body;
         let m = body.attrs();
-        let points = m.position.as_slice();
+        let points = m.position().as_slice();
         let displacement: Vec<Vec3> = points
             .iter()
-            .zip(m.rest_position.as_slice())
+            .zip(m.rest_position().as_slice())
             .map(|(p, r)| [p[0] - r[0], p[1] - r[1], p[2] - r[2]])
             .collect();
         let stress = vertex_stress(scene, points.len());
@@ -135,7 +135,7 @@ impl Output {
             tets: &tets,
             vectors: vec![
                 ("displacement", &displacement),
-                ("velocity", m.velocity.as_slice()),
+                ("velocity", m.velocity().as_slice()),
                 ("stress", &stress[..]),
             ],
         };

@@ -65,7 +65,7 @@ pub struct Refined {
 /// [`DemoError::SpringLaws`] when a spring law fails, [`DemoError::Levels`] when a level law
 /// fails, [`DemoError::Balance`] when Σ tet mass changed by more than the tolerance.
 pub fn refine(body: &Body, tets: &[CellId], run: &mut StageRun, bar: &ProgressBar) -> Result<Refined, DemoError> {
-    let mut lm = LeveledMap::new(body.map().clone(), body.attrs().rest_position.as_slice().to_vec());
+    let mut lm = LeveledMap::new(body.map().clone(), body.attrs().rest_position().as_slice().to_vec());
     // The leveled map starts as a copy of the body's map: same cell ids, so the same masses and
     // the same springs per edge cell.
     let masses =
@@ -73,8 +73,8 @@ pub fn refine(body: &Body, tets: &[CellId], run: &mut StageRun, bar: &ProgressBa
     let coupling = |tet: Option<CellId>| move |source| DemoError::Coupling { tet, source };
     let mut mech = LeveledMechanics::with_masses(&lm, *body.attrs().material(), masses).map_err(coupling(None))?;
     same_springs(body, &mech)?;
-    mech.position.iter_mut().zip(body.attrs().position.as_slice()).for_each(|(x, p)| *x = *p);
-    mech.velocity.iter_mut().zip(body.attrs().velocity.as_slice()).for_each(|(x, v)| *x = *v);
+    mech.position.iter_mut().zip(body.attrs().position().as_slice()).for_each(|(x, p)| *x = *p);
+    mech.velocity.iter_mut().zip(body.attrs().velocity().as_slice()).for_each(|(x, v)| *x = *v);
     let (before, springs_before) = (mech.masses.total(&lm), mech.springs().count());
     let doubled = doubled_edges(&mech);
     let t0 = Instant::now();
@@ -146,7 +146,7 @@ pub fn simulate_refined(
     steps: u64,
 ) -> Result<RefinedSim, DemoError> {
     let (lm, mech) = (&refined.lm, &mut refined.mech);
-    let pins = body.attrs().pinned.as_slice();
+    let pins = body.attrs().pinned().as_slice();
     let rest = lm.points();
     let fixed: Vec<bool> = (0..mech.position.len())
         .map(|v| {
@@ -354,7 +354,7 @@ mod tests {
         let (points, tets) = generate::kuhn_cube(3);
         let mut body = Body::from_tets(&points, &tets, cut::ops::material()).unwrap().0;
         let map = body.map();
-        let inner = |v: CellId| body.attrs().rest_position[v].iter().all(|&c| c > 0.5 && c < 2.5);
+        let inner = |v: CellId| body.attrs().rest_position()[v].iter().all(|&c| c > 0.5 && c < 2.5);
         let edge = map
             .one_dart_per_cell(1)
             .into_iter()

@@ -150,7 +150,7 @@ impl Scene {
         let pins = PinSpec { ids: Vec::new(), below: Some((long_axis, pin_limit)), inside: None };
         body.attrs_mut().pin_where(|id, p| pins.pins(id, p));
         let live = topomech::mechanics::Mechanics::live_vertices(body.map());
-        let pinned = body.attrs().pinned.as_slice().iter().zip(&live).filter(|(&p, &l)| p && l).count();
+        let pinned = body.attrs().pinned().as_slice().iter().zip(&live).filter(|(&p, &l)| p && l).count();
         let probe = Simulation::new(&mut body, gravity, StepConfig::new(Integrator::Symplectic, MAX_DT))
             .map_err(|source| DemoError::Sim { stage: "setup", source })?;
         let omega = probe.projection.system.omega_max();
@@ -246,7 +246,7 @@ impl Scene {
     /// The inner faces across `plane` (tet centroids on opposite sides, as `incise_plane`) whose
     /// centroid is above the cut depth. O(darts).
     fn incision_faces(&self, plane: &Plane, a: usize, up: usize) -> Vec<DartId> {
-        let (map, x) = (self.body.map(), &self.body.attrs().position);
+        let (map, x) = (self.body.map(), self.body.attrs().position());
         let near = 0.1 * self.config.extent();
         let (mut top, mut bottom) = (f64::NEG_INFINITY, f64::INFINITY);
         for d in map.one_dart_per_cell(0) {
@@ -275,7 +275,7 @@ impl Scene {
         let mut ids: Vec<CellId> = map.orbit(d, AlphaMask::of(&[0, 1])).into_iter().map(|x| map.vertex_id(x)).collect();
         ids.sort_unstable();
         ids.dedup();
-        centroid(ids.iter().map(|&v| self.body.attrs().position[v]))
+        centroid(ids.iter().map(|&v| self.body.attrs().position()[v]))
     }
 
     /// The tear threshold: [`TEAR_FRACTION`] of the largest vertex stress now. O(springs + slots).
@@ -318,7 +318,7 @@ impl Scene {
 
     /// Current position of the live vertex farthest along the longest axis. O(darts).
     fn free_tip(&self) -> Vec3 {
-        let (map, x) = (self.body.map(), &self.body.attrs().position);
+        let (map, x) = (self.body.map(), self.body.attrs().position());
         let a = self.config.long_axis;
         map.one_dart_per_cell(0).into_iter().map(|d| x[map.vertex_id(d)]).fold(self.config.lo, |best, p| {
             if p[a] > best[a] {
@@ -332,7 +332,7 @@ impl Scene {
     /// Volume ids whose centroid (current positions) is within `r` of `c`, with the squared
     /// distance, by id. O(darts).
     fn tets_in_ball(&self, c: Vec3, r: f64) -> Vec<(CellId, f64)> {
-        let (map, x) = (self.body.map(), &self.body.attrs().position);
+        let (map, x) = (self.body.map(), self.body.attrs().position());
         let mut out = Vec::new();
         for d in map.one_dart_per_cell(3) {
             let mut ids: Vec<CellId> = map.cell_darts(3, d).into_iter().map(|y| map.vertex_id(y)).collect();

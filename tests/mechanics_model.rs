@@ -70,10 +70,10 @@ fn laws_hold_on_a_fresh_body_and_match_the_flat_baseline() {
         assert!(rel_close(mech.vertex_mass(CellId(v as u32)), m, 1e-12), "vertex {v}");
     }
     let projection = Projection::build(&body, G);
-    assert_eq!(projection.system.ends, flat.system.ends);
+    assert_eq!(projection.system().ends, flat.system.ends);
     for s in 0..flat.system.springs() {
-        assert!(rel_close(projection.system.stiffness[s], flat.system.stiffness[s], 1e-12), "spring {s}");
-        assert!(rel_close(projection.system.rest[s], flat.system.rest[s], 1e-12), "spring {s}");
+        assert!(rel_close(projection.system().stiffness[s], flat.system.stiffness[s], 1e-12), "spring {s}");
+        assert!(rel_close(projection.system().rest[s], flat.system.rest[s], 1e-12), "spring {s}");
     }
 }
 
@@ -83,10 +83,10 @@ fn an_interior_edge_gets_the_sum_of_its_tets_contributions() {
     let (points, tets) = kuhn_cube(1);
     let (body, _) = Body::from_tets(&points, &tets, material()).unwrap();
     let p = Projection::build(&body, G);
-    let s = (0..p.system.springs()).find(|&s| p.system.ends[s] == [0, 7]).expect("diagonal spring");
+    let s = (0..p.system().springs()).find(|&s| p.system().ends[s] == [0, 7]).expect("diagonal spring");
     let l = 3f64.sqrt();
     let expected = 6.0 * 700.0 * (1.0 / 6.0) / (l * l);
-    assert!(rel_close(p.system.stiffness[s], expected, 1e-12), "{} vs {expected}", p.system.stiffness[s]);
+    assert!(rel_close(p.system().stiffness[s], expected, 1e-12), "{} vs {expected}", p.system().stiffness[s]);
     // Corner vertex 0 belongs to all 6 tets: m = 6 · ρ (1/6) / 4.
     assert!(rel_close(body.attrs().vertex_mass(CellId(0)), 2.5 / 4.0, 1e-12));
 }
@@ -130,8 +130,8 @@ fn unsew3_along_a_plane_splits_masses_and_stiffnesses_conservatively() {
     let (half_points, half_tets) = split_at_plane(&points, &tets, 1.0);
     let flat = FlatModel::from_tets(&half_points, &half_tets, material(), G, &[]).unwrap();
     let projection = Projection::build(&body, G);
-    assert_eq!(projection.system.springs(), flat.system.springs());
-    let mut ours: Vec<f64> = projection.system.stiffness.clone();
+    assert_eq!(projection.system().springs(), flat.system.springs());
+    let mut ours: Vec<f64> = projection.system().stiffness.clone();
     let mut theirs = flat.system.stiffness.clone();
     ours.sort_by(f64::total_cmp);
     theirs.sort_by(f64::total_cmp);
@@ -160,10 +160,10 @@ fn unsew3_along_a_plane_splits_masses_and_stiffnesses_conservatively() {
     let flat = FlatModel::from_tets(&points, &tets, material(), G, &[]).unwrap();
     let point_of = |v: u32| points.iter().position(|p| *p == body.attrs().rest_position()[CellId(v)]).unwrap() as u32;
     let p1 = Projection::build(&body, G);
-    let mut springs: Vec<([u32; 2], f64)> = (0..p1.system.springs())
+    let mut springs: Vec<([u32; 2], f64)> = (0..p1.system().springs())
         .map(|s| {
-            let [a, b] = p1.system.ends[s].map(point_of);
-            ([a.min(b), a.max(b)], p1.system.stiffness[s])
+            let [a, b] = p1.system().ends[s].map(point_of);
+            ([a.min(b), a.max(b)], p1.system().stiffness[s])
         })
         .collect();
     springs.sort_by_key(|&(e, _)| e);
@@ -255,11 +255,13 @@ fn projection_forces_equal_the_orbit_walk_to_1e_12() {
             body.unsew3(d).unwrap();
         }
         let p = Projection::build(&body, G);
-        let n = p.system.slots();
+        let n = p.system().slots();
         let m = body.attrs();
-        let mut sf = vec![[0.0; 3]; p.system.springs()];
+        let mut sf = vec![[0.0; 3]; p.system().springs()];
         let mut f = vec![[0.0; 3]; n];
-        p.system.forces(&m.position().as_slice()[..n], &m.velocity().as_slice()[..n], &mut sf, &mut f, false).unwrap();
+        p.system()
+            .forces(&m.position().as_slice()[..n], &m.velocity().as_slice()[..n], &mut sf, &mut f, false)
+            .unwrap();
         let reference = forces_by_coverage(&body, G);
         let scale = reference.iter().flat_map(|v| v.iter()).fold(0.0f64, |a, &b| a.max(b.abs()));
         assert!(scale > 1.0);
@@ -274,12 +276,12 @@ fn projection_forces_equal_the_orbit_walk_to_1e_12() {
             }
         }
         // Every spring knows its edge and dart.
-        for s in 0..p.system.springs() {
+        for s in 0..p.system().springs() {
             let d = p.dart_of_spring(s);
             assert_eq!(body.map().cell_id(1, d), p.edge_of_spring(s));
             assert_eq!(p.spring_of_edge(p.edge_of_spring(s)), Some(s));
             let ends = [body.map().vertex_id(d).0, body.map().vertex_id(body.map().alpha::<0>(d)).0];
-            assert!(ends.contains(&p.system.ends[s][0]) && ends.contains(&p.system.ends[s][1]));
+            assert!(ends.contains(&p.system().ends[s][0]) && ends.contains(&p.system().ends[s][1]));
         }
     }
 }

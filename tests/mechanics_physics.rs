@@ -169,7 +169,7 @@ fn a_liver_pinned_on_one_side_settles_under_gravity_with_its_mass_unchanged() {
     let mass0 = body.total_vertex_mass();
     let g = [0.0, 0.0, -9.81];
     let probe = Simulation::new(&mut body, g, StepConfig::new(Integrator::Symplectic, 1.0)).unwrap();
-    let dt = 0.5 / probe.projection.system.omega_max();
+    let dt = 0.5 / probe.projection.system().omega_max();
     let mut sim = Simulation::new(&mut body, g, StepConfig::new(Integrator::Symplectic, dt)).unwrap();
     let steps = (6.0 / dt) as usize;
     let mut peak: f64 = 0.0;
@@ -182,22 +182,22 @@ fn a_liver_pinned_on_one_side_settles_under_gravity_with_its_mass_unchanged() {
     let sag = sim.max_displacement(&body);
     assert!(sag > 1e-4 * size && sag < 0.5 * size, "sag {sag} for a body of size {size}");
     // Static equilibrium: every free vertex's net force is ~0 compared with its weight.
-    let n = sim.projection.system.slots();
+    let n = sim.projection.system().slots();
     let m = body.attrs();
-    let (mut sf, mut f) = (vec![[0.0; 3]; sim.projection.system.springs()], vec![[0.0; 3]; n]);
+    let (mut sf, mut f) = (vec![[0.0; 3]; sim.projection.system().springs()], vec![[0.0; 3]; n]);
     sim.projection
-        .system
+        .system()
         .forces(&m.position().as_slice()[..n], &m.velocity().as_slice()[..n], &mut sf, &mut f, false)
         .unwrap();
     for (v, fv) in f.iter().enumerate() {
-        if sim.projection.system.inv_mass[v] > 0.0 {
-            let weight = sim.projection.system.mass[v] * 9.81;
+        if sim.projection.system().inv_mass[v] > 0.0 {
+            let weight = sim.projection.system().mass[v] * 9.81;
             assert!(fv.iter().all(|c| c.abs() < 1e-3 * weight), "vertex {v} not at rest: {fv:?}");
         }
     }
     let mass1 = body.total_vertex_mass();
     assert!((mass1 - mass0).abs() <= 1e-12 * mass0);
-    let sys_mass: f64 = sim.projection.system.mass.iter().sum();
+    let sys_mass: f64 = sim.projection.system().mass.iter().sum();
     assert!((sys_mass - mass0).abs() <= 1e-12 * mass0);
     check_conservation(body.map(), body.attrs()).unwrap();
 }
@@ -212,7 +212,7 @@ fn implicit_euler_is_stable_where_explicit_euler_blows_up() {
     let g = [0.0, 0.0, -9.81];
     let mut explicit = body.clone();
     let probe = Simulation::new(&mut explicit, g, StepConfig::new(Integrator::Euler, 1.0)).unwrap();
-    let dt = 20.0 / probe.projection.system.omega_max(); // ten times the explicit limit 2/ω
+    let dt = 20.0 / probe.projection.system().omega_max(); // ten times the explicit limit 2/ω
     let mut sim = Simulation::new(&mut explicit, g, StepConfig::new(Integrator::Euler, dt)).unwrap();
     let mut blew = None;
     for _ in 0..1000 {
@@ -222,7 +222,7 @@ fn implicit_euler_is_stable_where_explicit_euler_blows_up() {
         }
     }
     match blew {
-        Some(SimError::Step(StepError::BlowUp { slot, .. })) => assert!(slot < sim.projection.system.slots()),
+        Some(SimError::Step(StepError::BlowUp { slot, .. })) => assert!(slot < sim.projection.system().slots()),
         other => panic!("explicit Euler at 10x its limit should blow up, got {other:?}"),
     }
     // Implicit Euler at the same step runs and comes to rest at the same equilibrium as a

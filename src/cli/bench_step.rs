@@ -250,7 +250,7 @@ fn run_step(args: StepBenchArgs) -> Result<(), CliError> {
         map_step_us: map_us,
         flat_step_us: flat_us,
         ratio: map_us / flat_us,
-        springs: sim.projection.system.springs(),
+        springs: sim.projection.system().springs(),
         vertices: body.map().count_cells().0[0],
         kernel: sim.stepper.kernel().name(),
     };

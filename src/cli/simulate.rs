@@ -153,7 +153,7 @@ fn simulate(args: &SimulateArgs, parallel: bool) -> Result<(), CliError> {
     let mut config = StepConfig::new(args.integrator, args.dt);
     config.parallel = parallel;
     let mut sim = Simulation::new(&mut body, args.gravity, config).map_err(other)?;
-    let omega = sim.projection.system.omega_max();
+    let omega = sim.projection.system().omega_max();
     if args.integrator != Integrator::Implicit && omega * args.dt > 2.0 {
         eprintln!(
             "topomech: warning: dt = {:.3e} exceeds the explicit stability bound 2/ω_max = {:.3e}",
@@ -192,7 +192,7 @@ fn print_summary(
     pvd: Option<PathBuf>,
 ) -> Result<(), CliError> {
     print_report(args.json, s, |out| {
-        let sys = &sim.projection.system;
+        let sys = &sim.projection.system();
         let fixed = sys.inv_mass.iter().zip(&sys.mass).filter(|(&w, &m)| w == 0.0 && m > 0.0).count();
         writeln!(out, "{}", args.mesh.display())?;
         let (springs, slots) = (sys.springs(), sys.slots());

@@ -534,7 +534,7 @@ impl SpringSystem {
     /// let (points, tets) = kuhn_cube(1);
     /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
     /// let p = Projection::build(&body, [0.0; 3]);
-    /// assert_eq!(p.system.slots(), 8); // one slot per vertex of the cube
+    /// assert_eq!(p.system().slots(), 8); // one slot per vertex of the cube
     /// ```
     pub fn slots(&self) -> usize {
         self.mass.len()

@@ -165,7 +165,7 @@ impl Simulation {
     /// body.attrs_mut().pinned_mut().as_mut_slice()[0] = true;
     /// let sim = Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Rk4, 1e-3)).unwrap();
     /// assert_eq!(body.attrs().velocity().as_slice()[0], [0.0; 3]); // a pinned vertex starts still
-    /// assert_eq!(sim.projection.system.springs(), 19); // one spring per edge
+    /// assert_eq!(sim.projection.system().springs(), 19); // one spring per edge
     /// assert!(Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Rk4, -1.0)).is_err());
     /// ```
     pub fn new(body: &mut Body, gravity: Vec3, config: StepConfig) -> Result<Self, SimError> {

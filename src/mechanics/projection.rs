@@ -59,14 +59,16 @@ use super::model::{Body, Mechanics};
 /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
 /// let p = Projection::build(&body, [0.0, 0.0, -9.81]);
 /// let cells = body.map().count_cells();
-/// assert_eq!((p.system.slots(), p.system.springs()), (cells.0[0], cells.0[1])); // vertices, edges
-/// assert_eq!(p.system.gravity, [0.0, 0.0, -9.81]);
+/// assert_eq!((p.system().slots(), p.system().springs()), (cells.0[0], cells.0[1])); // vertices, edges
+/// assert_eq!(p.system().gravity, [0.0, 0.0, -9.81]);
 /// assert_eq!(p.version(), body.version());
 /// ```
 #[derive(Clone, Debug)]
 pub struct Projection {
-    /// The arrays the step loop reads.
-    pub system: SpringSystem,
+    /// The arrays the step loop reads: private, so that they cannot fall out of step with the
+    /// spring ↔ edge and slot ↔ vertex tables beside them (finding 34); read with
+    /// [`Projection::system`].
+    pub(crate) system: SpringSystem,
     spring_edge: Vec<CellId>,
     spring_dart: Vec<DartId>,
     edge_spring: Vec<u32>,
@@ -90,8 +92,8 @@ impl Projection {
     /// let (points, tets) = kuhn_cube(1);
     /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
     /// let p = Projection::build(&body, [0.0, 0.0, -9.81]);
-    /// assert_eq!((p.system.slots(), p.system.springs()), (8, 19));
-    /// for s in 0..p.system.springs() {
+    /// assert_eq!((p.system().slots(), p.system().springs()), (8, 19));
+    /// for s in 0..p.system().springs() {
     ///     assert_eq!(p.spring_of_edge(p.edge_of_spring(s)), Some(s));
     /// }
     /// assert!(p.is_current(&body));
@@ -132,6 +134,42 @@ impl Projection {
         }
     }
 
+    /// The arrays the step loop reads (springs as index pairs and parameters, per-slot masses),
+    /// read-only: they change only with the body, through [`Projection::update`] and
+    /// [`Projection::rebuild`]. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, Projection};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let p = Projection::build(&body, [0.0, 0.0, -9.81]);
+    /// let (x, v) = (body.attrs().position().as_slice(), body.attrs().velocity().as_slice());
+    /// let (mut sf, mut f) = (vec![[0.0; 3]; p.system().springs()], vec![[0.0; 3]; p.system().slots()]);
+    /// p.system().forces(x, v, &mut sf, &mut f, false).unwrap();
+    /// let weight: f64 = f.iter().map(|f| f[2]).sum(); // springs at rest: only gravity
+    /// assert!((weight + 9.81 * body.total_vertex_mass()).abs() < 1e-12);
+    /// ```
+    ///
+    /// Changing them from outside would leave the tables beside them wrong, so it does not
+    /// compile:
+    ///
+    /// ```compile_fail
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, Projection};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let mut p = Projection::build(&body, [0.0; 3]);
+    /// p.system.swap_remove_spring(0).unwrap(); // private field
+    /// ```
+    pub fn system(&self) -> &SpringSystem {
+        &self.system
+    }
+
     /// Rebuilds from scratch after topological changes (keeps the gravity). O(darts + E log E).
     ///
     /// # Examples
@@ -148,7 +186,7 @@ impl Projection {
     /// remove_volume(&mut body, CellId(0)).unwrap();
     /// assert!(!p.is_current(&body));
     /// p.rebuild(&body);
-    /// assert_eq!((p.version(), p.system.springs()), (body.version(), body.map().count_cells().0[1]));
+    /// assert_eq!((p.version(), p.system().springs()), (body.version(), body.map().count_cells().0[1]));
     /// ```
     pub fn rebuild(&mut self, body: &Body) {
         *self = Projection::build(body, self.system.gravity);
@@ -287,7 +325,7 @@ impl Projection {
     /// assert!(p.update(&body, &cut.touched)); // incremental
     /// assert!(p.is_current(&body));
     /// assert!(p.equivalent(&Projection::build(&body, [0.0, 0.0, -9.81])).is_ok());
-    /// assert_eq!(p.system.slots(), body.map().cell_id_bound(0)); // new vertex ids got slots
+    /// assert_eq!(p.system().slots(), body.map().cell_id_bound(0)); // new vertex ids got slots
     /// ```
     pub fn update(&mut self, body: &Body, touched: &TouchedCells) -> bool {
         let brings_up_to_date = match touched.span {
@@ -427,7 +465,7 @@ impl Projection {
     /// let (points, tets) = kuhn_cube(1);
     /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
     /// let p = Projection::build(&body, [0.0; 3]);
-    /// let mut edges: Vec<_> = (0..p.system.springs()).map(|s| p.edge_of_spring(s)).collect();
+    /// let mut edges: Vec<_> = (0..p.system().springs()).map(|s| p.edge_of_spring(s)).collect();
     /// edges.sort_unstable();
     /// edges.dedup();
     /// assert_eq!(edges.len(), 19); // one spring per edge, every edge once
@@ -449,10 +487,10 @@ impl Projection {
     /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
     /// let p = Projection::build(&body, [0.0; 3]);
     /// let map = body.map();
-    /// for s in 0..p.system.springs() {
+    /// for s in 0..p.system().springs() {
     ///     let d = p.dart_of_spring(s);
     ///     assert_eq!(map.cell_id(1, d), p.edge_of_spring(s));
-    ///     let [a, b] = p.system.ends[s];
+    ///     let [a, b] = p.system().ends[s];
     ///     assert!(a < b && [a, b].contains(&map.vertex_id(d).0));
     ///     assert_eq!(map.vertex_id(map.alpha::<0>(d)).0, a + b - map.vertex_id(d).0); // α0: the other end
     /// }
@@ -476,7 +514,7 @@ impl Projection {
     /// remove_volume(&mut body, CellId(0)).unwrap(); // edge (1,0,0)–(1,1,0) was only in tet 0
     /// let (p, map) = (Projection::build(&body, [0.0; 3]), body.map());
     /// let live: Vec<CellId> = map.one_dart_per_cell(1).iter().map(|&d| map.cell_id(1, d)).collect();
-    /// assert!(live.iter().all(|&e| p.spring_of_edge(e).is_some()) && p.system.springs() == live.len());
+    /// assert!(live.iter().all(|&e| p.spring_of_edge(e).is_some()) && p.system().springs() == live.len());
     /// let dead: Vec<CellId> = (0..map.cell_id_bound(1) as u32).map(CellId).filter(|e| !live.contains(e)).collect();
     /// assert!(!dead.is_empty() && dead.iter().all(|&e| p.spring_of_edge(e).is_none()));
     /// ```
@@ -495,7 +533,7 @@ impl Projection {
     /// let (points, tets) = kuhn_cube(1);
     /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
     /// let p = Projection::build(&body, [0.0; 3]);
-    /// for slot in 0..p.system.slots() {
+    /// for slot in 0..p.system().slots() {
     ///     assert_eq!(body.map().vertex_id(p.dart_of_vertex(slot).unwrap()).index(), slot); // slot = vertex id
     /// }
     /// assert_eq!(p.dart_of_vertex(99), None);

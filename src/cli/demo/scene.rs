@@ -153,7 +153,7 @@ impl Scene {
         let pinned = body.attrs().pinned().as_slice().iter().zip(&live).filter(|(&p, &l)| p && l).count();
         let probe = Simulation::new(&mut body, gravity, StepConfig::new(Integrator::Symplectic, MAX_DT))
             .map_err(|source| DemoError::Sim { stage: "setup", source })?;
-        let omega = probe.projection.system.omega_max();
+        let omega = probe.projection.system().omega_max();
         let dt = if omega > 0.0 { MAX_DT.min(1.0 / omega) } else { MAX_DT };
         let sim = Simulation::new(&mut body, gravity, StepConfig::new(Integrator::Symplectic, dt))
             .map_err(|source| DemoError::Sim { stage: "setup", source })?;

@@ -118,14 +118,14 @@ fn main() {
 fn step_against_floor(flat: &mut FlatModel, stepper: &mut Stepper, batches: usize, steps: usize) {
     let sys = &flat.system;
     let l2: Vec<f64> = sys
-        .ends
+        .ends()
         .iter()
         .map(|&[a, b]| {
             let (p, q) = (flat.position[a as usize], flat.position[b as usize]);
             (0..3).map(|c| (q[c] - p[c]) * (q[c] - p[c])).sum()
         })
         .collect();
-    let damped: Vec<f64> = sys.damping.iter().map(|c| 0.25 * c).collect();
+    let damped: Vec<f64> = sys.damping().iter().map(|c| 0.25 * c).collect();
     let mut scale = vec![0.0; l2.len()];
     let (isa, scales) = floor::widest();
     let (mut step_us, mut floor_us) = (f64::INFINITY, f64::INFINITY);
@@ -137,7 +137,7 @@ fn step_against_floor(flat: &mut FlatModel, stepper: &mut Stepper, batches: usiz
         step_us = step_us.min((now() - t0) * 1e6 / steps as f64);
         let t0 = now();
         for _ in 0..4 * steps {
-            scales(&l2, &flat.system.rest, &flat.system.stiffness, &damped, &mut scale);
+            scales(&l2, flat.system.rest(), flat.system.stiffness(), &damped, &mut scale);
             std::hint::black_box(&mut scale);
         }
         floor_us = floor_us.min((now() - t0) * 1e6 / steps as f64);

@@ -15,7 +15,7 @@
 //! let (points, tets) = generate::kuhn_cube(2);
 //! let s = surface::boundary_surface_of_tets(&points, &tets).unwrap();
 //! assert_eq!(s.triangles.len(), 2 * 6 * 2 * 2); // two triangles per unit square of each side
-//! assert!((s.enclosed_volume() - 8.0).abs() < 1e-12);
+//! assert!((s.enclosed_volume().unwrap() - 8.0).abs() < 1e-12);
 //! ```
 
 use crate::mechanics::geom::{cross, dot, norm, sub};
@@ -27,7 +27,7 @@ use rustc_hash::FxHashMap;
 use crate::mechanics::{Body, Vec3};
 use crate::DartId;
 
-/// Errors of the surface extraction and of the OBJ writer.
+/// Errors of the surface extraction, of the measures and of the OBJ writer.
 ///
 /// # Examples
 ///
@@ -38,8 +38,12 @@ use crate::DartId;
 /// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 /// let bad = boundary_surface_of_tets(&points, &[[0, 1, 2, 7]]);
 /// assert!(matches!(bad, Err(SurfaceError::PointOutOfRange { tet: 0, point: 7, points: 4 })));
-/// let s = boundary_surface_of_tets(&points, &[[0, 1, 2, 3]]).unwrap();
+/// let mut s = boundary_surface_of_tets(&points, &[[0, 1, 2, 3]]).unwrap();
 /// assert!(matches!(s.write_obj(Path::new("/nonexistent-dir/x.obj")), Err(SurfaceError::Write { .. })));
+/// s.triangles.push([0, 1, 9]);
+/// let err = s.area().unwrap_err();
+/// assert!(matches!(err, SurfaceError::VertexOutOfRange { triangle: 4, corner: 2, index: 9, vertices: 4 }));
+/// assert_eq!(err.to_string(), "triangle 4 corner 2 refers to vertex 9, but the surface has only 4 vertices");
 /// ```
 #[derive(Debug, thiserror::Error)]
 pub enum SurfaceError {
@@ -61,6 +65,21 @@ pub enum SurfaceError {
         /// The repeated point index.
         point: u32,
     },
+    /// A triangle refers to a vertex index outside `positions` (the fields of [`Surface`] are
+    /// public, so such a surface is one assignment away).
+    #[error(
+        "triangle {triangle} corner {corner} refers to vertex {index}, but the surface has only {vertices} vertices"
+    )]
+    VertexOutOfRange {
+        /// The triangle's index in `triangles`.
+        triangle: usize,
+        /// The corner within the triangle (0, 1 or 2).
+        corner: usize,
+        /// The bad vertex index.
+        index: u32,
+        /// The number of vertices (`positions.len()`).
+        vertices: usize,
+    },
     /// The OBJ file could not be written (the cause names the file or its temporary sibling).
     #[error("cannot write the surface OBJ file {}: {source}", .path.display())]
     Write {
@@ -73,8 +92,9 @@ pub enum SurfaceError {
 
 /// An indexed triangle mesh: the boundary of a solid.
 ///
-/// Invariants (kept by the constructors of this module): every index of `triangles` is
-/// `< positions.len()`; every surface vertex is used by some triangle (the vertex array is
+/// Invariants (kept by the constructors of this module; the fields are public, so
+/// [`Surface::check`] checks the first, and the measures and OBJ writers call it): every index
+/// of `triangles` is `< positions.len()`; every surface vertex is used by some triangle (the vertex array is
 /// compacted); `vertex_ids.len() == positions.len()` and `face_volumes.len() == triangles.len()`;
 /// each triangle is oriented outward, i.e. its normal (b − a) × (c − a) points away from the
 /// fourth vertex of the tetrahedron behind it (measured at rest for a body).
@@ -165,7 +185,7 @@ pub fn boundary_surface(body: &Body) -> Surface {
 /// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 /// let s = boundary_surface_of_tets(&points, &[[0, 1, 2, 3]]).unwrap();
 /// assert_eq!(s.triangles.len(), 4);
-/// assert!((s.enclosed_volume() - 1.0 / 6.0).abs() < 1e-15);
+/// assert!((s.enclosed_volume().unwrap() - 1.0 / 6.0).abs() < 1e-15);
 /// assert!(boundary_surface_of_tets(&points, &[[0, 1, 2, 9]]).is_err());
 /// assert!(boundary_surface_of_tets(&points, &[[0, 1, 2, 3], [0, 2, 2, 3]]).is_err());
 /// ```
@@ -262,6 +282,38 @@ impl Builder {
 }
 
 impl Surface {
+    /// Checks that every triangle corner is an index into `positions`, the invariant the
+    /// measures ([`Surface::area`], [`Surface::enclosed_volume`]) and the OBJ writers
+    /// ([`Surface::to_obj`], [`Surface::write_obj`]) rely on; they call it first. O(triangles).
+    ///
+    /// # Errors
+    /// [`SurfaceError::VertexOutOfRange`] naming the first triangle, corner and index past the
+    /// vertices.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::surface::{boundary_surface_of_tets, SurfaceError};
+    ///
+    /// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let mut s = boundary_surface_of_tets(&points, &[[0, 1, 2, 3]]).unwrap();
+    /// assert!(s.check().is_ok());
+    /// s.triangles[1][0] = 4; // one past the last vertex
+    /// assert!(matches!(
+    ///     s.check(),
+    ///     Err(SurfaceError::VertexOutOfRange { triangle: 1, corner: 0, index: 4, vertices: 4 })
+    /// ));
+    /// ```
+    pub fn check(&self) -> Result<(), SurfaceError> {
+        let vertices = self.positions.len();
+        for (triangle, tri) in self.triangles.iter().enumerate() {
+            if let Some((corner, &index)) = tri.iter().enumerate().find(|(_, &i)| i as usize >= vertices) {
+                return Err(SurfaceError::VertexOutOfRange { triangle, corner, index, vertices });
+            }
+        }
+        Ok(())
+    }
+
     /// The axis-aligned bounding box `(min, max)` of the vertices, or `None` for an empty
     /// surface. Non-finite coordinates are skipped. O(vertices).
     ///
@@ -284,7 +336,11 @@ impl Surface {
 
     /// The signed volume enclosed by the triangles, Σ a·(b × c) / 6 (divergence theorem). For a
     /// closed, outward-oriented surface it is the volume of the solid; it is independent of the
-    /// origin only when the surface is closed. O(triangles).
+    /// origin only when the surface is closed. O(triangles), including the index check.
+    ///
+    /// # Errors
+    /// [`SurfaceError::VertexOutOfRange`] naming the first triangle corner past the vertices
+    /// (see [`Surface::check`]).
     ///
     /// # Examples
     ///
@@ -293,15 +349,22 @@ impl Surface {
     /// use topomech::surface::boundary_surface_of_tets;
     ///
     /// let (points, tets) = kuhn_cube(2); // side 2
-    /// let s = boundary_surface_of_tets(&points, &tets).unwrap();
-    /// assert!((s.enclosed_volume() - 8.0).abs() < 1e-12);
+    /// let mut s = boundary_surface_of_tets(&points, &tets).unwrap();
+    /// assert!((s.enclosed_volume().unwrap() - 8.0).abs() < 1e-12);
+    /// s.triangles.push([0, 1, 999]);
+    /// assert!(s.enclosed_volume().is_err()); // vertex 999 of 26
     /// ```
-    pub fn enclosed_volume(&self) -> f64 {
+    pub fn enclosed_volume(&self) -> Result<f64, SurfaceError> {
+        self.check()?;
         let p = |i: u32| self.positions[i as usize];
-        self.triangles.iter().map(|&[a, b, c]| dot(p(a), cross(p(b), p(c)))).sum::<f64>() / 6.0
+        Ok(self.triangles.iter().map(|&[a, b, c]| dot(p(a), cross(p(b), p(c)))).sum::<f64>() / 6.0)
     }
 
-    /// Total area of the triangles. O(triangles).
+    /// Total area of the triangles. O(triangles), including the index check.
+    ///
+    /// # Errors
+    /// [`SurfaceError::VertexOutOfRange`] naming the first triangle corner past the vertices
+    /// (see [`Surface::check`]).
     ///
     /// # Examples
     ///
@@ -310,28 +373,41 @@ impl Surface {
     /// use topomech::surface::boundary_surface_of_tets;
     ///
     /// let (points, tets) = kuhn_cube(1);
-    /// let s = boundary_surface_of_tets(&points, &tets).unwrap();
+    /// let mut s = boundary_surface_of_tets(&points, &tets).unwrap();
     /// assert_eq!(s.triangles.len(), 12);
-    /// assert!((s.area() - 6.0).abs() < 1e-12);
+    /// assert!((s.area().unwrap() - 6.0).abs() < 1e-12);
+    /// s.triangles.push([0, 1, 8]);
+    /// assert!(s.area().is_err()); // vertex 8 of 8
     /// ```
-    pub fn area(&self) -> f64 {
+    pub fn area(&self) -> Result<f64, SurfaceError> {
+        self.check()?;
         let p = |i: u32| self.positions[i as usize];
-        self.triangles.iter().map(|&[a, b, c]| norm(cross(sub(p(b), p(a)), sub(p(c), p(a)))) / 2.0).sum()
+        Ok(self.triangles.iter().map(|&[a, b, c]| norm(cross(sub(p(b), p(a)), sub(p(c), p(a)))) / 2.0).sum())
     }
 
     /// The surface as Wavefront OBJ text: a comment header, one `v x y z` line per vertex
     /// (shortest round-trip decimal form), one `f i j k` line per triangle (1-based indices, in
-    /// the triangle's outward orientation). O(vertices + triangles).
+    /// the triangle's outward orientation). O(vertices + triangles), including the index check.
+    ///
+    /// # Errors
+    /// [`SurfaceError::VertexOutOfRange`] naming the first triangle corner past the vertices
+    /// (see [`Surface::check`]): a face with no vertex is not written.
+    ///
+    /// # Examples
     ///
     /// ```
-    /// use topomech::surface::boundary_surface_of_tets;
+    /// use topomech::surface::{boundary_surface_of_tets, SurfaceError};
     ///
     /// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-    /// let obj = boundary_surface_of_tets(&points, &[[0, 1, 2, 3]]).unwrap().to_obj();
+    /// let mut s = boundary_surface_of_tets(&points, &[[0, 1, 2, 3]]).unwrap();
+    /// let obj = s.to_obj().unwrap();
     /// assert_eq!(obj.lines().filter(|l| l.starts_with("v ")).count(), 4);
     /// assert_eq!(obj.lines().filter(|l| l.starts_with("f ")).count(), 4);
+    /// s.positions.pop(); // vertex 3 is gone, the triangles still use it
+    /// assert!(matches!(s.to_obj(), Err(SurfaceError::VertexOutOfRange { index: 3, vertices: 3, .. })));
     /// ```
-    pub fn to_obj(&self) -> String {
+    pub fn to_obj(&self) -> Result<String, SurfaceError> {
+        self.check()?;
         let mut s = String::with_capacity(40 * self.positions.len() + 24 * self.triangles.len() + 128);
         let _ = writeln!(
             s,
@@ -345,14 +421,15 @@ impl Surface {
         for t in &self.triangles {
             let _ = writeln!(s, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1);
         }
-        s
+        Ok(s)
     }
 
     /// Writes [`Surface::to_obj`] to `path` atomically (a temporary file in the same directory,
     /// then a rename: see [`crate::store::write_atomically`]). O(vertices + triangles).
     ///
     /// # Errors
-    /// [`SurfaceError::Write`] naming `path`.
+    /// [`SurfaceError::VertexOutOfRange`] as [`Surface::to_obj`], checked before anything is
+    /// written (no file is created or replaced); [`SurfaceError::Write`] naming `path`.
     ///
     /// # Examples
     ///
@@ -360,15 +437,18 @@ impl Surface {
     /// use topomech::surface::boundary_surface_of_tets;
     ///
     /// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-    /// let s = boundary_surface_of_tets(&points, &[[0, 1, 2, 3]]).unwrap();
+    /// let mut s = boundary_surface_of_tets(&points, &[[0, 1, 2, 3]]).unwrap();
     /// let path = std::env::temp_dir().join(format!("topomech_doc_{}.obj", std::process::id()));
     /// s.write_obj(&path).unwrap();
-    /// assert_eq!(std::fs::read_to_string(&path).unwrap(), s.to_obj());
+    /// assert_eq!(std::fs::read_to_string(&path).unwrap(), s.to_obj().unwrap());
     /// std::fs::remove_file(&path).unwrap();
     /// assert!(s.write_obj(std::path::Path::new("/nonexistent-dir/x.obj")).is_err());
+    /// s.triangles.push([0, 1, 999]);
+    /// assert!(s.write_obj(&path).is_err() && !path.exists()); // refused before writing
     /// ```
     pub fn write_obj(&self, path: &Path) -> Result<(), SurfaceError> {
-        crate::store::write_atomically(path, self.to_obj().as_bytes())
+        let text = self.to_obj()?;
+        crate::store::write_atomically(path, text.as_bytes())
             .map_err(|source| SurfaceError::Write { path: path.to_path_buf(), source })
     }
 }

@@ -53,6 +53,16 @@ pub enum VtkError {
         /// The number of points.
         expected: usize,
     },
+    /// A point array name holding a control character (`char::is_control`: C0 such as NUL or
+    /// U+0001, DEL, C1). XML 1.0 forbids most C0 controls, so readers would reject the file, and
+    /// tab, line feed and carriage return in an attribute come back as spaces.
+    #[error("point array {array} has the name {name:?}, which holds a control character")]
+    BadArrayName {
+        /// The array's index in [`Frame::vectors`].
+        array: usize,
+        /// The name given.
+        name: String,
+    },
     /// A tetrahedron names a point the frame does not have (readers would accept the file and
     /// index past their point array).
     #[error("tetrahedron {tet} names point {point}, but the frame has {points} points")]
@@ -110,11 +120,14 @@ impl Frame<'_> {
     /// The frame as VTU XML text. O(points + tets).
     ///
     /// Array names are written as XML attribute values (`&`, `<`, `>`, `"` and `'` as entities),
-    /// so a reader gets back the name as given.
+    /// so a reader gets back the name as given; a name with a control character, which XML
+    /// cannot carry, is refused. Everything is checked before any text is made: the names and
+    /// lengths in O(arrays + name lengths), the tets in O(tets).
     ///
     /// # Errors
-    /// [`VtkError::BadArray`] when a vector array has the wrong length, [`VtkError::BadTet`]
-    /// when a tetrahedron names a point past the end of `points`.
+    /// For the first array in order: [`VtkError::BadArrayName`] when its name holds a control
+    /// character (`char::is_control`), [`VtkError::BadArray`] when it has the wrong length;
+    /// then [`VtkError::BadTet`] when a tetrahedron names a point past the end of `points`.
     ///
     /// # Examples
     ///
@@ -130,12 +143,19 @@ impl Frame<'_> {
     /// assert!(matches!(bad.to_vtu(), Err(VtkError::BadArray { got: 3, expected: 4, .. })));
     /// let bad = Frame { tets: &[[0, 1, 2, 3], [1, 2, 3, 4]], ..frame.clone() };
     /// assert!(matches!(bad.to_vtu(), Err(VtkError::BadTet { tet: 1, point: 4, points: 4 })));
-    /// let named = Frame { vectors: vec![("v<&>w", &velocity[..])], ..frame };
+    /// let named = Frame { vectors: vec![("v<&>w", &velocity[..])], ..frame.clone() };
     /// assert!(named.to_vtu().unwrap().contains("Name=\"v&lt;&amp;&gt;w\""));
+    /// let control = Frame { vectors: vec![("v", &velocity[..]), ("a\u{1}b", &velocity[..])], ..frame };
+    /// let err = control.to_vtu().unwrap_err();
+    /// assert!(matches!(&err, VtkError::BadArrayName { array: 1, name } if name == "a\u{1}b"));
+    /// assert!(err.to_string().contains("\"a\\u{1}b\"")); // the name, escaped
     /// ```
     pub fn to_vtu(&self) -> Result<String, VtkError> {
         let n = self.points.len();
-        for (name, values) in &self.vectors {
+        for (array, (name, values)) in self.vectors.iter().enumerate() {
+            if name.chars().any(char::is_control) {
+                return Err(VtkError::BadArrayName { array, name: name.to_string() });
+            }
             if values.len() != n {
                 return Err(VtkError::BadArray { name: name.to_string(), got: values.len(), expected: n });
             }
@@ -172,12 +192,13 @@ impl Frame<'_> {
     /// Writes the frame to `path`. O(points + tets).
     ///
     /// # Errors
-    /// [`VtkError`].
+    /// The errors of [`Frame::to_vtu`], checked before the file is created (nothing is written
+    /// then); [`VtkError::Io`] naming `path`.
     ///
     /// # Examples
     ///
     /// ```
-    /// use topomech::vtk::Frame;
+    /// use topomech::vtk::{Frame, VtkError};
     ///
     /// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
     /// let frame = Frame { points: &points, tets: &[[0, 1, 2, 3]], vectors: vec![] };
@@ -186,6 +207,9 @@ impl Frame<'_> {
     /// let text = std::fs::read_to_string(&path).unwrap();
     /// std::fs::remove_file(&path).unwrap();
     /// assert_eq!(text, frame.to_vtu().unwrap());
+    /// let nul = Frame { vectors: vec![("f\0", &points[..])], ..frame };
+    /// assert!(matches!(nul.write(&path), Err(VtkError::BadArrayName { array: 0, .. })));
+    /// assert!(!path.exists()); // refused before the file was created
     /// ```
     pub fn write(&self, path: &Path) -> Result<(), VtkError> {
         write_file(path, &self.to_vtu()?)

@@ -127,10 +127,10 @@ proptest! {
             }
             prop_assert!(sys.check_incidence().is_ok(), "{:?}", sys.check_incidence());
         }
-        let fixed: Vec<bool> = sys.inv_mass.iter().map(|&w| w == 0.0).collect();
+        let fixed: Vec<bool> = sys.inv_mass().iter().map(|&w| w == 0.0).collect();
         let fresh = SpringSystem::new(
-            sys.ends.clone(), sys.rest.clone(), sys.stiffness.clone(), sys.damping.clone(),
-            sys.mass.clone(), &fixed, sys.viscosity.clone(), sys.gravity,
+            sys.ends().to_vec(), sys.rest().to_vec(), sys.stiffness().to_vec(), sys.damping().to_vec(),
+            sys.mass().to_vec(), &fixed, sys.viscosity().to_vec(), sys.gravity(),
         ).unwrap();
         let n = sys.slots();
         let x: Vec<Vec3> = (0..n).map(|i| [i as f64 * 0.37, (i * i % 5) as f64 * 0.11, (i % 3) as f64]).collect();

@@ -48,7 +48,7 @@ fn stretched_cube_tears() {
     let (mut body, mut sim) = stretched_cube(1.5);
     let mass = total_mass(&body);
     let vertices = body.map().count_cells().0[0];
-    let stress = cut::principal_stress(&body, &sim);
+    let stress = cut::principal_stress(&body, &sim).unwrap();
     let max = stress.iter().map(|s| s.magnitude).fold(0.0, f64::max);
     assert!(max > 0.0, "a stretched body must be under tension");
     // The stress of an affine stretch along x points along x.
@@ -75,7 +75,7 @@ fn stretched_cube_tears() {
 #[test]
 fn body_at_rest_does_not_tear() {
     let (mut body, mut sim) = stretched_cube(0.0);
-    let stress = cut::principal_stress(&body, &sim);
+    let stress = cut::principal_stress(&body, &sim).unwrap();
     assert!(stress.iter().all(|s| s.magnitude == 0.0), "a body at rest has no tension");
     let version = body.version();
     let step = cut::tear_step(&mut body, &mut sim, 0.0, 10).unwrap();
@@ -130,4 +130,43 @@ fn bad_directions_gravity_and_step_parameters_are_refused() {
         assert!(matches!(err, SimError::Step(StepError::BadParameter { name: n, .. }) if n == name), "{err}");
     }
     assert!(Simulation::new(&mut body, [0.0, 0.0, -9.81], config).is_ok());
+}
+
+/// Finding 35 (docs/VERIFICATION.md): the simulation's read-outs trusted the body they were
+/// given. `kinetic_energy` and `max_displacement` of a simulation built for a larger body
+/// panicked on a smaller one ("range end index 27 out of range for slice of length 8") and
+/// summed a prefix of a larger one; `principal_stress` and `tear_step` on a simulation the body
+/// had left behind (volumes removed since) reported the stress of a vertex that no longer
+/// existed and tore along springs that were gone. All four now refuse another body
+/// (`SimError::OtherBody`) and a stale projection (`SimError::StaleProjection`), like `step`.
+#[test]
+fn read_outs_refuse_another_body_and_a_stale_simulation() {
+    use topomech::cut::CutError;
+    use topomech::mechanics::SimError;
+    let (mut big, sim) = stretched_cube(1.0);
+    let (points, tets) = kuhn_cube(1);
+    let (small, _) = Body::from_tets(&points, &tets, material()).unwrap();
+    let other = |r: Result<f64, SimError>| matches!(r, Err(SimError::OtherBody { .. }));
+    assert!(other(sim.kinetic_energy(&small)) && other(sim.max_displacement(&small)));
+    assert!(matches!(cut::principal_stress(&small, &sim), Err(SimError::OtherBody { .. })));
+    // The small body's simulation given the big one: refused, not a sum over 8 of its 64 vertices.
+    let mut small = small;
+    let small_sim = Simulation::new(&mut small, [0.0; 3], StepConfig::new(Integrator::Euler, 1e-4)).unwrap();
+    assert!(other(small_sim.kinetic_energy(&big)));
+    // The body's own simulation works, then goes stale when a volume is removed.
+    let before = sim.max_displacement(&big).unwrap();
+    assert!(before > 0.0 && sim.kinetic_energy(&big).unwrap() == 0.0);
+    assert!(!cut::principal_stress(&big, &sim).unwrap().is_empty());
+    cut::remove_volume(&mut big, topomech::CellId(0)).unwrap();
+    let stale = |r: Result<f64, SimError>| matches!(r, Err(SimError::StaleProjection { .. }));
+    assert!(stale(sim.kinetic_energy(&big)) && stale(sim.max_displacement(&big)));
+    assert!(matches!(cut::principal_stress(&big, &sim), Err(SimError::StaleProjection { .. })));
+    let (version, mut sim) = (big.version(), sim);
+    let refused = cut::tear_step(&mut big, &mut sim, 0.0, 5);
+    assert!(matches!(refused, Err(CutError::Sim(SimError::StaleProjection { .. }))), "{refused:?}");
+    assert_eq!(big.version(), version, "nothing torn");
+    // Once the simulation follows the body again, every read-out answers.
+    sim.rebuild(&mut big).unwrap();
+    assert!(sim.max_displacement(&big).unwrap() > 0.0);
+    assert!(cut::tear_step(&mut big, &mut sim, 0.0, 1).is_ok());
 }

@@ -66,14 +66,14 @@ fn laws_hold_on_a_fresh_body_and_match_the_flat_baseline() {
     assert!(rel_close(mech.total_tet_mass(body.map()).unwrap(), 2.5 * volume, 1e-12));
     // Every vertex mass and spring stiffness equals the flat baseline's (built with no map).
     let flat = FlatModel::from_tets(&points, &tets, material(), G, &[]).unwrap();
-    for (v, &m) in flat.system.mass.iter().enumerate() {
+    for (v, &m) in flat.system.mass().iter().enumerate() {
         assert!(rel_close(mech.vertex_mass(CellId(v as u32)), m, 1e-12), "vertex {v}");
     }
     let projection = Projection::build(&body, G);
-    assert_eq!(projection.system().ends, flat.system.ends);
+    assert_eq!(projection.system().ends(), flat.system.ends());
     for s in 0..flat.system.springs() {
-        assert!(rel_close(projection.system().stiffness[s], flat.system.stiffness[s], 1e-12), "spring {s}");
-        assert!(rel_close(projection.system().rest[s], flat.system.rest[s], 1e-12), "spring {s}");
+        assert!(rel_close(projection.system().stiffness()[s], flat.system.stiffness()[s], 1e-12), "spring {s}");
+        assert!(rel_close(projection.system().rest()[s], flat.system.rest()[s], 1e-12), "spring {s}");
     }
 }
 
@@ -83,10 +83,10 @@ fn an_interior_edge_gets_the_sum_of_its_tets_contributions() {
     let (points, tets) = kuhn_cube(1);
     let (body, _) = Body::from_tets(&points, &tets, material()).unwrap();
     let p = Projection::build(&body, G);
-    let s = (0..p.system().springs()).find(|&s| p.system().ends[s] == [0, 7]).expect("diagonal spring");
+    let s = (0..p.system().springs()).find(|&s| p.system().ends()[s] == [0, 7]).expect("diagonal spring");
     let l = 3f64.sqrt();
     let expected = 6.0 * 700.0 * (1.0 / 6.0) / (l * l);
-    assert!(rel_close(p.system().stiffness[s], expected, 1e-12), "{} vs {expected}", p.system().stiffness[s]);
+    assert!(rel_close(p.system().stiffness()[s], expected, 1e-12), "{} vs {expected}", p.system().stiffness()[s]);
     // Corner vertex 0 belongs to all 6 tets: m = 6 · ρ (1/6) / 4.
     assert!(rel_close(body.attrs().vertex_mass(CellId(0)), 2.5 / 4.0, 1e-12));
 }
@@ -131,8 +131,8 @@ fn unsew3_along_a_plane_splits_masses_and_stiffnesses_conservatively() {
     let flat = FlatModel::from_tets(&half_points, &half_tets, material(), G, &[]).unwrap();
     let projection = Projection::build(&body, G);
     assert_eq!(projection.system().springs(), flat.system.springs());
-    let mut ours: Vec<f64> = projection.system().stiffness.clone();
-    let mut theirs = flat.system.stiffness.clone();
+    let mut ours: Vec<f64> = projection.system().stiffness().to_vec();
+    let mut theirs = flat.system.stiffness().to_vec();
     ours.sort_by(f64::total_cmp);
     theirs.sort_by(f64::total_cmp);
     for (a, b) in ours.iter().zip(&theirs) {
@@ -162,19 +162,19 @@ fn unsew3_along_a_plane_splits_masses_and_stiffnesses_conservatively() {
     let p1 = Projection::build(&body, G);
     let mut springs: Vec<([u32; 2], f64)> = (0..p1.system().springs())
         .map(|s| {
-            let [a, b] = p1.system().ends[s].map(point_of);
-            ([a.min(b), a.max(b)], p1.system().stiffness[s])
+            let [a, b] = p1.system().ends()[s].map(point_of);
+            ([a.min(b), a.max(b)], p1.system().stiffness()[s])
         })
         .collect();
     springs.sort_by_key(|&(e, _)| e);
     assert_eq!(springs.len(), flat.system.springs());
     for (s, (ends, k)) in springs.iter().enumerate() {
-        assert_eq!(*ends, flat.system.ends[s]);
-        assert!(rel_close(*k, flat.system.stiffness[s], 1e-12));
+        assert_eq!(*ends, flat.system.ends()[s]);
+        assert!(rel_close(*k, flat.system.stiffness()[s], 1e-12));
     }
     for d in body.map().one_dart_per_cell(0) {
         let v = body.map().vertex_id(d);
-        assert!(rel_close(body.attrs().vertex_mass(v), flat.system.mass[point_of(v.0) as usize], 1e-12));
+        assert!(rel_close(body.attrs().vertex_mass(v), flat.system.mass()[point_of(v.0) as usize], 1e-12));
     }
 }
 
@@ -281,7 +281,7 @@ fn projection_forces_equal_the_orbit_walk_to_1e_12() {
             assert_eq!(body.map().cell_id(1, d), p.edge_of_spring(s));
             assert_eq!(p.spring_of_edge(p.edge_of_spring(s)), Some(s));
             let ends = [body.map().vertex_id(d).0, body.map().vertex_id(body.map().alpha::<0>(d)).0];
-            assert!(ends.contains(&p.system().ends[s][0]) && ends.contains(&p.system().ends[s][1]));
+            assert!(ends.contains(&p.system().ends()[s][0]) && ends.contains(&p.system().ends()[s][1]));
         }
     }
 }
@@ -480,7 +480,7 @@ fn a_model_whose_totals_overflow_is_refused_naming_the_tet_and_quantity() {
     let (body, _) = Body::from_tets(&scaled(1e50), &tets, with(1.0, 1.0, 1.0)).unwrap();
     check_conservation(body.map(), body.attrs()).unwrap();
     let flat = FlatModel::from_tets(&scaled(1e50), &tets, with(1.0, 1.0, 1.0), G, &[]).unwrap();
-    let total: f64 = flat.system.mass.iter().sum();
+    let total: f64 = flat.system.mass().iter().sum();
     assert!(rel_close(total, body.total_vertex_mass(), 1e-12) && total.is_finite());
 }
 

@@ -274,7 +274,7 @@ fn masses_are_conserved_exactly_and_every_vertex_has_mass() {
     assert!((vm.iter().sum::<f64>() - total).abs() < 1e-12 * total);
     assert!(vm.iter().all(|&x| x > 0.0), "a vertex without mass would be pinned by the projection");
     let sys = mech.spring_system(&m, [0.0; 3], &[]).unwrap();
-    assert!((sys.mass.iter().sum::<f64>() - total).abs() < 1e-12 * total);
+    assert!((sys.mass().iter().sum::<f64>() - total).abs() < 1e-12 * total);
     assert_eq!(sys.springs(), m.map().count_cells().0[1]);
 }
 
@@ -497,7 +497,7 @@ fn a_cut_edge_whose_ends_stay_joined_carries_two_springs_through_refinement() {
     assert!(c0.iter().all(|h| !c1.contains(h)), "two chains, no link shared");
     let sys = mech.spring_system(&m, [0.0; 3], &[]).unwrap();
     assert_eq!(sys.springs(), m.map().count_cells().0[1], "one spring per edge cell");
-    let mut ends: Vec<[u32; 2]> = sys.ends.clone();
+    let mut ends: Vec<[u32; 2]> = sys.ends().to_vec();
     ends.sort_unstable();
     let repeated = ends.windows(2).filter(|w| w[0] == w[1]).count();
     let doubled: usize = doubled_pairs(m.map()).values().map(|n| n - 1).sum();

@@ -179,8 +179,8 @@ fn simulate(args: &SimulateArgs, parallel: bool) -> Result<(), CliError> {
         integrator: args.integrator.name(),
         step_us_median: median(&mut times),
         total_mass: body.total_vertex_mass(),
-        kinetic_energy: sim.kinetic_energy(&body),
-        max_displacement: sim.max_displacement(&body),
+        kinetic_energy: sim.kinetic_energy(&body).map_err(other)?,
+        max_displacement: sim.max_displacement(&body).map_err(other)?,
     };
     print_summary(args, &summary, &sim, frames.pvd())
 }
@@ -192,8 +192,8 @@ fn print_summary(
     pvd: Option<PathBuf>,
 ) -> Result<(), CliError> {
     print_report(args.json, s, |out| {
-        let sys = &sim.projection.system();
-        let fixed = sys.inv_mass.iter().zip(&sys.mass).filter(|(&w, &m)| w == 0.0 && m > 0.0).count();
+        let sys = sim.projection.system();
+        let fixed = sys.inv_mass().iter().zip(sys.mass()).filter(|(&w, &m)| w == 0.0 && m > 0.0).count();
         writeln!(out, "{}", args.mesh.display())?;
         let (springs, slots) = (sys.springs(), sys.slots());
         writeln!(out, "  {:<22}mass/spring ({springs} springs, {slots} vertex slots, {fixed} fixed)", "system")?;

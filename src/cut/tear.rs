@@ -10,7 +10,7 @@
 
 use crate::mechanics::geom::{cross, dot, sub};
 use crate::mechanics::model::{closed_triangle_vertices, triangle_vertices};
-use crate::mechanics::{Body, Simulation, TouchedCells, Vec3};
+use crate::mechanics::{Body, SimError, Simulation, TouchedCells, Vec3};
 use crate::{CellId, DartId, GMap};
 
 use super::{dissociate_face, CutError, Dissociation};
@@ -30,7 +30,7 @@ use super::{dissociate_face, CutError, Dissociation};
 /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
 /// let sim = Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Euler, 1e-3)).unwrap();
 /// body.attrs_mut().position_mut().as_mut_slice()[7][0] += 0.5; // pull a corner along x
-/// let s = principal_stress(&body, &sim)[7];
+/// let s = principal_stress(&body, &sim).unwrap()[7];
 /// let norm = s.direction.iter().map(|c| c * c).sum::<f64>().sqrt();
 /// assert!(s.magnitude > 0.0 && (norm - 1.0).abs() < 1e-9);
 /// ```
@@ -95,8 +95,16 @@ pub struct TearStep {
 }
 
 /// σ_v's principal pair for every vertex slot of `sim`'s projection, from `body`'s current
-/// positions. O(springs + slots). Empty when `sim` was not built for `body`
-/// ([`crate::mechanics::Projection::is_for`]): its slots and springs are another body's.
+/// positions. O(springs + slots).
+///
+/// # Errors
+/// [`SimError::OtherBody`] when `sim` was not built for `body`
+/// ([`crate::mechanics::Projection::is_for`]: its slots and springs are another body's), and
+/// [`SimError::StaleProjection`] when `body` changed topologically since `sim` last followed it
+/// (its springs may join vertices that no longer exist).
+///
+/// [`SimError::OtherBody`]: crate::mechanics::SimError::OtherBody
+/// [`SimError::StaleProjection`]: crate::mechanics::SimError::StaleProjection
 ///
 /// # Examples
 ///
@@ -108,16 +116,14 @@ pub struct TearStep {
 /// let (points, tets) = kuhn_cube(1);
 /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
 /// let sim = Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Euler, 1e-3)).unwrap();
-/// assert!(principal_stress(&body, &sim).iter().all(|s| s.magnitude == 0.0)); // at rest
+/// assert!(principal_stress(&body, &sim).unwrap().iter().all(|s| s.magnitude == 0.0)); // at rest
 /// body.attrs_mut().position_mut().as_mut_slice()[7][2] += 0.5; // pull the top corner up
-/// let stress = principal_stress(&body, &sim);
+/// let stress = principal_stress(&body, &sim).unwrap();
 /// assert!(stress[7].magnitude > 0.0 && stress[7].direction[2].abs() > 0.5);
-/// assert!(principal_stress(&body.clone(), &sim).is_empty()); // another body
+/// assert!(principal_stress(&body.clone(), &sim).is_err()); // another body
 /// ```
-pub fn principal_stress(body: &Body, sim: &Simulation) -> Vec<Stress> {
-    if !sim.projection.is_for(body) {
-        return Vec::new();
-    }
+pub fn principal_stress(body: &Body, sim: &Simulation) -> Result<Vec<Stress>, SimError> {
+    sim.check_current(body)?;
     let sys = &sim.projection.system;
     let x = body.attrs().position.as_slice();
     let mut sigma = vec![[[0.0f64; 3]; 3]; sys.slots()];
@@ -137,7 +143,7 @@ pub fn principal_stress(body: &Body, sim: &Simulation) -> Vec<Stress> {
             }
         }
     }
-    sigma.iter().map(largest_eigenpair).collect()
+    Ok(sigma.iter().map(largest_eigenpair).collect())
 }
 
 /// Largest eigenpair of a symmetric positive semi-definite 3×3 matrix by power iteration started
@@ -361,8 +367,9 @@ pub fn tear_vertex(body: &mut Body, v: CellId, direction: Vec3, hint: Option<Dar
 /// # Errors
 /// [`CutError::BadThreshold`] for a NaN, infinite or negative threshold, and
 /// [`CutError::Sim`] with [`crate::mechanics::SimError::OtherBody`] when `sim` was built for
-/// another body (nothing done either way); [`CutError::Body`] or [`CutError::Sim`] (bugs or a
-/// bad time step).
+/// another body or [`crate::mechanics::SimError::StaleProjection`] when the body changed since
+/// `sim` last followed it (nothing done in these cases); [`CutError::Body`] or [`CutError::Sim`]
+/// (bugs or a bad time step).
 ///
 /// # Examples
 ///
@@ -392,8 +399,7 @@ pub fn tear_step(
     if !(threshold.is_finite() && threshold >= 0.0) {
         return Err(CutError::BadThreshold(threshold));
     }
-    sim.check_body(body)?;
-    let stress = principal_stress(body, sim);
+    let stress = principal_stress(body, sim)?;
     let mut order: Vec<usize> = (0..stress.len()).filter(|&v| stress[v].magnitude > threshold).collect();
     order.sort_by(|&a, &b| stress[b].magnitude.total_cmp(&stress[a].magnitude).then(a.cmp(&b)));
     let mut out = TearStep::default();

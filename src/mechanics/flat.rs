@@ -25,8 +25,8 @@ use crate::build::BuildError;
 /// let flat = FlatModel::from_tets(&points, &tets, Material::default(), [0.0; 3], &pinned).unwrap();
 /// assert_eq!(flat.rest_position, flat.position); // starts at rest
 /// assert!(flat.velocity.iter().all(|v| *v == [0.0; 3]));
-/// assert_eq!(flat.system.inv_mass[0], 0.0); // the pinned point does not move
-/// assert!(flat.system.inv_mass[1] > 0.0);
+/// assert_eq!(flat.system.inv_mass()[0], 0.0); // the pinned point does not move
+/// assert!(flat.system.inv_mass()[1] > 0.0);
 /// ```
 #[derive(Clone, Debug)]
 pub struct FlatModel {
@@ -58,7 +58,7 @@ impl FlatModel {
     /// let (points, tets) = kuhn_cube(1);
     /// let flat = FlatModel::from_tets(&points, &tets, Material::default(), [0.0; 3], &[]).unwrap();
     /// assert_eq!((flat.system.slots(), flat.system.springs()), (8, 19)); // one spring per edge
-    /// assert!((flat.system.mass.iter().sum::<f64>() - 1.0).abs() < 1e-12); // density 1, unit cube
+    /// assert!((flat.system.mass().iter().sum::<f64>() - 1.0).abs() < 1e-12); // density 1, unit cube
     /// assert_eq!(flat.position, points);
     /// ```
     pub fn from_tets(

@@ -66,28 +66,45 @@ pub const PARALLEL_CHUNK: usize = 4096;
 /// let (a, b) = (sys.push_slot(2.0, false, 0.0).unwrap(), sys.push_slot(1.0, true, 0.0).unwrap());
 /// let s = sys.push_spring([a as u32, b as u32], 1.0, 50.0, 0.1).unwrap();
 /// assert_eq!((sys.slots(), sys.springs()), (2, 1));
-/// assert_eq!((sys.inv_mass[a], sys.inv_mass[b]), (0.5, 0.0)); // slot b is fixed
+/// assert_eq!((sys.inv_mass()[a], sys.inv_mass()[b]), (0.5, 0.0)); // slot b is fixed
 /// assert_eq!(sys.incident(a).map(|(spring, _)| spring).collect::<Vec<_>>(), vec![s]);
 /// assert!(sys.check_incidence().is_ok());
 /// ```
+///
+/// The arrays are read through accessors and written only through the checked mutators, so a
+/// spring end past the slots (which made `Stepper::step` index out of bounds, finding 36) does
+/// not compile:
+///
+/// ```compile_fail
+/// use topomech::mechanics::SpringSystem;
+///
+/// let mut sys = SpringSystem::default();
+/// sys.push_slot(1.0, false, 0.0).unwrap();
+/// sys.push_slot(1.0, false, 0.0).unwrap();
+/// sys.push_spring([0, 1], 1.0, 1.0, 0.0).unwrap();
+/// sys.ends[0] = [0, 7]; // private field
+/// ```
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct SpringSystem {
+    // The arrays are crate-private and read through the accessors of the same names: every
+    // way in ([`SpringSystem::new`] and the mutators) checks what it stores, so a system is
+    // always what [`SpringSystem::check`] accepts and the step loop can trust it (finding 36).
     /// Spring end slots (a, b).
-    pub ends: Vec<[u32; 2]>,
+    pub(crate) ends: Vec<[u32; 2]>,
     /// Rest length L of each spring.
-    pub rest: Vec<f64>,
+    pub(crate) rest: Vec<f64>,
     /// Stiffness k of each spring.
-    pub stiffness: Vec<f64>,
+    pub(crate) stiffness: Vec<f64>,
     /// Damping c of each spring.
-    pub damping: Vec<f64>,
+    pub(crate) damping: Vec<f64>,
     /// Mass of each slot.
-    pub mass: Vec<f64>,
+    pub(crate) mass: Vec<f64>,
     /// 1/m for a free slot, 0 for a fixed one.
-    pub inv_mass: Vec<f64>,
+    pub(crate) inv_mass: Vec<f64>,
     /// Ambient viscosity γ of each slot.
-    pub viscosity: Vec<f64>,
+    pub(crate) viscosity: Vec<f64>,
     /// Gravity acceleration g.
-    pub gravity: Vec3,
+    pub(crate) gravity: Vec3,
     /// Incident springs per slot (module docs). Change `ends` only through the mutators, which
     /// keep it in step; [`SpringSystem::check_incidence`] verifies it.
     inc: Incidence,
@@ -114,7 +131,7 @@ impl SpringSystem {
     ///     vec![1.0, 2.0], &[false, true], vec![0.0; 2], [0.0; 3], // mass, fixed, viscosity, gravity
     /// )
     /// .unwrap();
-    /// assert_eq!(sys.inv_mass, vec![1.0, 0.0]); // slot 1 is fixed
+    /// assert_eq!(sys.inv_mass(), vec![1.0, 0.0]); // slot 1 is fixed
     /// assert_eq!((sys.slots(), sys.springs()), (2, 1));
     /// assert_eq!(sys.incident(1).collect::<Vec<_>>(), vec![(0, -1.0)]); // end b of spring 0
     /// sys.check_incidence().unwrap();
@@ -177,7 +194,10 @@ impl SpringSystem {
     /// every spring joins two different slots, every mass, inverse mass, viscosity, rest length,
     /// stiffness and damping is finite and ≥ 0, gravity is finite. O(slots + springs).
     ///
-    /// The public arrays can be written directly; this is the check to run after doing so.
+    /// Every way in ([`SpringSystem::new`], the mutators, [`SpringSystem::set_gravity`]) refuses
+    /// what this check refuses and the arrays are private (finding 36), so a system made through
+    /// the API always passes; the stepper runs it once anyway, as a guard against the crate's own
+    /// unchecked builders.
     ///
     /// # Errors
     /// The first fault found, as a [`SystemError`] naming the array, spring or slot.
@@ -190,8 +210,9 @@ impl SpringSystem {
     /// let mut sys = SpringSystem::default();
     /// sys.push_slot(1.0, false, 0.0).unwrap();
     /// assert_eq!(sys.check(), Ok(()));
-    /// sys.viscosity[0] = f64::NAN;
-    /// assert!(matches!(sys.check(), Err(SystemError::BadValue { quantity: "viscosity", index: 0, .. })));
+    /// let refused = sys.set_slot(0, 1.0, false, f64::NAN); // the way in checks first
+    /// assert!(matches!(refused, Err(SystemError::BadValue { quantity: "viscosity", index: 0, .. })));
+    /// assert_eq!(sys.check(), Ok(())); // nothing was stored
     /// ```
     pub fn check(&self) -> Result<(), SystemError> {
         self.check_shape()?;
@@ -274,7 +295,7 @@ impl SpringSystem {
     /// let mut sys = SpringSystem::default();
     /// assert_eq!(sys.push_slot(2.0, false, 0.1), Ok(0));
     /// assert_eq!(sys.push_slot(3.0, true, 0.0), Ok(1)); // fixed: infinite inertia
-    /// assert_eq!(sys.inv_mass, vec![0.5, 0.0]);
+    /// assert_eq!(sys.inv_mass(), vec![0.5, 0.0]);
     /// assert_eq!(sys.incident(1).count(), 0); // no spring yet
     /// assert!(sys.push_slot(f64::NAN, false, 0.0).is_err());
     /// assert_eq!(sys.slots(), 2);
@@ -309,9 +330,9 @@ impl SpringSystem {
     /// let mut sys = SpringSystem::default();
     /// let v = sys.push_slot(1.0, false, 0.0).unwrap();
     /// sys.set_slot(v, 4.0, false, 0.5).unwrap();
-    /// assert_eq!((sys.mass[v], sys.inv_mass[v], sys.viscosity[v]), (4.0, 0.25, 0.5));
+    /// assert_eq!((sys.mass()[v], sys.inv_mass()[v], sys.viscosity()[v]), (4.0, 0.25, 0.5));
     /// sys.set_slot(v, 4.0, true, 0.5).unwrap(); // pin it
-    /// assert_eq!(sys.inv_mass[v], 0.0);
+    /// assert_eq!(sys.inv_mass()[v], 0.0);
     /// assert_eq!(sys.set_slot(7, 1.0, false, 0.0), Err(SystemError::NoSuchSlot { slot: 7, slots: 1 }));
     /// ```
     pub fn set_slot(&mut self, v: usize, mass: f64, fixed: bool, viscosity: f64) -> Result<(), SystemError> {
@@ -342,7 +363,7 @@ impl SpringSystem {
     ///
     /// let mut sys = SpringSystem::default();
     /// let (a, b) = (sys.push_slot(1.0, false, 0.0).unwrap(), sys.push_slot(0.0, false, 0.0).unwrap());
-    /// assert_eq!(sys.inv_mass, vec![1.0, 0.0]); // a massless slot does not move
+    /// assert_eq!(sys.inv_mass(), vec![1.0, 0.0]); // a massless slot does not move
     /// let s = sys.push_spring([a as u32, b as u32], 1.0, 3.0, 0.0).unwrap();
     /// assert_eq!((s, sys.springs()), (0, 1));
     /// assert_eq!(sys.incident(a).collect::<Vec<_>>(), vec![(s, 1.0)]);
@@ -390,7 +411,7 @@ impl SpringSystem {
     /// sys.push_spring([0, 1], 1.0, 1.0, 0.0).unwrap();
     /// sys.set_spring(0, [0, 2], 2.0, 5.0, 0.1).unwrap(); // re-attach end b to slot 2
     /// assert_eq!((sys.incident(1).count(), sys.incident(2).count()), (0, 1));
-    /// assert_eq!((sys.rest[0], sys.stiffness[0], sys.damping[0]), (2.0, 5.0, 0.1));
+    /// assert_eq!((sys.rest()[0], sys.stiffness()[0], sys.damping()[0]), (2.0, 5.0, 0.1));
     /// assert_eq!(sys.set_spring(3, [0, 1], 1.0, 1.0, 0.0), Err(SystemError::NoSuchSpring { spring: 3, springs: 1 }));
     /// sys.check_incidence().unwrap();
     /// ```
@@ -441,7 +462,7 @@ impl SpringSystem {
     /// sys.push_spring([0, 1], 1.0, 1.0, 0.0).unwrap();
     /// sys.push_spring([1, 2], 1.0, 1.0, 0.0).unwrap();
     /// assert_eq!(sys.swap_remove_spring(0), Ok(Some(1))); // spring 1 moved into index 0
-    /// assert_eq!((sys.springs(), sys.ends[0]), (1, [1, 2]));
+    /// assert_eq!((sys.springs(), sys.ends()[0]), (1, [1, 2]));
     /// assert_eq!(sys.incident(0).count(), 0);
     /// assert!(sys.swap_remove_spring(1).is_err()); // only spring 0 is left
     /// sys.check_incidence().unwrap();
@@ -555,6 +576,156 @@ impl SpringSystem {
     /// ```
     pub fn springs(&self) -> usize {
         self.ends.len()
+    }
+
+    /// End slots (a, b) of each spring, two different slots below [`SpringSystem::slots`]. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// let (a, b) = (sys.push_slot(1.0, false, 0.0).unwrap(), sys.push_slot(1.0, false, 0.0).unwrap());
+    /// sys.push_spring([b as u32, a as u32], 1.0, 10.0, 0.5).unwrap();
+    /// assert_eq!(sys.ends(), &[[1, 0]]);
+    /// assert_eq!((sys.rest(), sys.stiffness(), sys.damping()), (&[1.0][..], &[10.0][..], &[0.5][..]));
+    /// ```
+    pub fn ends(&self) -> &[[u32; 2]] {
+        &self.ends
+    }
+
+    /// Rest length L of each spring (finite, ≥ 0). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{FlatModel, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let flat = FlatModel::from_tets(&points, &tets, Material::default(), [0.0; 3], &[]).unwrap();
+    /// let diagonals = flat.system.rest().iter().filter(|&&l| (l - 3f64.sqrt()).abs() < 1e-12).count();
+    /// assert_eq!(diagonals, 1); // the Kuhn cube's one main diagonal
+    /// ```
+    pub fn rest(&self) -> &[f64] {
+        &self.rest
+    }
+
+    /// Stiffness k of each spring (finite, ≥ 0). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{FlatModel, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let flat = FlatModel::from_tets(&points, &tets, Material::default(), [0.0; 3], &[]).unwrap();
+    /// assert!(flat.system.stiffness().iter().all(|&k| k > 0.0));
+    /// ```
+    pub fn stiffness(&self) -> &[f64] {
+        &self.stiffness
+    }
+
+    /// Damping c of each spring (finite, ≥ 0). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{FlatModel, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let no_damping = Material { damping: 0.0, ..Material::default() };
+    /// let flat = FlatModel::from_tets(&points, &tets, no_damping, [0.0; 3], &[]).unwrap();
+    /// assert!(flat.system.damping().iter().all(|&c| c == 0.0));
+    /// ```
+    pub fn damping(&self) -> &[f64] {
+        &self.damping
+    }
+
+    /// Mass of each slot (finite, ≥ 0). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// sys.push_slot(2.5, true, 0.0).unwrap();
+    /// assert_eq!((sys.mass(), sys.inv_mass()), (&[2.5][..], &[0.0][..])); // fixed: it does not move
+    /// ```
+    pub fn mass(&self) -> &[f64] {
+        &self.mass
+    }
+
+    /// 1/m of each free slot, 0 for a fixed or massless one. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// sys.push_slot(4.0, false, 0.0).unwrap();
+    /// sys.push_slot(0.0, false, 0.0).unwrap(); // massless: cannot be accelerated
+    /// assert_eq!(sys.inv_mass(), &[0.25, 0.0]);
+    /// ```
+    pub fn inv_mass(&self) -> &[f64] {
+        &self.inv_mass
+    }
+
+    /// Ambient viscosity γ of each slot (finite, ≥ 0). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// sys.push_slot(1.0, false, 0.3).unwrap();
+    /// assert_eq!(sys.viscosity(), &[0.3]);
+    /// ```
+    pub fn viscosity(&self) -> &[f64] {
+        &self.viscosity
+    }
+
+    /// Gravity acceleration g (finite). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let sys = SpringSystem::new(vec![], vec![], vec![], vec![], vec![], &[], vec![], [0.0, 0.0, -9.81]).unwrap();
+    /// assert_eq!(sys.gravity(), [0.0, 0.0, -9.81]);
+    /// ```
+    pub fn gravity(&self) -> Vec3 {
+        self.gravity
+    }
+
+    /// Sets the gravity acceleration g. O(1).
+    ///
+    /// # Errors
+    /// [`SystemError::BadGravity`] for a NaN or infinite component; the gravity is unchanged.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::{SpringSystem, SystemError};
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// sys.set_gravity([0.0, -9.81, 0.0]).unwrap();
+    /// assert!(matches!(sys.set_gravity([0.0, 0.0, f64::INFINITY]), Err(SystemError::BadGravity(_))));
+    /// assert_eq!(sys.gravity(), [0.0, -9.81, 0.0]); // unchanged
+    /// ```
+    pub fn set_gravity(&mut self, gravity: Vec3) -> Result<(), SystemError> {
+        if gravity.iter().any(|g| !g.is_finite()) {
+            return Err(SystemError::BadGravity(gravity));
+        }
+        self.gravity = gravity;
+        Ok(())
     }
 
     /// Pass 1: F_s (force on end a) of every spring into `sf`. O(springs).
@@ -704,7 +875,7 @@ impl SpringSystem {
     /// use topomech::mechanics::SpringSystem;
     ///
     /// let mut sys = SpringSystem::default();
-    /// sys.gravity = [0.0, 0.0, -10.0];
+    /// sys.set_gravity([0.0, 0.0, -10.0]).unwrap();
     /// sys.push_slot(2.0, false, 0.5).unwrap(); // mass 2, viscosity 0.5, no spring
     /// let (v, sf) = ([[1.0, 0.0, 0.0]], []);
     /// assert_eq!(sys.vertex_force(0, &v, &sf), Ok([-0.5, 0.0, -20.0])); // m·g − γ·v
@@ -783,7 +954,7 @@ impl SpringSystem {
     ///
     /// // No springs: a free slot falls with g, a fixed one does not move.
     /// let mut sys = SpringSystem::default();
-    /// sys.gravity = [0.0, 0.0, -9.81];
+    /// sys.set_gravity([0.0, 0.0, -9.81]).unwrap();
     /// sys.push_slot(2.0, false, 0.0).unwrap();
     /// sys.push_slot(2.0, true, 0.0).unwrap();
     /// let (x, v, mut acc) = ([[0.0; 3]; 2], [[0.0; 3]; 2], [[1.0; 3]; 2]);
@@ -813,7 +984,7 @@ impl SpringSystem {
     /// use topomech::mechanics::{Kernel, SpringSystem};
     ///
     /// let mut sys = SpringSystem::default();
-    /// sys.gravity = [0.0, 0.0, -9.81];
+    /// sys.set_gravity([0.0, 0.0, -9.81]).unwrap();
     /// (0..3).for_each(|i| drop(sys.push_slot(1.0 + i as f64, i == 0, 0.1)));
     /// sys.push_spring([0, 1], 1.0, 30.0, 0.2).unwrap();
     /// sys.push_spring([1, 2], 1.0, 20.0, 0.2).unwrap();
@@ -998,7 +1169,7 @@ impl SpringSystem {
     /// use topomech::mechanics::SpringSystem;
     ///
     /// let mut sys = SpringSystem::default();
-    /// sys.gravity = [0.0, 0.0, -10.0];
+    /// sys.set_gravity([0.0, 0.0, -10.0]).unwrap();
     /// sys.push_slot(2.0, false, 0.0).unwrap();
     /// assert_eq!(sys.gravity_energy(&[[0.0, 0.0, 3.0]]), Ok(60.0)); // m g h
     /// assert_eq!(sys.kinetic_energy(&[[0.0, 4.0, 0.0]]), Ok(16.0)); // ½ m v²
@@ -1534,8 +1705,10 @@ fn spring_scale_padded(
 /// let mut sys = SpringSystem::default();
 /// (0..3).for_each(|_| drop(sys.push_slot(1.0, false, 0.0)));
 /// sys.push_spring([0, 1], 1.0, 1.0, 0.0).unwrap();
-/// sys.ends[0] = [0, 2]; // bypasses the mutators: the incidence lists are now stale
-/// assert!(matches!(sys.check_incidence(), Err(IncidenceError::Lists { .. })));
+/// sys.set_spring(0, [0, 2], 1.0, 1.0, 0.0).unwrap(); // the mutators keep the lists in step
+/// assert_eq!(sys.check_incidence(), Ok(()));
+/// let e = IncidenceError::SlotCount { expected: 3, got: 2 }; // what a stale table would report
+/// assert_eq!(e.to_string(), "incidence table has 2 slots, the system 3");
 /// ```
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum IncidenceError {

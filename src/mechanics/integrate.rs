@@ -243,7 +243,7 @@ impl StepConfig {
 /// use topomech::mechanics::{Integrator, SpringSystem, StepConfig, Stepper};
 ///
 /// let mut sys = SpringSystem::default();
-/// sys.gravity = [0.0, 0.0, -10.0];
+/// sys.set_gravity([0.0, 0.0, -10.0]).unwrap();
 /// sys.push_slot(1.0, false, 0.0).unwrap();
 /// let (mut x, mut v) = (vec![[0.0; 3]], vec![[0.0; 3]]);
 /// let mut stepper = Stepper::new(StepConfig::new(Integrator::Symplectic, 0.1), &sys, &x, &v).unwrap();
@@ -307,9 +307,9 @@ impl Stepper {
     /// assert_eq!((stepper.steps_done(), stepper.config().dt), (0, 0.01));
     /// let bad = Stepper::new(StepConfig::new(Integrator::Implicit, 0.01), &sys, &[], &v);
     /// assert!(matches!(bad, Err(StepError::SizeMismatch { .. })));
-    /// sys.viscosity[0] = f64::NAN; // a parameter the stepping cannot use
-    /// let bad = Stepper::new(StepConfig::new(Integrator::Implicit, 0.01), &sys, &x, &v).unwrap_err();
-    /// assert_eq!(bad.to_string(), "cannot step this input: viscosity of slot 0 is NaN (must be finite and >= 0)");
+    /// let nan = vec![[f64::NAN, 0.0, 0.0]]; // a start state the stepping cannot use
+    /// let bad = Stepper::new(StepConfig::new(Integrator::Implicit, 0.01), &sys, &nan, &v).unwrap_err();
+    /// assert!(bad.to_string().starts_with("cannot step this input: start position of slot 0"), "{bad}");
     /// ```
     pub fn new(config: StepConfig, sys: &SpringSystem, x: &[Vec3], v: &[Vec3]) -> Result<Self, StepError> {
         if !(config.dt.is_finite() && config.dt > 0.0) {
@@ -407,7 +407,7 @@ impl Stepper {
     /// use topomech::mechanics::{Integrator, Kernel, SpringSystem, StepConfig, Stepper};
     ///
     /// let mut sys = SpringSystem::default();
-    /// sys.gravity = [0.0, 0.0, -9.81];
+    /// sys.set_gravity([0.0, 0.0, -9.81]).unwrap();
     /// sys.push_slot(1.0, false, 0.3).unwrap();
     /// let run = |kernel| {
     ///     let (mut x, mut v) = (vec![[0.0; 3]], vec![[1.0, 0.0, 0.0]]);
@@ -489,7 +489,7 @@ impl Stepper {
     ///
     /// // A unit mass hanging from a fixed point on a spring, released at the spring's rest length.
     /// let mut sys = SpringSystem::default();
-    /// sys.gravity = [0.0, 0.0, -10.0];
+    /// sys.set_gravity([0.0, 0.0, -10.0]).unwrap();
     /// sys.push_slot(1.0, true, 0.0).unwrap();
     /// sys.push_slot(1.0, false, 0.0).unwrap();
     /// sys.push_spring([0, 1], 1.0, 100.0, 0.0).unwrap();
@@ -987,4 +987,76 @@ fn apply_system(
 
 fn dot_all(a: &[Vec3], b: &[Vec3]) -> f64 {
     a.iter().zip(b).map(|(x, y)| dot(*x, *y)).sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mechanics::SystemError;
+
+    /// A chain of `n` unit masses on springs, the first pinned, hanging under gravity.
+    fn chain(n: usize) -> (SpringSystem, Vec<Vec3>, Vec<Vec3>) {
+        let mut sys = SpringSystem::default();
+        sys.set_gravity([0.0, 0.0, -10.0]).unwrap();
+        for i in 0..n {
+            sys.push_slot(1.0, i == 0, 0.1).unwrap();
+        }
+        for i in 1..n {
+            sys.push_spring([(i - 1) as u32, i as u32], 1.0, 100.0, 0.1).unwrap();
+        }
+        let x = (0..n).map(|i| [0.0, 0.0, -(i as f64)]).collect();
+        (sys, x, vec![[0.0; 3]; n])
+    }
+
+    /// Finding 25: `Stepper::new` refuses a system with a NaN, negative or misplaced value, named.
+    /// Since finding 36 such a system can only be made inside the crate (the arrays are private
+    /// and every way in checks), so the refusals are tested here.
+    #[test]
+    fn stepper_new_refuses_a_broken_system() {
+        type Tamper = fn(&mut SpringSystem);
+        let cases: [(Tamper, &str); 11] = [
+            (|s| s.mass[1] = f64::NAN, "mass of slot 1 is NaN"),
+            (|s| s.mass[2] = -1.0, "mass of slot 2 is -1"),
+            (|s| s.inv_mass[3] = f64::INFINITY, "inverse mass of slot 3 is inf"),
+            (|s| s.viscosity[0] = -0.5, "viscosity of slot 0 is -0.5"),
+            (|s| s.rest[0] = f64::NAN, "rest length of spring 0 is NaN"),
+            (|s| s.stiffness[2] = f64::NAN, "stiffness of spring 2 is NaN"),
+            (|s| s.damping[1] = -2.0, "damping of spring 1 is -2"),
+            (|s| s.gravity[1] = f64::NAN, "gravity [0.0, NaN, -10.0] is not finite"),
+            (|s| s.ends[1] = [1, 9], "spring 1 joins slots [1, 9]"),
+            (|s| s.ends[2] = [3, 3], "spring 2 joins slots [3, 3]"),
+            (|s| s.damping.truncate(2), "damping has 2 entries for 3 springs"),
+        ];
+        for (tamper, expected) in cases {
+            let (mut sys, x, v) = chain(4);
+            tamper(&mut sys);
+            for integrator in [Integrator::Euler, Integrator::Rk4, Integrator::Implicit] {
+                match Stepper::new(StepConfig::new(integrator, 1e-3), &sys, &x, &v) {
+                    Err(StepError::BadInput(text)) => assert!(text.starts_with(expected), "{expected}: {text}"),
+                    other => panic!("{expected}: {other:?}"),
+                }
+            }
+        }
+    }
+
+    /// Finding 28: the public passes and `check` find a spring end past the slots, a short array
+    /// and a NaN value instead of indexing them (a system broken inside the crate, as above).
+    #[test]
+    fn passes_and_check_refuse_a_system_broken_inside_the_crate() {
+        let (sys, _, _) = chain(3);
+        let (x, v) = (vec![[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [2.0, 3.0, 0.0]], vec![[1.0, 0.0, 0.0]; 3]);
+        let (mut sf, mut out) = (vec![[0.0; 3]; 2], vec![[0.0; 3]; 3]);
+        let mut broken = sys.clone();
+        broken.ends[1] = [1, 8];
+        let bad_ends = Err(SystemError::BadEnds { spring: 1, ends: [1, 8], slots: 3 });
+        assert_eq!(broken.forces(&x, &v, &mut sf, &mut out, false), bad_ends);
+        assert_eq!(broken.elastic_energy(&x), Err(SystemError::BadEnds { spring: 1, ends: [1, 8], slots: 3 }));
+        broken.viscosity.pop();
+        let short = Err(SystemError::Length { array: "viscosity", len: 2, expected: 3, of: "slots" });
+        assert_eq!(broken.check(), short);
+        let mut nan = sys.clone();
+        nan.damping[1] = f64::NAN;
+        assert!(matches!(nan.check(), Err(SystemError::BadValue { quantity: "damping", of: "spring", index: 1, .. })));
+        assert_eq!(sys.check(), Ok(()));
+    }
 }

@@ -198,6 +198,16 @@ impl Simulation {
         }
     }
 
+    /// [`Simulation::check_body`], then [`SimError::StaleProjection`] unless the projection is
+    /// current for `body` (its slots, masses and springs are the body's now). O(1).
+    pub(crate) fn check_current(&self, body: &Body) -> Result<(), SimError> {
+        self.check_body(body)?;
+        match self.projection.is_current(body) {
+            true => Ok(()),
+            false => Err(SimError::StaleProjection { built: self.projection.version(), now: body.version() }),
+        }
+    }
+
     /// One step on the body's positions and velocities. O(springs + vertex ids).
     ///
     /// # Errors
@@ -222,13 +232,10 @@ impl Simulation {
     /// let m = body.attrs();
     /// let z = |v: usize| m.position().as_slice()[v][2];
     /// assert!(z(7) < 1.0 && z(0) == 0.0); // the top corner sags, the pinned one stays
-    /// assert!(sim.kinetic_energy(&body) > 0.0 && sim.max_displacement(&body) > 0.0);
+    /// assert!(sim.kinetic_energy(&body).unwrap() > 0.0 && sim.max_displacement(&body).unwrap() > 0.0);
     /// ```
     pub fn step(&mut self, body: &mut Body) -> Result<(), SimError> {
-        self.check_body(body)?;
-        if !self.projection.is_current(body) {
-            return Err(SimError::StaleProjection { built: self.projection.version(), now: body.version() });
-        }
+        self.check_current(body)?;
         let slots = self.projection.system.slots();
         let mech = body.attrs_mut();
         let x = &mut mech.position.as_mut_slice()[..slots];
@@ -310,6 +317,11 @@ impl Simulation {
 
     /// Kinetic energy of the body's free vertices. O(vertex ids).
     ///
+    /// # Errors
+    /// [`SimError::OtherBody`] for a body the simulation was not built for, and
+    /// [`SimError::StaleProjection`] after a topological change (its masses are not the body's
+    /// any more): the energy would be a sum over another set of vertices.
+    ///
     /// # Examples
     ///
     /// ```
@@ -320,15 +332,21 @@ impl Simulation {
     /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
     /// body.attrs_mut().velocity_mut().as_mut_slice().fill([0.0, 3.0, 0.0]);
     /// let sim = Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Euler, 1e-3)).unwrap();
-    /// assert!((sim.kinetic_energy(&body) - 0.5 * 1.0 * 9.0).abs() < 1e-12); // ½ M v², M = 1
-    /// assert!((sim.kinetic_energy(&body) - body.kinetic_energy()).abs() < 1e-12);
+    /// assert!((sim.kinetic_energy(&body).unwrap() - 0.5 * 1.0 * 9.0).abs() < 1e-12); // ½ M v², M = 1
+    /// assert!((sim.kinetic_energy(&body).unwrap() - body.kinetic_energy()).abs() < 1e-12);
+    /// let (other, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// assert!(sim.kinetic_energy(&other).is_err()); // not the body it was built for
     /// ```
-    pub fn kinetic_energy(&self, body: &Body) -> f64 {
+    pub fn kinetic_energy(&self, body: &Body) -> Result<f64, SimError> {
+        self.check_current(body)?;
         let slots = self.projection.system.slots();
-        self.projection.system.kinetic_energy_raw(&body.attrs().velocity.as_slice()[..slots])
+        Ok(self.projection.system.kinetic_energy_raw(&body.attrs().velocity.as_slice()[..slots]))
     }
 
     /// Largest distance of a live vertex from its rest position. O(vertex ids).
+    ///
+    /// # Errors
+    /// As [`Simulation::kinetic_energy`]: another body, or a stale projection.
     ///
     /// # Examples
     ///
@@ -339,15 +357,16 @@ impl Simulation {
     /// let (points, tets) = kuhn_cube(1);
     /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
     /// let sim = Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Euler, 1e-3)).unwrap();
-    /// assert_eq!(sim.max_displacement(&body), 0.0);
+    /// assert_eq!(sim.max_displacement(&body), Ok(0.0));
     /// body.attrs_mut().position_mut().as_mut_slice()[5] = [1.0, 0.0, 1.25]; // vertex 5 rests at (1, 0, 1)
-    /// assert_eq!(sim.max_displacement(&body), 0.25);
+    /// assert_eq!(sim.max_displacement(&body), Ok(0.25));
     /// ```
-    pub fn max_displacement(&self, body: &Body) -> f64 {
+    pub fn max_displacement(&self, body: &Body) -> Result<f64, SimError> {
+        self.check_current(body)?;
         let m = body.attrs();
-        (0..self.projection.system.slots())
+        Ok((0..self.projection.system.slots())
             .filter(|&v| self.projection.dart_of_vertex(v).is_some())
             .map(|v| geom::norm(geom::sub(m.position.as_slice()[v], m.rest_position.as_slice()[v])))
-            .fold(0.0, f64::max)
+            .fold(0.0, f64::max))
     }
 }

@@ -60,7 +60,7 @@ use super::model::{Body, Mechanics};
 /// let p = Projection::build(&body, [0.0, 0.0, -9.81]);
 /// let cells = body.map().count_cells();
 /// assert_eq!((p.system().slots(), p.system().springs()), (cells.0[0], cells.0[1])); // vertices, edges
-/// assert_eq!(p.system().gravity, [0.0, 0.0, -9.81]);
+/// assert_eq!(p.system().gravity(), [0.0, 0.0, -9.81]);
 /// assert_eq!(p.version(), body.version());
 /// ```
 #[derive(Clone, Debug)]
@@ -490,7 +490,7 @@ impl Projection {
     /// for s in 0..p.system().springs() {
     ///     let d = p.dart_of_spring(s);
     ///     assert_eq!(map.cell_id(1, d), p.edge_of_spring(s));
-    ///     let [a, b] = p.system().ends[s];
+    ///     let [a, b] = p.system().ends()[s];
     ///     assert!(a < b && [a, b].contains(&map.vertex_id(d).0));
     ///     assert_eq!(map.vertex_id(map.alpha::<0>(d)).0, a + b - map.vertex_id(d).0); // α0: the other end
     /// }

@@ -39,7 +39,8 @@ use crate::mechanics::Vec3;
 use crate::surface::Surface;
 use raster::{cross, dot, norm, sub, Target, View};
 
-/// The largest image [`render`] accepts, in pixels (a bound on the buffers it allocates).
+/// The largest image [`render`] and [`Image::new`] accept, in pixels (a bound on the buffers
+/// they allocate: 3 bytes per pixel for the picture, 8 more for the depth buffer of [`render`]).
 pub const MAX_PIXELS: u64 = 1 << 26;
 
 /// Errors of the renderer and of the PNG writer.
@@ -223,13 +224,15 @@ impl Camera {
 /// An 8-bit RGB picture, rows top to bottom.
 ///
 /// Invariant (checked by [`Image::encode_png`]): `rgb.len() == 3 · width · height`.
+/// [`Image::new`] makes images of 1 to [`MAX_PIXELS`] pixels; the fields are public, so a
+/// larger one can be built by hand from its buffer.
 ///
 /// # Examples
 ///
 /// ```
 /// use topomech::render::Image;
 ///
-/// let mut img = Image::new(3, 2, [0; 3]);
+/// let mut img = Image::new(3, 2, [0; 3]).unwrap();
 /// img.set_pixel(2, 1, [7, 8, 9]);
 /// assert_eq!(img.rgb.len(), 3 * img.width as usize * img.height as usize);
 /// assert_eq!(&img.rgb[3 * (1 * 3 + 2)..][..3], &[7, 8, 9]); // row-major, rows top to bottom
@@ -245,20 +248,31 @@ pub struct Image {
 }
 
 impl Image {
-    /// A `width` × `height` image filled with `background`. O(pixels).
+    /// A `width` × `height` image filled with `background`. The size is checked first, in
+    /// O(1), as [`render`] checks it: both sides positive and at most [`MAX_PIXELS`] pixels in
+    /// all, so nothing is allocated for a size refused. O(pixels).
+    ///
+    /// # Errors
+    /// [`RenderError::BadSize`] naming the size, for a zero side or more than [`MAX_PIXELS`]
+    /// pixels.
     ///
     /// # Examples
     ///
     /// ```
-    /// use topomech::render::Image;
+    /// use topomech::render::{Image, RenderError};
     ///
-    /// let img = Image::new(4, 2, [1, 2, 3]);
+    /// let img = Image::new(4, 2, [1, 2, 3]).unwrap();
     /// assert_eq!(img.rgb.len(), 3 * 4 * 2);
     /// assert_eq!(img.pixel(3, 1), Some([1, 2, 3]));
+    /// assert!(matches!(Image::new(0, 2, [0; 3]), Err(RenderError::BadSize { width: 0, height: 2 })));
+    /// let too_big = Image::new(u32::MAX, u32::MAX, [0; 3]); // refused, not allocated
+    /// assert!(matches!(too_big, Err(RenderError::BadSize { width: u32::MAX, height: u32::MAX })));
+    /// assert!(Image::new(1 << 13, (1 << 13) + 1, [0; 3]).is_err()); // one row past MAX_PIXELS
     /// ```
-    pub fn new(width: u32, height: u32, background: [u8; 3]) -> Image {
+    pub fn new(width: u32, height: u32, background: [u8; 3]) -> Result<Image, RenderError> {
+        check_size(width, height)?;
         let n = width as usize * height as usize;
-        Image { width, height, rgb: background.repeat(n) }
+        Ok(Image { width, height, rgb: background.repeat(n) })
     }
 
     /// The colour of pixel (x, y), `None` outside the image. O(1).
@@ -268,7 +282,7 @@ impl Image {
     /// ```
     /// use topomech::render::Image;
     ///
-    /// let img = Image::new(4, 2, [9, 9, 9]);
+    /// let img = Image::new(4, 2, [9, 9, 9]).unwrap();
     /// assert_eq!(img.pixel(0, 0), Some([9, 9, 9]));
     /// assert_eq!((img.pixel(4, 0), img.pixel(0, 2)), (None, None)); // outside
     /// ```
@@ -284,7 +298,7 @@ impl Image {
     /// ```
     /// use topomech::render::Image;
     ///
-    /// let mut img = Image::new(3, 3, [0; 3]);
+    /// let mut img = Image::new(3, 3, [0; 3]).unwrap();
     /// img.set_pixel(1, 2, [255, 0, 0]);
     /// img.set_pixel(7, 7, [255, 0, 0]); // outside: ignored
     /// assert_eq!(img.pixel(1, 2), Some([255, 0, 0]));
@@ -313,11 +327,11 @@ impl Image {
     /// ```
     /// use topomech::render::Image;
     ///
-    /// let png = Image::new(5, 3, [0, 128, 255]).encode_png().unwrap();
+    /// let png = Image::new(5, 3, [0, 128, 255]).unwrap().encode_png().unwrap();
     /// assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
     /// assert_eq!(&png[12..16], b"IHDR");
     /// assert_eq!((&png[16..20], &png[20..24]), (&5u32.to_be_bytes()[..], &3u32.to_be_bytes()[..])); // width, height
-    /// assert!(Image::new(0, 3, [0; 3]).encode_png().is_err());
+    /// assert!(Image { width: 0, height: 3, rgb: vec![] }.encode_png().is_err());
     /// let broken = Image { width: 2, height: 2, rgb: vec![0; 5] };
     /// assert!(broken.encode_png().is_err());
     /// ```
@@ -342,7 +356,7 @@ impl Image {
     /// ```
     /// use topomech::render::Image;
     ///
-    /// let img = Image::new(2, 2, [10, 20, 30]);
+    /// let img = Image::new(2, 2, [10, 20, 30]).unwrap();
     /// let path = std::env::temp_dir().join(format!("topomech_doc_{}.png", std::process::id()));
     /// img.write_png(&path).unwrap();
     /// assert_eq!(std::fs::read(&path).unwrap(), img.encode_png().unwrap());
@@ -543,13 +557,11 @@ pub fn render_styled(
     height: u32,
     style: &Style,
 ) -> Result<Image, RenderError> {
-    if width == 0 || height == 0 || width as u64 * height as u64 > MAX_PIXELS {
-        return Err(RenderError::BadSize { width, height });
-    }
+    check_size(width, height)?;
     let view = View::new(camera)?;
     check_surface(surface)?;
     let colors = shading.colors(surface.triangles.len())?;
-    let mut image = Image::new(width, height, style.background);
+    let mut image = Image::new(width, height, style.background)?;
     let ambient = if style.ambient.is_finite() { style.ambient.clamp(0.0, 1.0) } else { 0.3 };
     let mut target = Target::new(&mut image);
     for (tri, &base) in surface.triangles.iter().zip(&colors) {
@@ -579,6 +591,15 @@ fn headlight(p: [Vec3; 3], eye: Vec3) -> f64 {
     } else {
         -0.8 * cos
     }
+}
+
+/// [`RenderError::BadSize`] unless both sides are positive and the image has at most
+/// [`MAX_PIXELS`] pixels. O(1).
+fn check_size(width: u32, height: u32) -> Result<(), RenderError> {
+    if width == 0 || height == 0 || width as u64 * height as u64 > MAX_PIXELS {
+        return Err(RenderError::BadSize { width, height });
+    }
+    Ok(())
 }
 
 fn check_surface(surface: &Surface) -> Result<(), RenderError> {

@@ -297,7 +297,7 @@ fn play(args: &DemoArgs, loaded: &Loaded, log: &mut dyn Write) -> Result<Played,
     finish_stage(log, &scene, &incision, &mut rows, "2/5", what)?;
     output.stress_picture("2_incision.png", &scene)?;
 
-    let threshold = scene.tear_threshold();
+    let threshold = scene.tear_threshold()?;
     let mut tear = StageRun { name: "tear", ..StageRun::default() };
     bar.set_message("tear");
     scene.simulate(&mut tear, n / 2, Some(threshold), &mut output, &bar)?;

@@ -82,10 +82,12 @@ impl Output {
     /// triangle's vertices (on the fixed scale) and writes it as `name`. O(pixels + surface).
     ///
     /// # Errors
-    /// [`DemoError::Render`] naming the file.
+    /// [`DemoError::Render`] naming the file; [`DemoError::Sim`] if the simulation does not
+    /// follow the body (a bug of the demo).
     pub fn stress_picture(&mut self, name: &str, scene: &Scene) -> Result<(), DemoError> {
         let surface = surface::boundary_surface(&scene.body);
-        let stress = cut::principal_stress(&scene.body, &scene.sim);
+        let stress = cut::principal_stress(&scene.body, &scene.sim)
+            .map_err(|source| DemoError::Sim { stage: "picture", source })?;
         let at = |i: u32| stress.get(surface.vertex_ids[i as usize] as usize).map_or(0.0, |s| s.magnitude);
         let values = surface.triangles.iter().map(|t| t.iter().map(|&i| at(i)).sum::<f64>() / 3.0).collect();
         let shading = Shading::PerTriangle { values, range: self.stress_range, colormap: Colormap::Sequential };
@@ -128,7 +130,7 @@ impl Output {
             .zip(m.rest_position().as_slice())
             .map(|(p, r)| [p[0] - r[0], p[1] - r[1], p[2] - r[2]])
             .collect();
-        let stress = vertex_stress(scene, points.len());
+        let stress = vertex_stress(scene, points.len())?;
         let tets = body_tets(body);
         let frame = Frame {
             points,
@@ -158,10 +160,14 @@ impl Output {
 
 /// The principal tensile stress of every vertex slot as magnitude × direction, padded with zeros
 /// to `len` entries. O(springs + slots).
-pub fn vertex_stress(scene: &Scene, len: usize) -> Vec<Vec3> {
-    let mut out: Vec<Vec3> =
-        cut::principal_stress(&scene.body, &scene.sim).iter().map(|s| s.direction.map(|c| c * s.magnitude)).collect();
+///
+/// # Errors
+/// [`DemoError::Sim`] if the simulation does not follow the body (a bug of the demo).
+pub fn vertex_stress(scene: &Scene, len: usize) -> Result<Vec<Vec3>, DemoError> {
+    let stress =
+        cut::principal_stress(&scene.body, &scene.sim).map_err(|source| DemoError::Sim { stage: "frame", source })?;
+    let mut out: Vec<Vec3> = stress.iter().map(|s| s.direction.map(|c| c * s.magnitude)).collect();
     out.resize(len, [0.0; 3]);
     out.truncate(len);
-    out
+    Ok(out)
 }

@@ -155,7 +155,7 @@ pub fn simulate_refined(
         .collect();
     let sys =
         mech.spring_system(lm, config.gravity, &fixed).map_err(|source| DemoError::Coupling { tet: None, source })?;
-    let (slot_mass, tet_mass) = (sys.mass.iter().sum::<f64>(), mech.masses.total(lm));
+    let (slot_mass, tet_mass) = (sys.mass().iter().sum::<f64>(), mech.masses.total(lm));
     let residual = (slot_mass - tet_mass) / tet_mass;
     if residual.is_nan() || residual.abs() > super::checks::TOLERANCE {
         return Err(DemoError::Balance { stage: "refinement", step: 0, quantity: "slot mass", residual });
@@ -181,7 +181,7 @@ pub fn simulate_refined(
         .kinetic_energy(&mech.velocity)
         .map_err(|e| DemoError::RefinedStep { step: steps, source: StepError::BadInput(e.to_string()) })?;
     let max_displacement = (0..sys.slots().min(rest.len()))
-        .filter(|&v| sys.mass[v] > 0.0)
+        .filter(|&v| sys.mass()[v] > 0.0)
         .map(|v| dist(mech.position[v], rest[v]))
         .fold(0.0, f64::max);
     Ok(RefinedSim {
@@ -331,8 +331,8 @@ mod tests {
         assert_eq!(r.doubled_edges, 0, "an uncut cube has no doubled edge");
         let (after, levels) = refined_surface(&r.lm, &r.mech.position);
         assert_eq!(levels.len(), after.triangles.len());
-        assert!((after.enclosed_volume() - before.enclosed_volume()).abs() < 1e-12, "same solid");
-        assert!((after.enclosed_volume() - 8.0).abs() < 1e-12);
+        assert!((after.enclosed_volume().unwrap() - before.enclosed_volume().unwrap()).abs() < 1e-12, "same solid");
+        assert!((after.enclosed_volume().unwrap() - 8.0).abs() < 1e-12);
         assert!(levels.contains(&0) && levels.contains(&LEVEL), "both levels show on the boundary");
         assert!(after.triangles.len() > before.triangles.len());
     }
@@ -344,7 +344,7 @@ mod tests {
         let (s, levels) = refined_surface(&r.lm, &r.mech.position);
         assert_eq!(s.triangles.len(), 12 * 4, "12k² boundary faces for k = 2");
         assert!(levels.iter().all(|&l| l == 0));
-        assert!((s.enclosed_volume() - 8.0).abs() < 1e-12);
+        assert!((s.enclosed_volume().unwrap() - 8.0).abs() < 1e-12);
     }
 
     /// A cube whose ring of tets around an inner edge is opened at two faces: the edge becomes two

@@ -279,9 +279,13 @@ impl Scene {
     }
 
     /// The tear threshold: [`TEAR_FRACTION`] of the largest vertex stress now. O(springs + slots).
-    pub fn tear_threshold(&self) -> f64 {
-        let stress = cut::principal_stress(&self.body, &self.sim);
-        TEAR_FRACTION * stress.iter().map(|s| s.magnitude).fold(0.0, f64::max)
+    ///
+    /// # Errors
+    /// [`DemoError::Sim`] if the simulation does not follow the body (a bug of the demo).
+    pub fn tear_threshold(&self) -> Result<f64, DemoError> {
+        let stress =
+            cut::principal_stress(&self.body, &self.sim).map_err(|source| DemoError::Sim { stage: "tear", source })?;
+        Ok(TEAR_FRACTION * stress.iter().map(|s| s.magnitude).fold(0.0, f64::max))
     }
 
     /// Removes the tets whose centroid (current positions) lies within [`REMOVAL_RADIUS`] of the

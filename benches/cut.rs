@@ -94,7 +94,7 @@ fn fixture_of(name: &str, mesh: &topomech::mesh::TetMesh) -> Fixture {
 fn fixture(name: &str, points: &[Vec3], tets: &[[u32; 4]]) -> Fixture {
     let (body, _) = Body::from_tets(points, tets, Material::default()).expect("mesh");
     let incision = cut_select::incision_faces(&body, points);
-    let projection = Projection::build(&body, G);
+    let projection = Projection::build(&body, G).unwrap();
     let map = body.map();
     let (faces, vertices) = cut_select::faces_and_vertices(map);
     Fixture { name: name.to_string(), body, projection, faces, vertices, incision, done: Vec::new() }

@@ -45,7 +45,7 @@ fn main() {
     let mesh = topomech::io::read_mesh(path).expect("liver_547.msh");
     let (z, _) = mesh.spatially_ordered();
     let (mut body, _) = Body::from_tets(&z.points, &z.tets, Material::default()).expect("mesh");
-    let mut projection = Projection::build(&body, [0.0, 0.0, -9.81]);
+    let mut projection = Projection::build(&body, [0.0, 0.0, -9.81]).unwrap();
     let (faces, _) = cut_select::faces_and_vertices(body.map());
     let (mut total, mut max) = (0, 0);
     for pass in 0..2 {

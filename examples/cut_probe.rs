@@ -62,7 +62,7 @@ fn main() {
     let mesh = topomech::io::read_mesh(path).expect("liver_547.msh");
     let (z, _) = mesh.spatially_ordered();
     let (body, _) = Body::from_tets(&z.points, &z.tets, Material::default()).expect("mesh");
-    let projection = Projection::build(&body, G);
+    let projection = Projection::build(&body, G).unwrap();
     let map = body.map();
     // The bench's selection: the same seed, the same shuffles.
     let (faces, vertices) = cut_select::faces_and_vertices(map);

@@ -100,7 +100,7 @@ fn main() {
     let mesh = topomech::io::read_mesh(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let (z, _) = mesh.spatially_ordered();
     let (mut body, _) = Body::from_tets(&z.points, &z.tets, Material::default()).expect("mesh");
-    let mut projection = Projection::build(&body, G);
+    let mut projection = Projection::build(&body, G).unwrap();
     let (faces, vertices) = cut_select::faces_and_vertices(body.map());
     if which == "tear" {
         let (calls, digest) = tears(&mut body, &mut projection, &vertices, passes);

@@ -38,7 +38,7 @@ fn check(body: &Body, sim: &Simulation, mass: f64) {
     check_conservation(body.map(), body.attrs()).unwrap();
     let m = total_mass(body);
     assert!((m - mass).abs() <= 1e-12 * mass, "mass {m} vs {mass}");
-    let fresh = Projection::build(body, [0.0; 3]);
+    let fresh = Projection::build(body, [0.0; 3]).unwrap();
     sim.projection.equivalent(&fresh).unwrap();
     assert!(sim.projection.is_current(body));
 }

@@ -69,7 +69,7 @@ fn laws_hold_on_a_fresh_body_and_match_the_flat_baseline() {
     for (v, &m) in flat.system.mass().iter().enumerate() {
         assert!(rel_close(mech.vertex_mass(CellId(v as u32)), m, 1e-12), "vertex {v}");
     }
-    let projection = Projection::build(&body, G);
+    let projection = Projection::build(&body, G).unwrap();
     assert_eq!(projection.system().ends(), flat.system.ends());
     for s in 0..flat.system.springs() {
         assert!(rel_close(projection.system().stiffness()[s], flat.system.stiffness()[s], 1e-12), "spring {s}");
@@ -82,7 +82,7 @@ fn an_interior_edge_gets_the_sum_of_its_tets_contributions() {
     // The Kuhn cube's main diagonal (0,0,0)–(1,1,1) of a unit cube is shared by its 6 tets.
     let (points, tets) = kuhn_cube(1);
     let (body, _) = Body::from_tets(&points, &tets, material()).unwrap();
-    let p = Projection::build(&body, G);
+    let p = Projection::build(&body, G).unwrap();
     let s = (0..p.system().springs()).find(|&s| p.system().ends()[s] == [0, 7]).expect("diagonal spring");
     let l = 3f64.sqrt();
     let expected = 6.0 * 700.0 * (1.0 / 6.0) / (l * l);
@@ -129,7 +129,7 @@ fn unsew3_along_a_plane_splits_masses_and_stiffnesses_conservatively() {
     // The body is now two halves: it must equal the flat model of the two halves, built apart.
     let (half_points, half_tets) = split_at_plane(&points, &tets, 1.0);
     let flat = FlatModel::from_tets(&half_points, &half_tets, material(), G, &[]).unwrap();
-    let projection = Projection::build(&body, G);
+    let projection = Projection::build(&body, G).unwrap();
     assert_eq!(projection.system().springs(), flat.system.springs());
     let mut ours: Vec<f64> = projection.system().stiffness().to_vec();
     let mut theirs = flat.system.stiffness().to_vec();
@@ -159,7 +159,7 @@ fn unsew3_along_a_plane_splits_masses_and_stiffnesses_conservatively() {
     // Ids may have moved (a merge keeps one side's id), so compare through rest positions.
     let flat = FlatModel::from_tets(&points, &tets, material(), G, &[]).unwrap();
     let point_of = |v: u32| points.iter().position(|p| *p == body.attrs().rest_position()[CellId(v)]).unwrap() as u32;
-    let p1 = Projection::build(&body, G);
+    let p1 = Projection::build(&body, G).unwrap();
     let mut springs: Vec<([u32; 2], f64)> = (0..p1.system().springs())
         .map(|s| {
             let [a, b] = p1.system().ends()[s].map(point_of);
@@ -254,7 +254,7 @@ fn projection_forces_equal_the_orbit_walk_to_1e_12() {
             let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
             body.unsew3(d).unwrap();
         }
-        let p = Projection::build(&body, G);
+        let p = Projection::build(&body, G).unwrap();
         let n = p.system().slots();
         let m = body.attrs();
         let mut sf = vec![[0.0; 3]; p.system().springs()];
@@ -534,7 +534,7 @@ fn a_body_from_parts_that_disagree_is_refused_and_the_parts_come_back() {
 fn a_projection_update_takes_only_lists_that_bring_it_up_to_date() {
     use topomech::cut::dissociate_face;
     use topomech::mechanics::TouchedCells;
-    let fresh = |b: &Body| Projection::build(b, G);
+    let fresh = |b: &Body| Projection::build(b, G).unwrap();
     let inner = |b: &Body, k: usize| b.map().darts().filter(|&d| !b.map().is_free(3, d)).nth(k).unwrap();
     let (points, tets) = kuhn_cube(2);
     let base = Body::from_tets(&points, &tets, material()).unwrap().0;
@@ -640,7 +640,7 @@ fn check_reports_a_broken_law_and_the_layer_checks_after_each_operation() {
 fn removing_a_lone_tet_moves_the_version_on() {
     let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
     let (mut body, _) = Body::from_tets(&points, &[[0, 1, 2, 3]], material()).unwrap();
-    let projection = Projection::build(&body, G);
+    let projection = Projection::build(&body, G).unwrap();
     let removal = topomech::cut::remove_volume(&mut body, CellId(0)).unwrap();
     assert!(removal.dissociations.is_empty());
     assert_eq!(body.version(), 1);
@@ -684,4 +684,47 @@ fn attributes_given_another_bodys_map_or_a_dead_dart_are_refused() {
             < 1e-12
     );
     assert_eq!(copy.update_normals(small.map()), Ok(()));
+}
+
+/// Finding 40 (docs/VERIFICATION.md): the flat oracle and the projections took what the body
+/// refuses. `FlatModel::from_tets` built a model with negative spring stiffnesses from
+/// `young = -1` and massless slots (silently fixed) from `density = 0`, took a pin list of any
+/// length (a short one left the rest free) and a NaN gravity; `Projection::build` and
+/// `LeveledMechanics::spring_system` stored a NaN gravity in a system that `SpringSystem::check`
+/// then refused. Each is now refused at the door with the error naming the value.
+#[test]
+fn the_flat_oracle_and_the_projections_refuse_what_the_body_refuses() {
+    use topomech::mechanics::{ModelError, SystemError};
+    use topomech::subdivide::{CouplingError, LeveledMap, LeveledMechanics};
+    let (points, tets) = kuhn_cube(1);
+    let flat = |m: Material, g: [f64; 3], pins: &[bool]| FlatModel::from_tets(&points, &tets, m, g, pins);
+    for (name, bad) in [
+        ("young", Material { young: -1.0, ..material() }),
+        ("density", Material { density: 0.0, ..material() }),
+        ("density", Material { density: f64::NAN, ..material() }),
+        ("viscosity", Material { viscosity: f64::INFINITY, ..material() }),
+    ] {
+        assert!(
+            matches!(Body::from_tets(&points, &tets, bad), Err(ModelError::BadMaterial { name: n, .. }) if n == name)
+        );
+        let e = flat(bad, [0.0; 3], &[]).unwrap_err();
+        assert!(matches!(e, ModelError::BadMaterial { name: n, .. } if n == name), "{name}: {e}");
+    }
+    assert!(matches!(flat(material(), [0.0, f64::NAN, 0.0], &[]), Err(ModelError::BadGravity(_))));
+    assert_eq!(flat(material(), [0.0; 3], &[true; 2]).unwrap_err(), ModelError::PinCount { len: 2, points: 8 });
+    assert_eq!(flat(material(), [0.0; 3], &[true; 9]).unwrap_err(), ModelError::PinCount { len: 9, points: 8 });
+    let pinned = flat(material(), [0.0; 3], &[true; 8]).unwrap();
+    assert!(pinned.system.inv_mass().iter().all(|&w| w == 0.0) && pinned.system.check().is_ok());
+
+    let (body, _) = Body::from_tets(&points, &tets, material()).unwrap();
+    let e = Projection::build(&body, [f64::INFINITY, 0.0, 0.0]).unwrap_err();
+    assert!(matches!(e, SystemError::BadGravity(g) if g[0] == f64::INFINITY));
+    assert!(Projection::build(&body, G).unwrap().system().check().is_ok());
+
+    let (map, _) = topomech::GMap::<3>::from_tets(points.len(), &tets).unwrap();
+    let leveled = LeveledMap::new(map, points.clone());
+    let coupling = LeveledMechanics::new(&leveled, material()).unwrap();
+    let e = coupling.spring_system(&leveled, [0.0, 0.0, f64::NAN], &[]).unwrap_err();
+    assert!(matches!(e, CouplingError::System(SystemError::BadGravity(_))), "{e}");
+    assert!(coupling.spring_system(&leveled, G, &[]).unwrap().check().is_ok());
 }

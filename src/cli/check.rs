@@ -94,7 +94,7 @@ fn json_report(
 }
 
 /// Stable law names: involution, quasi_manifold, cell_id_constant, cell_id_unique, conservation,
-/// and for levels: level_record, mu_order, mu_constant, level_closed, level_valid.
+/// and for levels: level_record, mu_order, mu_constant, level_closed, level_valid, flat_flag.
 fn law_name(f: &Finding) -> &'static str {
     match f {
         Finding::Map(v) => map_law_name(v),
@@ -104,6 +104,7 @@ fn law_name(f: &Finding) -> &'static str {
             LevelError::MuNotConstant { .. } => "mu_constant",
             LevelError::NotClosed { .. } => "level_closed",
             LevelError::InvalidLevel { .. } | LevelError::InvalidMap(_) => "level_valid",
+            LevelError::FlatFlag { .. } => "flat_flag",
         },
         Finding::Level(_) => "level_record",
         Finding::LevelMap { .. } => "level_valid",
@@ -146,7 +147,7 @@ fn violation_darts(v: &InvariantViolation) -> Vec<u32> {
 fn level_darts(e: &LevelPartsError) -> Vec<u32> {
     match e {
         LevelPartsError::DartLevelAboveMax { dart, .. } | LevelPartsError::BadHistory { dart, .. } => vec![dart.0],
-        LevelPartsError::Law(LevelError::MuOrder { dart, .. }) => vec![dart.0],
+        LevelPartsError::Law(LevelError::MuOrder { dart, .. } | LevelError::FlatFlag { dart, .. }) => vec![dart.0],
         LevelPartsError::Law(LevelError::MuNotConstant { dart, other, .. }) => vec![dart.0, other.0],
         LevelPartsError::Law(LevelError::NotClosed { dart, image, .. }) => vec![dart.0, image.0],
         LevelPartsError::Law(LevelError::InvalidLevel { source: v, .. } | LevelError::InvalidMap(v)) => {

@@ -403,7 +403,7 @@ impl Clone for Harness {
         let body = self.body.clone();
         let projection = match self.projection.for_clone(&self.body, &body) {
             Some(p) => p,
-            None => Projection::build(&body, self.projection.system.gravity),
+            None => Projection::build_raw(&body, self.projection.system.gravity),
         };
         Harness {
             body,
@@ -458,7 +458,7 @@ impl Harness {
     /// ```
     pub fn new(points: Vec<Vec3>, tets: Vec<[u32; 4]>) -> Result<Self, crate::mechanics::ModelError> {
         let (body, _) = Body::from_tets(&points, &tets, material())?;
-        let projection = Projection::build(&body, G);
+        let projection = Projection::build_raw(&body, G);
         let mass = body.total_vertex_mass();
         let stiffness = total_stiffness(&body);
         let oracle = Oracle::new(points, tets);
@@ -641,7 +641,7 @@ impl Harness {
         if !rel_close(k, self.stiffness - self.removed_stiffness) {
             return Err(format!("stiffness {k} != {} - {}", self.stiffness, self.removed_stiffness));
         }
-        let fresh = Projection::build(&self.body, G);
+        let fresh = Projection::build_raw(&self.body, G);
         self.projection.equivalent(&fresh).map_err(|e| format!("incremental projection: {e}"))?;
         if !self.projection.is_current(&self.body) {
             return Err("projection not current after update".into());

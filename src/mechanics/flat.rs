@@ -9,7 +9,7 @@
 
 use super::force::SpringSystem;
 use super::geom::{norm, sub, tet_volume, Vec3};
-use super::model::{stiffness_contribution, Material, ModelError, ModelTotals};
+use super::model::{check_material, stiffness_contribution, Material, ModelError, ModelTotals};
 use crate::build::BuildError;
 
 /// A flat mass/spring model: its [`SpringSystem`] and its own state arrays.
@@ -45,9 +45,12 @@ impl FlatModel {
     /// empty slice pins nothing). O(T log T).
     ///
     /// # Errors
-    /// [`ModelError::Build`] for a bad index or repeated point, [`ModelError::DegenerateTet`] for a
-    /// zero-volume tet, [`ModelError::NonFinitePoint`], [`ModelError::Overflow`] when a volume or a
-    /// total (mass, stiffness, damping) overflows f64.
+    /// What [`crate::mechanics::Body::from_tets`] refuses, so that the oracle and the body are
+    /// built from the same inputs: [`ModelError::BadMaterial`], [`ModelError::Build`] for a bad
+    /// index or repeated point, [`ModelError::DegenerateTet`] for a zero-volume tet,
+    /// [`ModelError::NonFinitePoint`], [`ModelError::Overflow`] when a volume or a total (mass,
+    /// stiffness, damping) overflows f64; and [`ModelError::BadGravity`] for a non-finite gravity,
+    /// [`ModelError::PinCount`] for a pin list that is neither empty nor one flag per point.
     ///
     /// # Examples
     ///
@@ -60,6 +63,9 @@ impl FlatModel {
     /// assert_eq!((flat.system.slots(), flat.system.springs()), (8, 19)); // one spring per edge
     /// assert!((flat.system.mass().iter().sum::<f64>() - 1.0).abs() < 1e-12); // density 1, unit cube
     /// assert_eq!(flat.position, points);
+    /// let negative = Material { young: -1.0, ..Material::default() };
+    /// assert!(FlatModel::from_tets(&points, &tets, negative, [0.0; 3], &[]).is_err()); // as Body::from_tets
+    /// assert!(FlatModel::from_tets(&points, &tets, Material::default(), [0.0; 3], &[true; 2]).is_err()); // 2 pins, 8 points
     /// ```
     pub fn from_tets(
         points: &[Vec3],
@@ -68,6 +74,13 @@ impl FlatModel {
         gravity: Vec3,
         pinned: &[bool],
     ) -> Result<Self, ModelError> {
+        check_material(&material)?;
+        if gravity.iter().any(|g| !g.is_finite()) {
+            return Err(ModelError::BadGravity(gravity));
+        }
+        if !(pinned.is_empty() || pinned.len() == points.len()) {
+            return Err(ModelError::PinCount { len: pinned.len(), points: points.len() });
+        }
         check(points, tets)?;
         let n = points.len();
         let mut mass = vec![0.0; n];

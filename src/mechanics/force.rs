@@ -554,7 +554,7 @@ impl SpringSystem {
     ///
     /// let (points, tets) = kuhn_cube(1);
     /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
-    /// let p = Projection::build(&body, [0.0; 3]);
+    /// let p = Projection::build(&body, [0.0; 3]).unwrap();
     /// assert_eq!(p.system().slots(), 8); // one slot per vertex of the cube
     /// ```
     pub fn slots(&self) -> usize {

@@ -178,7 +178,7 @@ impl Simulation {
                 *v = [0.0; 3];
             }
         }
-        let projection = Projection::build(body, gravity);
+        let projection = Projection::build_raw(body, gravity);
         let slots = projection.system.slots();
         let mech = body.attrs();
         let stepper = Stepper::new(
@@ -296,7 +296,7 @@ impl Simulation {
     /// let cut = dissociate_face(&mut body, d).unwrap();
     /// sim.update(&mut body, &cut.touched).unwrap(); // incremental: only the touched cells
     /// assert!(sim.projection.is_current(&body));
-    /// assert!(sim.projection.equivalent(&Projection::build(&body, [0.0; 3])).is_ok()); // = a fresh build
+    /// assert!(sim.projection.equivalent(&Projection::build(&body, [0.0; 3]).unwrap()).is_ok()); // = a fresh build
     /// sim.step(&mut body).unwrap();
     /// ```
     pub fn update(&mut self, body: &mut Body, touched: &TouchedCells) -> Result<(), SimError> {

@@ -133,6 +133,17 @@ pub enum ModelError {
         /// Its value there (infinite or NaN).
         value: f64,
     },
+    /// A gravity vector with a NaN or infinite component (the flat model's constructor).
+    #[error("gravity {0:?} must be finite")]
+    BadGravity(Vec3),
+    /// A pin list that is neither empty nor one flag per point (the flat model's constructor).
+    #[error("{len} pin flags for {points} points (give one per point, or none)")]
+    PinCount {
+        /// Flags given.
+        len: usize,
+        /// Points.
+        points: usize,
+    },
 }
 
 /// The mechanical attributes of a tetrahedral 3-G-map, all in arrays keyed by cell id.

@@ -43,7 +43,7 @@
 use crate::gmap::{CellChanges, DartSet};
 use crate::{AlphaMask, CellId, DartId, GMap};
 
-use super::force::{spring_force, IncidenceError, SpringSystem};
+use super::force::{spring_force, IncidenceError, SpringSystem, SystemError};
 use super::geom::Vec3;
 use super::model::{Body, Mechanics};
 
@@ -57,7 +57,7 @@ use super::model::{Body, Mechanics};
 ///
 /// let (points, tets) = kuhn_cube(1);
 /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
-/// let p = Projection::build(&body, [0.0, 0.0, -9.81]);
+/// let p = Projection::build(&body, [0.0, 0.0, -9.81]).unwrap();
 /// let cells = body.map().count_cells();
 /// assert_eq!((p.system().slots(), p.system().springs()), (cells.0[0], cells.0[1])); // vertices, edges
 /// assert_eq!(p.system().gravity(), [0.0, 0.0, -9.81]);
@@ -91,14 +91,22 @@ impl Projection {
     ///
     /// let (points, tets) = kuhn_cube(1);
     /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
-    /// let p = Projection::build(&body, [0.0, 0.0, -9.81]);
+    /// let p = Projection::build(&body, [0.0, 0.0, -9.81]).unwrap();
     /// assert_eq!((p.system().slots(), p.system().springs()), (8, 19));
     /// for s in 0..p.system().springs() {
     ///     assert_eq!(p.spring_of_edge(p.edge_of_spring(s)), Some(s));
     /// }
     /// assert!(p.is_current(&body));
     /// ```
-    pub fn build(body: &Body, gravity: Vec3) -> Self {
+    pub fn build(body: &Body, gravity: Vec3) -> Result<Self, SystemError> {
+        if gravity.iter().any(|g| !g.is_finite()) {
+            return Err(SystemError::BadGravity(gravity));
+        }
+        Ok(Projection::build_raw(body, gravity))
+    }
+
+    /// [`Projection::build`] with a gravity known to be finite. O(darts + E log E).
+    pub(crate) fn build_raw(body: &Body, gravity: Vec3) -> Self {
         let map = body.map();
         let mech = body.attrs();
         let n = map.cell_id_bound(0);
@@ -146,7 +154,7 @@ impl Projection {
     ///
     /// let (points, tets) = kuhn_cube(1);
     /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
-    /// let p = Projection::build(&body, [0.0, 0.0, -9.81]);
+    /// let p = Projection::build(&body, [0.0, 0.0, -9.81]).unwrap();
     /// let (x, v) = (body.attrs().position().as_slice(), body.attrs().velocity().as_slice());
     /// let (mut sf, mut f) = (vec![[0.0; 3]; p.system().springs()], vec![[0.0; 3]; p.system().slots()]);
     /// p.system().forces(x, v, &mut sf, &mut f, false).unwrap();
@@ -163,7 +171,7 @@ impl Projection {
     ///
     /// let (points, tets) = kuhn_cube(1);
     /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
-    /// let mut p = Projection::build(&body, [0.0; 3]);
+    /// let mut p = Projection::build(&body, [0.0; 3]).unwrap();
     /// p.system.swap_remove_spring(0).unwrap(); // private field
     /// ```
     pub fn system(&self) -> &SpringSystem {
@@ -182,14 +190,14 @@ impl Projection {
     ///
     /// let (points, tets) = kuhn_cube(1);
     /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
-    /// let mut p = Projection::build(&body, [0.0; 3]);
+    /// let mut p = Projection::build(&body, [0.0; 3]).unwrap();
     /// remove_volume(&mut body, CellId(0)).unwrap();
     /// assert!(!p.is_current(&body));
     /// p.rebuild(&body);
     /// assert_eq!((p.version(), p.system().springs()), (body.version(), body.map().count_cells().0[1]));
     /// ```
     pub fn rebuild(&mut self, body: &Body) {
-        *self = Projection::build(body, self.system.gravity);
+        *self = Projection::build_raw(body, self.system.gravity);
     }
 
     /// Whether the body has not changed topologically since the projection was built. O(1).
@@ -203,7 +211,7 @@ impl Projection {
     ///
     /// let (points, tets) = kuhn_cube(1);
     /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
-    /// let mut p = Projection::build(&body, [0.0; 3]);
+    /// let mut p = Projection::build(&body, [0.0; 3]).unwrap();
     /// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
     /// let cut = dissociate_face(&mut body, d).unwrap();
     /// assert!(!p.is_current(&body) && !cut.touched.is_empty());
@@ -225,7 +233,7 @@ impl Projection {
     ///
     /// let (points, tets) = kuhn_cube(1);
     /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
-    /// let p = Projection::build(&body, [0.0; 3]);
+    /// let p = Projection::build(&body, [0.0; 3]).unwrap();
     /// assert!(p.is_for(&body) && p.is_current(&body));
     /// let copy = body.clone();
     /// assert!(!p.is_for(&copy) && !p.is_current(&copy)); // same version, another body
@@ -244,7 +252,7 @@ impl Projection {
     ///
     /// let (points, tets) = kuhn_cube(1);
     /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
-    /// assert_eq!(Projection::build(&body, [0.0; 3]).body_identity(), body.identity());
+    /// assert_eq!(Projection::build(&body, [0.0; 3]).unwrap().body_identity(), body.identity());
     /// ```
     pub fn body_identity(&self) -> u64 {
         self.body
@@ -263,7 +271,7 @@ impl Projection {
     ///
     /// let (points, tets) = kuhn_cube(1);
     /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
-    /// let p = Projection::build(&body, [0.0; 3]);
+    /// let p = Projection::build(&body, [0.0; 3]).unwrap();
     /// let copy = body.clone();
     /// let q = p.for_clone(&body, &copy).unwrap();
     /// assert!(q.is_current(&copy) && !q.is_for(&body));
@@ -290,7 +298,7 @@ impl Projection {
     /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
     /// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
     /// body.unsew3(d).unwrap();
-    /// let p = Projection::build(&body, [0.0; 3]);
+    /// let p = Projection::build(&body, [0.0; 3]).unwrap();
     /// assert_eq!((p.version(), body.version()), (1, 1));
     /// ```
     pub fn version(&self) -> u64 {
@@ -320,11 +328,11 @@ impl Projection {
     ///
     /// let (points, tets) = kuhn_cube(2);
     /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
-    /// let mut p = Projection::build(&body, [0.0, 0.0, -9.81]);
+    /// let mut p = Projection::build(&body, [0.0, 0.0, -9.81]).unwrap();
     /// let cut = incise_plane(&mut body, &Plane { point: [1.0; 3], normal: [1.0, 0.0, 0.0] }).unwrap();
     /// assert!(p.update(&body, &cut.touched)); // incremental
     /// assert!(p.is_current(&body));
-    /// assert!(p.equivalent(&Projection::build(&body, [0.0, 0.0, -9.81])).is_ok());
+    /// assert!(p.equivalent(&Projection::build(&body, [0.0, 0.0, -9.81]).unwrap()).is_ok());
     /// assert_eq!(p.system().slots(), body.map().cell_id_bound(0)); // new vertex ids got slots
     /// ```
     pub fn update(&mut self, body: &Body, touched: &TouchedCells) -> bool {
@@ -418,9 +426,9 @@ impl Projection {
     ///
     /// let (points, tets) = kuhn_cube(1);
     /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
-    /// let a = Projection::build(&body, [0.0; 3]);
-    /// assert!(a.equivalent(&Projection::build(&body, [0.0; 3])).is_ok());
-    /// assert!(a.equivalent(&Projection::build(&body, [0.0, 0.0, -1.0])).is_err()); // other gravity
+    /// let a = Projection::build(&body, [0.0; 3]).unwrap();
+    /// assert!(a.equivalent(&Projection::build(&body, [0.0; 3]).unwrap()).is_ok());
+    /// assert!(a.equivalent(&Projection::build(&body, [0.0, 0.0, -1.0]).unwrap()).is_err()); // other gravity
     /// ```
     pub fn equivalent(&self, other: &Projection) -> Result<(), ProjectionMismatch> {
         let (a, b) = (&self.system, &other.system);
@@ -464,7 +472,7 @@ impl Projection {
     ///
     /// let (points, tets) = kuhn_cube(1);
     /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
-    /// let p = Projection::build(&body, [0.0; 3]);
+    /// let p = Projection::build(&body, [0.0; 3]).unwrap();
     /// let mut edges: Vec<_> = (0..p.system().springs()).map(|s| p.edge_of_spring(s)).collect();
     /// edges.sort_unstable();
     /// edges.dedup();
@@ -485,7 +493,7 @@ impl Projection {
     ///
     /// let (points, tets) = kuhn_cube(1);
     /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
-    /// let p = Projection::build(&body, [0.0; 3]);
+    /// let p = Projection::build(&body, [0.0; 3]).unwrap();
     /// let map = body.map();
     /// for s in 0..p.system().springs() {
     ///     let d = p.dart_of_spring(s);
@@ -512,7 +520,7 @@ impl Projection {
     /// let (points, tets) = kuhn_cube(1);
     /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
     /// remove_volume(&mut body, CellId(0)).unwrap(); // edge (1,0,0)–(1,1,0) was only in tet 0
-    /// let (p, map) = (Projection::build(&body, [0.0; 3]), body.map());
+    /// let (p, map) = (Projection::build(&body, [0.0; 3]).unwrap(), body.map());
     /// let live: Vec<CellId> = map.one_dart_per_cell(1).iter().map(|&d| map.cell_id(1, d)).collect();
     /// assert!(live.iter().all(|&e| p.spring_of_edge(e).is_some()) && p.system().springs() == live.len());
     /// let dead: Vec<CellId> = (0..map.cell_id_bound(1) as u32).map(CellId).filter(|e| !live.contains(e)).collect();
@@ -532,7 +540,7 @@ impl Projection {
     ///
     /// let (points, tets) = kuhn_cube(1);
     /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
-    /// let p = Projection::build(&body, [0.0; 3]);
+    /// let p = Projection::build(&body, [0.0; 3]).unwrap();
     /// for slot in 0..p.system().slots() {
     ///     assert_eq!(body.map().vertex_id(p.dart_of_vertex(slot).unwrap()).index(), slot); // slot = vertex id
     /// }
@@ -553,8 +561,8 @@ impl Projection {
 ///
 /// let (points, tets) = kuhn_cube(1);
 /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
-/// let a = Projection::build(&body, [0.0; 3]);
-/// let b = Projection::build(&body, [0.0, 0.0, -1.0]);
+/// let a = Projection::build(&body, [0.0; 3]).unwrap();
+/// let b = Projection::build(&body, [0.0, 0.0, -1.0]).unwrap();
 /// assert!(matches!(a.equivalent(&b), Err(ProjectionMismatch::Sizes { slots: (8, 8), .. })));
 /// ```
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -817,7 +825,7 @@ impl TouchedCells {
     ///
     /// let (points, tets) = kuhn_cube(2);
     /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
-    /// let mut p = Projection::build(&body, [0.0; 3]);
+    /// let mut p = Projection::build(&body, [0.0; 3]).unwrap();
     /// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
     /// let cut = dissociate_face(&mut body, d).unwrap();
     /// let mut touched = TouchedCells::default();
@@ -826,7 +834,7 @@ impl TouchedCells {
     /// touched.record_change(&body, &changes);
     /// assert_eq!(touched.versions(&body), Some((0, 2)));
     /// assert!(p.update(&body, &touched)); // incremental, both changes at once
-    /// assert!(p.equivalent(&Projection::build(&body, [0.0; 3])).is_ok());
+    /// assert!(p.equivalent(&Projection::build(&body, [0.0; 3]).unwrap()).is_ok());
     /// ```
     pub fn record_change(&mut self, body: &Body, changes: &CellChanges) {
         let before = (self.span, self.is_empty());
@@ -1040,7 +1048,7 @@ mod tests {
     fn deduplicated_records_resolve_as_per_dart_records() {
         let (points, tets) = jittered_cube(3, 7);
         let (mut body, _) = Body::from_tets(&points, &tets, material()).unwrap();
-        let mut projection = Projection::build(&body, [0.0, 0.0, -1.0]);
+        let mut projection = Projection::build_raw(&body, [0.0, 0.0, -1.0]);
         let mut rng = SplitMix64(19);
         let mut cut: Vec<(DartId, DartId)> = Vec::new();
         let (mut vertex_splits, mut vertex_merges) = (0, 0);
@@ -1075,7 +1083,7 @@ mod tests {
                 assert_eq!(resolve(map, dim, &r), resolve_by_hash(map, dim, &r));
             }
             assert!(projection.update(&body, &fast), "the recorded changes are taken incrementally");
-            projection.equivalent(&Projection::build(&body, [0.0, 0.0, -1.0])).unwrap();
+            projection.equivalent(&Projection::build_raw(&body, [0.0, 0.0, -1.0])).unwrap();
         }
         assert!(vertex_splits > 10 && vertex_merges > 10, "splits {vertex_splits}, merges {vertex_merges}");
     }

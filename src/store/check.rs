@@ -84,7 +84,8 @@ pub struct CheckReport {
 /// unique (one id per orbit, no orphan live id), then conservation for a body whose map is valid,
 /// then, for a document with levels: malformed records, μt ≤ μf ≤ μa and μ constant on cells at
 /// every dart, and (when the map is valid and the records well formed) every law of every
-/// extracted level G_0 … G_k, with the leveled map's dart ids.
+/// extracted level G_0 … G_k and the flat flag of every dart (the one its level and link history
+/// determine, [`crate::subdivide::LevelError::FlatFlag`]), with the leveled map's dart ids.
 /// The verdict comes from the kernel's `validate()` when n ≤ 3; the listing is a separate pass
 /// on the raw arrays that never stops at the first violation.
 /// Cost O(capacity · n² + cell ids) time and memory, O(k · capacity · n²) with k levels.

@@ -1,7 +1,7 @@
 //! The level laws of a document's levels part, every violation listed (what `topomech check`
 //! prints for a leveled map): malformed records, μt ≤ μf ≤ μa at every dart, μ constant on the
-//! cells of the finest map, and every level G_0 … G_k closed, an involution at every dart and a
-//! valid G-map.
+//! cells of the finest map, every level G_0 … G_k closed, an involution at every dart and a
+//! valid G-map, and every dart's flat flag the one its level and link history determine.
 
 use crate::gmap::InvariantViolation;
 use crate::subdivide::{record_errors, LevelError, LevelParts, LevelPartsError, LeveledMap};
@@ -96,6 +96,10 @@ fn every_level<const N: usize>(m: LeveledMap<N>, out: &mut Collector) -> bool {
             }
         }
     }
+    // Every level is closed (checked above), so the flat law reads live darts only.
+    let flats = m.flat_errors(usize::MAX);
+    broken |= !flats.is_empty();
+    flats.into_iter().for_each(|e| out.push(Finding::Level(LevelPartsError::Law(e))));
     broken
 }
 

@@ -30,6 +30,7 @@
 mod conform;
 mod cut;
 mod cut_error;
+mod flat;
 pub mod fuzz;
 mod history;
 mod ops;
@@ -355,6 +356,18 @@ pub enum LevelError {
     /// The finest map breaks a G-map law.
     #[error("the finest map is not valid: {0}")]
     InvalidMap(InvariantViolation),
+    /// A dart's flat flag (its vertex is an inserted vertex of a side of its face) disagrees
+    /// with the flag its level and link history determine: flat exactly when the dart was made,
+    /// with its α1 partner, by the split of one edge at its level L ≥ 1 (the two half-edges'
+    /// far darts record each other as their α0 before level L) and neither α1 link changed
+    /// since (see [`LeveledMap::check_all`]).
+    #[error("{dart}: flat flag is {flat}, but its level and link history make it {}", !.flat)]
+    FlatFlag {
+        /// The dart.
+        dart: DartId,
+        /// The flag stored for it.
+        flat: bool,
+    },
 }
 
 /// An extracted level G_i together with the ids its darts have in the leveled map.
@@ -783,8 +796,13 @@ impl<const N: usize> LeveledMap<N> {
         Ok(())
     }
 
-    /// Every law: the finest map valid, [`Self::check_levels`], and every level 0..=k extracted
-    /// and valid (B_{i−1} ⊂ B_i holds by construction of B_i from dart levels).
+    /// Every law: the finest map valid, [`Self::check_levels`], every level 0..=k extracted
+    /// and valid (B_{i−1} ⊂ B_i holds by construction of B_i from dart levels), and the flat
+    /// flag of every dart the one its level and history determine: a dart d of level L is flat
+    /// iff L ≥ 1, e = α1(d) ≠ d has level L, neither d nor e has an α1 history entry, and
+    /// x = α0^L(d), y = α0^L(e) have the history entries (L, α0, y) and (L, α0, x) (its vertex
+    /// was inserted on one edge at level L and no face split has made it a corner since;
+    /// [`LevelError::FlatFlag`]).
     /// O(k · capacity · n²).
     ///
     /// # Examples
@@ -807,6 +825,10 @@ impl<const N: usize> LeveledMap<N> {
             let view = self.level(i)?;
             view.map.validate().map_err(|source| LevelError::InvalidLevel { level: i, source })?;
         }
-        Ok(())
+        // Every level is closed now, so the flat law reads live darts only.
+        match self.flat_errors(1).into_iter().next() {
+            Some(e) => Err(e),
+            None => Ok(()),
+        }
     }
 }

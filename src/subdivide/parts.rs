@@ -244,7 +244,8 @@ impl<const N: usize> LeveledMap<N> {
     /// `DartLevelAboveMax`, `BadHistory`), then [`LevelPartsError::Law`] with the first level law
     /// broken: a level not closed or not an involution at some dart, then (from
     /// [`Self::check_all`]) the finest map invalid, μ order or constancy, a level not a valid
-    /// G-map.
+    /// G-map, a flat flag other than the one the levels and history determine
+    /// ([`LevelError::FlatFlag`]).
     ///
     /// # Examples
     ///

@@ -232,6 +232,11 @@ pub enum CouplingError {
         /// A dart of it.
         dart: DartId,
     },
+    /// The flat system would hold a value the step loop cannot use: a non-finite gravity, or a
+    /// spring value set out of range through [`LeveledMechanics::spring_mut`]
+    /// ([`LeveledMechanics::spring_system`]).
+    #[error("cannot project the coupling: {0}")]
+    System(crate::mechanics::SystemError),
 }
 
 /// A level-0 tet: its corner vertex ids (increasing) and the keys of its six edges in [`PAIRS`]
@@ -934,7 +939,8 @@ impl LeveledMechanics {
     ///
     /// # Errors
     /// As [`Self::vertex_masses`]: a coupling given another map (whose spring ends could reach
-    /// past its vertex ids) is refused.
+    /// past its vertex ids) is refused. [`CouplingError::System`] for a non-finite gravity or a
+    /// spring value out of range (what [`SpringSystem::new`] refuses).
     ///
     /// # Examples
     ///
@@ -954,6 +960,7 @@ impl LeveledMechanics {
     /// let (x, v) = (&mut mech.position, &mut mech.velocity);
     /// stepper.step(&sys, x, v).unwrap();
     /// assert!(mech.position[3][2] < 1.0 && mech.position[0] == [0.0; 3]); // falls, pinned stays
+    /// assert!(mech.spring_system(&m, [f64::NAN; 3], &[]).is_err()); // gravity must be finite
     /// ```
     pub fn spring_system(
         &self,
@@ -970,7 +977,8 @@ impl LeveledMechanics {
         let rest = self.springs.values().map(|s| s.rest).collect();
         let stiffness = self.springs.values().map(|s| s.stiffness).collect();
         let damping = self.springs.values().map(|s| s.damping).collect();
-        Ok(SpringSystem::from_arrays(ends, rest, stiffness, damping, mass, &pinned, viscosity, gravity))
+        SpringSystem::new(ends, rest, stiffness, damping, mass, &pinned, viscosity, gravity)
+            .map_err(CouplingError::System)
     }
 }
 

@@ -619,6 +619,9 @@ pub fn permuted_copy<const N: usize>(map: &GMap<N>, perm: &[u32]) -> Result<GMap
 
 /// A random permutation of 0..k (Fisher–Yates with SplitMix64). O(k).
 ///
+/// # Panics
+/// If `k` exceeds 2³² (the entries are `u32` dart indices).
+///
 /// # Examples
 ///
 /// ```
@@ -631,8 +634,9 @@ pub fn permuted_copy<const N: usize>(map: &GMap<N>, perm: &[u32]) -> Result<GMap
 /// assert_eq!(sorted, (0..10).collect::<Vec<u32>>());
 /// ```
 pub fn random_permutation(k: usize, seed: u64) -> Vec<u32> {
+    assert!(k as u64 <= 1 << 32, "a permutation of {k} entries does not fit u32 indices");
     let mut rng = SplitMix64(seed);
-    let mut p: Vec<u32> = (0..k as u32).collect();
+    let mut p: Vec<u32> = (0..=u32::MAX).take(k).collect();
     for j in (1..k).rev() {
         p.swap(j, rng.below(j + 1));
     }

@@ -400,6 +400,10 @@ impl<const N: usize> GMap<N> {
 
     /// The id of the i-cell that contains d. O(1).
     ///
+    /// # Panics
+    /// If `i > n` or `d` is not below [`GMap::capacity`] (the hot-path accessor; a dead dart
+    /// below the capacity returns the id it last had).
+    ///
     /// # Examples
     ///
     /// ```
@@ -420,6 +424,9 @@ impl<const N: usize> GMap<N> {
     }
 
     /// The vertex (0-cell) id of d. O(1).
+    ///
+    /// # Panics
+    /// If `d` is not below [`GMap::capacity`].
     ///
     /// # Examples
     ///

@@ -274,6 +274,9 @@ impl Mechanics {
 
     /// Rest volume V_t of volume `t`. O(1).
     ///
+    /// # Panics
+    /// If `t` is not below [`Mechanics::attribute_len`]`(3)` (no volume id of this body's map is).
+    ///
     /// # Examples
     ///
     /// ```
@@ -290,6 +293,9 @@ impl Mechanics {
     }
 
     /// Mass m_t = ρ·V_t of volume `t`. O(1).
+    ///
+    /// # Panics
+    /// If `t` is not below [`Mechanics::attribute_len`]`(3)` (no volume id of this body's map is).
     ///
     /// # Examples
     ///
@@ -313,6 +319,9 @@ impl Mechanics {
 
     /// Young's modulus of volume `t`. O(1).
     ///
+    /// # Panics
+    /// If `t` is not below [`Mechanics::attribute_len`]`(3)` (no volume id of this body's map is).
+    ///
     /// # Examples
     ///
     /// ```
@@ -330,6 +339,9 @@ impl Mechanics {
     }
 
     /// Rest length L_e of edge `e`. O(1).
+    ///
+    /// # Panics
+    /// If `e` is not below [`Mechanics::attribute_len`]`(1)` (no edge id of this body's map is).
     ///
     /// # Examples
     ///
@@ -352,6 +364,9 @@ impl Mechanics {
 
     /// Stiffness k_e of edge `e`. O(1).
     ///
+    /// # Panics
+    /// If `e` is not below [`Mechanics::attribute_len`]`(1)` (no edge id of this body's map is).
+    ///
     /// # Examples
     ///
     /// ```
@@ -373,6 +388,9 @@ impl Mechanics {
 
     /// Damping c_e of edge `e`. O(1).
     ///
+    /// # Panics
+    /// If `e` is not below [`Mechanics::attribute_len`]`(1)` (no edge id of this body's map is).
+    ///
     /// # Examples
     ///
     /// ```
@@ -393,6 +411,9 @@ impl Mechanics {
 
     /// Mass m_v of vertex `v`. O(1).
     ///
+    /// # Panics
+    /// If `v` is not below [`Mechanics::attribute_len`]`(0)` (no vertex id of this body's map is).
+    ///
     /// # Examples
     ///
     /// ```
@@ -412,6 +433,9 @@ impl Mechanics {
     }
 
     /// Ambient viscosity γ_v = ν·m_v of vertex `v`. O(1).
+    ///
+    /// # Panics
+    /// If `v` is not below [`Mechanics::attribute_len`]`(0)` (no vertex id of this body's map is).
     ///
     /// # Examples
     ///
@@ -449,6 +473,9 @@ impl Mechanics {
 
     /// Outward unit normal of boundary face `f` at the last [`Mechanics::update_normals`] (zero
     /// for inner faces). O(1).
+    ///
+    /// # Panics
+    /// If `f` is not below [`Mechanics::attribute_len`]`(2)` (no face id of this body's map is).
     ///
     /// # Examples
     ///

@@ -464,6 +464,9 @@ impl Projection {
 
     /// The edge of spring s. O(1).
     ///
+    /// # Panics
+    /// If `s` is not below `self.system().springs()`.
+    ///
     /// # Examples
     ///
     /// ```
@@ -484,6 +487,9 @@ impl Projection {
 
     /// A dart of spring s's edge; its vertex is one of the spring's two ends (either one: ends are
     /// stored as `[lo, hi]`). O(1).
+    ///
+    /// # Panics
+    /// If `s` is not below `self.system().springs()`.
     ///
     /// # Examples
     ///

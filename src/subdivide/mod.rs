@@ -559,7 +559,10 @@ impl<const N: usize> LeveledMap<N> {
         self.max_level
     }
 
-    /// The level at which dart `d` was created. O(1). Panics if `d` was never allocated.
+    /// The level at which dart `d` was created. O(1).
+    ///
+    /// # Panics
+    /// If `d` was never allocated (not below the map's capacity).
     ///
     /// # Examples
     ///
@@ -576,7 +579,10 @@ impl<const N: usize> LeveledMap<N> {
         self.dart_level[d.index()]
     }
 
-    /// μa, μf, μt of dart `d`. O(1). Panics if `d` was never allocated.
+    /// μa, μf, μt of dart `d`. O(1).
+    ///
+    /// # Panics
+    /// If `d` was never allocated (not below the map's capacity).
     ///
     /// # Examples
     ///
@@ -657,6 +663,9 @@ impl<const N: usize> LeveledMap<N> {
     }
 
     /// Position of the vertex of dart `d` (the origin if no geometry was given). O(1).
+    ///
+    /// # Panics
+    /// If `d` is not below the map's capacity (as [`GMap::vertex_id`]).
     ///
     /// # Examples
     ///

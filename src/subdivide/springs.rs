@@ -91,6 +91,9 @@ impl EdgeKey {
     /// The key of the edge of dart `d` in `map`: its cell id and the vertex ids of d and α0(d).
     /// O(1).
     ///
+    /// # Panics
+    /// If `d` is not below the map's capacity (as [`GMap::cell_id`]).
+    ///
     /// # Examples
     ///
     /// ```

@@ -19,6 +19,19 @@
 //! (one 3×3 determinant per quad); a segment parallel to Qᵢ (determinant below a relative 1e-12)
 //! does not cross it. Cost: O(darts) for the centroids plus O(inner faces × n) tests, each
 //! skipped when the segment's box misses the surface's box.
+//!
+//! # Scale invariance
+//! No test here (the well-formedness checks of [`PolylineSweep::check`] and the crossing test)
+//! depends on the scale of the coordinates, for any finite coordinates: no squared length or
+//! product is formed from raw coordinates, so nothing overflows for huge ones (up to `f64::MAX`)
+//! or underflows for tiny ones. A difference that overflows is taken of halved coordinates
+//! instead (exact, and finite even between ±`f64::MAX`); each vector is scaled by a power of two
+//! (exactly) so that its largest component has a fixed magnitude before any cross product or
+//! determinant; and the crossing parameters are compared with their bounds through the exponents
+//! of those scales. Multiplying every coordinate by a power of two therefore gives bit-identical
+//! decisions, ties included (a centroid exactly on the surface), unless a component of some
+//! vector is about 2^1000 times smaller than its largest one; any other factor changes them only
+//! through the rounding of the scaled coordinates themselves.
 
 use crate::mechanics::{geom, Body, Vec3};
 use crate::DartId;
@@ -52,6 +65,14 @@ impl PolylineSweep {
     /// Checks the surface is well formed: at least two points, all coordinates finite, consecutive
     /// points distinct, w non-zero and no segment parallel to w. O(n).
     ///
+    /// The tests do not depend on the scale of the coordinates (module docs): two points are
+    /// refused as coinciding only when they are equal (points that differ at all, even by one
+    /// ulp of a tiny coordinate, make a segment), w only when all its components are zero, and
+    /// "parallel" is a relative 1e-12 on the sine of the angle between the segment and w,
+    /// computed from the two directions each scaled (by a power of two) so that its largest
+    /// component is in [1, 2): neither huge (up to `f64::MAX`) nor tiny coordinates overflow or
+    /// underflow.
+    ///
     /// # Errors
     /// [`CutError::BadSweep`] naming the first problem.
     ///
@@ -66,6 +87,11 @@ impl PolylineSweep {
     /// assert!(along.check().unwrap_err().to_string().contains("segment 0"));
     /// let nan = PolylineSweep { points: vec![[0.0; 3], [f64::NAN, 0.0, 0.0]], sweep: [0.0, 0.0, 1.0] };
     /// assert!(nan.check().is_err());
+    /// // Scale-invariant: a huge perpendicular slit and a tiny one are both well formed.
+    /// let huge = PolylineSweep { points: vec![[0.0, -1e300, 0.0], [0.0, 1e300, 0.0]], sweep: [0.0, 0.0, 1e300] };
+    /// assert!(huge.check().is_ok());
+    /// let tiny = PolylineSweep { points: vec![[0.0; 3], [0.0, 2e-300, 0.0]], sweep: [0.0, 0.0, 2e-300] };
+    /// assert!(tiny.check().is_ok());
     /// ```
     pub fn check(&self) -> Result<(), CutError> {
         let bad = |reason: String| Err(CutError::BadSweep { reason });
@@ -75,22 +101,25 @@ impl PolylineSweep {
         if let Some(i) = self.points.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
             return bad(format!("point {i} {:?} is not finite", self.points[i]));
         }
-        if self.sweep.iter().any(|c| !c.is_finite()) || geom::norm(self.sweep) == 0.0 {
+        if self.sweep.iter().any(|c| !c.is_finite()) || self.sweep.iter().all(|&c| c == 0.0) {
             return bad(format!("sweep vector {:?} is not finite or is zero", self.sweep));
         }
+        let w = Scaled::new(self.sweep, 0, 0).dir;
         for (i, p) in self.points.windows(2).enumerate() {
-            let e = geom::sub(p[1], p[0]);
-            if geom::norm(e) == 0.0 {
+            if p[0] == p[1] {
                 return bad(format!("segment {i} has zero length (points {i} and {} coincide)", i + 1));
             }
-            if geom::norm(geom::cross(e, self.sweep)) <= 1e-12 * geom::norm(e) * geom::norm(self.sweep) {
+            // Distinct finite points: the difference is not zero (gradual underflow).
+            let e = Scaled::diff(p[1], p[0], 0).dir;
+            if geom::norm(geom::cross(e, w)) <= 1e-12 * geom::norm(e) * geom::norm(w) {
                 return bad(format!("segment {i} is parallel to the sweep vector: it sweeps no area"));
             }
         }
         Ok(())
     }
 
-    /// Whether the closed segment a–b meets the surface (module docs). O(n).
+    /// Whether the closed segment a–b meets the surface (module docs). O(n). Scale-invariant: the
+    /// answer is the same when a, b and the surface are all scaled by one factor (module docs).
     ///
     /// # Examples
     ///
@@ -107,8 +136,9 @@ impl PolylineSweep {
     /// assert!(!wall.crosses([0.5, 2.0, 1.0], [0.8, 2.0, 1.0])); // outside the L
     /// ```
     pub fn crosses(&self, a: Vec3, b: Vec3) -> bool {
-        let d = geom::sub(b, a);
-        self.points.windows(2).any(|p| crosses_quad(a, d, p[0], geom::sub(p[1], p[0]), self.sweep))
+        let d = Scaled::diff(b, a, QUAD_EXP);
+        let w = Scaled::new(self.sweep, 0, QUAD_EXP);
+        self.points.windows(2).any(|p| crosses_quad(a, d, p[0], Scaled::diff(p[1], p[0], QUAD_EXP), w))
     }
 
     /// The axis-aligned box of the surface. O(n).
@@ -127,17 +157,92 @@ impl PolylineSweep {
 }
 
 /// Whether a + u d (u ∈ [0, 1]) meets p + s e + t w (s, t ∈ [0, 1]): Cramer's rule on
-/// [d, −e, −w] (u, s, t)ᵀ = p − a. O(1).
-fn crosses_quad(a: Vec3, d: Vec3, p: Vec3, e: Vec3, w: Vec3) -> bool {
-    let r = geom::sub(p, a);
-    let (ne, nw) = (geom::scale(e, -1.0), geom::scale(w, -1.0));
-    let det = triple(d, ne, nw);
-    let size = geom::norm(d) * geom::norm(e) * geom::norm(w);
+/// [d, −e, −w] (u, s, t)ᵀ = p − a, with d, e, w scaled by [`Scaled`] to `QUAD_EXP`. O(1).
+///
+/// Scale-invariant: each of d, e, w and r = p − a is used as 2^k times a direction whose largest
+/// component lies in [2^`QUAD_EXP`, 2^(`QUAD_EXP`+1)) (exact power-of-two scalings), so that the
+/// determinants (products of three components) neither overflow nor lose their leading terms to
+/// underflow. By multilinearity u = 2^(k_r − k_d) det[r̂, −ê, −ŵ] / det[d̂, −ê, −ŵ], and likewise
+/// s (k_e) and t (k_w); each is tested for 0 ≤ x ≤ 1 as X ≥ 0 and X ≤ 2^(k_λ − k_r), with the
+/// power of two exact or saturated ([`pow2`]), so a centroid exactly on the surface stays a tie
+/// at every scale.
+fn crosses_quad(a: Vec3, d: Scaled, p: Vec3, e: Scaled, w: Scaled) -> bool {
+    let r = Scaled::diff(p, a, QUAD_EXP);
+    let (ne, nw) = (geom::scale(e.dir, -1.0), geom::scale(w.dir, -1.0));
+    let det = triple(d.dir, ne, nw);
+    let size = geom::norm(d.dir) * geom::norm(e.dir) * geom::norm(w.dir);
     if det.abs() <= 1e-12 * size {
         return false;
     }
-    let inside = |x: f64| (0.0..=1.0).contains(&x);
-    inside(triple(r, ne, nw) / det) && inside(triple(d, r, nw) / det) && inside(triple(d, ne, r) / det)
+    // A zero r (a = p) gives X = 0 for all three: inside, whatever its exponent.
+    let inside = |x: f64, by: Scaled| x >= 0.0 && x <= pow2(by.exp - r.exp);
+    inside(triple(r.dir, ne, nw) / det, d)
+        && inside(triple(d.dir, r.dir, nw) / det, e)
+        && inside(triple(d.dir, ne, r.dir) / det, w)
+}
+
+/// The exponent the largest component of each vector of the crossing test is scaled to: three of
+/// them multiply to below 2^(3 · 301 + 3), far from overflow, and a component 2^-1000 times the
+/// largest stays a normal number.
+const QUAD_EXP: i32 = 300;
+
+/// A vector v = 2^(`exp` − target) · `dir`, with the largest absolute component of `dir` in
+/// [2^target, 2^(target+1)) (or `dir` zero and `exp` 0 for the zero vector). The scaling is by a
+/// power of two, so it is exact unless a component is about 2^1000 or more times smaller than
+/// the largest one, and cross and triple products of `dir`s neither overflow nor lose their
+/// leading terms to underflow, whatever the magnitude of v.
+#[derive(Clone, Copy, Debug)]
+struct Scaled {
+    dir: Vec3,
+    exp: i32,
+}
+
+impl Scaled {
+    /// `v` · 2^`extra` as above, scaled to `target` (|target| ≤ 300). O(1).
+    fn new(v: Vec3, extra: i32, target: i32) -> Self {
+        let m = v.iter().fold(0.0f64, |m, c| m.max(c.abs()));
+        if m == 0.0 {
+            return Scaled { dir: v, exp: 0 };
+        }
+        let k = exponent(m);
+        // target − k ∈ [−1323, 1374]: two steps, each a normal power of two.
+        let shift = target - k;
+        let (f1, f2) = (pow2(shift / 2), pow2(shift - shift / 2));
+        Scaled { dir: v.map(|c| c * f1 * f2), exp: k + extra }
+    }
+
+    /// x − y for finite x, y, scaled to `target`. When the difference overflows it is taken of
+    /// halved coordinates (finite even between ±`f64::MAX`, and exact) and the exponent raised
+    /// by one. Zero only when x = y. O(1).
+    fn diff(x: Vec3, y: Vec3, target: i32) -> Self {
+        let v = geom::sub(x, y);
+        if v.iter().all(|c| c.is_finite()) {
+            return Scaled::new(v, 0, target);
+        }
+        Scaled::new(geom::sub(geom::scale(x, 0.5), geom::scale(y, 0.5)), 1, target)
+    }
+}
+
+/// The exponent k with 2^k ≤ m < 2^(k+1), for finite m > 0 (subnormals included). O(1).
+fn exponent(m: f64) -> i32 {
+    let bits = m.to_bits();
+    let biased = ((bits >> 52) & 0x7ff) as i32;
+    if biased == 0 {
+        // Subnormal: m = bits · 2^-1074.
+        63 - bits.leading_zeros() as i32 - 1074
+    } else {
+        biased - 1023
+    }
+}
+
+/// 2^e, exact for e in [−1074, 1023] (subnormals included), 0 below and +∞ above. O(1).
+fn pow2(e: i32) -> f64 {
+    match e {
+        1024.. => f64::INFINITY,
+        -1022..=1023 => f64::from_bits(((e + 1023) as u64) << 52),
+        -1074..=-1023 => f64::from_bits(1u64 << (e + 1074)),
+        _ => 0.0,
+    }
 }
 
 /// The determinant of the matrix with columns a, b, c: a · (b × c). O(1).
@@ -152,6 +257,9 @@ fn boxes_meet((lo, hi): (Vec3, Vec3), a: Vec3, b: Vec3) -> bool {
 
 /// The inner faces (one dart each, face order) whose tets' centroid segment crosses `surface`.
 /// O(darts + inner faces × n). The body is not changed.
+///
+/// Scale-invariant (module docs): scaling the body's positions and the surface by one factor
+/// selects the same faces, for any finite coordinates (a slit reaching ±`f64::MAX` included).
 ///
 /// # Errors
 /// [`CutError::BadSweep`].
@@ -199,6 +307,7 @@ pub fn sweep_faces(body: &Body, surface: &PolylineSweep) -> Result<Vec<DartId>, 
 /// conserves mass and stiffness ([`dissociate_face`](super::dissociate_face)).
 ///
 /// Cost: O(darts + inner faces × n) to select, plus one [`dissociate_face`](super::dissociate_face) per cut face.
+/// The selection is scale-invariant ([`sweep_faces`]).
 ///
 /// # Errors
 /// [`CutError::BadSweep`] (body unchanged); [`CutError::Body`] is a bug.

@@ -974,7 +974,9 @@ fn system_of(
 /// Forces on every vertex id computed by covering the map (seed §4.2), without the projection:
 /// each edge orbit is covered once with a dart set, its spring taken between the vertices of b
 /// and α0(b); then each vertex gets gravity and viscosity. Pinned vertices get their force too.
-/// Dead ids get zero. O(darts).
+/// Dead ids get zero. The reference formula, evaluated as given: a non-finite `gravity` gives
+/// non-finite forces on every live vertex (the step's entries refuse it, [`Projection::build`]).
+/// O(darts).
 ///
 /// # Examples
 ///

@@ -233,7 +233,8 @@ fn triangle_distance(p: [f64; 3], [a, b, c]: [[f64; 3]; 3]) -> f64 {
 }
 
 /// Distance from `p` to the closed tetrahedron with corners `t`: 0 inside, else the distance to
-/// the nearest face. O(1).
+/// the nearest face; NaN when a coordinate of `p` or `t` is NaN (not the infinity a minimum
+/// that skips NaN would give). O(1).
 ///
 /// # Examples
 ///
@@ -242,8 +243,12 @@ fn triangle_distance(p: [f64; 3], [a, b, c]: [[f64; 3]; 3]) -> f64 {
 /// let t = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 /// assert_eq!(tet_distance([0.1, 0.1, 0.1], t), 0.0);
 /// assert!((tet_distance([0.0, 0.0, -3.0], t) - 3.0).abs() < 1e-12);
+/// assert!(tet_distance([f64::NAN, 0.0, 0.0], t).is_nan());
 /// ```
 pub fn tet_distance(p: [f64; 3], t: [[f64; 3]; 4]) -> f64 {
+    if p.iter().chain(t.iter().flatten()).any(|c| c.is_nan()) {
+        return f64::NAN;
+    }
     let faces = [[t[1], t[2], t[3]], [t[0], t[3], t[2]], [t[0], t[1], t[3]], [t[0], t[2], t[1]]];
     let vol = crate::mesh::signed_volume(t[0], t[1], t[2], t[3]);
     // Each face is listed so that the opposite corner gives the sign of −vol: p is inside when it

@@ -4,10 +4,12 @@
 //! one piece, an L-shaped wall cuts a block off, bad surfaces are refused without change, and the
 //! map and the conservation laws hold after every cut.
 
-use std::collections::HashMap;
+mod sweep_oracle;
+
 use std::process::Command;
 
 use proptest::prelude::*;
+use sweep_oracle::crossing_faces;
 use topomech::cut::{components, incise_plane, incise_sweep, sweep_faces, tet_sides, CutError, Plane, PolylineSweep};
 use topomech::generate::kuhn_cube;
 use topomech::mechanics::{check_conservation, Body, Material, Vec3};
@@ -16,27 +18,6 @@ fn cube(k: usize) -> (Vec<Vec3>, Vec<[u32; 4]>, Body) {
     let (points, tets) = kuhn_cube(k);
     let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
     (points, tets, body)
-}
-
-/// The oracle: from the tet list only, the number of inner faces (vertex triples shared by two
-/// tets) whose tets' centroids are joined by a segment crossing `surface`.
-fn oracle_cut_count(points: &[Vec3], tets: &[[u32; 4]], surface: &PolylineSweep) -> usize {
-    let centroid = |t: &[u32; 4]| {
-        let mut c = [0.0; 3];
-        for &v in t {
-            (0..3).for_each(|k| c[k] += points[v as usize][k] / 4.0);
-        }
-        c
-    };
-    let mut owners: HashMap<[u32; 3], Vec<usize>> = HashMap::new();
-    for (i, t) in tets.iter().enumerate() {
-        for skip in 0..4 {
-            let mut f: Vec<u32> = (0..4).filter(|&j| j != skip).map(|j| t[j]).collect();
-            f.sort_unstable();
-            owners.entry([f[0], f[1], f[2]]).or_default().push(i);
-        }
-    }
-    owners.values().filter(|o| o.len() == 2 && surface.crosses(centroid(&tets[o[0]]), centroid(&tets[o[1]]))).count()
 }
 
 /// Cuts `body` along `surface` and checks the laws: valid map, conservation, unchanged mass,
@@ -50,7 +31,7 @@ fn cut_and_check(points: &[Vec3], tets: &[[u32; 4]], body: &mut Body, surface: &
     let after = body.total_vertex_mass();
     assert!((after - mass).abs() <= 1e-12 * mass, "mass {mass} -> {after}");
     assert_eq!(map.boundary_cell_count(), boundary + 2 * cut.cut_faces());
-    assert_eq!(cut.cut_faces(), oracle_cut_count(points, tets, surface), "cut faces vs the tet-list oracle");
+    assert_eq!(cut.cut_faces(), crossing_faces(points, tets, surface), "cut faces vs the tet-list oracle");
     cut.cut_faces()
 }
 

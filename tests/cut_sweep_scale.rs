@@ -3,8 +3,9 @@
 //! answers whatever the scale of the coordinates, from 1e-150 to 1e300 and up to `f64::MAX`,
 //! while a genuinely parallel segment and a genuinely repeated point stay refused.
 
-use std::collections::HashMap;
+mod sweep_oracle;
 
+use sweep_oracle::crossing_faces;
 use topomech::cut::{incise_sweep, sweep_faces, CutError, PolylineSweep};
 use topomech::generate::kuhn_cube;
 use topomech::mechanics::{Body, Material, Vec3};
@@ -31,26 +32,6 @@ fn slit(s: f64) -> PolylineSweep {
 
 fn is_bad_sweep(r: Result<(), CutError>, what: &str) -> bool {
     matches!(r, Err(CutError::BadSweep { reason }) if reason.contains(what))
-}
-
-/// From the tet list only: the inner faces whose tets' centroid segment crosses `surface`.
-fn crossing_faces(points: &[Vec3], tets: &[[u32; 4]], surface: &PolylineSweep) -> usize {
-    let centroid = |t: &[u32; 4]| {
-        let mut c = [0.0; 3];
-        for &v in t {
-            (0..3).for_each(|k| c[k] += points[v as usize][k] / 4.0);
-        }
-        c
-    };
-    let mut owners: HashMap<[u32; 3], Vec<usize>> = HashMap::new();
-    for (i, t) in tets.iter().enumerate() {
-        for skip in 0..4 {
-            let mut f: Vec<u32> = (0..4).filter(|&j| j != skip).map(|j| t[j]).collect();
-            f.sort_unstable();
-            owners.entry([f[0], f[1], f[2]]).or_default().push(i);
-        }
-    }
-    owners.values().filter(|o| o.len() == 2 && surface.crosses(centroid(&tets[o[0]]), centroid(&tets[o[1]]))).count()
 }
 
 #[test]

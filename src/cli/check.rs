@@ -94,7 +94,8 @@ fn json_report(
 }
 
 /// Stable law names: involution, quasi_manifold, cell_id_constant, cell_id_unique, conservation,
-/// and for levels: level_record, mu_order, mu_constant, level_closed, level_valid, flat_flag.
+/// and for levels: level_record, mu_order, mu_constant, level_closed, level_valid, flat_flag
+/// (and structure, which a decoded file never has).
 fn law_name(f: &Finding) -> &'static str {
     match f {
         Finding::Map(v) => map_law_name(v),
@@ -108,6 +109,7 @@ fn law_name(f: &Finding) -> &'static str {
         },
         Finding::Level(_) => "level_record",
         Finding::LevelMap { .. } => "level_valid",
+        Finding::Structure(_) => "structure",
     }
 }
 
@@ -125,7 +127,7 @@ fn map_law_name(v: &InvariantViolation) -> &'static str {
 fn darts_of(f: &Finding) -> Vec<u32> {
     match f {
         Finding::Map(v) | Finding::LevelMap { violation: v, .. } => violation_darts(v),
-        Finding::Conservation(_) => Vec::new(),
+        Finding::Conservation(_) | Finding::Structure(_) => Vec::new(),
         Finding::Level(e) => level_darts(e),
     }
 }

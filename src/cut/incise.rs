@@ -4,6 +4,7 @@
 use crate::mechanics::{Body, TouchedCells, Vec3};
 use crate::{CellId, DartId};
 
+use super::sweep::Scaled;
 use super::{dissociate_face, CutError, Dissociation};
 
 /// A cutting plane through `point` with normal `normal` (any length but zero).
@@ -27,7 +28,15 @@ pub struct Plane {
 }
 
 impl Plane {
-    /// Whether `x` is strictly on the positive side. O(1).
+    /// Whether `x` is strictly on the positive side: (x − point) · normal > 0. O(1).
+    ///
+    /// The answer does not depend on the length of the normal nor on the scale of the
+    /// coordinates (for finite ones): x − point and the normal are each scaled by a power of two
+    /// (exactly) so that their largest component is in [1, 2) before the dot product, so a tiny
+    /// normal does not underflow (with `[5e-324, 0, 0]` every point 0.25 from the plane was
+    /// "on" it) and a huge one or huge coordinates do not overflow (∞ − ∞ = NaN, "not
+    /// positive"); a difference that overflows is taken of halved coordinates. Where nothing
+    /// overflows or underflows, the decision is bit for bit that of the plain dot product.
     ///
     /// # Examples
     ///
@@ -38,9 +47,16 @@ impl Plane {
     /// assert!(plane.positive([5.0, 5.0, 1.5]));
     /// assert!(!plane.positive([0.0, 0.0, 1.0])); // on the plane: not strictly positive
     /// assert!(!plane.positive([0.0, 0.0, -3.0]));
+    /// // The smallest normal and the largest one give the same sides.
+    /// let tiny = Plane { point: [1.0; 3], normal: [5e-324, 0.0, 0.0] };
+    /// assert!(tiny.positive([1.25, 0.0, 0.0]) && !tiny.positive([0.75, 0.0, 0.0]));
+    /// let huge = Plane { point: [1.0; 3], normal: [f64::MAX, -f64::MAX, 0.0] };
+    /// assert!(huge.positive([4.0, 3.0, 1.0])); // 3·MAX − 2·MAX > 0, unscaled ∞ − ∞ = NaN
     /// ```
     pub fn positive(&self, x: Vec3) -> bool {
-        (0..3).map(|k| (x[k] - self.point[k]) * self.normal[k]).sum::<f64>() > 0.0
+        let n = Scaled::new(self.normal, 0, 0).dir;
+        let r = Scaled::diff(x, self.point, 0).dir;
+        (0..3).map(|k| r[k] * n[k]).sum::<f64>() > 0.0
     }
 
     /// [`CutError::BadPlane`] unless the point and normal are finite and the normal is not zero.

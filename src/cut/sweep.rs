@@ -192,14 +192,14 @@ const QUAD_EXP: i32 = 300;
 /// the largest one, and cross and triple products of `dir`s neither overflow nor lose their
 /// leading terms to underflow, whatever the magnitude of v.
 #[derive(Clone, Copy, Debug)]
-struct Scaled {
-    dir: Vec3,
+pub(super) struct Scaled {
+    pub(super) dir: Vec3,
     exp: i32,
 }
 
 impl Scaled {
     /// `v` · 2^`extra` as above, scaled to `target` (|target| ≤ 300). O(1).
-    fn new(v: Vec3, extra: i32, target: i32) -> Self {
+    pub(super) fn new(v: Vec3, extra: i32, target: i32) -> Self {
         let m = v.iter().fold(0.0f64, |m, c| m.max(c.abs()));
         if m == 0.0 {
             return Scaled { dir: v, exp: 0 };
@@ -214,7 +214,7 @@ impl Scaled {
     /// x − y for finite x, y, scaled to `target`. When the difference overflows it is taken of
     /// halved coordinates (finite even between ±`f64::MAX`, and exact) and the exponent raised
     /// by one. Zero only when x = y. O(1).
-    fn diff(x: Vec3, y: Vec3, target: i32) -> Self {
+    pub(super) fn diff(x: Vec3, y: Vec3, target: i32) -> Self {
         let v = geom::sub(x, y);
         if v.iter().all(|c| c.is_finite()) {
             return Scaled::new(v, 0, target);

@@ -13,6 +13,7 @@ use crate::mechanics::model::{closed_triangle_vertices, triangle_vertices};
 use crate::mechanics::{Body, SimError, Simulation, TouchedCells, Vec3};
 use crate::{CellId, DartId, GMap};
 
+use super::sweep::Scaled;
 use super::{dissociate_face, CutError, Dissociation};
 
 /// The tensile stress at a vertex: the largest principal value of σ_v = Σ_s T_s n_s n_sᵀ over the
@@ -303,6 +304,9 @@ fn start_face(body: &Body, start: DartId, direction: Vec3) -> Option<DartId> {
 /// Tears vertex `v` along `direction`: among the inner faces around v, the one whose normal is
 /// closest to ±`direction` starts the fan ([`fan_darts`]); every inner face of the fan is then
 /// dissociated. `v` is a vertex id; `hint`, when given and still on v, saves the O(darts) search.
+/// Only the direction counts, not its length: the direction scaled by any power of two (down to
+/// a subnormal, up to near `f64::MAX`) chooses the same face, as the face scores are formed from
+/// it scaled to a largest component in [1, 2).
 ///
 /// Cost: O(star of v) to choose the face and walk the fan, plus one dissociation per fan face.
 ///
@@ -335,7 +339,9 @@ pub fn tear_vertex(body: &mut Body, v: CellId, direction: Vec3, hint: Option<Dar
     let on_v = |d: DartId| map.contains(d) && map.vertex_id(d) == v;
     let start = hint.filter(|&d| on_v(d)).or_else(|| map.darts().find(|&d| on_v(d)));
     let start = start.ok_or(CutError::NoSuchVertex(v))?;
-    let best = start_face(body, start, direction);
+    // Scaled by a power of two (exact) to a largest component in [1, 2): the scores neither
+    // underflow for a tiny direction nor overflow for a huge one, and keep their order.
+    let best = start_face(body, start, Scaled::new(direction, 0, 0).dir);
     let mut tear =
         Tear { vertex: v, fan: Vec::new(), dissociations: Vec::new(), split: false, touched: TouchedCells::default() };
     let from = body.version();

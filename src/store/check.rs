@@ -39,6 +39,10 @@ pub enum Finding {
         /// The law broken.
         violation: InvariantViolation,
     },
+    /// A document built or changed in memory that no decoder would return: the structural error
+    /// of [`RawMap::check`](super::RawMap::check), or a NaN or infinite attribute (the message of
+    /// the [`StoreError`](super::StoreError)). Nothing else is checked then.
+    Structure(String),
 }
 
 impl std::fmt::Display for Finding {
@@ -48,6 +52,7 @@ impl std::fmt::Display for Finding {
             Finding::Conservation(c) => write!(f, "conservation: {c}"),
             Finding::Level(e) => write!(f, "levels: {e}"),
             Finding::LevelMap { level, violation } => write!(f, "level {level}: {violation}"),
+            Finding::Structure(message) => write!(f, "structure: {message}"),
         }
     }
 }
@@ -87,7 +92,9 @@ pub struct CheckReport {
 /// extracted level G_0 … G_k and the flat flag of every dart (the one its level and link history
 /// determine, [`crate::subdivide::LevelError::FlatFlag`]), with the leveled map's dart ids.
 /// The verdict comes from the kernel's `validate()` when n ≤ 3; the listing is a separate pass
-/// on the raw arrays that never stops at the first violation.
+/// on the raw arrays that never stops at the first violation. A document no decoder would return
+/// (built or changed in memory: [`RawMap::check`](super::RawMap::check) refuses its structure, or
+/// an attribute is NaN or infinite) gets one [`Finding::Structure`] and nothing else is checked.
 /// Cost O(capacity · n² + cell ids) time and memory, O(k · capacity · n²) with k levels.
 ///
 /// # Examples
@@ -105,6 +112,14 @@ pub struct CheckReport {
 pub fn check_all_laws(doc: &Document, limit: usize) -> CheckReport {
     let mut out = Collector { findings: Vec::new(), limit, truncated: false };
     let raw = &doc.map;
+    let non_finite = doc.mechanics.as_ref().and_then(|m| m.first_non_finite());
+    let structure = raw.check().err().or_else(|| {
+        non_finite.map(|(field, index)| super::StoreError::NonFinite { at: super::Where::Document, field, index })
+    });
+    if let Some(e) = structure {
+        out.push(Finding::Structure(e.to_string()));
+        return CheckReport { valid: false, findings: out.findings, truncated: out.truncated };
+    }
     let live = raw.live();
     involution_and_quasi_manifold(raw, &live, &mut out);
     cell_ids_constant(raw, &live, &mut out);

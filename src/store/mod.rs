@@ -132,6 +132,9 @@ pub enum Where {
     Line(usize),
     /// 0-based byte offset in the binary form.
     Byte(usize),
+    /// A [`Document`] built or changed in memory, not read from a file (its fields are public):
+    /// [`encode`], the `into_*` conversions and [`check_all_laws`] check it as the decoders do.
+    Document,
 }
 
 impl fmt::Display for Where {
@@ -139,6 +142,7 @@ impl fmt::Display for Where {
         match self {
             Where::Line(l) => write!(f, "line {l}"),
             Where::Byte(b) => write!(f, "byte {b}"),
+            Where::Document => write!(f, "in the document"),
         }
     }
 }
@@ -405,7 +409,9 @@ impl Document {
     /// The map, required to satisfy every law. O(darts · n²).
     ///
     /// # Errors
-    /// [`StoreError::WrongDimension`], [`StoreError::BrokenLaw`] (the first law broken).
+    /// The structural errors of [`RawMap::check`] (a map built or changed in memory that no
+    /// decoder would return), [`StoreError::WrongDimension`], [`StoreError::BrokenLaw`] (the first
+    /// law broken).
     ///
     /// # Examples
     ///
@@ -419,6 +425,7 @@ impl Document {
     /// assert!(matches!(e, store::StoreError::WrongDimension { found: 3, expected: 2 }));
     /// ```
     pub fn into_map<const N: usize>(self) -> Result<GMap<N>, StoreError> {
+        self.map.check()?;
         let map = self.map.to_gmap_raw::<N>()?;
         map.validate()?;
         Ok(map)
@@ -428,8 +435,9 @@ impl Document {
     /// ([`LeveledMap::from_parts`]). O(k · darts · n²).
     ///
     /// # Errors
-    /// [`StoreError::NoLevels`], [`StoreError::WrongDimension`], [`StoreError::BrokenLaw`],
-    /// [`StoreError::Levels`] (a malformed record or the first level law broken).
+    /// [`StoreError::NoLevels`], the structural errors of [`RawMap::check`],
+    /// [`StoreError::WrongDimension`], [`StoreError::BrokenLaw`], [`StoreError::Levels`] (a
+    /// malformed record or the first level law broken).
     ///
     /// # Examples
     ///
@@ -447,6 +455,7 @@ impl Document {
     /// ```
     pub fn into_leveled<const N: usize>(self) -> Result<LeveledMap<N>, StoreError> {
         let parts = self.levels.ok_or(StoreError::NoLevels)?;
+        self.map.check()?;
         let map = self.map.to_gmap_raw::<N>()?;
         map.validate()?;
         Ok(LeveledMap::from_parts(map, parts)?)
@@ -455,7 +464,9 @@ impl Document {
     /// The body, required to satisfy every law of the map and of conservation. O(darts).
     ///
     /// # Errors
-    /// [`StoreError::NoMechanics`], [`StoreError::WrongDimension`], [`StoreError::BrokenLaw`],
+    /// [`StoreError::NoMechanics`], the structural errors of [`RawMap::check`],
+    /// [`StoreError::NonFinite`] (at [`Where::Document`]) for a NaN or infinite attribute (which
+    /// no decoder returns), [`StoreError::WrongDimension`], [`StoreError::BrokenLaw`],
     /// [`StoreError::Conservation`].
     ///
     /// # Examples
@@ -472,6 +483,10 @@ impl Document {
     /// ```
     pub fn into_body(self) -> Result<Body, StoreError> {
         let raw_mech = self.mechanics.ok_or(StoreError::NoMechanics)?;
+        self.map.check()?;
+        if let Some((field, index)) = raw_mech.first_non_finite() {
+            return Err(StoreError::NonFinite { at: Where::Document, field, index });
+        }
         let map = self.map.to_gmap_raw::<3>()?;
         map.validate()?;
         let mech = raw_mech.to_mechanics();
@@ -483,7 +498,9 @@ impl Document {
 /// Encodes a document in one form. O(size).
 ///
 /// # Errors
-/// [`StoreError::Unrepresentable`] when an attribute is NaN or infinite (it could not be read back).
+/// The structural errors of [`RawMap::check`] for a map no decoder would accept (it could not
+/// be read back; nothing is written); [`StoreError::Unrepresentable`] when an attribute is NaN or
+/// infinite or the levels part does not fit the map (it could not be read back either).
 ///
 /// # Examples
 ///
@@ -499,6 +516,7 @@ impl Document {
 /// assert_eq!(store::decode(&bin).unwrap(), store::decode(&text).unwrap());
 /// ```
 pub fn encode(doc: &Document, format: Format) -> Result<Vec<u8>, StoreError> {
+    doc.map.check()?;
     if let Some(m) = &doc.mechanics {
         m.check_finite().map_err(|what| StoreError::Unrepresentable { what })?;
     }
@@ -511,11 +529,21 @@ pub fn encode(doc: &Document, format: Format) -> Result<Vec<u8>, StoreError> {
     })
 }
 
-/// `Err(description)` when the levels part cannot be written: not one record per dart slot, or
-/// a non-finite point. O(capacity + points).
+/// `Err(description)` when the levels part cannot be written: not one record per dart slot, a
+/// history entry of a live dart naming an involution above the dimension or a dart past the
+/// capacity (the decoders refuse both), or a non-finite point. O(capacity + entries + points).
 fn check_levels_representable(map: &RawMap, l: &LevelParts) -> Result<(), String> {
     if l.darts.len() != map.capacity as usize {
         return Err(format!("{} dart level records for {} dart slots", l.darts.len(), map.capacity));
+    }
+    let live = map.live();
+    for (d, rec) in l.darts.iter().enumerate().filter(|&(d, _)| live[d]) {
+        if let Some(e) = rec.history.iter().find(|e| usize::from(e.j) > map.dimension || e.old >= map.capacity) {
+            return Err(format!(
+                "history entry {e:?} of dart {d} names α{} or dart {} (the map has dimension {} and {} dart slots)",
+                e.j, e.old, map.dimension, map.capacity
+            ));
+        }
     }
     if let Some(k) = l.points.iter().position(|p| p.iter().any(|x| !x.is_finite())) {
         return Err(format!("point {k} is not finite"));
@@ -720,7 +748,7 @@ pub fn save_body(body: &Body, path: &Path, format: Format) -> Result<(), StoreEr
 /// error the temporary file is removed and an existing `path` is left untouched. O(size).
 ///
 /// # Errors
-/// [`StoreError::Unrepresentable`] (see [`encode`]); [`StoreError::Io`] naming the file the
+/// The errors of [`encode`] (nothing is written); [`StoreError::Io`] naming the file the
 /// system refused.
 ///
 /// # Examples

@@ -117,6 +117,10 @@ impl RawMap {
 
     /// Liveness of every slot (false for the slots of `free_darts`). O(capacity).
     ///
+    /// # Panics
+    /// If a free dart slot is not below `capacity` ([`RawMap::check`] refuses such a map; a
+    /// decoded one never has it).
+    ///
     /// # Examples
     ///
     /// ```
@@ -169,7 +173,42 @@ impl RawMap {
         self.cell[d as usize * self.alphas() + i]
     }
 
+    /// Checks the structure [`decode`](super::decode) guarantees of every map it returns, for a map
+    /// built or changed in memory (the fields are public): a dimension in 1..=[`MAX_DIMENSION`],
+    /// `alpha` and `cell` of `capacity · (n + 1)` entries, one allocator per dimension, every link
+    /// a dart slot, free dart slots in range, listed once and blank, free cell ids below `next`
+    /// and listed once, at most `capacity` live ids per dimension. The laws are not checked
+    /// ([`Document::into_map`](super::Document::into_map) does). [`encode`](super::encode), the
+    /// `into_*` conversions and [`check_all_laws`](super::check_all_laws) call it first.
+    /// O(capacity · n + free ids).
+    ///
+    /// [`MAX_DIMENSION`]: super::MAX_DIMENSION
+    ///
+    /// # Errors
+    /// [`StoreError::BadDimension`], [`StoreError::BadCount`] (a capacity of `u32::MAX`),
+    /// [`StoreError::Inconsistent`] (array lengths, allocators, free lists),
+    /// [`StoreError::DartOutOfRange`], each located at [`Where::Document`](super::Where::Document).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::GMap;
+    /// # use topomech::store::{RawMap, StoreError};
+    /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    /// let mut raw = RawMap::from_map(&map);
+    /// assert!(raw.check().is_ok());
+    /// raw.alpha[5] = 24; // one past the last dart slot
+    /// assert!(matches!(raw.check(), Err(StoreError::DartOutOfRange { dart: 24, capacity: 24, .. })));
+    /// raw.alpha.pop();
+    /// assert!(raw.check().unwrap_err().to_string().contains("the alpha array has 95 entries"));
+    /// ```
+    pub fn check(&self) -> Result<(), StoreError> {
+        super::structure::check_shape(self)
+    }
+
     /// Rebuilds the map exactly, with no law checked (the crate-private raw layer). O(capacity · n).
+    /// The structure must be one [`RawMap::check`] accepts (a decoded map's always is), else this
+    /// may panic on an index.
     ///
     /// # Errors
     /// [`StoreError::WrongDimension`] when the file's dimension is not `N`.
@@ -398,26 +437,30 @@ impl RawMechanics {
     /// assert!(raw.check_finite().unwrap_err().contains("record 2"));
     /// ```
     pub fn check_finite(&self) -> Result<(), String> {
-        let bad = |what: &str, k: usize| Err(format!("{what} of record {k} is not finite"));
+        match self.first_non_finite() {
+            Some((what, k)) => Err(format!("{what} of record {k} is not finite")),
+            None => Ok(()),
+        }
+    }
+
+    /// The attribute and record of the first NaN or infinite value. O(cells).
+    pub(crate) fn first_non_finite(&self) -> Option<(&'static str, usize)> {
         if self.material.iter().any(|x| !x.is_finite()) {
-            return bad("material", 0);
+            return Some(("material", 0));
         }
         for (k, v) in self.vertices.iter().enumerate() {
             let all =
                 v.rest.iter().chain(&v.position).chain(&v.velocity).chain(&v.force).chain([&v.mass, &v.viscosity]);
             if all.into_iter().any(|x| !x.is_finite()) {
-                return bad("a vertex attribute", k);
+                return Some(("a vertex attribute", k));
             }
         }
         if let Some(k) = self.edges.iter().position(|e| e.iter().any(|x| !x.is_finite())) {
-            return bad("an edge attribute", k);
+            return Some(("an edge attribute", k));
         }
         if let Some(k) = self.faces.iter().position(|f| f.1.iter().any(|x| !x.is_finite())) {
-            return bad("a face normal", k);
+            return Some(("a face normal", k));
         }
-        if let Some(k) = self.volumes.iter().position(|t| t.iter().any(|x| !x.is_finite())) {
-            return bad("a volume attribute", k);
-        }
-        Ok(())
+        self.volumes.iter().position(|t| t.iter().any(|x| !x.is_finite())).map(|k| ("a volume attribute", k))
     }
 }

@@ -180,7 +180,9 @@ impl LeveledMap<3> {
     /// [`SubdivideError::DegenerateFace`] if a face polygon cannot be triangulated (zero area,
     /// reflex corner) or a cone tet would have a non-positive volume;
     /// [`SubdivideError::NoPosition`] first if a live vertex has no position (it was read as the
-    /// origin, and the error then blamed a degenerate face).
+    /// origin, and the error then blamed a degenerate face), then
+    /// [`SubdivideError::NonFinitePosition`] for the smallest live vertex whose position is NaN or
+    /// infinite (the triangulation then failed and blamed a face too).
     ///
     /// ```
     /// use topomech::generate::kuhn_cube;
@@ -201,9 +203,14 @@ impl LeveledMap<3> {
     /// assert!((v - 8.0).abs() < 1e-12);
     /// let short = LeveledMap::new(m.map().clone(), vec![[0.0; 3]; 5]);
     /// assert!(matches!(short.conforming_tets(), Err(topomech::subdivide::SubdivideError::NoPosition { vertex: 5, .. })));
+    /// let mut nan = m.points().to_vec();
+    /// nan[3][1] = f64::NAN;
+    /// let nan = LeveledMap::new(m.map().clone(), nan);
+    /// assert!(matches!(nan.conforming_tets(), Err(topomech::subdivide::SubdivideError::NonFinitePosition { vertex: 3, .. })));
     /// ```
     pub fn conforming_tets(&self) -> Result<ConformingMesh, SubdivideError> {
         self.check_positions_given()?;
+        self.check_positions_finite()?;
         let mut out = ConformingMesh { points: self.points.clone(), ..ConformingMesh::default() };
         let mut face_tris: FxHashMap<u32, Vec<[u32; 3]>> = FxHashMap::default();
         for d in self.map.one_dart_per_cell(3) {
@@ -233,6 +240,17 @@ impl LeveledMap<3> {
             out.closed += 1;
         }
         Ok(out)
+    }
+
+    /// [`SubdivideError::NonFinitePosition`] for the smallest live vertex id whose position is NaN
+    /// or infinite (positions of dead ids are not read). Every live vertex has a position
+    /// ([`Self::check_positions_given`]). O(darts).
+    fn check_positions_finite(&self) -> Result<(), SubdivideError> {
+        let bad = |v: u32| !self.points[v as usize].iter().all(|c| c.is_finite());
+        let vertex = self.map.darts().map(|d| self.map.vertex_id(d).0).filter(|&v| bad(v)).min();
+        vertex.map_or(Ok(()), |vertex| {
+            Err(SubdivideError::NonFinitePosition { vertex, position: self.points[vertex as usize] })
+        })
     }
 
     /// The boundary faces (α3-free) of the finest map as vertex cycles (corners and inserted

@@ -276,6 +276,15 @@ pub enum SubdivideError {
     /// A density for [`TetMasses::from_density`] that is not a finite number > 0.
     #[error("density {0} must be a finite number > 0")]
     BadDensity(f64),
+    /// The masses of the live volumes sum to more than the largest `f64` (a density so large
+    /// that masses overflow, or finite entries whose total does): the totals a refinement
+    /// reports would be ∞ and NaN. A [`crate::mechanics::Body`] refuses such masses too
+    /// (`ModelError::Overflow`).
+    #[error("the volume masses sum to {total}: beyond the range of f64")]
+    MassOverflow {
+        /// The sum (+∞).
+        total: f64,
+    },
     /// A refinement would grow the map past its dart limit ([`LeveledMap::set_max_darts`]):
     /// refused before anything changed at that level (the levels done before it are kept).
     #[error(
@@ -426,6 +435,8 @@ pub struct LeveledMap<const N: usize> {
     op: ops::OpLog,
     /// The dart limit of the refinements ([`LeveledMap::set_max_darts`]).
     max_darts: usize,
+    /// Operations that changed the map so far ([`LeveledMap::version`]).
+    version: u64,
 }
 
 impl<const N: usize> LeveledMap<N> {
@@ -467,7 +478,32 @@ impl<const N: usize> LeveledMap<N> {
             edge_splits: Vec::new(),
             op: ops::OpLog::default(),
             max_darts: DEFAULT_MAX_DARTS,
+            version: 0,
         }
+    }
+
+    /// Number of operations that changed the map since [`LeveledMap::new`] (or
+    /// [`LeveledMap::from_parts`]): every accepted split, subdivision, bulk refinement level and
+    /// face cut adds one; a refused operation adds nothing. A [`LeveledMechanics`] records the
+    /// version it followed, so it can tell an operation called on the map alone. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::subdivide::LeveledMap;
+    /// use topomech::GMap;
+    ///
+    /// let (map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [1, 2, 3, 4]]).unwrap();
+    /// let mut m = LeveledMap::new(map, vec![]);
+    /// assert_eq!(m.version(), 0);
+    /// let glued = m.map().darts().find(|&d| !m.map().is_free(3, d)).unwrap();
+    /// m.unsew_face(glued, 1).unwrap();
+    /// assert_eq!(m.version(), 1);
+    /// assert!(m.unsew_face(glued, 1).is_err()); // refused: no change
+    /// assert_eq!(m.version(), 1);
+    /// ```
+    pub fn version(&self) -> u64 {
+        self.version
     }
 
     /// Sets the limit on the live darts the level-by-level refinements

@@ -76,7 +76,9 @@ impl TetMasses {
     ///
     /// Errors: [`SubdivideError::BadDensity`] unless the density is finite and > 0;
     /// [`SubdivideError::NotATetrahedron`] if a volume does not have 4 vertices;
-    /// [`SubdivideError::NoPosition`] for a vertex without a position.
+    /// [`SubdivideError::NoPosition`] for a vertex without a position;
+    /// [`SubdivideError::MassOverflow`] when a mass or their sum overflows (what
+    /// [`Self::check`] refuses).
     ///
     /// # Examples
     ///
@@ -92,6 +94,10 @@ impl TetMasses {
     /// let short = LeveledMap::new(map, pts[..3].to_vec()); // vertex 3 has no position
     /// assert!(matches!(TetMasses::from_density(&short, 6.0), Err(SubdivideError::NoPosition { vertex: 3, points: 3 })));
     /// assert!((masses.total(&m) - 1.0).abs() < 1e-12);
+    /// let big = LeveledMap::new(m.map().clone(), pts.iter().map(|p| p.map(|c| 2.0 * c)).collect());
+    /// assert!(TetMasses::from_density(&m, f64::MAX).is_ok()); // MAX · 1/6
+    /// let e = TetMasses::from_density(&big, f64::MAX).unwrap_err(); // MAX · 8/6 overflows
+    /// assert!(matches!(e, SubdivideError::MassOverflow { .. }));
     /// ```
     pub fn from_density(m: &LeveledMap<3>, density: f64) -> Result<Self, SubdivideError> {
         if !(density.is_finite() && density > 0.0) {
@@ -101,6 +107,10 @@ impl TetMasses {
         let mut mass = vec![0.0; map.cell_id_bound(3)];
         for d in map.one_dart_per_cell(3) {
             mass[map.cell_id(3, d).index()] = density * m.tet_volume(d)?.abs();
+        }
+        let total = mass.iter().sum::<f64>();
+        if !total.is_finite() {
+            return Err(SubdivideError::MassOverflow { total });
         }
         Ok(TetMasses { mass })
     }
@@ -146,7 +156,8 @@ impl TetMasses {
     }
 
     /// Every live volume of `m` has an entry ([`SubdivideError::NoMass`]) whose mass is finite and ≥ 0
-    /// ([`SubdivideError::BadMass`]). O(darts).
+    /// ([`SubdivideError::BadMass`]), and their sum is finite ([`SubdivideError::MassOverflow`]).
+    /// O(darts).
     ///
     /// # Examples
     ///
@@ -158,12 +169,18 @@ impl TetMasses {
     /// assert_eq!(TetMasses { mass: vec![1.0, 2.0] }.check(&m), Ok(()));
     /// assert_eq!(TetMasses { mass: vec![1.0] }.check(&m), Err(SubdivideError::NoMass { volume: 1, masses: 1 }));
     /// assert!(matches!(TetMasses { mass: vec![1.0, f64::NAN] }.check(&m), Err(SubdivideError::BadMass { volume: 1, .. })));
+    /// let huge = TetMasses { mass: vec![f64::MAX, f64::MAX] }; // each finite, the sum is not
+    /// assert!(matches!(huge.check(&m), Err(SubdivideError::MassOverflow { .. })));
     /// ```
     pub fn check(&self, m: &LeveledMap<3>) -> Result<(), SubdivideError> {
         self.check_cover(m)?;
         let map = m.map();
+        let mut total = 0.0;
         for t in map.one_dart_per_cell(3).into_iter().map(|d| map.cell_id(3, d)) {
-            self.check_mass(t)?;
+            total += self.check_mass(t)?;
+        }
+        if !total.is_finite() {
+            return Err(SubdivideError::MassOverflow { total });
         }
         Ok(())
     }
@@ -230,6 +247,19 @@ fn triangle_distance(p: [f64; 3], [a, b, c]: [[f64; 3]; 3]) -> f64 {
         }
     }
     segment_distance(p, a, b).min(segment_distance(p, b, c)).min(segment_distance(p, c, a))
+}
+
+/// m · v / total: the share of the mass m of a parent for a child of volume v out of the
+/// children's total volume. Formed as m · (v / total) when m · v overflows (masses near
+/// `f64::MAX`, which [`TetMasses::check`] accepts as long as their sum is finite), so a finite
+/// mass never gives an infinite or NaN share; bit for bit m · v / total otherwise. O(1).
+pub(super) fn share(m: f64, v: f64, total: f64) -> f64 {
+    let mv = m * v;
+    if mv.is_finite() {
+        mv / total
+    } else {
+        m * (v / total)
+    }
 }
 
 /// Distance from `p` to the closed tetrahedron with corners `t`: 0 inside, else the distance to
@@ -406,7 +436,7 @@ impl LeveledMap<3> {
             let share = if k + 1 == children.len() {
                 parent - given
             } else if total > 0.0 {
-                parent * volumes[k] / total
+                share(parent, volumes[k], total)
             } else {
                 parent / children.len() as f64
             };

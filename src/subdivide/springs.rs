@@ -222,6 +222,18 @@ pub enum CouplingError {
         /// The map's vertex id bound.
         vertices: usize,
     },
+    /// The map changed by an operation the coupling did not follow: called on the map alone, and
+    /// neither inserting a vertex ([`CouplingError::OutOfSync`]) nor adding a vertex id
+    /// ([`CouplingError::StateCount`]) — a [`LeveledMap::unsew_face`] that splits an edge but no
+    /// vertex, or a subdivision whose edges were all split before. Its new edge cells have no
+    /// spring. Refused before the map changes.
+    #[error("the map is at version {version} but the coupling followed it up to version {followed}: an operation was called on the map alone")]
+    Unfollowed {
+        /// The map's [`LeveledMap::version`] after the last operation the coupling followed.
+        followed: u64,
+        /// The map's version now.
+        version: u64,
+    },
     /// A material constant is refused ([`crate::mechanics::ModelError::BadMaterial`], as for a
     /// [`crate::mechanics::Body`]).
     #[error(transparent)]
@@ -300,6 +312,8 @@ pub struct LeveledMechanics {
     pub(super) tets0: Vec<Tet0>,
     /// Entries of the map's split log already followed.
     pub(super) applied: usize,
+    /// The [`LeveledMap::version`] of the map after the last operation followed.
+    pub(super) followed: u64,
     /// Σ m_t when the coupling was built.
     pub(super) total_mass: f64,
 }
@@ -391,6 +405,7 @@ impl LeveledMechanics {
             halves: BTreeSet::new(),
             tets0: Vec::new(),
             applied: m.edge_split_log().len(),
+            followed: m.version(),
         };
         for t in &tets0 {
             mech.add_tet(m, t);
@@ -631,6 +646,9 @@ impl LeveledMechanics {
         if states != vertices || self.position.len() != self.velocity.len() {
             return Err(CouplingError::StateCount { states, vertices });
         }
+        if m.version() != self.followed {
+            return Err(CouplingError::Unfollowed { followed: self.followed, version: m.version() });
+        }
         Ok(())
     }
 }
@@ -651,8 +669,9 @@ impl LeveledMechanics {
     /// interpolated (module docs). Returns the map's result. O(edge · n + log E).
     ///
     /// Errors: [`CouplingError::OutOfSync`], [`CouplingError::StateCount`] (another map's
-    /// coupling), the map's refusals (all three: both unchanged), or [`CouplingError::NoSpring`]
-    /// (the map changed; a tampered coupling).
+    /// coupling), [`CouplingError::Unfollowed`] (the map was changed alone), the map's refusals
+    /// (all four: both unchanged), or [`CouplingError::NoSpring`] (the map changed; a tampered
+    /// coupling).
     ///
     /// # Examples
     ///
@@ -834,6 +853,7 @@ impl LeveledMechanics {
             self.split_spring(m, s)?;
         }
         self.applied = log.len();
+        self.followed = m.version();
         let mut region: Vec<DartId> = Vec::new();
         for &f in faces {
             region.extend(m.map().orbit(f, AlphaMask::of(&[0, 1])));
@@ -897,8 +917,9 @@ impl LeveledMechanics {
     /// vertex id: a scatter from the volumes. Σ_v m_v = Σ_t m_t. O(darts).
     ///
     /// # Errors
-    /// [`CouplingError::OutOfSync`] or [`CouplingError::StateCount`] when `m` is not the map this
-    /// coupling follows (checked as every coupling operation does).
+    /// [`CouplingError::OutOfSync`], [`CouplingError::StateCount`] or
+    /// [`CouplingError::Unfollowed`] when `m` is not the map this coupling follows (checked as
+    /// every coupling operation does).
     ///
     /// # Examples
     ///

@@ -663,6 +663,7 @@ impl<const N: usize> LeveledMap<N> {
         }
         self.write_midpoints(&next, lab);
         self.max_level = level;
+        self.version += 1;
         child_ids
     }
 
@@ -805,7 +806,7 @@ impl LeveledMap<3> {
                 let share = if c + 1 == volumes.len() {
                     m - given
                 } else if total > 0.0 {
-                    m * v / total
+                    super::region::share(m, v, total)
                 } else {
                     m / volumes.len() as f64
                 };

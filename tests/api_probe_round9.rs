@@ -298,3 +298,44 @@ fn masses_whose_total_overflows_are_refused() {
     assert!(r.total_mass_before.is_finite() && r.total_mass_after.is_finite(), "{r:?}");
     assert!(fine.check(&m).is_ok());
 }
+
+/// Finding 49: `into_body` took a stored material that `Body::from_tets` refuses and a face
+/// boundary flag that disagrees with the map. Each is now refused by `into_body` (naming the
+/// constant or the face) and listed by `check_all_laws`; the untouched document still loads.
+#[test]
+fn a_stored_body_keeps_the_material_and_boundary_flags_the_map_allows() {
+    let doc = Document::from_body(&cube_body(2));
+    assert!(doc.clone().into_body().is_ok());
+    assert!(check_all_laws(&doc, 10).valid);
+    let refused = |d: &Document, what: &str| {
+        match d.clone().into_body() {
+            Err(StoreError::Inconsistent { at: Where::Document, message }) => {
+                assert!(message.contains(what), "{what}: {message}")
+            }
+            other => panic!("{what}: {other:?}"),
+        }
+        let report = check_all_laws(d, 10);
+        assert!(!report.valid, "{what}");
+        assert!(
+            report.findings.iter().any(|f| matches!(f, Finding::BodyState(m) if m.contains(what))),
+            "{what}: {report:?}"
+        );
+    };
+    for (k, name) in ["density", "young", "damping", "viscosity"].into_iter().enumerate() {
+        let mut d = doc.clone();
+        d.mechanics.as_mut().unwrap().material[k] = -1.0;
+        refused(&d, name);
+    }
+    let mut d = doc.clone();
+    d.mechanics.as_mut().unwrap().material[0] = 0.0; // a density must be > 0
+    refused(&d, "density");
+    let faces = doc.mechanics.as_ref().unwrap().faces.len();
+    let boundary = doc.mechanics.as_ref().unwrap().faces.iter().filter(|f| f.0).count();
+    assert!(boundary > 0 && boundary < faces);
+    for f in 0..faces {
+        let mut d = doc.clone();
+        let flag = &mut d.mechanics.as_mut().unwrap().faces[f].0;
+        *flag = !*flag;
+        refused(&d, &format!("face {f} is flagged"));
+    }
+}

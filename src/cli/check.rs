@@ -110,6 +110,7 @@ fn law_name(f: &Finding) -> &'static str {
         Finding::Level(_) => "level_record",
         Finding::LevelMap { .. } => "level_valid",
         Finding::Structure(_) => "structure",
+        Finding::BodyState(_) => "body_state",
     }
 }
 
@@ -127,7 +128,7 @@ fn map_law_name(v: &InvariantViolation) -> &'static str {
 fn darts_of(f: &Finding) -> Vec<u32> {
     match f {
         Finding::Map(v) | Finding::LevelMap { violation: v, .. } => violation_darts(v),
-        Finding::Conservation(_) | Finding::Structure(_) => Vec::new(),
+        Finding::Conservation(_) | Finding::Structure(_) | Finding::BodyState(_) => Vec::new(),
         Finding::Level(e) => level_darts(e),
     }
 }

@@ -43,6 +43,10 @@ pub enum Finding {
     /// of [`RawMap::check`](super::RawMap::check), or a NaN or infinite attribute (the message of
     /// the [`StoreError`](super::StoreError)). Nothing else is checked then.
     Structure(String),
+    /// A body whose material [`Body::from_tets`](crate::mechanics::Body::from_tets) refuses, or a
+    /// face whose boundary flag disagrees with the map (the message of the
+    /// [`StoreError`](super::StoreError) that [`Document::into_body`] returns).
+    BodyState(String),
 }
 
 impl std::fmt::Display for Finding {
@@ -53,6 +57,7 @@ impl std::fmt::Display for Finding {
             Finding::Level(e) => write!(f, "levels: {e}"),
             Finding::LevelMap { level, violation } => write!(f, "level {level}: {violation}"),
             Finding::Structure(message) => write!(f, "structure: {message}"),
+            Finding::BodyState(message) => write!(f, "body: {message}"),
         }
     }
 }
@@ -86,7 +91,8 @@ pub struct CheckReport {
 
 /// Lists up to `limit` broken laws of `doc`: involution (dangling links, αi(αi(d)) ≠ d),
 /// quasi-manifold (αiαj ≠ αjαi for j ≥ i + 2), cell ids constant and live on each cell, cell ids
-/// unique (one id per orbit, no orphan live id), then conservation for a body whose map is valid,
+/// unique (one id per orbit, no orphan live id), then, for a body whose map is valid, its material
+/// and face boundary flags and conservation,
 /// then, for a document with levels: malformed records, μt ≤ μf ≤ μa and μ constant on cells at
 /// every dart, and (when the map is valid and the records well formed) every law of every
 /// extracted level G_0 … G_k and the flat flag of every dart (the one its level and link history
@@ -136,10 +142,16 @@ pub fn check_all_laws(doc: &Document, limit: usize) -> CheckReport {
     if map_valid {
         if let (Some(mech), 3) = (&doc.mechanics, raw.dimension) {
             if let Ok(map) = raw.to_gmap_raw::<3>() {
+                // The material and the flags first: a bad material breaks every mass law after it.
+                let mechanics = mech.to_mechanics();
+                if let Err(e) = super::check_body_state(&map, &mechanics) {
+                    valid = false;
+                    out.push(Finding::BodyState(e.to_string()));
+                }
                 // Every conservation violation, not only the first (one more than the room left, so
                 // the collector sees the listing is truncated).
                 let room = limit.saturating_sub(out.findings.len()).saturating_add(1);
-                for e in crate::mechanics::conservation_violations(&map, &mech.to_mechanics(), room) {
+                for e in crate::mechanics::conservation_violations(&map, &mechanics, room) {
                     valid = false;
                     out.push(Finding::Conservation(e));
                 }

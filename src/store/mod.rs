@@ -467,7 +467,8 @@ impl Document {
     /// [`StoreError::NoMechanics`], the structural errors of [`RawMap::check`],
     /// [`StoreError::NonFinite`] (at [`Where::Document`]) for a NaN or infinite attribute (which
     /// no decoder returns), [`StoreError::WrongDimension`], [`StoreError::BrokenLaw`],
-    /// [`StoreError::Conservation`].
+    /// [`StoreError::Conservation`]; [`StoreError::Inconsistent`] (at [`Where::Document`]) for a
+    /// material [`Body::from_tets`] refuses or a face whose boundary flag disagrees with the map.
     ///
     /// # Examples
     ///
@@ -490,9 +491,28 @@ impl Document {
         let map = self.map.to_gmap_raw::<3>()?;
         map.validate()?;
         let mech = raw_mech.to_mechanics();
+        check_body_state(&map, &mech)?;
         crate::mechanics::check_conservation(&map, &mech)?;
         Ok(Body::from_checked_parts(map, mech))
     }
+}
+
+/// What a body keeps besides the conservation laws and must still agree with: its material is
+/// one [`Body::from_tets`] accepts, and each face's boundary flag says whether the face is
+/// α3-free in the map (the flag is derived from the map; a flipped one would make the surface and
+/// the boundary forces wrong). Face normals are derived from the positions at the last topological
+/// change and are kept as stored. O(darts).
+pub(super) fn check_body_state(map: &GMap<3>, mech: &crate::mechanics::Mechanics) -> Result<(), StoreError> {
+    let inconsistent = |message: String| StoreError::Inconsistent { at: Where::Document, message };
+    crate::mechanics::model::check_material(mech.material()).map_err(|e| inconsistent(format!("material: {e}")))?;
+    for d in map.one_dart_per_cell(2) {
+        let (f, free) = (map.cell_id(2, d), map.is_free(3, d));
+        if mech.face_is_boundary(f) != free {
+            let (flag, truth) = if free { ("inner", "boundary") } else { ("boundary", "inner") };
+            return Err(inconsistent(format!("face {} is flagged {flag} but is a {truth} face of the map", f.0)));
+        }
+    }
+    Ok(())
 }
 
 /// Encodes a document in one form. O(size).

@@ -25,10 +25,7 @@ impl<const N: usize> GMap<N> {
         let tets = self.live_tet_blocks().filter(|_| self.tets_as_built())?;
         let (w, capacity) = (N + 1, self.capacity() as u32);
         // Union-find forests over the corner, edge and face pieces, and over the tets.
-        let mut forests: [Vec<u32>; 4] = std::array::from_fn(|dim| {
-            let per_tet = if dim < 3 { PIECES[dim] } else { 1 };
-            (0..(per_tet * tets) as u32).collect()
-        });
+        let mut forests: [Vec<u32>; 4] = std::array::from_fn(|dim| (0..(PIECES[dim] * tets) as u32).collect());
         let mut joins = [0usize; 4];
         for (t, rows) in self.alpha.chunks_exact(24 * w).enumerate() {
             for (k, row) in rows.chunks_exact(w).enumerate() {

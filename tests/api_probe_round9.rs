@@ -339,3 +339,30 @@ fn a_stored_body_keeps_the_material_and_boundary_flags_the_map_allows() {
         refused(&d, &format!("face {f} is flagged"));
     }
 }
+
+/// Finding 50: `measure_cut` given the incision of another body of the same size measured that
+/// body's faces (the incision's darts are live there too). It now requires each dissociation to
+/// stand in the body measured: both darts live, α3-free, on the face ids the dissociation
+/// reported.
+#[test]
+fn measure_cut_refuses_the_incision_of_another_body_of_the_same_size() {
+    use topomech::cut::CutError;
+    use topomech::subdivide::measure_cut;
+    let plane = Plane { point: [1.0, 0.0, 0.0], normal: [1.0, 0.0, 0.0] };
+    let (mut cut, other) = (cube_body(2), cube_body(2));
+    let incision = incise_plane(&mut cut, &plane).unwrap();
+    assert!(incision.cut_faces() > 0);
+    let own = measure_cut(&cut, &incision, &plane, None).unwrap();
+    assert_eq!(own.measured, incision.cut_faces());
+    match measure_cut(&other, &incision, &plane, None) {
+        Err(CutError::NotDissociated { dart, face }) => {
+            let first = &incision.dissociations[0];
+            assert_eq!((dart, face), (first.dart, first.faces.0));
+        }
+        other => panic!("{other:?}"),
+    }
+    // A body cut by another plane: its free darts are elsewhere.
+    let mut elsewhere = cube_body(2);
+    incise_plane(&mut elsewhere, &Plane { point: [0.0, 1.0, 0.0], normal: [0.0, 1.0, 0.0] }).unwrap();
+    assert!(matches!(measure_cut(&elsewhere, &incision, &plane, None), Err(CutError::NotDissociated { .. })));
+}

@@ -68,6 +68,15 @@ pub enum CutError {
     /// A face id that no live dart carries.
     #[error("face {0} does not exist in this body")]
     NoSuchFace(CellId),
+    /// A dissociation given back (to [`crate::subdivide::measure_cut`]) whose dart is live but not
+    /// α3-free on the face it reported: the incision was made on another body.
+    #[error("dart {dart} is not an α3-free dart of face {face} in this body: the incision was not made on it")]
+    NotDissociated {
+        /// A dart of the dissociation.
+        dart: DartId,
+        /// The face id the dissociation reported for it.
+        face: CellId,
+    },
     /// The face is α3-free: it is on the boundary already, there is nothing to dissociate.
     #[error("face {face} (dart {dart}) is a boundary face: nothing to dissociate")]
     BoundaryFace {

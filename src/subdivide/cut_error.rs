@@ -13,9 +13,10 @@
 //! B(c, r) only those whose centroid lies in the ball — the error is the maximum vertex distance
 //! and the mean over faces of the mean vertex distance. With no face measured both are NaN.
 
-use crate::cut::{incise_plane, CutError, Incision, Plane};
+use crate::cut::{incise_plane, CutError, Dissociation, Incision, Plane};
 use crate::gmap::AlphaMask;
 use crate::mechanics::Body;
+use crate::GMap;
 
 /// The geometric error of a cut surface against its plane (module docs).
 ///
@@ -51,8 +52,9 @@ pub struct CutSurfaceError {
 ///
 /// # Errors
 /// [`CutError::BadPlane`], [`CutError::BadZone`] (non-finite centre, radius not finite and ≥ 0),
-/// [`CutError::NoSuchDart`] for a dissociation whose dart is not live in `body` (an incision of
-/// another body).
+/// [`CutError::NoSuchDart`] for a dissociation whose dart is not live in `body`,
+/// [`CutError::NotDissociated`] for one whose dart is live but not α3-free on the face the
+/// dissociation reported (an incision of another body, in both cases).
 ///
 /// # Examples
 ///
@@ -82,8 +84,8 @@ pub fn measure_cut(
         check_zone(center, radius)?;
     }
     let (map, mech) = (body.map(), body.attrs());
-    if let Some(dis) = incision.dissociations.iter().find(|dis| !map.contains(dis.dart)) {
-        return Err(CutError::NoSuchDart(dis.dart));
+    for dis in &incision.dissociations {
+        check_applied(map, dis)?;
     }
     // The normal scaled by its largest component, so that a tiny (or huge) normal does not
     // underflow (overflow) in its squared length.
@@ -111,6 +113,21 @@ pub fn measure_cut(
     }
     let (max, mean) = if measured == 0 { (f64::NAN, f64::NAN) } else { (max, sum / measured as f64) };
     Ok(CutSurfaceError { faces: incision.cut_faces(), measured, max, mean })
+}
+
+/// `Ok` when the dissociation `dis` stands in `map`: both of its darts live, α3-free and on the
+/// face ids it reported. An incision of another body (or of a copy cut elsewhere) fails it unless
+/// that body was cut in the same places. O(1).
+fn check_applied(map: &GMap<3>, dis: &Dissociation) -> Result<(), CutError> {
+    for (d, face) in [(dis.dart, dis.faces.0), (dis.opposite, dis.faces.1)] {
+        if !map.contains(d) {
+            return Err(CutError::NoSuchDart(d));
+        }
+        if !map.is_free(3, d) || map.cell_id(2, d) != face {
+            return Err(CutError::NotDissociated { dart: d, face });
+        }
+    }
+    Ok(())
 }
 
 /// [`CutError::BadZone`] unless the centre is finite and the radius a finite number ≥ 0. O(1).

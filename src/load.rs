@@ -242,6 +242,7 @@ pub fn warning_lines(loaded: &Loaded) -> Vec<String> {
     };
     push("zero-volume tets", ids(&w.zero_volume_tets));
     push("inverted tets (negative signed volume)", ids(&w.inverted_tets));
+    push("tets whose volume overflows f64 (coordinates too large)", ids(&w.unmeasurable_tets));
     push("unreferenced points", ids(&w.unreferenced_points));
     push("file triangles that are not boundary faces", ids(&w.file_triangles_not_on_boundary));
     push(

@@ -16,6 +16,7 @@
 //! | more than `u32::MAX - 1` points | error [`MeshError::TooManyPoints`] | error [`MeshError::TooManyPoints`] |
 //! | zero volume / zero area (see [`DEGENERACY_TOLERANCE`]) | warning | warning |
 //! | negative signed volume (inverted tet) | warning | — |
+//! | signed volume not a finite number (coordinates so large that it overflows f64) | warning | — |
 //! | point used by no cell | warning | warning |
 //! | file triangles that are not boundary faces, or boundary faces missing from the file | warning | — |
 
@@ -214,6 +215,10 @@ pub struct MeshReport {
     pub zero_volume_tets: Vec<usize>,
     /// Tets with negative signed volume (and not zero-volume): inverted orientation.
     pub inverted_tets: Vec<usize>,
+    /// Tets whose signed volume is not a finite number: finite coordinates so large (about
+    /// 1e102 apart) that the volume overflows f64. Neither zero-volume nor inverted can be told;
+    /// [`TetMesh::total_volume`] is then not finite and a body refuses them.
+    pub unmeasurable_tets: Vec<usize>,
     /// Points that no tet uses.
     pub unreferenced_points: Vec<usize>,
     /// Entries of `boundary_triangles` that are not a boundary face of the tets.
@@ -237,6 +242,7 @@ impl MeshReport {
     pub fn is_clean(&self) -> bool {
         self.zero_volume_tets.is_empty()
             && self.inverted_tets.is_empty()
+            && self.unmeasurable_tets.is_empty()
             && self.unreferenced_points.is_empty()
             && self.file_triangles_not_on_boundary.is_empty()
             && self.boundary_faces_missing_from_file == 0
@@ -595,7 +601,9 @@ impl TetMesh {
         for (i, t) in self.tets.iter().enumerate() {
             let c = t.map(|v| self.points[v as usize]);
             let six_v = 6.0 * signed_volume(c[0], c[1], c[2], c[3]);
-            if six_v.abs() <= DEGENERACY_TOLERANCE * longest_edge(&c).powi(3) {
+            if !six_v.is_finite() {
+                report.unmeasurable_tets.push(i);
+            } else if six_v.abs() <= DEGENERACY_TOLERANCE * longest_edge(&c).powi(3) {
                 report.zero_volume_tets.push(i);
             } else if six_v < 0.0 {
                 report.inverted_tets.push(i);
@@ -629,7 +637,8 @@ impl TetMesh {
 
     /// Sum of the absolute tet volumes `sum |signed_volume|`. O(T).
     ///
-    /// Equals the enclosed volume for a valid mesh; inverted tets count positively.
+    /// Equals the enclosed volume for a valid mesh; inverted tets count positively. Not finite
+    /// when a tet's volume overflows f64 ([`MeshReport::unmeasurable_tets`]); +0.0 for no tets.
     ///
     /// # Errors
     /// [`MeshError::IndexOutOfRange`] naming the first tet corner past the points.
@@ -653,7 +662,7 @@ impl TetMesh {
             let c = t.map(|v| self.points[v as usize]);
             signed_volume(c[0], c[1], c[2], c[3]).abs()
         };
-        Ok(self.tets.iter().map(volume).sum())
+        Ok(self.tets.iter().map(volume).fold(0.0, |sum, v| sum + v))
     }
 
     /// The distinct edges of the tets, each as `[lo, hi]` with `lo < hi`, sorted. O(T log T).
@@ -897,7 +906,7 @@ impl TriMesh {
             let c = t.map(|v| self.points[v as usize]);
             triangle_area(c[0], c[1], c[2])
         };
-        Ok(self.triangles.iter().map(area).sum())
+        Ok(self.triangles.iter().map(area).fold(0.0, |sum, a| sum + a))
     }
 }
 

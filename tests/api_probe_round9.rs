@@ -366,3 +366,31 @@ fn measure_cut_refuses_the_incision_of_another_body_of_the_same_size() {
     incise_plane(&mut elsewhere, &Plane { point: [0.0, 1.0, 0.0], normal: [0.0, 1.0, 0.0] }).unwrap();
     assert!(matches!(measure_cut(&elsewhere, &incision, &plane, None), Err(CutError::NotDissociated { .. })));
 }
+
+/// Finding 51: `TetMesh::check` called a tet with coordinates near ±`f64::MAX` clean (its signed
+/// volume is NaN, so neither zero nor negative) while `total_volume` returned NaN and a body
+/// refused the mesh. Such tets are now listed as unmeasurable, a warning. The totals of an empty
+/// mesh are +0.0, not −0.0.
+#[test]
+fn a_tet_whose_volume_overflows_is_reported_not_called_clean() {
+    use topomech::mesh::{TetMesh, TriMesh};
+    let m = f64::MAX / 2.0;
+    let unit = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    let huge = vec![[-m, -m, -m], [m, -m, -m], [-m, m, -m], [-m, -m, m]];
+    let mut points = unit.clone();
+    points.extend(huge);
+    let mesh = TetMesh { points, tets: vec![[0, 1, 2, 3], [4, 5, 6, 7]], ..Default::default() };
+    let report = mesh.check().unwrap();
+    assert_eq!(report.unmeasurable_tets, vec![1], "{report:?}");
+    assert!(report.zero_volume_tets.is_empty() && report.inverted_tets.is_empty());
+    assert!(!report.is_clean());
+    assert!(!mesh.total_volume().unwrap().is_finite());
+    let body = Body::from_tets(&mesh.points, &mesh.tets, Material::default());
+    assert!(body.is_err(), "a body refuses what the check reports");
+    let small = TetMesh { points: unit, tets: vec![[0, 1, 2, 3]], ..Default::default() };
+    assert!(small.check().unwrap().is_clean());
+    let empty = TetMesh { tets: Vec::new(), ..small };
+    assert!(empty.total_volume().unwrap().is_sign_positive());
+    let no_triangles = TriMesh { points: vec![[0.0; 3]], triangles: Vec::new() };
+    assert!(no_triangles.total_area().unwrap().is_sign_positive());
+}

@@ -394,3 +394,28 @@ fn a_tet_whose_volume_overflows_is_reported_not_called_clean() {
     let no_triangles = TriMesh { points: vec![[0.0; 3]], triangles: Vec::new() };
     assert!(no_triangles.total_area().unwrap().is_sign_positive());
 }
+
+/// Finding 49, normals: a stored face normal must be zero, or of length 1 on a boundary face.
+#[test]
+fn a_stored_body_keeps_normals_of_length_one_or_zero() {
+    let doc = Document::from_body(&cube_body(2));
+    let faces = &doc.mechanics.as_ref().unwrap().faces;
+    let boundary = faces.iter().position(|f| f.0).unwrap();
+    let inner = faces.iter().position(|f| !f.0).unwrap();
+    let with_normal = |f: usize, n: [f64; 3]| {
+        let mut d = doc.clone();
+        d.mechanics.as_mut().unwrap().faces[f].1 = n;
+        d
+    };
+    let refused = |d: &Document, face: usize| {
+        let e = d.clone().into_body().unwrap_err();
+        assert!(e.to_string().contains(&format!("face {face} has the normal")), "{e}");
+        assert!(check_all_laws(d, 10).findings.iter().any(|f| matches!(f, Finding::BodyState(_))));
+    };
+    refused(&with_normal(boundary, [5.0, 0.0, 0.0]), boundary);
+    refused(&with_normal(boundary, [0.5, 0.5, 0.0]), boundary);
+    refused(&with_normal(inner, [1.0, 0.0, 0.0]), inner);
+    // A unit normal in another direction and a zero normal (a degenerate face) are kept.
+    assert!(with_normal(boundary, [0.0, 0.6, 0.8]).into_body().is_ok());
+    assert!(with_normal(boundary, [0.0; 3]).into_body().is_ok());
+}

@@ -468,7 +468,8 @@ impl Document {
     /// [`StoreError::NonFinite`] (at [`Where::Document`]) for a NaN or infinite attribute (which
     /// no decoder returns), [`StoreError::WrongDimension`], [`StoreError::BrokenLaw`],
     /// [`StoreError::Conservation`]; [`StoreError::Inconsistent`] (at [`Where::Document`]) for a
-    /// material [`Body::from_tets`] refuses or a face whose boundary flag disagrees with the map.
+    /// material [`Body::from_tets`] refuses, a face whose boundary flag disagrees with the map, or a
+    /// face normal that is neither zero nor (on a boundary face) of length 1.
     ///
     /// # Examples
     ///
@@ -497,12 +498,18 @@ impl Document {
     }
 }
 
+/// How far from 1 the length of a stored boundary face normal may be (a normalized vector is
+/// within a few ulps of it).
+const NORMAL_TOLERANCE: f64 = 1e-9;
+
 /// What a body keeps besides the conservation laws and must still agree with: its material is
-/// one [`Body::from_tets`] accepts, and each face's boundary flag says whether the face is
-/// α3-free in the map (the flag is derived from the map; a flipped one would make the surface and
-/// the boundary forces wrong). Face normals are derived from the positions at the last topological
-/// change and are kept as stored. O(darts).
+/// one [`Body::from_tets`] accepts, each face's boundary flag says whether the face is α3-free in
+/// the map (the flag is derived from the map; a flipped one would make the surface and the
+/// boundary forces wrong), and each face normal is zero or, on a boundary face, of length 1.
+/// (Normals are computed from the positions at the last topological change, so their directions
+/// are kept as stored.) O(darts).
 pub(super) fn check_body_state(map: &GMap<3>, mech: &crate::mechanics::Mechanics) -> Result<(), StoreError> {
+    mech.check_covers(map)?;
     let inconsistent = |message: String| StoreError::Inconsistent { at: Where::Document, message };
     crate::mechanics::model::check_material(mech.material()).map_err(|e| inconsistent(format!("material: {e}")))?;
     for d in map.one_dart_per_cell(2) {
@@ -510,6 +517,13 @@ pub(super) fn check_body_state(map: &GMap<3>, mech: &crate::mechanics::Mechanics
         if mech.face_is_boundary(f) != free {
             let (flag, truth) = if free { ("inner", "boundary") } else { ("boundary", "inner") };
             return Err(inconsistent(format!("face {} is flagged {flag} but is a {truth} face of the map", f.0)));
+        }
+        let n = mech.face_normal(f);
+        let len = n.iter().map(|c| c * c).sum::<f64>().sqrt();
+        let zero = n == [0.0; 3];
+        if !(zero || free && (len - 1.0).abs() <= NORMAL_TOLERANCE) {
+            let rule = if free { "of length 1 (or zero for a degenerate face)" } else { "zero (an inner face)" };
+            return Err(inconsistent(format!("face {} has the normal {n:?} of length {len}, not {rule}", f.0)));
         }
     }
     Ok(())

@@ -93,9 +93,9 @@ fn json_report(
     })
 }
 
-/// Stable law names: involution, quasi_manifold, cell_id_constant, cell_id_unique, conservation,
-/// and for levels: level_record, mu_order, mu_constant, level_closed, level_valid, flat_flag
-/// (and structure, which a decoded file never has).
+/// Stable law names: involution, quasi_manifold, cell_id_constant, cell_id_unique, body_state,
+/// conservation, and for levels: level_record, mu_order, mu_constant, level_closed, level_valid,
+/// flat_flag (and structure, which a decoded file never has).
 fn law_name(f: &Finding) -> &'static str {
     match f {
         Finding::Map(v) => map_law_name(v),

@@ -319,3 +319,21 @@ fn masses_that_miss_a_volume_or_are_not_finite_are_refused_before_any_change() {
     assert_eq!(r.subdivided_per_level, vec![0, 6]);
     assert!((r.total_mass_after - 1.0).abs() < 1e-12 && (r.total_mass_before - 1.0).abs() < 1e-12);
 }
+
+/// A flat tet (four coplanar corners, zero volume) still shares its mass: with no volume to
+/// share by, each of the eight children gets an equal part, and the parts sum to the parent's
+/// (not 0/0 = NaN shares).
+#[test]
+fn a_flat_tet_shares_its_mass_equally_among_its_children() {
+    let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+    let flat = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]];
+    let mut m = LeveledMap::new(map, flat);
+    let mut masses = TetMasses { mass: vec![2.0] };
+    let d = m.map().darts().next().unwrap();
+    let children = m.subdivide_tet_with_mass(d, 1, &mut masses).unwrap();
+    assert_eq!(children.len(), 8);
+    for &c in &children {
+        let share = masses.mass[m.map().cell_id(3, c).index()];
+        assert_eq!(share, 0.25, "child {c:?}");
+    }
+}

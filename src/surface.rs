@@ -336,7 +336,8 @@ impl Surface {
 
     /// The signed volume enclosed by the triangles, Σ a·(b × c) / 6 (divergence theorem). For a
     /// closed, outward-oriented surface it is the volume of the solid; it is independent of the
-    /// origin only when the surface is closed. O(triangles), including the index check.
+    /// origin only when the surface is closed. +0.0 for no triangles. O(triangles), including the
+    /// index check.
     ///
     /// # Errors
     /// [`SurfaceError::VertexOutOfRange`] naming the first triangle corner past the vertices
@@ -357,10 +358,11 @@ impl Surface {
     pub fn enclosed_volume(&self) -> Result<f64, SurfaceError> {
         self.check()?;
         let p = |i: u32| self.positions[i as usize];
-        Ok(self.triangles.iter().map(|&[a, b, c]| dot(p(a), cross(p(b), p(c)))).sum::<f64>() / 6.0)
+        // A fold from +0.0, not `sum` (which starts at −0.0): no triangles measure +0.0.
+        Ok(self.triangles.iter().map(|&[a, b, c]| dot(p(a), cross(p(b), p(c)))).fold(0.0, |sum, v| sum + v) / 6.0)
     }
 
-    /// Total area of the triangles. O(triangles), including the index check.
+    /// Total area of the triangles, +0.0 for none. O(triangles), including the index check.
     ///
     /// # Errors
     /// [`SurfaceError::VertexOutOfRange`] naming the first triangle corner past the vertices
@@ -382,7 +384,9 @@ impl Surface {
     pub fn area(&self) -> Result<f64, SurfaceError> {
         self.check()?;
         let p = |i: u32| self.positions[i as usize];
-        Ok(self.triangles.iter().map(|&[a, b, c]| norm(cross(sub(p(b), p(a)), sub(p(c), p(a)))) / 2.0).sum())
+        let area = |&[a, b, c]: &[u32; 3]| norm(cross(sub(p(b), p(a)), sub(p(c), p(a)))) / 2.0;
+        // A fold from +0.0, not `sum` (which starts at −0.0): no triangles measure +0.0.
+        Ok(self.triangles.iter().map(area).fold(0.0, |sum, a| sum + a))
     }
 
     /// The surface as Wavefront OBJ text: a comment header, one `v x y z` line per vertex

@@ -53,10 +53,12 @@ pub enum VtkError {
         /// The number of points.
         expected: usize,
     },
-    /// A point array name holding a control character (`char::is_control`: C0 such as NUL or
-    /// U+0001, DEL, C1). XML 1.0 forbids most C0 controls, so readers would reject the file, and
-    /// tab, line feed and carriage return in an attribute come back as spaces.
-    #[error("point array {array} has the name {name:?}, which holds a control character")]
+    /// A point array name holding a character XML cannot carry: a control character
+    /// (`char::is_control`: C0 such as NUL or U+0001, DEL, C1) or a character outside the XML 1.0
+    /// `Char` production (the noncharacters U+FFFE and U+FFFF). XML 1.0 forbids most C0 controls
+    /// and U+FFFE/U+FFFF, so readers would reject the file, and tab, line feed and carriage return
+    /// in an attribute come back as spaces.
+    #[error("point array {array} has the name {name:?}, which holds a control character or a non-XML character")]
     BadArrayName {
         /// The array's index in [`Frame::vectors`].
         array: usize,
@@ -74,9 +76,10 @@ pub enum VtkError {
         /// The number of points.
         points: usize,
     },
-    /// A series stem that is empty or holds a path separator or a control character (the frames
-    /// would land outside the series directory, or under a name no listing shows).
-    #[error("series stem {stem:?} must be a non-empty file name without '/', '\\' or control characters")]
+    /// A series stem that is empty or holds a path separator, a control character or a character
+    /// outside the XML 1.0 `Char` production such as U+FFFE (the frames would land outside the
+    /// series directory, under a name no listing shows, or in a `.pvd` no XML reader accepts).
+    #[error("series stem {stem:?} must be a non-empty file name without '/', '\\', control or non-XML characters")]
     BadStem {
         /// The stem given.
         stem: String,
@@ -120,13 +123,15 @@ impl Frame<'_> {
     /// The frame as VTU XML text. O(points + tets).
     ///
     /// Array names are written as XML attribute values (`&`, `<`, `>`, `"` and `'` as entities),
-    /// so a reader gets back the name as given; a name with a control character, which XML
-    /// cannot carry, is refused. Everything is checked before any text is made: the names and
-    /// lengths in O(arrays + name lengths), the tets in O(tets).
+    /// so a reader gets back the name as given; a name with a control character or a character
+    /// outside the XML 1.0 `Char` production (U+FFFE, U+FFFF), which XML cannot carry, is
+    /// refused. Everything is checked before any text is made: the names and lengths in
+    /// O(arrays + name lengths), the tets in O(tets).
     ///
     /// # Errors
     /// For the first array in order: [`VtkError::BadArrayName`] when its name holds a control
-    /// character (`char::is_control`), [`VtkError::BadArray`] when it has the wrong length;
+    /// character (`char::is_control`) or a non-XML character (U+FFFE, U+FFFF),
+    /// [`VtkError::BadArray`] when it has the wrong length;
     /// then [`VtkError::BadTet`] when a tetrahedron names a point past the end of `points`.
     ///
     /// # Examples
@@ -149,11 +154,13 @@ impl Frame<'_> {
     /// let err = control.to_vtu().unwrap_err();
     /// assert!(matches!(&err, VtkError::BadArrayName { array: 1, name } if name == "a\u{1}b"));
     /// assert!(err.to_string().contains("\"a\\u{1}b\"")); // the name, escaped
+    /// let nonchar = Frame { vectors: vec![("a\u{FFFE}b", &velocity[..])], ..control };
+    /// assert!(matches!(nonchar.to_vtu(), Err(VtkError::BadArrayName { array: 0, .. })));
     /// ```
     pub fn to_vtu(&self) -> Result<String, VtkError> {
         let n = self.points.len();
         for (array, (name, values)) in self.vectors.iter().enumerate() {
-            if name.chars().any(char::is_control) {
+            if !name.chars().all(is_name_char) {
                 return Err(VtkError::BadArrayName { array, name: name.to_string() });
             }
             if values.len() != n {
@@ -214,6 +221,19 @@ impl Frame<'_> {
     pub fn write(&self, path: &Path) -> Result<(), VtkError> {
         write_file(path, &self.to_vtu()?)
     }
+}
+
+/// The XML 1.0 `Char` production: #x9 | #xA | #xD | \[#x20–#xD7FF\] | \[#xE000–#xFFFD\] |
+/// \[#x10000–#x10FFFF\] (a Rust `char` is never a surrogate, U+D800–U+DFFF). O(1).
+fn is_xml_char(c: char) -> bool {
+    matches!(c, '\t' | '\n' | '\r' | '\u{20}'..='\u{D7FF}' | '\u{E000}'..='\u{FFFD}' | '\u{10000}'..='\u{10FFFF}')
+}
+
+/// A character a name or stem may hold: an XML `Char` that is not a control character (tab, line
+/// feed and carriage return are XML characters, but an attribute value turns them into spaces,
+/// so the name would not come back as given). O(1).
+fn is_name_char(c: char) -> bool {
+    is_xml_char(c) && !c.is_control()
 }
 
 fn vector_array(s: &mut String, name: &str, values: &[Vec3]) {
@@ -279,8 +299,9 @@ impl Series {
     /// A series of files `DIR/STEM_NNNNNN.vtu` and `DIR/STEM.pvd`; creates DIR.
     ///
     /// # Errors
-    /// [`VtkError::BadStem`] for an empty stem or one with a path separator or a control
-    /// character; [`VtkError::CreateDir`] if DIR cannot be created.
+    /// [`VtkError::BadStem`] for an empty stem or one with a path separator, a control character
+    /// or a non-XML character (U+FFFE, U+FFFF: the stem is written into the `.pvd`);
+    /// [`VtkError::CreateDir`] if DIR cannot be created.
     ///
     /// # Examples
     ///
@@ -297,9 +318,12 @@ impl Series {
     /// for stem in ["", "../run", "a\\b", "run\n"] {
     ///     assert!(matches!(Series::new(&std::env::temp_dir(), stem), Err(VtkError::BadStem { .. })));
     /// }
+    /// for stem in ["run\u{FFFE}", "run\u{FFFF}"] { // not XML characters
+    ///     assert!(matches!(Series::new(&std::env::temp_dir(), stem), Err(VtkError::BadStem { .. })));
+    /// }
     /// ```
     pub fn new(dir: &Path, stem: &str) -> Result<Self, VtkError> {
-        if stem.is_empty() || stem.contains(['/', '\\']) || stem.chars().any(char::is_control) {
+        if stem.is_empty() || stem.contains(['/', '\\']) || !stem.chars().all(is_name_char) {
             return Err(VtkError::BadStem { stem: stem.to_string() });
         }
         std::fs::create_dir_all(dir).map_err(|source| VtkError::CreateDir { path: dir.to_path_buf(), source })?;

@@ -260,6 +260,16 @@ pub(crate) fn named(path: &Path, message: String) -> String {
     }
 }
 
+/// The larger of a and b, NaN if either is NaN ([`f64::max`] drops a NaN, which would report a
+/// lost state as its other values). For `fold(0.0, nan_max)` over magnitudes. O(1).
+pub(crate) fn nan_max(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.max(b)
+    }
+}
+
 /// One number of a command-line value: NaN and ±∞ are refused with the value named (they
 /// would run silently or blow up far from the argument that caused it).
 pub(crate) fn parse_finite(t: &str) -> Result<f64, String> {

@@ -67,8 +67,10 @@ impl CombinatorialMap {
 }
 
 impl<const N: usize> GMap<N> {
-    /// The combinatorial map of an orientable G-map, or `None` if it is not orientable or some
-    /// dart is 0-free or 1-free (β1 would not be a permutation). O(darts · n).
+    /// The combinatorial map of an orientable G-map, or `None` if it is not orientable, some
+    /// dart is 0-free or 1-free (β1 would not be a permutation), or some dart d has
+    /// αi(d) = α0(d) for an i ≥ 2 (a cell sewn onto itself across that edge: βi = α0αi would fix
+    /// d, and a βi with a fixed point is no involution of a combinatorial map). O(darts · n).
     ///
     /// # Examples
     ///
@@ -86,6 +88,10 @@ impl<const N: usize> GMap<N> {
     pub fn to_combinatorial_map(&self) -> Option<CombinatorialMap> {
         let colour = self.orientation()?;
         if self.darts().any(|d| self.is_free(0, d) || self.is_free(1, d)) {
+            return None;
+        }
+        let folded = |d: DartId| (2..=N).any(|i| !self.is_free(i, d) && self.alpha_dyn(i, d) == self.alpha_dyn(0, d));
+        if self.darts().any(folded) {
             return None;
         }
         let origin: Vec<DartId> = self.darts().filter(|d| colour[d.index()] == 0).collect();

@@ -2,6 +2,11 @@
 
 /// A subset of {α0, …, α7} as a bit set; bit i stands for αi.
 ///
+/// Indices above [`AlphaMask::MAX_INDEX`] cannot be stored (a map has dimension ≤ 7). The
+/// constructors that would have to store one ([`AlphaMask::of`], and [`AlphaMask::all`] /
+/// [`AlphaMask::commuting_with`] for n > 7) panic in every build, naming the index; the queries
+/// answer for them: [`AlphaMask::contains`] is false and [`AlphaMask::cell`] removes nothing.
+///
 /// The i-cell orbit of an n-G-map is `⟨⟩N−{i}`: [`AlphaMask::cell`]. The involutions that commute
 /// with αi by the quasi-manifold law (|i − j| ≥ 2) form [`AlphaMask::commuting_with`]; an i-sew
 /// links exactly the darts of that orbit.
@@ -24,7 +29,13 @@ impl AlphaMask {
     /// The empty set.
     pub const EMPTY: AlphaMask = AlphaMask(0);
 
-    /// All involutions α0..=αn of an n-map.
+    /// The largest index a mask can hold: 7 (one bit per involution of a map of dimension ≤ 7).
+    pub const MAX_INDEX: usize = 7;
+
+    /// All involutions α0..=αn of an n-map. O(1).
+    ///
+    /// # Panics
+    /// If n > [`AlphaMask::MAX_INDEX`] (α8 cannot be stored), in every build.
     ///
     /// # Examples
     ///
@@ -35,10 +46,15 @@ impl AlphaMask {
     /// assert_eq!(AlphaMask::all(3).0, 0b1111);
     /// ```
     pub const fn all(n: usize) -> AlphaMask {
+        assert!(n <= Self::MAX_INDEX, "AlphaMask::all: a mask holds α0..=α7 only");
         AlphaMask(((1u16 << (n + 1)) - 1) as u8)
     }
 
-    /// The set {αj : j in `indices`}.
+    /// The set {αj : j in `indices`}. O(|indices|).
+    ///
+    /// # Panics
+    /// If an index is above [`AlphaMask::MAX_INDEX`], in every build (before, release builds
+    /// wrapped α9 onto α1).
     ///
     /// # Examples
     ///
@@ -53,13 +69,18 @@ impl AlphaMask {
         let mut bits = 0u8;
         let mut k = 0;
         while k < indices.len() {
+            assert!(indices[k] <= Self::MAX_INDEX, "AlphaMask::of: an index above 7 (a mask holds α0..=α7 only)");
             bits |= 1 << indices[k];
             k += 1;
         }
         AlphaMask(bits)
     }
 
-    /// The generators of the i-cell orbit of an n-map: every αj but αi.
+    /// The generators of the i-cell orbit of an n-map: every αj but αi (all of them for i > n).
+    /// O(1).
+    ///
+    /// # Panics
+    /// As [`AlphaMask::all`], if n > [`AlphaMask::MAX_INDEX`].
     ///
     /// # Examples
     ///
@@ -72,10 +93,17 @@ impl AlphaMask {
     /// assert_eq!(map.orbit(d, AlphaMask::cell(3, 1)).len(), 4); // an edge: 2 ends × 2 faces
     /// ```
     pub const fn cell(n: usize, i: usize) -> AlphaMask {
+        if i > Self::MAX_INDEX {
+            return Self::all(n);
+        }
         AlphaMask(Self::all(n).0 & !(1 << i))
     }
 
-    /// The involutions that must commute with αi in an n-map: αj with |i − j| ≥ 2.
+    /// The involutions that must commute with αi in an n-map: αj with j ≤ n and |i − j| ≥ 2.
+    /// O(n).
+    ///
+    /// # Panics
+    /// As [`AlphaMask::all`], if n > [`AlphaMask::MAX_INDEX`].
     ///
     /// # Examples
     ///
@@ -87,6 +115,7 @@ impl AlphaMask {
     /// assert_eq!(AlphaMask::commuting_with(2, 1), AlphaMask::EMPTY);
     /// ```
     pub const fn commuting_with(n: usize, i: usize) -> AlphaMask {
+        assert!(n <= Self::MAX_INDEX, "AlphaMask::commuting_with: a mask holds α0..=α7 only");
         let mut bits = 0u8;
         let mut j = 0;
         while j <= n {
@@ -98,7 +127,7 @@ impl AlphaMask {
         AlphaMask(bits)
     }
 
-    /// Whether αi is in the set.
+    /// Whether αi is in the set (false for every i above [`AlphaMask::MAX_INDEX`]). O(1).
     ///
     /// # Examples
     ///
@@ -111,7 +140,7 @@ impl AlphaMask {
     /// ```
     #[inline(always)]
     pub const fn contains(self, i: usize) -> bool {
-        self.0 & (1 << i) != 0
+        i <= Self::MAX_INDEX && self.0 & (1 << i) != 0
     }
 
     /// The indices in the set, in increasing order.

@@ -378,7 +378,7 @@ impl<const N: usize> GMap<N> {
         (0..=N).all(|i| self.is_free(i, d))
     }
 
-    /// The i-sewn pairs {d, αi(d)} with d < αi(d), each once. O(capacity).
+    /// The i-sewn pairs {d, αi(d)} with d < αi(d), each once (none for i > n). O(capacity).
     ///
     /// # Examples
     ///
@@ -392,7 +392,7 @@ impl<const N: usize> GMap<N> {
     /// assert!(pairs.iter().all(|&(d, e)| d < e && map.alpha::<2>(d) == e));
     /// ```
     pub fn sewn_pairs(&self, i: usize) -> impl Iterator<Item = (DartId, DartId)> + '_ {
-        self.darts().filter_map(move |d| {
+        self.darts().take_while(move |_| i <= N).filter_map(move |d| {
             let e = self.alpha_dyn(i, d);
             (d < e).then_some((d, e))
         })

@@ -286,7 +286,7 @@ impl<const N: usize> GMap<N> {
     }
 
     /// One dart per i-cell, found by walking orbits with a mark and ignoring cell ids: the
-    /// independent oracle for [`GMap::one_dart_per_cell`]. O(darts · n).
+    /// independent oracle for [`GMap::one_dart_per_cell`] (none for i > n). O(darts · n).
     ///
     /// # Examples
     ///
@@ -302,6 +302,9 @@ impl<const N: usize> GMap<N> {
     /// ```
     pub fn one_dart_per_cell_by_traversal(&self, i: usize) -> Vec<DartId> {
         let mut out = Vec::new();
+        if i > N {
+            return out; // no i-cells, as in `one_dart_per_cell`
+        }
         self.for_each_orbit(AlphaMask::cell(N, i), |d| out.push(d));
         out
     }

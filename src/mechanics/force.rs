@@ -1275,6 +1275,14 @@ pub enum SystemError {
     /// A gravity with a non-finite component.
     #[error("gravity {0:?} is not finite")]
     BadGravity(Vec3),
+    /// A positive mass so small that its inverse overflows f64 (below about 5.6e-309).
+    #[error("mass of slot {slot} is {mass:e}: its inverse overflows f64 (give 0 for a massless slot)")]
+    MassTooSmall {
+        /// The slot's index.
+        slot: usize,
+        /// The mass given.
+        mass: f64,
+    },
 }
 
 /// 1/m for a free slot of mass m > 0, else 0 (fixed or massless). O(1).
@@ -1296,12 +1304,17 @@ fn ends_ok(ends: [u32; 2], slots: usize) -> bool {
     ends[0] != ends[1] && (ends[0].max(ends[1]) as usize) < slots
 }
 
-/// The value checks of a slot at index v. O(1).
+/// The value checks of a slot at index v: amounts, and a mass that is 0 or has a finite
+/// inverse (a subnormal mass such as 5e-324 would give 1/m = ∞, which [`SpringSystem::check`]
+/// refuses; it is refused here, pinned or not, so that every system built passes `check`). O(1).
 fn check_slot_values(v: usize, mass: f64, viscosity: f64) -> Result<(), SystemError> {
     for (quantity, value) in [("mass", mass), ("viscosity", viscosity)] {
         if !is_amount(value) {
             return Err(SystemError::BadValue { quantity, of: "slot", index: v, value });
         }
+    }
+    if mass > 0.0 && !(1.0 / mass).is_finite() {
+        return Err(SystemError::MassTooSmall { slot: v, mass });
     }
     Ok(())
 }

@@ -144,6 +144,9 @@ pub struct Simulation {
     pub projection: Projection,
     /// The integrator and its buffers.
     pub stepper: Stepper,
+    /// The body's velocity epoch (`Mechanics::velocity_epoch`) at which the pinned velocities
+    /// were last zeroed.
+    velocity_epoch: u64,
 }
 
 impl Simulation {
@@ -151,7 +154,8 @@ impl Simulation {
     /// zero velocity. O(darts + E log E).
     ///
     /// # Errors
-    /// [`StepError::BadTimeStep`].
+    /// [`SimError::BadGravity`]; the errors of [`Stepper::new`] ([`StepError::BadTimeStep`], a
+    /// bad parameter or input). On an error the body is unchanged.
     ///
     /// # Examples
     ///
@@ -172,22 +176,45 @@ impl Simulation {
         if gravity.iter().any(|g| !g.is_finite()) {
             return Err(SimError::BadGravity(gravity));
         }
-        let mech = body.attrs_mut();
-        for (v, &p) in mech.velocity.as_mut_slice().iter_mut().zip(mech.pinned.as_slice()) {
-            if p {
-                *v = [0.0; 3];
-            }
-        }
         let projection = Projection::build_raw(body, gravity);
         let slots = projection.system.slots();
         let mech = body.attrs();
+        // Checked before any change (the energy scale counts free slots only, so the pinned
+        // velocities zeroed below do not enter it).
         let stepper = Stepper::new(
             config,
             &projection.system,
             &mech.position.as_slice()[..slots],
             &mech.velocity.as_slice()[..slots],
         )?;
-        Ok(Simulation { projection, stepper })
+        let mut sim = Simulation { projection, stepper, velocity_epoch: 0 };
+        sim.hold_pinned(body);
+        Ok(sim)
+    }
+
+    /// Zeroes the velocity of every pinned vertex (the law "a pinned vertex does not move") and
+    /// records the body's velocity epoch. O(vertex ids).
+    fn hold_pinned(&mut self, body: &mut Body) {
+        let mech = body.attrs_mut();
+        for (v, &p) in mech.velocity.as_mut_slice().iter_mut().zip(mech.pinned.as_slice()) {
+            if p {
+                *v = [0.0; 3];
+            }
+        }
+        self.velocity_epoch = mech.velocity_epoch;
+    }
+
+    /// Takes up what was written into the body's pins or velocities since the last step: pins
+    /// handed out for writing are re-read into the projection's fixed slots, and the pinned
+    /// vertices' velocities are zeroed again. O(1) when nothing was handed out, else O(vertex ids).
+    fn follow_writes(&mut self, body: &mut Body) {
+        let pins_changed = !self.projection.pins_current(body);
+        if pins_changed {
+            self.projection.follow_pins(body);
+        }
+        if pins_changed || self.velocity_epoch != body.attrs().velocity_epoch {
+            self.hold_pinned(body);
+        }
     }
 
     /// [`SimError::OtherBody`] unless the simulation was built for `body`. O(1).
@@ -209,6 +236,11 @@ impl Simulation {
     }
 
     /// One step on the body's positions and velocities. O(springs + vertex ids).
+    ///
+    /// Pins and velocities written since the last step are taken up first: a vertex pinned
+    /// (or unpinned) through [`Mechanics::pinned_mut`] or [`Mechanics::pin_where`] is fixed (or
+    /// free) from this step on, and a pinned vertex given a velocity through
+    /// [`Mechanics::velocity_mut`] has it zeroed: pinned vertices do not move.
     ///
     /// # Errors
     /// [`SimError::OtherBody`] if the simulation was built for another body (nothing moves);
@@ -235,6 +267,10 @@ impl Simulation {
     /// assert!(sim.kinetic_energy(&body).unwrap() > 0.0 && sim.max_displacement(&body).unwrap() > 0.0);
     /// ```
     pub fn step(&mut self, body: &mut Body) -> Result<(), SimError> {
+        self.check_body(body)?;
+        if self.projection.version() == body.version() {
+            self.follow_writes(body);
+        }
         self.check_current(body)?;
         let slots = self.projection.system.slots();
         let mech = body.attrs_mut();
@@ -310,6 +346,7 @@ impl Simulation {
                 *v = [0.0; 3];
             }
         }
+        self.velocity_epoch = mech.velocity_epoch;
         let (x, v) = (&mech.position.as_slice()[..slots], &mech.velocity.as_slice()[..slots]);
         self.stepper = Stepper::new(config, &self.projection.system, x, v)?;
         Ok(())
@@ -343,7 +380,9 @@ impl Simulation {
         Ok(self.projection.system.kinetic_energy_raw(&body.attrs().velocity.as_slice()[..slots]))
     }
 
-    /// Largest distance of a live vertex from its rest position. O(vertex ids).
+    /// Largest distance of a live vertex from its rest position; NaN if a live vertex's position
+    /// is NaN (as [`Simulation::kinetic_energy`] is NaN for a NaN velocity: a lost state is never
+    /// reported as "no movement"). O(vertex ids).
     ///
     /// # Errors
     /// As [`Simulation::kinetic_energy`]: another body, or a stale projection.
@@ -367,6 +406,61 @@ impl Simulation {
         Ok((0..self.projection.system.slots())
             .filter(|&v| self.projection.dart_of_vertex(v).is_some())
             .map(|v| geom::norm(geom::sub(m.position.as_slice()[v], m.rest_position.as_slice()[v])))
-            .fold(0.0, f64::max))
+            .fold(0.0, nan_max))
+    }
+
+    /// Evaluates the forces on every vertex at the body's current positions and velocities
+    /// (springs with damping, gravity, ambient viscosity; pinned vertices get theirs too: the
+    /// reaction their pin holds) and writes them into the body's force accumulator
+    /// ([`Mechanics::force`]); dead vertex ids get zero. The step loop keeps its sums in its own
+    /// buffers and does not write the accumulator (a pass fewer per step): call this when the
+    /// forces are wanted. Pins and velocities written since the last step are taken up first, as
+    /// in [`Simulation::step`]. O(springs + vertex ids).
+    ///
+    /// # Errors
+    /// As [`Simulation::step`]: another body, or a stale projection (nothing is written).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Integrator, Material, Simulation, StepConfig};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let mut sim = Simulation::new(&mut body, [0.0, 0.0, -9.81], StepConfig::new(Integrator::Symplectic, 1e-3)).unwrap();
+    /// sim.write_forces(&mut body).unwrap();
+    /// let weight: f64 = body.attrs().force().as_slice().iter().map(|f| f[2]).sum(); // at rest: gravity alone
+    /// assert!((weight + 9.81 * body.total_vertex_mass()).abs() < 1e-12);
+    /// ```
+    pub fn write_forces(&mut self, body: &mut Body) -> Result<(), SimError> {
+        self.check_body(body)?;
+        if self.projection.version() == body.version() {
+            self.follow_writes(body);
+        }
+        self.check_current(body)?;
+        let sys = &self.projection.system;
+        let slots = sys.slots();
+        let (mut sf, mut out) = (vec![[0.0; 3]; sys.springs()], vec![[0.0; 3]; slots]);
+        let mech = body.attrs_mut();
+        let (x, v) = (&mech.position.as_slice()[..slots], &mech.velocity.as_slice()[..slots]);
+        sys.forces_raw(x, v, &mut sf, &mut out, self.stepper.config().parallel);
+        let force = mech.force.as_mut_slice();
+        force.fill([0.0; 3]);
+        for (v, f) in out.into_iter().enumerate() {
+            if self.projection.dart_of_vertex(v).is_some() {
+                force[v] = f;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The larger of a and b, NaN if either is NaN (unlike [`f64::max`], which drops a NaN). O(1).
+fn nan_max(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.max(b)
     }
 }

@@ -133,6 +133,16 @@ pub enum ModelError {
         /// Its value there (infinite or NaN).
         value: f64,
     },
+    /// A tet whose mass ρ·V is so small that a quarter of it (the least a vertex of that tet can
+    /// weigh) has an inverse that overflows f64, or rounds to 0 (density or volume too small):
+    /// the step divides by vertex masses.
+    #[error("tetrahedron {tet}: its mass {mass:e} is too small for f64 (a vertex's inverse mass would overflow; density or volume too small)")]
+    MassTooSmall {
+        /// Tet index (= volume id).
+        tet: usize,
+        /// Its mass ρ·V.
+        mass: f64,
+    },
     /// A gravity vector with a NaN or infinite component (the flat model's constructor).
     #[error("gravity {0:?} must be finite")]
     BadGravity(Vec3),
@@ -218,6 +228,13 @@ pub struct Mechanics {
     pub(crate) velocity: CellArray<Vec3>,
     pub(crate) force: CellArray<Vec3>,
     pub(crate) pinned: CellArray<bool>,
+    /// Bumped each time the pins are handed out for writing ([`Mechanics::pinned_mut`],
+    /// [`Mechanics::pin_where`]): a projection built before sees that its fixed slots may be
+    /// stale. Not part of the body's state (never stored or compared).
+    pub(crate) pins_epoch: u64,
+    /// Bumped each time the velocities are handed out for writing
+    /// ([`Mechanics::velocity_mut`]): the simulation then re-zeroes the pinned velocities.
+    pub(crate) velocity_epoch: u64,
 }
 
 /// A mechanical body: a 3-G-map whose sew/unsew keep the [`Mechanics`] attributes lawful.
@@ -581,11 +598,14 @@ impl Mechanics {
     /// assert!((body.kinetic_energy() - 0.5).abs() < 1e-12); // ½ · 1 kg · (1 m/s)²
     /// ```
     pub fn velocity_mut(&mut self) -> CellSliceMut<'_, Vec3> {
+        self.velocity_epoch += 1;
         CellSliceMut::new(&mut self.velocity)
     }
 
     /// Sum of the forces on each vertex at the last evaluation (seed §4.1 "for optimization"),
-    /// read-only: the simulation writes it. O(1).
+    /// read-only: [`crate::mechanics::Simulation::write_forces`] writes it (the step loop keeps
+    /// its sums in its own buffers); zero until then, and reset to zero on both sides of a vertex
+    /// that splits. O(1).
     ///
     /// # Examples
     ///
@@ -601,7 +621,8 @@ impl Mechanics {
         &self.force
     }
 
-    /// Which vertices are fixed (their velocity stays zero). O(1).
+    /// Which vertices are fixed (their velocity stays zero: a simulation zeroes it when it is
+    /// built and at each step after the pins or velocities were written). O(1).
     ///
     /// # Examples
     ///
@@ -633,6 +654,7 @@ impl Mechanics {
     /// assert_eq!(body.attrs().pinned().as_slice().iter().filter(|&&p| p).count(), 1);
     /// ```
     pub fn pinned_mut(&mut self) -> CellSliceMut<'_, bool> {
+        self.pins_epoch += 1;
         CellSliceMut::new(&mut self.pinned)
     }
 
@@ -976,6 +998,7 @@ impl Mechanics {
     /// assert_eq!(body.attrs().pinned().as_slice().iter().filter(|&&p| p).count(), 4);
     /// ```
     pub fn pin_where(&mut self, mut pin: impl FnMut(CellId, Vec3) -> bool) {
+        self.pins_epoch += 1;
         for (i, (p, r)) in self.pinned.as_mut_slice().iter_mut().zip(self.rest_position.as_slice()).enumerate() {
             *p = pin(CellId(i as u32), *r);
         }
@@ -1222,11 +1245,17 @@ impl ModelTotals {
     /// Adds tet `t` (its corners and volume) to the totals.
     ///
     /// # Errors
-    /// [`ModelError::DegenerateTet`] for a zero volume, [`ModelError::Overflow`] when the volume or
-    /// a total is no longer finite. O(1).
+    /// [`ModelError::DegenerateTet`] for a zero volume, [`ModelError::MassTooSmall`] when a
+    /// quarter of the tet's mass has no finite inverse (every vertex mass is at least the quarter
+    /// of one of its tets' masses, so this keeps every 1/m_v finite), [`ModelError::Overflow`]
+    /// when the volume or a total is no longer finite. O(1).
     pub(crate) fn add(&mut self, t: usize, c: [Vec3; 4], volume: f64, m: &Material) -> Result<(), ModelError> {
         if volume == 0.0 {
             return Err(ModelError::DegenerateTet { tet: t });
+        }
+        let mass = m.density * volume;
+        if !(4.0 / mass.abs()).is_finite() {
+            return Err(ModelError::MassTooSmall { tet: t, mass });
         }
         self.mass += m.density * volume;
         for (i, j) in [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)] {
@@ -1441,6 +1470,8 @@ impl Mechanics {
             velocity: CellArray::from_vec(Vec::new()),
             force: CellArray::from_vec(Vec::new()),
             pinned: CellArray::from_vec(Vec::new()),
+            pins_epoch: 0,
+            velocity_epoch: 0,
         }
     }
 

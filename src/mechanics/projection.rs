@@ -74,6 +74,8 @@ pub struct Projection {
     edge_spring: Vec<u32>,
     vertex_dart: Vec<Option<DartId>>,
     version: u64,
+    /// The body's pin epoch (`Mechanics::pins_epoch`) its fixed slots were read at.
+    pins_epoch: u64,
     /// The [`Body::identity`] of the body it was built from.
     body: u64,
     /// The lists of [`Resolved::of`], kept between updates.
@@ -137,6 +139,7 @@ impl Projection {
             edge_spring,
             vertex_dart,
             version: body.version(),
+            pins_epoch: mech.pins_epoch,
             body: body.identity(),
             scratch: Resolved::default(),
         }
@@ -200,7 +203,9 @@ impl Projection {
         *self = Projection::build_raw(body, self.system.gravity);
     }
 
-    /// Whether the body has not changed topologically since the projection was built. O(1).
+    /// Whether the body has not changed since the projection was built: no topological change,
+    /// and its pins not handed out for writing ([`crate::mechanics::Mechanics::pinned_mut`],
+    /// [`crate::mechanics::Mechanics::pin_where`]: the fixed slots may differ). O(1).
     ///
     /// # Examples
     ///
@@ -219,7 +224,25 @@ impl Projection {
     /// assert!(p.is_current(&body));
     /// ```
     pub fn is_current(&self, body: &Body) -> bool {
-        self.is_for(body) && self.version == body.version()
+        self.is_for(body) && self.version == body.version() && self.pins_epoch == body.attrs().pins_epoch
+    }
+
+    /// Whether the fixed slots were read at the body's current pin epoch. O(1).
+    pub(crate) fn pins_current(&self, body: &Body) -> bool {
+        self.pins_epoch == body.attrs().pins_epoch
+    }
+
+    /// Re-reads every live vertex's pin into its slot (fixed or not; mass and viscosity as
+    /// they are), after the pins were handed out for writing. O(slots).
+    pub(crate) fn follow_pins(&mut self, body: &Body) {
+        let mech = body.attrs();
+        for (v, d) in self.vertex_dart.iter().enumerate() {
+            if d.is_some() {
+                let id = CellId(v as u32);
+                self.system.set_slot_raw(v, mech.vertex_mass(id), mech.pinned[id], mech.vertex_viscosity(id));
+            }
+        }
+        self.pins_epoch = mech.pins_epoch;
     }
 
     /// Whether the projection was built from `body` (and not from another body, or a clone of
@@ -309,7 +332,10 @@ impl Projection {
     /// update"): afterwards the projection is [`Projection::equivalent`] to a fresh
     /// [`Projection::build`] of `body` and [`Projection::is_current`] holds.
     /// Cost: O(touched cells · degree + new ids) amortised (see [`SpringSystem`]'s incidence
-    /// lists); nothing proportional to the mesh. Returns `true` for this incremental update.
+    /// lists); nothing proportional to the mesh, except that the pins are re-read for every slot
+    /// (O(slots)) when they were handed out for writing since the projection last read them.
+    /// Returns `true` for this incremental update (empty lists at the body's version take only
+    /// the pins).
     ///
     /// `touched` must bring this projection to the body's version: the lists an operation of
     /// `crate::cut` returned, or several of them merged in order with [`TouchedCells::extend`]
@@ -374,6 +400,9 @@ impl Projection {
         }
         self.scratch = resolved;
         self.version = body.version();
+        if !self.pins_current(body) {
+            self.follow_pins(body); // the pins were handed out for writing: O(slots), only then
+        }
         true
     }
 

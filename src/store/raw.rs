@@ -419,6 +419,8 @@ impl RawMechanics {
             velocity: col(&|v| v.velocity),
             force: col(&|v| v.force),
             pinned: CellArray::from_vec(vs.iter().map(|v| v.pinned).collect()),
+            pins_epoch: 0,
+            velocity_epoch: 0,
         }
     }
 

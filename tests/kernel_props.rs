@@ -160,6 +160,31 @@ proptest! {
         }
         map.free_mark(mark);
     }
+
+    /// `mark_orbit` marks exactly the darts of the orbit ⟨mask⟩(d) (as `orbit` lists them) and
+    /// nothing else, on top of what was marked before; `unmark_orbit` takes exactly those off.
+    #[test]
+    fn marking_an_orbit_marks_exactly_its_darts(ops in op_sequence(), pick in any::<u32>(), bits in 0u8..16, other in any::<u32>()) {
+        let mut map = build::<3>(&ops);
+        let darts: Vec<DartId> = map.darts().collect();
+        prop_assume!(!darts.is_empty());
+        let (d, before) = (darts[pick as usize % darts.len()], darts[other as usize % darts.len()]);
+        let mask = topomech::AlphaMask(bits);
+        let orbit: std::collections::BTreeSet<DartId> = map.orbit(d, mask).into_iter().collect();
+        let mut mark = map.reserve_mark();
+        mark.mark(before);
+        map.mark_orbit(&mut mark, d, mask);
+        for &x in &darts {
+            prop_assert_eq!(mark.is_marked(x), orbit.contains(&x) || x == before, "dart {:?}", x);
+        }
+        prop_assert_eq!(mark.count(), orbit.len() + usize::from(!orbit.contains(&before)));
+        map.unmark_orbit(&mut mark, d, mask);
+        for &x in &darts {
+            prop_assert_eq!(mark.is_marked(x), x == before && !orbit.contains(&x), "dart {:?} after unmark", x);
+        }
+        mark.unmark(before);
+        map.free_mark(mark);
+    }
 }
 
 proptest! {

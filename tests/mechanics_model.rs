@@ -540,9 +540,7 @@ fn a_projection_update_takes_only_lists_that_bring_it_up_to_date() {
     let base = Body::from_tets(&points, &tets, material()).unwrap().0;
 
     // Hand-made lists: an id past the map, a dart past the map. Rebuilt, no panic.
-    let mut hand = TouchedCells::default();
-    hand.vertices.push((CellId(9999), None));
-    hand.edges.push((CellId(5000), Some(DartId(88888))));
+    let hand = TouchedCells::by_hand(vec![(CellId(9999), None)], vec![(CellId(5000), Some(DartId(88888)))]);
     let mut p = fresh(&base);
     assert!(!p.update(&base, &hand));
     assert!(p.is_current(&base) && p.equivalent(&fresh(&base)).is_ok());
@@ -586,9 +584,7 @@ fn a_projection_update_takes_only_lists_that_bring_it_up_to_date() {
     assert!(p.equivalent(&fresh(&body)).is_ok());
     let d = inner(&body, 0);
     let again = dissociate_face(&mut body, d).unwrap();
-    let mut by_hand = TouchedCells::default();
-    by_hand.vertices = again.touched.vertices.clone();
-    by_hand.edges = again.touched.edges.clone();
+    let by_hand = TouchedCells::by_hand(again.touched.vertices().to_vec(), again.touched.edges().to_vec());
     assert!(!p.update(&body, &by_hand), "a copy by hand has no version stamp");
     assert!(p.equivalent(&fresh(&body)).is_ok());
 }

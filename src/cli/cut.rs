@@ -129,7 +129,11 @@ pub fn stats(body: &Body, removed_mass: f64) -> BodyStats {
         cells: CellCensus::of(map),
         total_mass: body.total_vertex_mass(),
         removed_mass,
-        stiffness_sum: map.one_dart_per_cell(1).into_iter().map(|d| mech.edge_stiffness(map.cell_id(1, d))).sum(),
+        stiffness_sum: map
+            .one_dart_per_cell(1)
+            .into_iter()
+            .map(|d| mech.edge_stiffness(map.cell_id(1, d)))
+            .fold(0.0, |s, k| s + k), // +0 for an emptied body
         valid: map.validate().is_ok(),
         conservation_ok: check_conservation(map, mech).is_ok(),
     }

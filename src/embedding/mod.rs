@@ -519,10 +519,13 @@ pub struct Embedded<const N: usize, E> {
     attrs: E,
     version: u64,
     identity: u64,
+    /// For a clone: the identity and version of the body it was cloned from (its lineage, which
+    /// a version alone — an operation count — cannot tell).
+    source: Option<(u64, u64)>,
 }
 
 /// A number no earlier call returned in this process (1, 2, 3, …). O(1).
-fn next_identity() -> u64 {
+pub(crate) fn next_identity() -> u64 {
     static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
     NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
 }
@@ -531,7 +534,13 @@ fn next_identity() -> u64 {
 /// (so what was built for the original does not run on the copy unnoticed).
 impl<const N: usize, E: Clone> Clone for Embedded<N, E> {
     fn clone(&self) -> Self {
-        Embedded { map: self.map.clone(), attrs: self.attrs.clone(), version: self.version, identity: next_identity() }
+        Embedded {
+            map: self.map.clone(),
+            attrs: self.attrs.clone(),
+            version: self.version,
+            identity: next_identity(),
+            source: Some((self.identity, self.version)),
+        }
     }
 }
 
@@ -597,7 +606,7 @@ impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
         if let Err(error) = attrs.check(&map) {
             return Err(Box::new(RefusedParts { error, map, attrs }));
         }
-        Ok(Embedded { map, attrs, version: 0, identity: next_identity() })
+        Ok(Embedded { map, attrs, version: 0, identity: next_identity(), source: None })
     }
 
     /// [`Embedded::new`] without the check, for parts this crate has just built or checked
@@ -605,7 +614,7 @@ impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
     /// [`CellRules::grow_to`]).
     pub(crate) fn from_checked_parts(map: GMap<N>, mut attrs: E) -> Self {
         attrs.grow_to(&map);
-        Embedded { map, attrs, version: 0, identity: next_identity() }
+        Embedded { map, attrs, version: 0, identity: next_identity(), source: None }
     }
 
     /// The map (read-only). O(1).
@@ -680,6 +689,12 @@ impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
     /// ```
     pub fn identity(&self) -> u64 {
         self.identity
+    }
+
+    /// Whether this body is a clone of `original` taken at `original`'s present version, with
+    /// no operation on either since. O(1).
+    pub(crate) fn is_unchanged_clone_of(&self, original: &Self) -> bool {
+        self.source == Some((original.identity, original.version)) && self.version == original.version
     }
 
     /// Number of topological operations applied so far. O(1).

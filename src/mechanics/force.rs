@@ -1155,7 +1155,7 @@ impl SpringSystem {
                 let stretch = norm(sub(x[b as usize], x[a as usize])) - self.rest[s];
                 0.5 * self.stiffness[s] * stretch * stretch
             })
-            .sum()
+            .fold(0.0, |sum, e| sum + e) // +0 with no spring (`sum` starts at −0)
     }
 
     /// Gravitational potential −Σ m g·x over free slots. O(slots).
@@ -1178,7 +1178,8 @@ impl SpringSystem {
         self.check_given(&[("positions", x.len())], &[])?;
         let g = self.gravity;
         let free = self.mass.iter().zip(&self.inv_mass).zip(x).filter(|((_, &w), _)| w > 0.0);
-        Ok(free.map(|((&m, _), x)| -m * dot(g, *x)).sum())
+        Ok(free.map(|((&m, _), x)| -m * dot(g, *x)).fold(0.0, |sum, e| sum + e))
+        // +0 with no free slot
     }
 
     /// A bound on the largest angular frequency, ω_max² ≤ max_v Σ_{s ∋ v} 2 k_s / m_v

@@ -192,12 +192,13 @@ impl Simulation {
         Ok(sim)
     }
 
-    /// Zeroes the velocity of every pinned vertex (the law "a pinned vertex does not move") and
-    /// records the body's velocity epoch. O(vertex ids).
+    /// Zeroes the velocity of every fixed slot — pinned vertices (the law "a pinned vertex does
+    /// not move") and dead vertex ids — as [`Simulation::update`] does, and records the body's
+    /// velocity epoch. O(vertex ids).
     fn hold_pinned(&mut self, body: &mut Body) {
         let mech = body.attrs_mut();
-        for (v, &p) in mech.velocity.as_mut_slice().iter_mut().zip(mech.pinned.as_slice()) {
-            if p {
+        for (v, &w) in mech.velocity.as_mut_slice().iter_mut().zip(&self.projection.system.inv_mass) {
+            if w == 0.0 {
                 *v = [0.0; 3];
             }
         }
@@ -225,11 +226,14 @@ impl Simulation {
         }
     }
 
-    /// [`Simulation::check_body`], then [`SimError::StaleProjection`] unless the projection is
-    /// current for `body` (its slots, masses and springs are the body's now). O(1).
+    /// [`Simulation::check_body`], then [`SimError::StaleProjection`] unless the projection
+    /// follows the body's topology (its slots, masses and springs are the body's now). Pins and
+    /// velocities written since are not a staleness: the mutating entries take them up
+    /// ([`Simulation::step`], [`Simulation::write_forces`], [`Simulation::update`]) and the
+    /// read-outs read the body's own pins. O(1).
     pub(crate) fn check_current(&self, body: &Body) -> Result<(), SimError> {
         self.check_body(body)?;
-        match self.projection.is_current(body) {
+        match self.projection.version() == body.version() {
             true => Ok(()),
             false => Err(SimError::StaleProjection { built: self.projection.version(), now: body.version() }),
         }
@@ -340,13 +344,8 @@ impl Simulation {
         self.projection.update(body, touched);
         let config = *self.stepper.config();
         let slots = self.projection.system.slots();
-        let mech = body.attrs_mut();
-        for (v, &w) in mech.velocity.as_mut_slice()[..slots].iter_mut().zip(&self.projection.system.inv_mass) {
-            if w == 0.0 {
-                *v = [0.0; 3];
-            }
-        }
-        self.velocity_epoch = mech.velocity_epoch;
+        self.hold_pinned(body);
+        let mech = body.attrs();
         let (x, v) = (&mech.position.as_slice()[..slots], &mech.velocity.as_slice()[..slots]);
         self.stepper = Stepper::new(config, &self.projection.system, x, v)?;
         Ok(())
@@ -376,8 +375,14 @@ impl Simulation {
     /// ```
     pub fn kinetic_energy(&self, body: &Body) -> Result<f64, SimError> {
         self.check_current(body)?;
-        let slots = self.projection.system.slots();
-        Ok(self.projection.system.kinetic_energy_raw(&body.attrs().velocity.as_slice()[..slots]))
+        let (sys, mech) = (&self.projection.system, body.attrs());
+        let (pinned, v) = (mech.pinned.as_slice(), mech.velocity.as_slice());
+        // Free = live (mass > 0) and not pinned, by the body's pins now (a pin written since the
+        // last step counts already). `fold` from +0: no free vertex gives +0, not −0.
+        Ok((0..sys.slots())
+            .filter(|&i| sys.mass[i] > 0.0 && !pinned[i])
+            .map(|i| 0.5 * sys.mass[i] * geom::dot(v[i], v[i]))
+            .fold(0.0, |sum, e| sum + e))
     }
 
     /// Largest distance of a live vertex from its rest position; NaN if a live vertex's position

@@ -228,11 +228,12 @@ pub struct Mechanics {
     pub(crate) velocity: CellArray<Vec3>,
     pub(crate) force: CellArray<Vec3>,
     pub(crate) pinned: CellArray<bool>,
-    /// Bumped each time the pins are handed out for writing ([`Mechanics::pinned_mut`],
-    /// [`Mechanics::pin_where`]): a projection built before sees that its fixed slots may be
-    /// stale. Not part of the body's state (never stored or compared).
+    /// A fresh process-wide stamp each time the pins are handed out for writing
+    /// ([`Mechanics::pinned_mut`], [`Mechanics::pin_where`]; 0 before): a projection built
+    /// before sees that its fixed slots may be stale, and two bodies with the same stamp have
+    /// the same pins (a clone's, untouched since). Not part of the body's state (never stored).
     pub(crate) pins_epoch: u64,
-    /// Bumped each time the velocities are handed out for writing
+    /// A fresh stamp each time the velocities are handed out for writing
     /// ([`Mechanics::velocity_mut`]): the simulation then re-zeroes the pinned velocities.
     pub(crate) velocity_epoch: u64,
 }
@@ -598,7 +599,7 @@ impl Mechanics {
     /// assert!((body.kinetic_energy() - 0.5).abs() < 1e-12); // ½ · 1 kg · (1 m/s)²
     /// ```
     pub fn velocity_mut(&mut self) -> CellSliceMut<'_, Vec3> {
-        self.velocity_epoch += 1;
+        self.velocity_epoch = crate::embedding::next_identity();
         CellSliceMut::new(&mut self.velocity)
     }
 
@@ -654,7 +655,7 @@ impl Mechanics {
     /// assert_eq!(body.attrs().pinned().as_slice().iter().filter(|&&p| p).count(), 1);
     /// ```
     pub fn pinned_mut(&mut self) -> CellSliceMut<'_, bool> {
-        self.pins_epoch += 1;
+        self.pins_epoch = crate::embedding::next_identity();
         CellSliceMut::new(&mut self.pinned)
     }
 
@@ -816,7 +817,8 @@ impl Mechanics {
 
     /// [`Mechanics::total_vertex_mass`] for a map the attributes cover. O(darts).
     pub(crate) fn total_vertex_mass_raw(&self, map: &GMap<3>) -> f64 {
-        map.one_dart_per_cell(0).into_iter().map(|d| self.vertex_mass[map.vertex_id(d)]).sum()
+        map.one_dart_per_cell(0).into_iter().map(|d| self.vertex_mass[map.vertex_id(d)]).fold(0.0, |s, m| s + m)
+        // +0 when empty
     }
 
     /// Total mass Σ_t m_t over the live volumes of `map`. O(darts). [`Body::total_tet_mass`] is
@@ -847,7 +849,8 @@ impl Mechanics {
 
     /// [`Mechanics::total_tet_mass`] for a map the attributes cover. O(darts).
     pub(crate) fn total_tet_mass_raw(&self, map: &GMap<3>) -> f64 {
-        map.one_dart_per_cell(3).into_iter().map(|d| self.tet_mass[map.cell_id(3, d)]).sum()
+        map.one_dart_per_cell(3).into_iter().map(|d| self.tet_mass[map.cell_id(3, d)]).fold(0.0, |s, m| s + m)
+        // +0 when empty
     }
 
     /// Law 1 at the vertex of `d`: Σ m_t/4 over the distinct volumes of its orbit. O(vertex).
@@ -998,7 +1001,7 @@ impl Mechanics {
     /// assert_eq!(body.attrs().pinned().as_slice().iter().filter(|&&p| p).count(), 4);
     /// ```
     pub fn pin_where(&mut self, mut pin: impl FnMut(CellId, Vec3) -> bool) {
-        self.pins_epoch += 1;
+        self.pins_epoch = crate::embedding::next_identity();
         for (i, (p, r)) in self.pinned.as_mut_slice().iter_mut().zip(self.rest_position.as_slice()).enumerate() {
             *p = pin(CellId(i as u32), *r);
         }

@@ -284,7 +284,9 @@ impl Projection {
     /// A copy of this projection for `copy`, a clone of `original` taken while this projection
     /// was current for it (same map, attributes and version): the copy's arrays are the same,
     /// only the body it answers for changes. `None` unless the projection is current for
-    /// `original` and `copy` is at the same version. O(slots + springs) (the copy).
+    /// `original` and `copy` is a clone of `original` with no operation on either since
+    /// ([`Body::clone`] records its source's identity and version) and the same pins. O(slots +
+    /// springs) (the copy).
     ///
     /// # Examples
     ///
@@ -301,7 +303,8 @@ impl Projection {
     /// assert!(p.for_clone(&copy, &body).is_none()); // p is not current for `copy`
     /// ```
     pub fn for_clone(&self, original: &Body, copy: &Body) -> Option<Projection> {
-        if !self.is_current(original) || copy.version() != original.version() {
+        let same_pins = copy.attrs().pins_epoch == original.attrs().pins_epoch;
+        if !self.is_current(original) || !copy.is_unchanged_clone_of(original) || !same_pins {
             return None;
         }
         let mut out = self.clone();
@@ -644,14 +647,30 @@ pub enum ProjectionMismatch {
 /// let changes = body.unsew3(d).unwrap();
 /// let mut touched = TouchedCells::default();
 /// touched.record(body.map(), &changes);
-/// assert!(touched.vertices.iter().all(|&(v, dart)| dart.map_or(true, |d| body.map().vertex_id(d) == v)));
+/// assert!(touched.vertices().iter().all(|&(v, dart)| dart.map_or(true, |d| body.map().vertex_id(d) == v)));
+/// ```
+///
+/// The lists of an operation cannot be changed behind its stamp (an emptied list would be taken
+/// as complete by [`Projection::update`], finding 66), so this does not compile:
+///
+/// ```compile_fail
+/// use topomech::cut::dissociate_face;
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Material};
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+/// let mut cut = dissociate_face(&mut body, d).unwrap();
+/// cut.touched.edges.clear(); // private field
 /// ```
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TouchedCells {
-    /// Vertex ids and a dart of each.
-    pub vertices: Vec<(CellId, Option<DartId>)>,
-    /// Edge ids and a dart of each.
-    pub edges: Vec<(CellId, Option<DartId>)>,
+    /// Vertex ids and a dart of each (crate-private, read with [`TouchedCells::vertices`]: lists
+    /// changed after an operation stamped them would be taken as complete, finding 66).
+    pub(crate) vertices: Vec<(CellId, Option<DartId>)>,
+    /// Edge ids and a dart of each (read with [`TouchedCells::edges`]).
+    pub(crate) edges: Vec<(CellId, Option<DartId>)>,
     /// Which changes of which body the lists hold (stamped by the operations).
     span: Span,
 }
@@ -739,7 +758,7 @@ impl TouchedCells {
     /// let mut touched = TouchedCells::default();
     /// assert!(touched.is_empty());
     /// touched.record(body.map(), &changes);
-    /// assert!(!touched.is_empty() && !touched.vertices.is_empty());
+    /// assert!(!touched.is_empty() && !touched.vertices().is_empty());
     /// ```
     pub fn record(&mut self, map: &GMap<3>, changes: &CellChanges) {
         // A map has no version: what these records cover is unknown until an operation stamps them.
@@ -834,9 +853,9 @@ impl TouchedCells {
     /// for _ in 0..2 {
     ///     let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
     ///     let cut = dissociate_face(&mut body, d).unwrap();
-    ///     let n = batch.vertices.len() + cut.touched.vertices.len();
+    ///     let n = batch.vertices().len() + cut.touched.vertices().len();
     ///     batch.extend(&cut.touched);
-    ///     assert_eq!(batch.vertices.len(), n);
+    ///     assert_eq!(batch.vertices().len(), n);
     /// }
     /// ```
     pub fn extend(&mut self, other: &TouchedCells) {
@@ -876,6 +895,37 @@ impl TouchedCells {
         self.record(body.map(), changes);
         let step = Span::Versions { body: body.identity(), from: body.version().saturating_sub(1), to: body.version() };
         self.span = Span::joined(before, (step, false));
+    }
+
+    /// Lists given by hand (vertex and edge ids, each with a dart or `None` for a dead id): their
+    /// coverage is unknown, so [`Projection::update`] rebuilds instead of trusting them. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material, Projection, TouchedCells};
+    /// use topomech::CellId;
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let mut p = Projection::build(&body, [0.0; 3]).unwrap();
+    /// let hand = TouchedCells::by_hand(vec![(CellId(0), None)], Vec::new());
+    /// assert_eq!((hand.vertices().len(), hand.versions(&body)), (1, None));
+    /// assert!(!p.update(&body, &hand)); // not trusted: rebuilt
+    /// ```
+    pub fn by_hand(vertices: Vec<(CellId, Option<DartId>)>, edges: Vec<(CellId, Option<DartId>)>) -> Self {
+        TouchedCells { vertices, edges, span: Span::Unknown }
+    }
+
+    /// The vertex ids touched, each with a dart of its vertex (`None`: the id died). O(1).
+    pub fn vertices(&self) -> &[(CellId, Option<DartId>)] {
+        &self.vertices
+    }
+
+    /// The edge ids touched, each with a dart of its edge (`None`: the id died). O(1).
+    pub fn edges(&self) -> &[(CellId, Option<DartId>)] {
+        &self.edges
     }
 
     /// Whether nothing was recorded. O(1).

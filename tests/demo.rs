@@ -73,6 +73,10 @@ fn every_check_passes_and_mass_is_kept_or_accounted_for() {
     }
     let removal = stage(&s, "removal");
     assert!(num(removal, "removed_mass") > 0.0);
+    // The tear threshold is TEAR_FRACTION (0.8) of the largest vertex stress when the incision
+    // stage ends, the state its row measures (closes a survivor of the thirty-second mutation sample).
+    let (threshold, stress) = (num(&s["scene"], "tear_threshold"), num(stage(&s, "incision"), "max_stress"));
+    assert!(stress > 0.0 && (threshold - 0.8 * stress).abs() <= 1e-12 * stress, "{threshold} vs 0.8 × {stress}");
     assert!((num(&s, "final_mass") + num(&s, "removed_mass") - m0).abs() <= 1e-9 * m0);
     assert_eq!(int(&s, "checks_passed"), int(stage(&s, "refinement"), "checks_passed"));
     assert_eq!(s["mesh"]["vertices"], 547, "the built-in liver");

@@ -34,6 +34,10 @@ fn a_folded_edge_has_no_combinatorial_map() {
     m.sew_dyn(2, a, m.alpha::<0>(a)).unwrap();
     m.validate().unwrap();
     assert!(m.to_combinatorial_map().is_none());
+    let (points, tets) = kuhn_cube(2);
+    let (cube, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+    let sewn = cube.to_combinatorial_map().expect("a Kuhn cube is orientable, with no fold");
+    assert!(sewn.is_valid() && sewn.beta[0].iter().all(Option::is_some)); // β2 everywhere
     let (mut t, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
     t.sew_dyn(3, a, t.alpha::<0>(a)).unwrap();
     t.validate().unwrap();

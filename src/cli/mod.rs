@@ -295,3 +295,19 @@ pub fn print_warnings(loaded: &Loaded) {
         let _ = writeln!(err, "{line}");
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::nan_max;
+
+    /// `nan_max` is the maximum, except that a NaN on either side wins; a fold from 0 over
+    /// nothing is 0 (closes a survivor of the thirty-second mutation sample).
+    #[test]
+    fn nan_max_keeps_a_nan_and_is_the_maximum_otherwise() {
+        assert_eq!((nan_max(1.0, 2.5), nan_max(2.5, 1.0), nan_max(-3.0, 0.0)), (2.5, 2.5, 0.0));
+        assert!(nan_max(f64::NAN, 1.0).is_nan() && nan_max(1.0, f64::NAN).is_nan());
+        assert_eq!([3.0, 7.0, 5.0].into_iter().fold(0.0, nan_max), 7.0);
+        assert!([3.0, f64::NAN, 5.0].into_iter().fold(0.0, nan_max).is_nan());
+        assert_eq!(std::iter::empty::<f64>().fold(0.0, nan_max), 0.0);
+    }
+}

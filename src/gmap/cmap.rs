@@ -90,7 +90,8 @@ impl<const N: usize> GMap<N> {
         if self.darts().any(|d| self.is_free(0, d) || self.is_free(1, d)) {
             return None;
         }
-        let folded = |d: DartId| (2..=N).any(|i| !self.is_free(i, d) && self.alpha_dyn(i, d) == self.alpha_dyn(0, d));
+        // (An i-free d has αi(d) = d ≠ α0(d), d being 0-sewn here: only a fold matches.)
+        let folded = |d: DartId| (2..=N).any(|i| self.alpha_dyn(i, d) == self.alpha_dyn(0, d));
         if self.darts().any(folded) {
             return None;
         }

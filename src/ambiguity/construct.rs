@@ -336,7 +336,8 @@ pub fn glued_faces(map: &GMap<3>) -> Vec<[u32; 2]> {
 /// Every connected complex of at most `max_tets` tets on points 0..`points` whose first tet is
 /// [0, 1, 2, 3] and whose tets are in increasing lexicographic order, that builds (no face shared
 /// by three tets), with every subset of its glued faces cut. Bounded: C(C(points, 4) − 1,
-/// max_tets − 1) complexes times 2^(glued faces) cut sets.
+/// max_tets − 1) complexes times 2^(glued faces) cut sets. None for fewer than 4 points or
+/// `max_tets` = 0 (no tet fits).
 ///
 /// # Examples
 ///
@@ -348,8 +349,12 @@ pub fn glued_faces(map: &GMap<3>) -> Vec<[u32; 2]> {
 /// let all = cut_complexes(5, 2);
 /// assert_eq!(all.len(), 9);
 /// assert!(all.iter().all(|c| c.tets[0] == [0, 1, 2, 3] && c.build().is_ok()));
+/// assert!(cut_complexes(3, 2).is_empty() && cut_complexes(5, 0).is_empty());
 /// ```
 pub fn cut_complexes(points: usize, max_tets: usize) -> Vec<CutComplex> {
+    if points < 4 || max_tets == 0 {
+        return Vec::new(); // no tet on fewer than 4 points, none allowed at 0
+    }
     let all: Vec<[u32; 4]> = combinations4(points as u32);
     let mut out = Vec::new();
     let mut chosen = vec![0usize];
@@ -387,7 +392,7 @@ fn combinations4(n: u32) -> Vec<[u32; 4]> {
 /// elements. Recursion depth ≤ `max`.
 fn subsets_from(all: &[[u32; 4]], from: usize, max: usize, chosen: &mut Vec<usize>, visit: &mut dyn FnMut(&[usize])) {
     visit(chosen);
-    if chosen.len() == max {
+    if chosen.len() >= max {
         return;
     }
     for next in from..all.len() {

@@ -188,14 +188,14 @@ impl Simulation {
             &mech.velocity.as_slice()[..slots],
         )?;
         let mut sim = Simulation { projection, stepper, velocity_epoch: 0 };
-        sim.hold_pinned(body);
+        sim.hold_fixed(body);
         Ok(sim)
     }
 
     /// Zeroes the velocity of every fixed slot — pinned vertices (the law "a pinned vertex does
     /// not move") and dead vertex ids — as [`Simulation::update`] does, and records the body's
     /// velocity epoch. O(vertex ids).
-    fn hold_pinned(&mut self, body: &mut Body) {
+    fn hold_fixed(&mut self, body: &mut Body) {
         let mech = body.attrs_mut();
         for (v, &w) in mech.velocity.as_mut_slice().iter_mut().zip(&self.projection.system.inv_mass) {
             if w == 0.0 {
@@ -205,17 +205,23 @@ impl Simulation {
         self.velocity_epoch = mech.velocity_epoch;
     }
 
-    /// Takes up what was written into the body's pins or velocities since the last step: pins
-    /// handed out for writing are re-read into the projection's fixed slots, and the pinned
-    /// vertices' velocities are zeroed again. O(1) when nothing was handed out, else O(vertex ids).
-    fn follow_writes(&mut self, body: &mut Body) {
+    /// [`Simulation::check_current`], after taking up what was written into the body's pins or
+    /// velocities since the last step: pins handed out for writing are re-read into the
+    /// projection's fixed slots, and the fixed slots' velocities are zeroed again. O(1) when
+    /// nothing was handed out, else O(vertex ids).
+    ///
+    /// # Errors
+    /// As [`Simulation::check_current`] (another body: nothing is taken up).
+    fn follow_writes(&mut self, body: &mut Body) -> Result<(), SimError> {
+        self.check_current(body)?;
         let pins_changed = !self.projection.pins_current(body);
         if pins_changed {
             self.projection.follow_pins(body);
         }
         if pins_changed || self.velocity_epoch != body.attrs().velocity_epoch {
-            self.hold_pinned(body);
+            self.hold_fixed(body);
         }
+        Ok(())
     }
 
     /// [`SimError::OtherBody`] unless the simulation was built for `body`. O(1).
@@ -271,11 +277,7 @@ impl Simulation {
     /// assert!(sim.kinetic_energy(&body).unwrap() > 0.0 && sim.max_displacement(&body).unwrap() > 0.0);
     /// ```
     pub fn step(&mut self, body: &mut Body) -> Result<(), SimError> {
-        self.check_body(body)?;
-        if self.projection.version() == body.version() {
-            self.follow_writes(body);
-        }
-        self.check_current(body)?;
+        self.follow_writes(body)?;
         let slots = self.projection.system.slots();
         let mech = body.attrs_mut();
         let x = &mut mech.position.as_mut_slice()[..slots];
@@ -344,7 +346,7 @@ impl Simulation {
         self.projection.update(body, touched);
         let config = *self.stepper.config();
         let slots = self.projection.system.slots();
-        self.hold_pinned(body);
+        self.hold_fixed(body);
         let mech = body.attrs();
         let (x, v) = (&mech.position.as_slice()[..slots], &mech.velocity.as_slice()[..slots]);
         self.stepper = Stepper::new(config, &self.projection.system, x, v)?;
@@ -439,11 +441,7 @@ impl Simulation {
     /// assert!((weight + 9.81 * body.total_vertex_mass()).abs() < 1e-12);
     /// ```
     pub fn write_forces(&mut self, body: &mut Body) -> Result<(), SimError> {
-        self.check_body(body)?;
-        if self.projection.version() == body.version() {
-            self.follow_writes(body);
-        }
-        self.check_current(body)?;
+        self.follow_writes(body)?;
         let sys = &self.projection.system;
         let slots = sys.slots();
         let (mut sf, mut out) = (vec![[0.0; 3]; sys.springs()], vec![[0.0; 3]; slots]);

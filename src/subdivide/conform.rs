@@ -245,7 +245,7 @@ impl LeveledMap<3> {
     /// [`SubdivideError::NonFinitePosition`] for the smallest live vertex id whose position is NaN
     /// or infinite (positions of dead ids are not read). Every live vertex has a position
     /// ([`Self::check_positions_given`]). O(darts).
-    fn check_positions_finite(&self) -> Result<(), SubdivideError> {
+    pub(super) fn check_positions_finite(&self) -> Result<(), SubdivideError> {
         let bad = |v: u32| !self.points[v as usize].iter().all(|c| c.is_finite());
         let vertex = self.map.darts().map(|d| self.map.vertex_id(d).0).filter(|&v| bad(v)).min();
         vertex.map_or(Ok(()), |vertex| {

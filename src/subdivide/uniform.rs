@@ -768,7 +768,9 @@ impl LeveledMap<3> {
     /// [`SubdivideError::AlreadyAtLevel`] (m ≥ `level`); [`SubdivideError::OpenEdge`] (an α0-,
     /// α1- or α2-free dart); [`SubdivideError::NotATetrahedron`] (a volume that is not a tet of
     /// 24 darts with four distinct corner vertices); those of [`TetMasses::check`] (a live
-    /// volume without a finite mass ≥ 0 in `masses`).
+    /// volume without a finite mass ≥ 0 in `masses`); [`SubdivideError::NoPosition`] and
+    /// [`SubdivideError::NonFinitePosition`] (the smallest live vertex without a position, or
+    /// with a NaN or infinite one: the masses follow the children's volumes).
     ///
     /// # Examples
     ///
@@ -788,6 +790,10 @@ impl LeveledMap<3> {
     pub fn refine_uniform(&mut self, level: u8, masses: &mut TetMasses) -> Result<Refinement, SubdivideError> {
         self.uniform_level(level)?;
         masses.check(self)?;
+        // The children's masses come from their volumes: like `subdivide_tet_with_mass`, refuse
+        // a live vertex without a position or with a NaN or infinite one (finding 70).
+        self.check_positions_given()?;
+        self.check_positions_finite()?;
         let tpl = templates(3);
         let lab = self.label_parents(&tpl)?;
         let parents = lab.template.len();

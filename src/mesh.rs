@@ -288,6 +288,33 @@ impl TriMeshReport {
     }
 }
 
+/// |a − b|, with the components scaled by the largest before squaring, so that neither
+/// overflows nor underflows (a plain √(Σ dₖ²) is ∞ for a distance of 1e200, and a ball test
+/// Σ dₖ² ≤ r² is then ∞ ≤ ∞: true). NaN when a coordinate is NaN; ∞ only when the distance itself
+/// is past `f64::MAX`. O(1).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mesh::distance;
+/// assert_eq!(distance([0.0; 3], [3.0, 4.0, 0.0]), 5.0);
+/// assert_eq!(distance([1e200, 0.0, 0.0], [0.0; 3]), 1e200); // no overflow in the squares
+/// assert!(distance([1e201; 3], [0.0; 3]) > 1e200);
+/// assert!(distance([f64::NAN, 0.0, 0.0], [0.0; 3]).is_nan());
+/// ```
+pub fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
+    let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    if d.iter().any(|c| c.is_nan()) {
+        return f64::NAN;
+    }
+    let s = d.iter().fold(0.0f64, |m, c| m.max(c.abs()));
+    if s == 0.0 || s.is_infinite() {
+        return s;
+    }
+    let q = d.map(|c| c / s);
+    s * (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt()
+}
+
 /// Signed volume of the tetrahedron `(a, b, c, d)`: `det[b - a, c - a, d - a] / 6`.
 ///
 /// Positive when `d` lies on the side of the plane `(a, b, c)` towards which

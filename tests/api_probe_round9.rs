@@ -137,8 +137,8 @@ fn the_sides_of_a_cutting_plane_do_not_depend_on_the_length_of_its_normal() {
             assert_eq!(cut(scaled), reference, "cube {k}, normal {normal:?} × 2^{e}");
             let negated = scaled.map(|c| -c);
             let body = cube_body(k);
-            let sides = topomech::cut::tet_sides(&body, &Plane { point, normal: scaled });
-            let other = topomech::cut::tet_sides(&body, &Plane { point, normal: negated });
+            let sides = topomech::cut::tet_sides(&body, &Plane { point, normal: scaled }).unwrap();
+            let other = topomech::cut::tet_sides(&body, &Plane { point, normal: negated }).unwrap();
             // Centroids are never on these planes: the two normals give opposite sides.
             assert!(sides.iter().zip(&other).all(|(a, b)| a.zip(*b).is_some_and(|(a, b)| a != b)), "2^{e}");
         }

@@ -63,7 +63,7 @@ fn a_sweep_spanning_the_body_cuts_exactly_what_the_plane_cuts() {
         Plane { point: [1.2, 1.7, 1.4], normal: [0.3, -0.8, 0.5] },
         Plane { point: [0.9, 2.1, 1.0], normal: [1.0, 1.0, 1.0] },
     ] {
-        let side = tet_sides(&body, &plane);
+        let side = tet_sides(&body, &plane).unwrap();
         let map = body.map();
         let by_plane: Vec<_> = map
             .one_dart_per_cell(2)

@@ -37,7 +37,7 @@ pub fn incision_faces(body: &Body, points: &[Vec3]) -> Vec<DartId> {
         }
     }
     let plane = cut::Plane { point: std::array::from_fn(|c| (lo[c] + hi[c]) / 2.0), normal: [1.0, 0.3, 0.2] };
-    let side = cut::tet_sides(body, &plane);
+    let side = cut::tet_sides(body, &plane).expect("finite positions");
     let map = body.map();
     map.one_dart_per_cell(2)
         .into_iter()

@@ -158,10 +158,15 @@ fn run_order(args: OrderBenchArgs) -> Result<(), CliError> {
     let mut out = std::io::stdout().lock();
     if json {
         serde_json::to_writer(&mut out, &report)?;
+        writeln!(out)?;
     } else {
-        write!(out, "{report:#?}")?;
+        // One "key  value" line per field of the JSON object, sorted by key (not Rust's Debug form).
+        if let serde_json::Value::Object(fields) = serde_json::to_value(&report)? {
+            for (key, value) in fields {
+                writeln!(out, "{key:<24} {value}")?;
+            }
+        }
     }
-    writeln!(out)?;
     out.flush()?;
     Ok(())
 }

@@ -2,13 +2,19 @@
 //! standard conformance vectors, or replay vector files and report one line per vector
 //! (`docs/CONFORMANCE.md`).
 //!
-//! `check` exits with 0 when every vector replays, 1 when one mismatches (or breaks a law),
-//! 2 when a file cannot be read or parsed (wrong format or version) or the directory holds none.
+//! `check` exits with 0 when every vector replays, 1 when one mismatches (or breaks a law, or is
+//! refused by [`Vector::check_fields`](topomech::conformance::Vector::check_fields), or its name
+//! is not its file stem), 2 when a file cannot be read or parsed (wrong format or version) or the
+//! directory holds none, and 3 when every vector
+//! passed but the report could not be written (stdout closed or failing, a broken pipe included).
+//! A write error does not stop the check: every vector is still replayed, and the status is the
+//! worst vector's when one failed. Report lines show control characters escaped (`\n`, `\u{1b}`),
+//! so no path or message can start a line of its own.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use topomech::conformance::{self, standard, ConformanceError, Vector};
+use topomech::conformance::{self, standard, ConformanceError};
 
 use super::CliError;
 
@@ -45,9 +51,9 @@ pub enum Action {
 /// replaying every vector.
 ///
 /// # Errors
-/// [`CliError::Output`] when stdout fails, [`CliError::Other`] when generation fails or a file
-/// cannot be written; `check` ends the process with status 1 or 2 on a failed or unreadable
-/// vector instead of returning.
+/// [`CliError::Output`] when stdout fails (`generate`), [`CliError::Other`] when generation fails
+/// or a file cannot be written; `check` ends the process with status 1, 2 or 3 (module docs)
+/// instead of returning an error.
 pub fn run(args: ConformanceArgs) -> Result<(), CliError> {
     match args.action {
         Action::Generate { dir, root } => generate(&dir, &root),
@@ -81,30 +87,62 @@ fn status(e: &ConformanceError) -> u8 {
     }
 }
 
+/// The report on stdout: each line with its control characters escaped. The first write error
+/// is kept and later lines are dropped (the check goes on).
+struct Report<W: Write> {
+    out: W,
+    error: Option<std::io::Error>,
+}
+
+impl<W: Write> Report<W> {
+    fn line(&mut self, text: &str) {
+        if self.error.is_none() {
+            let escaped: String = text
+                .chars()
+                .map(|c| if c.is_control() { c.escape_default().to_string() } else { c.to_string() })
+                .collect();
+            if let Err(e) = writeln!(self.out, "{escaped}") {
+                self.error = Some(e);
+            }
+        }
+    }
+
+    /// Flushes; the first write error, if any.
+    fn finish(mut self) -> Option<std::io::Error> {
+        if self.error.is_none() {
+            self.error = self.out.flush().err();
+        }
+        self.error
+    }
+}
+
 fn check(path: &Path, root: &Path) -> Result<(), CliError> {
     let files = if path.is_dir() {
         conformance::vector_files(path).map_err(|e| CliError::Other(Box::new(e)))?
     } else {
         vec![path.to_path_buf()]
     };
-    let mut out = std::io::stdout().lock();
     if files.is_empty() {
         let _ = writeln!(std::io::stderr(), "topomech: error: {}: no *.json vectors", path.display());
         std::process::exit(2);
     }
+    let mut report = Report { out: std::io::stdout().lock(), error: None };
     let (mut worst, mut failed) = (0, 0);
     for file in &files {
-        match Vector::read(file).and_then(|v| conformance::replay_in(&v, root).map(|()| v)) {
-            Ok(v) => writeln!(out, "ok    {} ({} steps)", v.name, v.steps.len())?,
+        match conformance::check_file(file, root) {
+            Ok(v) => report.line(&format!("ok    {} ({} steps)", v.name, v.steps.len())),
             Err(e) => {
                 worst = worst.max(status(&e));
                 failed += 1;
-                writeln!(out, "FAIL  {}", super::named(file, e.to_string()))?;
+                report.line(&format!("FAIL  {}", super::named(file, e.to_string())));
             }
         }
     }
-    writeln!(out, "{} vector(s) checked, {failed} failed", files.len())?;
-    out.flush()?;
+    report.line(&format!("{} vector(s) checked, {failed} failed", files.len()));
+    if let Some(e) = report.finish() {
+        let _ = writeln!(std::io::stderr(), "topomech: error: the report could not be written to stdout: {e}");
+        std::process::exit(if worst > 0 { worst.into() } else { 3 });
+    }
     if worst > 0 {
         std::process::exit(worst.into());
     }

@@ -246,8 +246,9 @@ fn tets_in_ball(body: &Body, c: Vec3, r: f64) -> Vec<u32> {
         ids.sort_unstable();
         ids.dedup();
         let n = ids.len() as f64;
-        let g: Vec<f64> = (0..3).map(|k| ids.iter().map(|v| rest[*v][k]).sum::<f64>() / n).collect();
-        if (0..3).map(|k| (g[k] - c[k]).powi(2)).sum::<f64>() <= r * r {
+        let g = [0, 1, 2].map(|k| ids.iter().map(|v| rest[*v][k]).sum::<f64>() / n);
+        // Scaled distance: Σ dₖ² and r² overflow to ∞ ≤ ∞ for a far ball (finding 80).
+        if topomech::mesh::distance(g, c) <= r {
             out.push(map.cell_id(3, d).0);
         }
     }

@@ -35,6 +35,13 @@ pub const FORMAT: &str = "topomech-conformance";
 pub const VERSION: u32 = 1;
 /// Default relative tolerance of every floating-point comparison (stored in each vector).
 pub const TOLERANCE: f64 = 1e-9;
+/// The largest [`Vector::tolerance`] a vector may ask for: 0 ≤ tolerance ≤ 10⁻³. A relative
+/// tolerance of 1 or more accepts every value of the same sign (|a − b| ≤ max(|a|, |b|)), so a
+/// loose bound would make the float fields vacuous; 10⁻³ still absorbs any rounding difference
+/// between engines (the standard set uses [`TOLERANCE`]).
+pub const MAX_TOLERANCE: f64 = 1e-3;
+/// The longest [`Vector::name`] (in bytes; names are ASCII, see [`Vector::check_fields`]).
+pub const MAX_NAME_LEN: usize = 128;
 
 /// Why a vector could not be read, generated or replayed. Every variant that concerns a vector
 /// names it; those that concern a step carry its index (`None` = the initial state).
@@ -96,13 +103,59 @@ pub enum ConformanceError {
         /// What is wrong.
         message: String,
     },
-    /// A field of the vector is invalid (a negative tolerance, a non-finite material constant).
+    /// A field of the vector is invalid (a tolerance outside 0 ..= [`MAX_TOLERANCE`], a
+    /// non-finite material constant).
     #[error("vector {vector}: {message}")]
     Invalid {
         /// The vector.
         vector: String,
         /// What is wrong.
         message: String,
+    },
+    /// The vector's (or recipe's) name is empty, longer than [`MAX_NAME_LEN`] or holds a
+    /// character outside `A–Z a–z 0–9 _ - .` (it is printed in reports and is a file stem, so a
+    /// newline or a path separator could forge a report line or a path). Shown escaped.
+    #[error("vector name {name:?} is not a plain name (1 to {MAX_NAME_LEN} of A-Z a-z 0-9 _ - .)")]
+    BadName {
+        /// The name as found.
+        name: String,
+    },
+    /// A vector file's `name` differs from the file's stem (`docs/CONFORMANCE.md`: the name is
+    /// the file stem), so a report line would name another vector than the file checked.
+    #[error("{}: the vector is named {name:?} but the file stem is {stem:?}; they must be equal", .path.display())]
+    NameMismatch {
+        /// The file.
+        path: PathBuf,
+        /// The vector's `name`.
+        name: String,
+        /// The file's stem (lossy UTF-8).
+        stem: String,
+    },
+    /// An expected float is ±∞ or NaN: |∞ − x| ≤ tolerance · ∞ holds for every x, so such an
+    /// expectation would match anything; vectors store finite values only.
+    #[error("vector {vector}, {}: expected {field}{} = {value:?} is not finite", at(.step), element(.index))]
+    NotFinite {
+        /// The vector.
+        vector: String,
+        /// The step index (`None` = initial state).
+        step: Option<usize>,
+        /// The field of [`Expect`].
+        field: &'static str,
+        /// The element, for `component_masses`.
+        index: Option<usize>,
+        /// The value found.
+        value: f64,
+    },
+    /// A vector's `file` mesh path resolves (through a symbolic link) to a place outside the
+    /// repository root; nothing is read from it.
+    #[error("vector {vector}: mesh path {path:?} resolves outside the repository root {}; not read", .root.display())]
+    OutsideRoot {
+        /// The vector.
+        vector: String,
+        /// The path as the vector gives it.
+        path: String,
+        /// The root it must stay inside.
+        root: PathBuf,
     },
     /// An operation names something the mesh does not have (tet id out of range, two tets that
     /// share no face, a point that is not a corner of the tet, a non-finite plane).
@@ -154,6 +207,11 @@ pub enum ConformanceError {
     },
 }
 
+/// "" or "\[i\]".
+fn element(index: &Option<usize>) -> String {
+    index.map(|i| format!("[{i}]")).unwrap_or_default()
+}
+
 /// "initial state" or "step k".
 fn at(step: &Option<usize>) -> String {
     match step {
@@ -188,12 +246,14 @@ impl ConformanceError {
             ConformanceError::BadOp { step, .. }
             | ConformanceError::Mismatch { step, .. }
             | ConformanceError::Law { step, .. }
+            | ConformanceError::NotFinite { step, .. }
             | ConformanceError::AmbiguousPlane { step, .. } => *step,
             _ => None,
         }
     }
 
-    /// The mismatching field, for a [`ConformanceError::Mismatch`]. O(1).
+    /// The mismatching field, for a [`ConformanceError::Mismatch`], or the non-finite one, for a
+    /// [`ConformanceError::NotFinite`]. O(1).
     ///
     /// # Examples
     ///
@@ -213,7 +273,7 @@ impl ConformanceError {
     /// ```
     pub fn field(&self) -> Option<&'static str> {
         match self {
-            ConformanceError::Mismatch { field, .. } => Some(field),
+            ConformanceError::Mismatch { field, .. } | ConformanceError::NotFinite { field, .. } => Some(field),
             _ => None,
         }
     }
@@ -242,7 +302,87 @@ impl Vector {
         if version.as_u64() != Some(u64::from(VERSION)) {
             return Err(ConformanceError::Version { origin: origin.to_string(), found: version.to_string() });
         }
-        serde_json::from_value(value).map_err(json)
+        let v: Vector = serde_json::from_value(value).map_err(json)?;
+        v.check_fields_from(origin)?;
+        Ok(v)
+    }
+
+    /// The checks every vector passes before it is replayed, whether it was decoded
+    /// ([`Vector::from_json`] runs them) or built in memory ([`replay_in`] runs them), in this
+    /// order: `format` is [`FORMAT`], `version` is [`VERSION`], `name` is 1 to [`MAX_NAME_LEN`]
+    /// characters of `A–Z a–z 0–9 _ - .` (it is printed in reports and is a file stem), the
+    /// tolerance is in 0 ..= [`MAX_TOLERANCE`], the material constants are finite and ≥ 0, and
+    /// every expected float (`total_mass`, `total_stiffness`, `component_masses`, initial state
+    /// and every step) is finite. O(size).
+    ///
+    /// # Errors
+    /// The first that fails: [`ConformanceError::Format`], [`ConformanceError::Version`] (origin
+    /// `<memory>`), [`ConformanceError::BadName`], [`ConformanceError::Invalid`],
+    /// [`ConformanceError::NotFinite`] (step and field).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::conformance::{generate, ConformanceError, MAX_TOLERANCE};
+    /// # use topomech::conformance::{MeshSpec, Op, Ops, Recipe};
+    /// # let recipe = Recipe {
+    /// #     name: "one".into(),
+    /// #     description: "remove a tet".into(),
+    /// #     mesh: MeshSpec::KuhnCube { k: 1 },
+    /// #     material: topomech::mechanics::Material::default().into(),
+    /// #     ops: Ops::Listed(vec![Op::Remove { tet: 0 }]),
+    /// # };
+    /// let v = generate(&recipe).unwrap();
+    /// v.check_fields().unwrap();
+    /// let mut loose = v.clone();
+    /// loose.tolerance = 2.0 * MAX_TOLERANCE;
+    /// assert!(matches!(loose.check_fields(), Err(ConformanceError::Invalid { .. })));
+    /// let mut inf = v.clone();
+    /// inf.steps[0].expect.total_mass = f64::INFINITY; // would match any mass
+    /// let e = inf.check_fields().unwrap_err();
+    /// assert_eq!((e.step(), e.field()), (Some(0), Some("total_mass")));
+    /// let mut forged = v.clone();
+    /// forged.name = "x\nok    everything_fine".into();
+    /// assert!(matches!(forged.check_fields(), Err(ConformanceError::BadName { .. })));
+    /// ```
+    pub fn check_fields(&self) -> Result<(), ConformanceError> {
+        self.check_fields_from("<memory>")
+    }
+
+    fn check_fields_from(&self, origin: &str) -> Result<(), ConformanceError> {
+        if self.format != FORMAT {
+            return Err(ConformanceError::Format { origin: origin.to_string(), found: self.format.clone() });
+        }
+        if self.version != VERSION {
+            return Err(ConformanceError::Version { origin: origin.to_string(), found: self.version.to_string() });
+        }
+        check_name(&self.name)?;
+        let invalid = |message: String| ConformanceError::Invalid { vector: self.name.clone(), message };
+        if !(0.0..=MAX_TOLERANCE).contains(&self.tolerance) {
+            return Err(invalid(format!(
+                "tolerance {:e} is outside 0 ..= {MAX_TOLERANCE:e} (a looser relative tolerance makes the float fields \
+                 vacuous)",
+                self.tolerance
+            )));
+        }
+        let m = self.material;
+        for (name, value) in
+            [("density", m.density), ("young", m.young), ("damping", m.damping), ("viscosity", m.viscosity)]
+        {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(invalid(format!("material {name} = {value} must be finite and ≥ 0")));
+            }
+        }
+        let expects = std::iter::once((None, &self.initial))
+            .chain(self.steps.iter().enumerate().map(|(k, s)| (Some(k), &s.expect)));
+        for (step, e) in expects {
+            let scalars = [("total_mass", None, e.total_mass), ("total_stiffness", None, e.total_stiffness)];
+            let masses = e.component_masses.iter().enumerate().map(|(i, &m)| ("component_masses", Some(i), m));
+            if let Some((field, index, value)) = scalars.into_iter().chain(masses).find(|(_, _, x)| !x.is_finite()) {
+                return Err(ConformanceError::NotFinite { vector: self.name.clone(), step, field, index, value });
+            }
+        }
+        Ok(())
     }
 
     /// Reads and parses the vector file at `path`. O(file).
@@ -304,6 +444,57 @@ impl Vector {
         s.push('\n');
         s
     }
+}
+
+/// Refuses a vector or recipe name that is empty, longer than [`MAX_NAME_LEN`] or holds a
+/// character outside `A–Z a–z 0–9 _ - .`. O(len).
+pub(crate) fn check_name(name: &str) -> Result<(), ConformanceError> {
+    let plain = |c: char| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.');
+    if name.is_empty() || name.len() > MAX_NAME_LEN || !name.chars().all(plain) {
+        return Err(ConformanceError::BadName { name: name.to_string() });
+    }
+    Ok(())
+}
+
+/// What `topomech conformance check` does with one file: reads the vector at `path`
+/// ([`Vector::read`], which runs [`Vector::check_fields`]), replays it with mesh files relative
+/// to `root` ([`replay_in`]), and then requires its `name` to be the file's stem, so the report
+/// line of a file names that file's vector. A vector that fails to replay is reported by that
+/// failure (it says what is wrong with the content). Cost: that of [`replay_in`].
+///
+/// # Errors
+/// As [`Vector::read`] and [`replay_in`]; then [`ConformanceError::NameMismatch`].
+///
+/// # Examples
+///
+/// ```
+/// use topomech::conformance::{check_file, generate, ConformanceError};
+/// # use topomech::conformance::{MeshSpec, Op, Ops, Recipe};
+/// # let recipe = Recipe {
+/// #     name: "one".into(),
+/// #     description: "remove a tet".into(),
+/// #     mesh: MeshSpec::KuhnCube { k: 1 },
+/// #     material: topomech::mechanics::Material::default().into(),
+/// #     ops: Ops::Listed(vec![Op::Remove { tet: 0 }]),
+/// # };
+/// let v = generate(&recipe).unwrap();
+/// let dir = std::env::temp_dir().join(format!("topomech_doc_check_file_{}", std::process::id()));
+/// std::fs::create_dir_all(&dir).unwrap();
+/// std::fs::write(dir.join("one.json"), v.to_json()).unwrap();
+/// assert_eq!(check_file(&dir.join("one.json"), &dir).unwrap(), v);
+/// std::fs::write(dir.join("other.json"), v.to_json()).unwrap();
+/// let e = check_file(&dir.join("other.json"), &dir).unwrap_err();
+/// assert!(matches!(e, ConformanceError::NameMismatch { ref stem, .. } if stem == "other"));
+/// std::fs::remove_dir_all(&dir).unwrap();
+/// ```
+pub fn check_file(path: &Path, root: &Path) -> Result<Vector, ConformanceError> {
+    let v = Vector::read(path)?;
+    replay_in(&v, root)?;
+    let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    if stem != v.name {
+        return Err(ConformanceError::NameMismatch { path: path.to_path_buf(), name: v.name, stem });
+    }
+    Ok(v)
 }
 
 /// The `*.json` files of `dir`, sorted by name. O(entries log entries).

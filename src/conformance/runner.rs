@@ -11,7 +11,7 @@ use crate::mechanics::{check_conservation, Body, Vec3};
 use crate::{CellId, DartId};
 
 use super::schema::{Expect, MaterialSpec, MeshSpec, Op, Refusal, Step, Vector};
-use super::{ConformanceError, FORMAT, TOLERANCE, VERSION};
+use super::{check_name, ConformanceError, FORMAT, TOLERANCE, VERSION};
 
 /// How a [`Recipe`] gives its operations.
 ///
@@ -60,7 +60,8 @@ pub enum Ops {
 /// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct Recipe {
-    /// File stem.
+    /// File stem: 1 to [`MAX_NAME_LEN`](super::MAX_NAME_LEN) characters of `A–Z a–z 0–9 _ - .`
+    /// ([`generate_in`] refuses any other name).
     pub name: String,
     /// What the vector exercises.
     pub description: String,
@@ -122,11 +123,15 @@ pub fn generate(recipe: &Recipe) -> Result<Vector, ConformanceError> {
 }
 
 /// [`generate`] with mesh files relative to `root`. The laws are checked after every step, and
-/// incision planes must keep `PLANE_MARGIN` (10⁻⁶ of the bounding-box diagonal) from every centroid.
+/// incision planes must keep `PLANE_MARGIN` (10⁻⁶ of the diagonal of the bounding box of the
+/// points the tets use) from every live centroid; a plane normal of any nonzero finite length is
+/// accepted (as [`incise_plane`](crate::cut::incise_plane) accepts it). The recipe's name must be a
+/// plain name and the vector produced passes [`Vector::check_fields`], so it can be replayed.
 ///
 /// # Errors
-/// [`ConformanceError::Mesh`], [`ConformanceError::BadOp`], [`ConformanceError::Law`],
-/// [`ConformanceError::AmbiguousPlane`].
+/// [`ConformanceError::BadName`], [`ConformanceError::Mesh`], [`ConformanceError::OutsideRoot`],
+/// [`ConformanceError::BadOp`], [`ConformanceError::Law`], [`ConformanceError::AmbiguousPlane`],
+/// then as [`Vector::check_fields`].
 ///
 /// ```
 /// use topomech::conformance::{generate, replay, MeshSpec, Op, Ops, Recipe};
@@ -142,6 +147,7 @@ pub fn generate(recipe: &Recipe) -> Result<Vector, ConformanceError> {
 /// replay(&v).unwrap();
 /// ```
 pub fn generate_in(recipe: &Recipe, root: &Path) -> Result<Vector, ConformanceError> {
+    check_name(&recipe.name)?;
     let mut r = Runner::new(&recipe.name, &recipe.mesh, recipe.material, root)?;
     r.check_laws(None)?;
     let initial = r.observe(Outcome { refused: None, dissociated: Vec::new() });
@@ -157,18 +163,19 @@ pub fn generate_in(recipe: &Recipe, root: &Path) -> Result<Vector, ConformanceEr
                 steps.push(r.run_generating(step, &op)?);
                 out.push(op);
             }
-            return Ok(vector(recipe, initial, steps));
+            return vector(recipe, initial, steps);
         }
     };
     let mut steps = Vec::with_capacity(ops.len());
     for (k, op) in ops.iter().enumerate() {
         steps.push(r.run_generating(k, op)?);
     }
-    Ok(vector(recipe, initial, steps))
+    vector(recipe, initial, steps)
 }
 
-fn vector(recipe: &Recipe, initial: Expect, steps: Vec<Step>) -> Vector {
-    Vector {
+/// The vector of a generation, checked as replay will check it.
+fn vector(recipe: &Recipe, initial: Expect, steps: Vec<Step>) -> Result<Vector, ConformanceError> {
+    let v = Vector {
         format: FORMAT.to_string(),
         version: VERSION,
         name: recipe.name.clone(),
@@ -178,7 +185,9 @@ fn vector(recipe: &Recipe, initial: Expect, steps: Vec<Step>) -> Vector {
         material: recipe.material,
         initial,
         steps,
-    }
+    };
+    v.check_fields()?;
+    Ok(v)
 }
 
 /// Replays `v` with mesh files relative to the current directory (see [`replay_in`]).
@@ -207,7 +216,9 @@ pub fn replay(v: &Vector) -> Result<(), ConformanceError> {
     replay_in(v, Path::new("."))
 }
 
-/// Rebuilds the body of `v` (mesh files relative to `root`; `data/liver_547_v22.msh` falls back
+/// Runs [`Vector::check_fields`] (the checks decoding runs: format, version, name, tolerance,
+/// material, finite expectations), then rebuilds the body of `v` (mesh files relative to `root`,
+/// and they must resolve inside it, symbolic links followed; `data/liver_547_v22.msh` falls back
 /// to the copy compiled into topomech), compares the initial state, then applies each step and
 /// compares every field of its [`Expect`] (floats to the vector's relative tolerance). After every
 /// step it also checks `validate()`, the conservation laws and the union-find model's counts.
@@ -215,7 +226,8 @@ pub fn replay(v: &Vector) -> Result<(), ConformanceError> {
 /// Cost: O(T log T) + Σ steps (operation + O(darts + T)).
 ///
 /// # Errors
-/// The first problem: [`ConformanceError::Invalid`], [`ConformanceError::Mesh`],
+/// The first problem: as [`Vector::check_fields`], [`ConformanceError::Mesh`],
+/// [`ConformanceError::OutsideRoot`],
 /// [`ConformanceError::BadOp`], [`ConformanceError::Mismatch`] (step, field, expected, got) or
 /// [`ConformanceError::Law`].
 ///
@@ -237,9 +249,12 @@ pub fn replay(v: &Vector) -> Result<(), ConformanceError> {
 /// let mut bad = v.clone();
 /// bad.tolerance = -1.0;
 /// assert!(replay_in(&bad, Path::new(".")).is_err());
+/// let mut foreign = v.clone();
+/// foreign.version = 99; // refused in memory as in a file
+/// assert!(replay_in(&foreign, Path::new(".")).is_err());
 /// ```
 pub fn replay_in(v: &Vector, root: &Path) -> Result<(), ConformanceError> {
-    check_header(v)?;
+    v.check_fields()?;
     let mut r = Runner::new(&v.name, &v.mesh, v.material, root)?;
     r.check_laws(None)?;
     let got = r.observe(Outcome { refused: None, dissociated: Vec::new() });
@@ -253,22 +268,6 @@ pub fn replay_in(v: &Vector, root: &Path) -> Result<(), ConformanceError> {
     Ok(())
 }
 
-fn check_header(v: &Vector) -> Result<(), ConformanceError> {
-    let invalid = |message: String| ConformanceError::Invalid { vector: v.name.clone(), message };
-    if !(v.tolerance.is_finite() && v.tolerance >= 0.0) {
-        return Err(invalid(format!("tolerance {} must be finite and ≥ 0", v.tolerance)));
-    }
-    let m = v.material;
-    for (name, value) in
-        [("density", m.density), ("young", m.young), ("damping", m.damping), ("viscosity", m.viscosity)]
-    {
-        if !(value.is_finite() && value >= 0.0) {
-            return Err(invalid(format!("material {name} = {value} must be finite and ≥ 0")));
-        }
-    }
-    Ok(())
-}
-
 /// The first field of `want` that `got` does not match.
 fn compare(v: &Vector, step: Option<usize>, want: &Expect, got: &Expect) -> Result<(), ConformanceError> {
     let fail = |field: &'static str, expected: String, got: String| ConformanceError::Mismatch {
@@ -278,7 +277,8 @@ fn compare(v: &Vector, step: Option<usize>, want: &Expect, got: &Expect) -> Resu
         expected,
         got,
     };
-    let close = |a: f64, b: f64| (a - b).abs() <= v.tolerance * a.abs().max(b.abs());
+    // `want` is finite (`check_fields`); a non-finite `got` never matches (|x − ∞| ≤ tol · ∞).
+    let close = |a: f64, b: f64| b.is_finite() && (a - b).abs() <= v.tolerance * a.abs().max(b.abs());
     macro_rules! exact {
         ($field:ident) => {
             if want.$field != got.$field {
@@ -326,7 +326,7 @@ fn mesh_of(name: &str, spec: &MeshSpec, root: &Path) -> Result<(Vec<Vec3>, Vec<[
             let loaded = if !full.exists() && Path::new(path) == Path::new("data/liver_547_v22.msh") {
                 load::load_builtin()
             } else {
-                load::load_tet_map(&full)
+                load::load_tet_map(&inside_root(name, path, root)?)
             };
             let mesh = loaded.map_err(|e| fail(e.to_string()))?.mesh;
             if (mesh.points.len(), mesh.tets.len()) != (*points, *tets) {
@@ -337,6 +337,28 @@ fn mesh_of(name: &str, spec: &MeshSpec, root: &Path) -> Result<(Vec<Vec3>, Vec<[
                 )));
             }
             Ok((mesh.points, mesh.tets))
+        }
+    }
+}
+
+/// `root/path` with every symbolic link resolved, when that lies inside `root` (also resolved).
+/// A path that does not exist is reported as missing only when its deepest existing ancestor
+/// lies inside `root`; nothing outside is read, so no error can echo an outside file.
+fn inside_root(name: &str, path: &str, root: &Path) -> Result<std::path::PathBuf, ConformanceError> {
+    let fail = |message: String| ConformanceError::Mesh { vector: name.to_string(), message };
+    let outside =
+        || ConformanceError::OutsideRoot { vector: name.to_string(), path: path.to_string(), root: root.to_path_buf() };
+    let base = root.canonicalize().map_err(|e| fail(format!("repository root {}: {e}", root.display())))?;
+    let full = root.join(path);
+    match full.canonicalize() {
+        Ok(resolved) if resolved.starts_with(&base) => Ok(resolved),
+        Ok(_) => Err(outside()),
+        Err(e) => {
+            let existing = full.ancestors().skip(1).find_map(|a| a.canonicalize().ok());
+            match existing {
+                Some(a) if a.starts_with(&base) => Err(fail(format!("{path}: {e}"))),
+                _ => Err(outside()),
+            }
         }
     }
 }
@@ -501,26 +523,34 @@ impl Runner {
         Ok(Outcome { refused: None, dissociated: pairs })
     }
 
-    /// Generation only: every live tet centroid keeps [`PLANE_MARGIN`] · diagonal from the plane.
+    /// Generation only: every live tet centroid keeps [`PLANE_MARGIN`] · diagonal from the plane,
+    /// the diagonal of the bounding box of the points the input tets use (an unused point does
+    /// not widen it). Lengths are taken scale-safe (divided by the largest component first), so
+    /// every nonzero finite normal is accepted, as [`cut::incise_plane`] accepts it.
     fn check_margin(&self, step: usize, plane: &Plane) -> Result<(), ConformanceError> {
         let n = plane.normal;
-        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-        if !(len > 0.0 && len.is_finite()) {
+        let scale = n.iter().fold(0.0_f64, |m, c| m.max(c.abs()));
+        if !(scale > 0.0 && n.iter().all(|c| c.is_finite())) {
             return Err(self.bad(step, format!("plane normal {n:?} is zero or not finite")));
         }
+        let unit = {
+            let m = n.map(|c| c / scale);
+            let len = norm(m);
+            m.map(|c| c / len)
+        };
         let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-        for p in &self.oracle.points {
+        for p in self.oracle.tets.iter().flatten().map(|&i| self.oracle.points[i as usize]) {
             for k in 0..3 {
                 lo[k] = lo[k].min(p[k]);
                 hi[k] = hi[k].max(p[k]);
             }
         }
-        let diagonal = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
+        let diagonal = if self.oracle.tets.is_empty() { 0.0 } else { norm([0, 1, 2].map(|k| hi[k] - lo[k])) };
         let distance = (0..self.oracle.tets.len())
             .filter(|&t| self.oracle.alive[t])
             .map(|t| {
                 let c = self.oracle.centroid(t);
-                ((0..3).map(|k| (c[k] - plane.point[k]) * n[k]).sum::<f64>() / len).abs()
+                ((0..3).map(|k| (c[k] - plane.point[k]) * unit[k]).sum::<f64>()).abs()
             })
             .fold(f64::INFINITY, f64::min);
         let margin = PLANE_MARGIN * diagonal;
@@ -617,6 +647,16 @@ impl Runner {
             }
         }
     }
+}
+
+/// |v|, without overflow or underflow in the squares: the largest |component| is divided out
+/// first. 0 for the zero vector; ∞ or NaN when a component is. O(1).
+fn norm(v: Vec3) -> f64 {
+    let scale = v.iter().fold(0.0_f64, |m, c| m.max(c.abs()));
+    if !(scale > 0.0 && scale.is_finite()) {
+        return scale;
+    }
+    scale * v.iter().map(|c| (c / scale) * (c / scale)).sum::<f64>().sqrt()
 }
 
 fn pair(a: u32, b: u32) -> [u32; 2] {

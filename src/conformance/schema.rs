@@ -22,11 +22,14 @@ pub struct Vector {
     pub format: String,
     /// Always [`VERSION`](super::VERSION).
     pub version: u32,
-    /// File stem; names the vector in every error.
+    /// File stem (`topomech conformance check` fails a file whose stem differs); names the vector
+    /// in every error. 1 to [`MAX_NAME_LEN`](super::MAX_NAME_LEN) characters of
+    /// `A–Z a–z 0–9 _ - .` ([`Vector::check_fields`]).
     pub name: String,
     /// What the vector exercises, for a human reader.
     pub description: String,
-    /// Relative tolerance of the floating-point fields: |a − b| ≤ tolerance · max(|a|, |b|).
+    /// Relative tolerance of the floating-point fields: |a − b| ≤ tolerance · max(|a|, |b|), in
+    /// 0 ..= [`MAX_TOLERANCE`](super::MAX_TOLERANCE).
     pub tolerance: f64,
     /// The input mesh.
     pub mesh: MeshSpec,
@@ -71,7 +74,8 @@ pub enum MeshSpec {
     /// A mesh file, relative to the repository root; the declared sizes are checked.
     File {
         /// Path relative to the repository root (e.g. `data/liver_547_v22.msh`); a root or a `..`
-        /// component is refused, so a vector reads nothing outside the repository.
+        /// component is refused, and the path with its symbolic links resolved must lie inside the
+        /// resolved root, so a vector reads nothing outside the repository.
         path: String,
         /// Points the file holds.
         points: usize,
@@ -175,7 +179,7 @@ pub enum Op {
     Incise {
         /// A point of the plane.
         point: Vec3,
-        /// Its normal (any nonzero length).
+        /// Its normal (any nonzero finite length).
         normal: Vec3,
     },
     /// Tear the vertex of `tet` at input point `vertex` along `direction` (seed §5.1). The faces
@@ -246,7 +250,7 @@ pub struct Expect {
     pub components: usize,
     /// V − E + F − T.
     pub euler: i64,
-    /// Σ_v m_v (= ρ · Σ live V_t).
+    /// Σ_v m_v (= ρ · Σ live V_t). Finite, as are the other two float fields.
     pub total_mass: f64,
     /// Σ_e k_e (= Σ over live tets and their edges of E·V_t/L_e²).
     pub total_stiffness: f64,

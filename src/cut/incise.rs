@@ -116,6 +116,10 @@ impl Incision {
 /// For every live volume id, whether its centroid (mean of its vertices' current positions) is on
 /// the positive side of `plane`; `None` for dead ids. O(darts).
 ///
+/// # Errors
+/// [`CutError::NonFinitePosition`] for the smallest live vertex with a NaN or infinite position
+/// (its tets have no side).
+///
 /// # Examples
 ///
 /// ```
@@ -125,17 +129,32 @@ impl Incision {
 ///
 /// let (points, tets) = kuhn_cube(2);
 /// let (body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
-/// let sides = tet_sides(&body, &Plane { point: [0.0, 0.0, 1.0], normal: [0.0, 0.0, 1.0] });
+/// let sides = tet_sides(&body, &Plane { point: [0.0, 0.0, 1.0], normal: [0.0, 0.0, 1.0] }).unwrap();
 /// assert_eq!(sides.iter().filter(|s| **s == Some(true)).count(), 24); // the upper layer
 /// assert_eq!(sides.iter().filter(|s| **s == Some(false)).count(), 24);
 /// ```
-pub fn tet_sides(body: &Body, plane: &Plane) -> Vec<Option<bool>> {
-    tet_centroids(body).into_iter().map(|c| c.map(|c| plane.positive(c))).collect()
+pub fn tet_sides(body: &Body, plane: &Plane) -> Result<Vec<Option<bool>>, CutError> {
+    Ok(tet_centroids(body)?.into_iter().map(|c| c.map(|c| plane.positive(c))).collect())
+}
+
+/// [`CutError::NonFinitePosition`] for the smallest live vertex id whose position is NaN or
+/// infinite. O(darts).
+pub(crate) fn check_positions_finite(body: &Body) -> Result<(), CutError> {
+    let (map, x) = (body.map(), body.attrs().position());
+    let bad = map
+        .one_dart_per_cell(0)
+        .into_iter()
+        .map(|d| map.vertex_id(d))
+        .filter(|&v| !x[v].iter().all(|c| c.is_finite()))
+        .min();
+    bad.map_or(Ok(()), |vertex| Err(CutError::NonFinitePosition { vertex, position: x[vertex] }))
 }
 
 /// For every volume id, the centroid of the live volume (mean of its distinct vertices' current
-/// positions), `None` for dead ids. O(darts).
-pub(crate) fn tet_centroids(body: &Body) -> Vec<Option<Vec3>> {
+/// positions), `None` for dead ids; [`CutError::NonFinitePosition`] as [`check_positions_finite`]
+/// (a NaN centroid would put its tet on a side at random). O(darts).
+pub(crate) fn tet_centroids(body: &Body) -> Result<Vec<Option<Vec3>>, CutError> {
+    check_positions_finite(body)?;
     let (map, mech) = (body.map(), body.attrs());
     let mut centroid = vec![None; map.cell_id_bound(3)];
     for d in map.one_dart_per_cell(3) {
@@ -150,7 +169,7 @@ pub(crate) fn tet_centroids(body: &Body) -> Vec<Option<Vec3>> {
         }
         centroid[map.cell_id(3, d).index()] = Some(c);
     }
-    centroid
+    Ok(centroid)
 }
 
 /// Dissociates every inner face whose two tets' centroids lie on opposite sides of `plane`
@@ -160,7 +179,8 @@ pub(crate) fn tet_centroids(body: &Body) -> Vec<Option<Vec3>> {
 /// Cost: O(darts) to classify, plus one [`dissociate_face`] per cut face.
 ///
 /// # Errors
-/// [`CutError::BadPlane`] (body unchanged); [`CutError::Body`] is a bug.
+/// [`CutError::BadPlane`], [`CutError::NonFinitePosition`] (body unchanged); [`CutError::Body`]
+/// is a bug.
 ///
 /// # Examples
 ///
@@ -180,7 +200,7 @@ pub(crate) fn tet_centroids(body: &Body) -> Vec<Option<Vec3>> {
 /// ```
 pub fn incise_plane(body: &mut Body, plane: &Plane) -> Result<Incision, CutError> {
     plane.check()?;
-    let side = tet_sides(body, plane);
+    let side = tet_sides(body, plane)?;
     let map = body.map();
     let faces: Vec<DartId> = map
         .one_dart_per_cell(2)

@@ -101,6 +101,15 @@ pub enum CutError {
     /// A vertex id that no live dart carries.
     #[error("vertex {0} does not exist in this body")]
     NoSuchVertex(CellId),
+    /// A live vertex whose current position is NaN or infinite, where the operation needs it
+    /// (the sides of an incision, the face normals of a tear): nothing is cut.
+    #[error("vertex {vertex} has the non-finite position {position:?}: its tets have no side to be cut on")]
+    NonFinitePosition {
+        /// The smallest such vertex id (for a tear: one on the face that needed it).
+        vertex: CellId,
+        /// Its position.
+        position: [f64; 3],
+    },
     /// The plane's point or normal is not finite, or the normal is zero.
     #[error("cut plane point {point:?} / normal {normal:?} is not finite or the normal is zero")]
     BadPlane {

@@ -262,7 +262,8 @@ fn boxes_meet((lo, hi): (Vec3, Vec3), a: Vec3, b: Vec3) -> bool {
 /// selects the same faces, for any finite coordinates (a slit reaching ±`f64::MAX` included).
 ///
 /// # Errors
-/// [`CutError::BadSweep`].
+/// [`CutError::BadSweep`]; [`CutError::NonFinitePosition`] for a live vertex with a NaN or
+/// infinite position (its tets have no centroid to test).
 ///
 /// # Examples
 ///
@@ -280,7 +281,7 @@ fn boxes_meet((lo, hi): (Vec3, Vec3), a: Vec3, b: Vec3) -> bool {
 /// ```
 pub fn sweep_faces(body: &Body, surface: &PolylineSweep) -> Result<Vec<DartId>, CutError> {
     surface.check()?;
-    let centroid = tet_centroids(body);
+    let centroid = tet_centroids(body)?;
     let map = body.map();
     let bounds = surface.bounds();
     let faces = map
@@ -310,7 +311,8 @@ pub fn sweep_faces(body: &Body, surface: &PolylineSweep) -> Result<Vec<DartId>, 
 /// The selection is scale-invariant ([`sweep_faces`]).
 ///
 /// # Errors
-/// [`CutError::BadSweep`] (body unchanged); [`CutError::Body`] is a bug.
+/// [`CutError::BadSweep`], [`CutError::NonFinitePosition`] (body unchanged); [`CutError::Body`]
+/// is a bug.
 ///
 /// # Examples
 ///

@@ -11,7 +11,7 @@
 use crate::mechanics::geom::{cross, dot, sub};
 use crate::mechanics::model::{closed_triangle_vertices, triangle_vertices};
 use crate::mechanics::{Body, SimError, Simulation, TouchedCells, Vec3};
-use crate::{CellId, DartId, GMap};
+use crate::{AlphaMask, CellId, DartId, GMap};
 
 use super::sweep::Scaled;
 use super::{dissociate_face, CutError, Dissociation};
@@ -281,9 +281,10 @@ fn face_normal_at(body: &Body, x: DartId) -> Vec3 {
 /// that of scoring every inner dart (unit test): every dart left out has a smaller one with the
 /// same score that is kept. The vertex orbit is walked once, corner by corner, with no list.
 /// O(vertex orbit).
-fn start_face(body: &Body, start: DartId, direction: Vec3) -> Option<DartId> {
+fn start_face(body: &Body, start: DartId, direction: Vec3) -> Result<Option<DartId>, CutError> {
     let map = body.map();
     let mut best: Option<(DartId, f64)> = None;
+    let mut bad: Option<DartId> = None;
     map.for_each_corner(start, |_, x| {
         // α1 is computed for tets as built (`alpha_local`): only α3(x) reads a row here.
         if x > map.alpha_local(1, x) {
@@ -294,11 +295,32 @@ fn start_face(body: &Body, start: DartId, direction: Vec3) -> Option<DartId> {
             return;
         }
         let score = dot(face_normal_at(body, x), direction).abs();
+        if score.is_nan() {
+            // A NaN normal would win every comparison (`total_cmp`): refused below.
+            bad = bad.or(Some(x));
+            return;
+        }
         if best.is_none_or(|(d, s)| score.total_cmp(&s).then(d.cmp(&x)).is_gt()) {
             best = Some((x, score));
         }
     });
-    best.map(|(d, _)| d)
+    match bad.and_then(|x| nonfinite_corner(body, x)) {
+        Some(e) => Err(e),
+        None => Ok(best.map(|(d, _)| d)),
+    }
+}
+
+/// [`CutError::NonFinitePosition`] for a vertex of the face of `x` (its darts' vertex ids)
+/// whose position is NaN or infinite, if there is one. O(face).
+fn nonfinite_corner(body: &Body, x: DartId) -> Option<CutError> {
+    let (map, pos) = (body.map(), body.attrs().position());
+    let vertex = map
+        .orbit(x, AlphaMask::of(&[0, 1]))
+        .into_iter()
+        .map(|d| map.vertex_id(d))
+        .filter(|&v| !pos[v].iter().all(|c| c.is_finite()))
+        .min()?;
+    Some(CutError::NonFinitePosition { vertex, position: pos[vertex] })
 }
 
 /// Tears vertex `v` along `direction`: among the inner faces around v, the one whose normal is
@@ -312,8 +334,10 @@ fn start_face(body: &Body, start: DartId, direction: Vec3) -> Option<DartId> {
 ///
 /// # Errors
 /// [`CutError::NoSuchVertex`] (no live dart carries `v`; body unchanged);
-/// [`CutError::BadDirection`] for a non-finite or zero direction; [`CutError::Body`] is a bug. A
-/// vertex with no inner face is left as is (an empty fan).
+/// [`CutError::BadDirection`] for a non-finite or zero direction;
+/// [`CutError::NonFinitePosition`] for a NaN or infinite position on a face around `v` (body
+/// unchanged); [`CutError::Body`] is a bug. A vertex with no inner face is left as is (an empty
+/// fan).
 ///
 /// # Examples
 ///
@@ -341,7 +365,7 @@ pub fn tear_vertex(body: &mut Body, v: CellId, direction: Vec3, hint: Option<Dar
     let start = start.ok_or(CutError::NoSuchVertex(v))?;
     // Scaled by a power of two (exact) to a largest component in [1, 2): the scores neither
     // underflow for a tiny direction nor overflow for a huge one, and keep their order.
-    let best = start_face(body, start, Scaled::new(direction, 0, 0).dir);
+    let best = start_face(body, start, Scaled::new(direction, 0, 0).dir)?;
     let mut tear =
         Tear { vertex: v, fan: Vec::new(), dissociations: Vec::new(), split: false, touched: TouchedCells::default() };
     let from = body.version();
@@ -374,8 +398,9 @@ pub fn tear_vertex(body: &mut Body, v: CellId, direction: Vec3, hint: Option<Dar
 /// [`CutError::BadThreshold`] for a NaN, infinite or negative threshold, and
 /// [`CutError::Sim`] with [`crate::mechanics::SimError::OtherBody`] when `sim` was built for
 /// another body or [`crate::mechanics::SimError::StaleProjection`] when the body changed since
-/// `sim` last followed it (nothing done in these cases); [`CutError::Body`] or [`CutError::Sim`]
-/// (bugs or a bad time step).
+/// `sim` last followed it, or [`crate::mechanics::StepError::BadInput`] when a position or
+/// velocity is NaN or infinite (nothing done in these cases); [`CutError::Body`] or
+/// [`CutError::Sim`] (bugs or a bad time step).
 ///
 /// # Examples
 ///
@@ -406,6 +431,9 @@ pub fn tear_step(
         return Err(CutError::BadThreshold(threshold));
     }
     let stress = principal_stress(body, sim)?;
+    // The simulation must be able to follow the tears (a new stepper starts from the state):
+    // refused before anything tears (finding 73).
+    crate::mechanics::check_state_finite(body)?;
     let mut order: Vec<usize> = (0..stress.len()).filter(|&v| stress[v].magnitude > threshold).collect();
     order.sort_by(|&a, &b| stress[b].magnitude.total_cmp(&stress[a].magnitude).then(a.cmp(&b)));
     let mut out = TearStep::default();

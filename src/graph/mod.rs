@@ -442,6 +442,7 @@ impl GraphInvariant {
 /// assert_eq!(json.edges, vec![[0, 1, 1]]); // ranks, not map ids
 /// ```
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct GraphJson {
     /// Which graph.
     pub kind: GraphKind,
@@ -485,8 +486,12 @@ impl GraphJson {
         GraphJson { kind, nodes: order.iter().map(|&n| g[n].dim).collect(), edges }
     }
 
-    /// Rebuilds a graph (node ids = ranks). Errors name the first edge with an endpoint out of
-    /// range. O(nodes + edges).
+    /// Rebuilds a graph (node ids = ranks), checking that it is one that [`GraphJson::of`] can
+    /// give: a simple graph (no two edges on one pair of nodes: the multiplicity is the weight),
+    /// weights ≥ 1, node dimensions ≤ [`AlphaMask::MAX_INDEX`], and the shape of its kind (a
+    /// 1-skeleton's nodes are vertices, a dual graph's nodes share one dimension, an incidence
+    /// edge joins a k-cell and a (k+1)-cell). The errors ([`GraphJsonError`]) name the first
+    /// node or edge at fault. O(nodes + edges · log edges).
     ///
     /// # Examples
     ///
@@ -505,13 +510,46 @@ impl GraphJson {
         let mut g = CellGraph::default();
         let nodes: Vec<NodeIndex> =
             self.nodes.iter().enumerate().map(|(i, &dim)| g.add_node(CellNode { dim, id: i as u32 })).collect();
+        self.check_nodes()?;
+        let mut seen = BTreeMap::new();
         for (k, &[a, b, w]) in self.edges.iter().enumerate() {
             let (Some(&na), Some(&nb)) = (nodes.get(a as usize), nodes.get(b as usize)) else {
                 return Err(GraphJsonError::BadEndpoint { edge: k, nodes: nodes.len() });
             };
+            if w == 0 {
+                return Err(GraphJsonError::ZeroWeight { edge: k });
+            }
+            if let Some(&earlier) = seen.get(&(a.min(b), a.max(b))) {
+                return Err(GraphJsonError::ParallelEdge { edge: k, earlier });
+            }
+            seen.insert((a.min(b), a.max(b)), k);
+            let (da, db) = (self.nodes[a as usize], self.nodes[b as usize]);
+            if self.kind == GraphKind::Incidence && da.abs_diff(db) != 1 {
+                return Err(GraphJsonError::WrongShape {
+                    what: format!("incidence edge {k} joins dimensions {da} and {db}"),
+                });
+            }
             g.add_edge(na, nb, w);
         }
         Ok(g)
+    }
+
+    /// The node part of [`GraphJson::to_graph`]'s checks. O(nodes).
+    fn check_nodes(&self) -> Result<(), GraphJsonError> {
+        if let Some(node) = self.nodes.iter().position(|&d| d as usize > AlphaMask::MAX_INDEX) {
+            return Err(GraphJsonError::BadDimension { node, dim: self.nodes[node] });
+        }
+        let odd = match self.kind {
+            GraphKind::VertexEdge => self.nodes.iter().position(|&d| d != 0),
+            GraphKind::Dual => self.nodes.iter().position(|&d| d != self.nodes[0]),
+            GraphKind::Incidence => None,
+        };
+        match odd {
+            Some(node) => Err(GraphJsonError::WrongShape {
+                what: format!("node {node} of dimension {} in a {:?} graph", self.nodes[node], self.kind),
+            }),
+            None => Ok(()),
+        }
     }
 }
 
@@ -535,6 +573,35 @@ pub enum GraphJsonError {
         edge: usize,
         /// Number of nodes.
         nodes: usize,
+    },
+    /// An edge of multiplicity 0 (a multiplicity counts incidences: at least 1).
+    #[error("edge {edge} has weight 0 (a multiplicity is at least 1)")]
+    ZeroWeight {
+        /// Index of the edge in the list.
+        edge: usize,
+    },
+    /// Two edges on the same pair of nodes (the graphs are simple: the multiplicity is the
+    /// weight of the one edge).
+    #[error("edge {edge} joins the same pair of nodes as edge {earlier} (one edge per pair; the weight is the multiplicity)")]
+    ParallelEdge {
+        /// Index of the second edge in the list.
+        edge: usize,
+        /// Index of the first.
+        earlier: usize,
+    },
+    /// A node dimension past the largest a map can have.
+    #[error("node {node} has dimension {dim}, past the largest a map can have (7)")]
+    BadDimension {
+        /// Index of the node.
+        node: usize,
+        /// Its dimension.
+        dim: u8,
+    },
+    /// A node or edge that does not fit the graph's kind.
+    #[error("not a graph of its kind: {what}")]
+    WrongShape {
+        /// What does not fit.
+        what: String,
     },
 }
 

@@ -14,8 +14,12 @@
 //!
 //! After every step the state is scanned: a NaN or infinite coordinate, or a kinetic energy above
 //! [`StepConfig::runaway_factor`] times the energy scale of the start (kinetic plus elastic energy
-//! plus M |g| D, with D the diagonal of the bounding box), is returned as [`StepError::BlowUp`]
-//! naming the step and the slot.
+//! plus M |g| D, with D the diagonal of the bounding box; when that is 0 — at rest in the rest
+//! shape without gravity — Σ ½ k L² over the springs, the material's own energy scale), is
+//! returned as [`StepError::BlowUp`] naming the step and the slot. A start state whose energy
+//! scale is not finite is refused. State written between steps is new energy put in by hand:
+//! [`Stepper::reset_energy_scale`] takes it as the new start ([`crate::mechanics::Simulation`]
+//! does so itself when positions or velocities were handed out for writing).
 
 use std::str::FromStr;
 
@@ -134,20 +138,24 @@ pub enum StepError {
         step: u64,
         /// Iterations made.
         iterations: usize,
-        /// ‖r‖/‖b‖ reached.
+        /// ‖r‖/‖b‖ reached; ‖b‖ itself (∞ or NaN, with 0 iterations) when the right-hand side is
+        /// not finite (the forces overflowed).
         residual: f64,
     },
     /// The time step is not a positive finite number.
     #[error("time step {0} must be positive and finite")]
     BadTimeStep(f64),
-    /// A parameter of the stepping other than the time step is not a finite number > 0 (with
-    /// NaN the runaway test or the solver's stopping test would never fire).
-    #[error("step parameter {name} = {value} must be a finite number > 0")]
+    /// A parameter of the stepping other than the time step is outside its range: `runaway_factor`
+    /// must be a finite number > 0 and `cg_tolerance` one in (0, 1) (with NaN the runaway test or
+    /// the solver's stopping test would never fire; a tolerance ≥ 1 accepts Δv = 0, no solve).
+    #[error("step parameter {name} = {value} must be {allowed}")]
     BadParameter {
         /// `runaway_factor` or `cg_tolerance`.
         name: &'static str,
         /// The value given.
         value: f64,
+        /// The range allowed, in words.
+        allowed: &'static str,
     },
     /// The state slices do not match the system.
     #[error("state has {got} slots, the system {expected}")]
@@ -202,7 +210,8 @@ pub struct StepConfig {
     pub parallel: bool,
     /// Kinetic energy above this many times the starting energy scale counts as a blow-up.
     pub runaway_factor: f64,
-    /// Relative residual at which conjugate gradient stops.
+    /// Relative residual ‖r‖/‖b‖ at which conjugate gradient stops, in (0, 1); a solve that
+    /// does not reach it within `cg_max_iterations` is [`StepError::SolverFailed`].
     pub cg_tolerance: f64,
     /// Iteration cap of conjugate gradient.
     pub cg_max_iterations: usize,
@@ -293,7 +302,8 @@ impl Stepper {
     ///
     /// # Errors
     /// [`StepError::BadTimeStep`], [`StepError::BadParameter`], [`StepError::SizeMismatch`],
-    /// [`StepError::BadInput`] (a system or start state it cannot step).
+    /// [`StepError::BadInput`] (a system or start state it cannot step, a start energy scale that
+    /// is not finite).
     ///
     /// # Examples
     ///
@@ -315,21 +325,25 @@ impl Stepper {
         if !(config.dt.is_finite() && config.dt > 0.0) {
             return Err(StepError::BadTimeStep(config.dt));
         }
-        for (name, value) in [("runaway_factor", config.runaway_factor), ("cg_tolerance", config.cg_tolerance)] {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(StepError::BadParameter { name, value });
-            }
+        let (factor, tol) = (config.runaway_factor, config.cg_tolerance);
+        if !(factor.is_finite() && factor > 0.0) {
+            return Err(StepError::BadParameter {
+                name: "runaway_factor",
+                value: factor,
+                allowed: "a finite number > 0",
+            });
         }
-        check_len(sys, x)?;
-        check_len(sys, v)?;
+        if !(tol > 0.0 && tol < 1.0) {
+            return Err(StepError::BadParameter { name: "cg_tolerance", value: tol, allowed: "a number in (0, 1)" });
+        }
         check_system(sys).map_err(StepError::BadInput)?;
-        check_start(x, v).map_err(StepError::BadInput)?;
+        let energy_scale = start_energy_scale(sys, x, v)?;
         let (n, s) = (sys.slots(), sys.springs());
         let z = |len| vec![[0.0; 3]; len];
         Ok(Stepper {
             config,
             step: 0,
-            energy_scale: energy_scale(sys, x, v),
+            energy_scale,
             sf: z(s),
             ys: vec![SlotState::default(); n],
             acc: z(n),
@@ -381,6 +395,57 @@ impl Stepper {
     /// ```
     pub fn steps_done(&self) -> u64 {
         self.step
+    }
+
+    /// Takes the state (x, v) as the new start of the runaway test: its energy scale replaces
+    /// the one recorded by [`Stepper::new`]. Call it after writing positions or velocities by hand
+    /// between steps — energy put in from outside is not a blow-up, and without it a body started
+    /// at rest would have a stale scale. The step count is kept. A caller that writes the state
+    /// before every step moves the threshold with it, so only the non-finite test is left to
+    /// catch a slow runaway then. O(slots + springs).
+    ///
+    /// # Errors
+    /// [`StepError::OtherSystem`], [`StepError::SizeMismatch`], [`StepError::BadInput`] (a
+    /// non-finite coordinate, or an energy scale that is not finite); the scale is unchanged then.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::{Integrator, SpringSystem, StepConfig, StepError, Stepper};
+    ///
+    /// // Two free unit masses on a spring of rest length 1, at rest: nothing can move.
+    /// let mut sys = SpringSystem::default();
+    /// sys.push_slot(1.0, false, 0.0).unwrap();
+    /// sys.push_slot(1.0, false, 0.0).unwrap();
+    /// sys.push_spring([0, 1], 1.0, 10.0, 0.0).unwrap();
+    /// let (mut x, mut v) = (vec![[0.0; 3], [1.0, 0.0, 0.0]], vec![[0.0; 3]; 2]);
+    /// let mut stepper = Stepper::new(StepConfig::new(Integrator::Symplectic, 1e-2), &sys, &x, &v).unwrap();
+    /// v[1] = [200.0, 0.0, 0.0]; // a kick by hand: 20 000 J against 10³ × (½ k L² = 5 J)
+    /// assert!(matches!(stepper.step(&sys, &mut x, &mut v), Err(StepError::BlowUp { .. })));
+    /// (x[1], v[1]) = ([1.0, 0.0, 0.0], [200.0, 0.0, 0.0]);
+    /// stepper.reset_energy_scale(&sys, &x, &v).unwrap(); // the kick is the new start
+    /// stepper.step(&sys, &mut x, &mut v).unwrap();
+    /// v[0] = [f64::NAN; 3];
+    /// assert!(matches!(stepper.reset_energy_scale(&sys, &x, &v), Err(StepError::BadInput(_))));
+    /// ```
+    pub fn reset_energy_scale(&mut self, sys: &SpringSystem, x: &[Vec3], v: &[Vec3]) -> Result<(), StepError> {
+        self.check_shape(sys)?;
+        self.energy_scale = start_energy_scale(sys, x, v)?;
+        Ok(())
+    }
+
+    /// [`StepError::OtherSystem`] unless `sys` has the slot and spring counts the buffers were
+    /// made for. O(1).
+    fn check_shape(&self, sys: &SpringSystem) -> Result<(), StepError> {
+        if (sys.slots(), sys.springs()) == (self.ys.len(), self.sf.len()) {
+            return Ok(());
+        }
+        Err(StepError::OtherSystem {
+            slots: self.ys.len(),
+            springs: self.sf.len(),
+            got_slots: sys.slots(),
+            got_springs: sys.springs(),
+        })
     }
 
     /// The instruction set of the hot loops ([`Kernel::detect`] unless set). O(1).
@@ -506,15 +571,7 @@ impl Stepper {
     /// assert!(matches!(e, topomech::mechanics::StepError::OtherSystem { slots: 2, got_slots: 3, .. }));
     /// ```
     pub fn step(&mut self, sys: &SpringSystem, x: &mut [Vec3], v: &mut [Vec3]) -> Result<(), StepError> {
-        if (sys.slots(), sys.springs()) != (self.ys.len(), self.sf.len()) {
-            let (got_slots, got_springs) = (sys.slots(), sys.springs());
-            return Err(StepError::OtherSystem {
-                slots: self.ys.len(),
-                springs: self.sf.len(),
-                got_slots,
-                got_springs,
-            });
-        }
+        self.check_shape(sys)?;
         check_len(sys, x)?;
         check_len(sys, v)?;
         match self.config.integrator {
@@ -777,13 +834,28 @@ fn check_system(sys: &SpringSystem) -> Result<(), String> {
 }
 
 /// What makes the start state unsteppable: a non-finite position or velocity. O(slots).
-fn check_start(x: &[Vec3], v: &[Vec3]) -> Result<(), String> {
+pub(super) fn check_start(x: &[Vec3], v: &[Vec3]) -> Result<(), String> {
     for (name, values) in [("position", x), ("velocity", v)] {
         if let Some((i, p)) = values.iter().enumerate().find(|(_, p)| !p.iter().all(|c| c.is_finite())) {
             return Err(format!("start {name} of slot {i} is {p:?} (must be finite)"));
         }
     }
     Ok(())
+}
+
+/// The checked start state (lengths, finite values) and its energy scale, which must be finite.
+/// O(slots + springs).
+fn start_energy_scale(sys: &SpringSystem, x: &[Vec3], v: &[Vec3]) -> Result<f64, StepError> {
+    check_len(sys, x)?;
+    check_len(sys, v)?;
+    check_start(x, v).map_err(StepError::BadInput)?;
+    let scale = energy_scale(sys, x, v);
+    if !scale.is_finite() {
+        return Err(StepError::BadInput(format!(
+            "the start energy (kinetic + elastic + M |g| D) is {scale:e}: the runaway test needs a finite one"
+        )));
+    }
+    Ok(scale)
 }
 
 fn check_len(sys: &SpringSystem, x: &[Vec3]) -> Result<(), StepError> {
@@ -794,7 +866,9 @@ fn check_len(sys: &SpringSystem, x: &[Vec3]) -> Result<(), StepError> {
     }
 }
 
-/// Kinetic + elastic energy + M |g| D (D = bounding-box diagonal of x). O(slots + springs).
+/// Kinetic + elastic energy + M |g| D (D = bounding-box diagonal of x); if that is 0, Σ ½ k L²
+/// (the elastic energy of every spring at twice its rest length): a body at rest in its rest
+/// shape without gravity keeps a runaway test of the material's scale. O(slots + springs).
 fn energy_scale(sys: &SpringSystem, x: &[Vec3], v: &[Vec3]) -> f64 {
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
     for p in x {
@@ -805,7 +879,11 @@ fn energy_scale(sys: &SpringSystem, x: &[Vec3], v: &[Vec3]) -> f64 {
     }
     let diag = if x.is_empty() { 0.0 } else { norm(sub(hi, lo)) };
     let total_mass: f64 = sys.mass.iter().sum();
-    sys.kinetic_energy_raw(v) + sys.elastic_energy_raw(x) + total_mass * norm(sys.gravity) * diag
+    let scale = sys.kinetic_energy_raw(v) + sys.elastic_energy_raw(x) + total_mass * norm(sys.gravity) * diag;
+    if scale != 0.0 {
+        return scale;
+    }
+    sys.stiffness.iter().zip(&sys.rest).map(|(&k, &l)| 0.5 * k * l * l).sum()
 }
 
 #[inline(always)]
@@ -879,6 +957,10 @@ impl Stepper {
         cg.dv.iter_mut().for_each(|d| *d = [0.0; 3]);
         cg.p.copy_from_slice(&cg.r);
         let b_norm = dot_all(&cg.r, &cg.r).sqrt();
+        if !b_norm.is_finite() {
+            // ‖b‖² overflowed (or b holds NaN): ∞ ≤ tol · ∞ would "converge" at once with Δv = 0.
+            return Err(StepError::SolverFailed { step: self.step, iterations: 0, residual: b_norm });
+        }
         if b_norm == 0.0 {
             return Ok(0);
         }
@@ -901,7 +983,7 @@ impl Stepper {
             }
         }
         let residual = rr.sqrt() / b_norm;
-        if residual <= self.config.cg_tolerance.max(1e-6) {
+        if residual <= self.config.cg_tolerance {
             return Ok(self.config.cg_max_iterations);
         }
         Err(StepError::SolverFailed { step: self.step, iterations: self.config.cg_max_iterations, residual })

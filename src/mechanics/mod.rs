@@ -145,8 +145,11 @@ pub struct Simulation {
     /// The integrator and its buffers.
     pub stepper: Stepper,
     /// The body's velocity epoch (`Mechanics::velocity_epoch`) at which the pinned velocities
-    /// were last zeroed.
+    /// were last zeroed and the runaway test's energy scale last taken.
     velocity_epoch: u64,
+    /// The body's position epoch (`Mechanics::position_epoch`) at which the energy scale was
+    /// last taken.
+    position_epoch: u64,
 }
 
 impl Simulation {
@@ -187,22 +190,27 @@ impl Simulation {
             &mech.position.as_slice()[..slots],
             &mech.velocity.as_slice()[..slots],
         )?;
-        let mut sim = Simulation { projection, stepper, velocity_epoch: 0 };
+        let mut sim = Simulation { projection, stepper, velocity_epoch: 0, position_epoch: 0 };
         sim.hold_fixed(body);
+        sim.record_epochs(body);
         Ok(sim)
     }
 
     /// Zeroes the velocity of every fixed slot — pinned vertices (the law "a pinned vertex does
-    /// not move") and dead vertex ids — as [`Simulation::update`] does, and records the body's
-    /// velocity epoch. O(vertex ids).
-    fn hold_fixed(&mut self, body: &mut Body) {
+    /// not move") and dead vertex ids — as [`Simulation::update`] does. O(vertex ids).
+    fn hold_fixed(&self, body: &mut Body) {
         let mech = body.attrs_mut();
         for (v, &w) in mech.velocity.as_mut_slice().iter_mut().zip(&self.projection.system.inv_mass) {
             if w == 0.0 {
                 *v = [0.0; 3];
             }
         }
-        self.velocity_epoch = mech.velocity_epoch;
+    }
+
+    /// Records the body's velocity and position epochs: what was written so far is taken up.
+    fn record_epochs(&mut self, body: &Body) {
+        self.velocity_epoch = body.attrs().velocity_epoch;
+        self.position_epoch = body.attrs().position_epoch;
     }
 
     /// [`Simulation::check_current`], after taking up what was written into the body's pins or
@@ -218,8 +226,18 @@ impl Simulation {
         if pins_changed {
             self.projection.follow_pins(body);
         }
-        if pins_changed || self.velocity_epoch != body.attrs().velocity_epoch {
+        let mech = body.attrs();
+        let written = mech.velocity_epoch != self.velocity_epoch || mech.position_epoch != self.position_epoch;
+        if pins_changed || written {
             self.hold_fixed(body);
+            // Energy put in by hand is a new start, not a blow-up (and a body started at rest
+            // would otherwise keep a stale scale). On an error the epochs stay unrecorded, so
+            // the next call checks again.
+            let slots = self.projection.system.slots();
+            let mech = body.attrs();
+            let (x, v) = (&mech.position.as_slice()[..slots], &mech.velocity.as_slice()[..slots]);
+            self.stepper.reset_energy_scale(&self.projection.system, x, v)?;
+            self.record_epochs(body);
         }
         Ok(())
     }
@@ -322,7 +340,8 @@ impl Simulation {
     /// its buffers in place.
     ///
     /// # Errors
-    /// As [`Simulation::new`].
+    /// As [`Simulation::new`]; [`StepError::BadInput`] for a NaN or infinite position or velocity
+    /// of a vertex id, before anything changes (the new stepper could not start from it).
     ///
     /// # Examples
     ///
@@ -343,6 +362,8 @@ impl Simulation {
     /// ```
     pub fn update(&mut self, body: &mut Body, touched: &TouchedCells) -> Result<(), SimError> {
         self.check_body(body)?;
+        // The new stepper refuses a non-finite state: refused here, before the projection changes.
+        check_state_finite(body)?;
         self.projection.update(body, touched);
         let config = *self.stepper.config();
         let slots = self.projection.system.slots();
@@ -350,6 +371,7 @@ impl Simulation {
         let mech = body.attrs();
         let (x, v) = (&mech.position.as_slice()[..slots], &mech.velocity.as_slice()[..slots]);
         self.stepper = Stepper::new(config, &self.projection.system, x, v)?;
+        self.record_epochs(body);
         Ok(())
     }
 
@@ -460,6 +482,16 @@ impl Simulation {
 }
 
 /// The larger of a and b, NaN if either is NaN (unlike [`f64::max`], which drops a NaN). O(1).
+/// [`StepError::BadInput`] naming the first vertex id (live or not: every id is a slot of the
+/// projection) whose position or velocity is NaN or infinite: the state a new stepper starts
+/// from. O(vertex ids).
+pub(crate) fn check_state_finite(body: &Body) -> Result<(), SimError> {
+    let slots = body.map().cell_id_bound(0);
+    let mech = body.attrs();
+    let (x, v) = (&mech.position.as_slice()[..slots], &mech.velocity.as_slice()[..slots]);
+    integrate::check_start(x, v).map_err(|e| SimError::Step(StepError::BadInput(e)))
+}
+
 fn nan_max(a: f64, b: f64) -> f64 {
     if a.is_nan() || b.is_nan() {
         f64::NAN

@@ -236,6 +236,10 @@ pub struct Mechanics {
     /// A fresh stamp each time the velocities are handed out for writing
     /// ([`Mechanics::velocity_mut`]): the simulation then re-zeroes the pinned velocities.
     pub(crate) velocity_epoch: u64,
+    /// A fresh stamp each time the positions are handed out for writing
+    /// ([`Mechanics::position_mut`]): the simulation then takes the state as the new start of
+    /// its runaway test (energy put in by hand is not a blow-up).
+    pub(crate) position_epoch: u64,
 }
 
 /// A mechanical body: a 3-G-map whose sew/unsew keep the [`Mechanics`] attributes lawful.
@@ -566,6 +570,7 @@ impl Mechanics {
     /// assert_eq!(body.attrs().position().len(), 8);
     /// ```
     pub fn position_mut(&mut self) -> CellSliceMut<'_, Vec3> {
+        self.position_epoch = crate::embedding::next_identity();
         CellSliceMut::new(&mut self.position)
     }
 
@@ -1475,6 +1480,7 @@ impl Mechanics {
             pinned: CellArray::from_vec(Vec::new()),
             pins_epoch: 0,
             velocity_epoch: 0,
+            position_epoch: 0,
         }
     }
 

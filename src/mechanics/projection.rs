@@ -224,7 +224,7 @@ impl Projection {
     /// assert!(p.is_current(&body));
     /// ```
     pub fn is_current(&self, body: &Body) -> bool {
-        self.is_for(body) && self.version == body.version() && self.pins_epoch == body.attrs().pins_epoch
+        self.is_for(body) && self.version == body.version() && self.pins_current(body)
     }
 
     /// Whether the fixed slots were read at the body's current pin epoch. O(1).

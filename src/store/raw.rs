@@ -421,6 +421,7 @@ impl RawMechanics {
             pinned: CellArray::from_vec(vs.iter().map(|v| v.pinned).collect()),
             pins_epoch: 0,
             velocity_epoch: 0,
+            position_epoch: 0,
         }
     }
 

@@ -102,7 +102,9 @@ pub fn measure_cut(
         let pts: Vec<[f64; 3]> = ids.iter().map(|&v| mech.position[v]).collect();
         let c = [0, 1, 2].map(|k| pts.iter().map(|p| p[k]).sum::<f64>() / pts.len() as f64);
         if let Some((centre, r)) = zone {
-            if (0..3).map(|k| (c[k] - centre[k]).powi(2)).sum::<f64>() > r * r {
+            // Scaled distance: (Σ dₖ²) and r² overflow to ∞ ≤ ∞ for far zones (finding 80).
+            let inside = crate::mesh::distance(c, centre) <= r; // false for a NaN distance
+            if !inside {
                 continue;
             }
         }

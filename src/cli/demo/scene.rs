@@ -17,7 +17,7 @@
 use std::time::Instant;
 
 use indicatif::ProgressBar;
-use topomech::cut::{self, Plane};
+use topomech::cut::{self, CutError, Plane};
 use topomech::mechanics::{Body, Integrator, Material, PinSpec, Simulation, StepConfig, TouchedCells, Vec3};
 use topomech::{AlphaMask, CellId, DartId};
 
@@ -223,7 +223,7 @@ impl Scene {
         normal[a] = 1.0;
         let plane = Plane { point, normal };
         let t = Instant::now();
-        let faces = self.incision_faces(&plane, a, up);
+        let faces = self.incision_faces(&plane, a, up).map_err(|source| DemoError::Cut { stage, source })?;
         let mut touched = TouchedCells::default();
         for d in faces {
             let map = self.body.map();
@@ -245,7 +245,7 @@ impl Scene {
 
     /// The inner faces across `plane` (tet centroids on opposite sides, as `incise_plane`) whose
     /// centroid is above the cut depth. O(darts).
-    fn incision_faces(&self, plane: &Plane, a: usize, up: usize) -> Vec<DartId> {
+    fn incision_faces(&self, plane: &Plane, a: usize, up: usize) -> Result<Vec<DartId>, CutError> {
         let (map, x) = (self.body.map(), self.body.attrs().position());
         let near = 0.1 * self.config.extent();
         let (mut top, mut bottom) = (f64::NEG_INFINITY, f64::INFINITY);
@@ -257,8 +257,9 @@ impl Scene {
             }
         }
         let depth = top - INCISION_DEPTH * (top - bottom);
-        let side = cut::tet_sides(&self.body, plane);
-        map.one_dart_per_cell(2)
+        let side = cut::tet_sides(&self.body, plane)?;
+        Ok(map
+            .one_dart_per_cell(2)
             .into_iter()
             .filter(|&d| {
                 let other = map.alpha::<3>(d);
@@ -266,7 +267,7 @@ impl Scene {
                     && side[map.cell_id(3, d).index()] != side[map.cell_id(3, other).index()]
                     && self.face_centroid(d)[up] >= depth
             })
-            .collect()
+            .collect())
     }
 
     /// Mean current position of the vertices of the face of `d`. O(face).
@@ -333,8 +334,8 @@ impl Scene {
         })
     }
 
-    /// Volume ids whose centroid (current positions) is within `r` of `c`, with the squared
-    /// distance, by id. O(darts).
+    /// Volume ids whose centroid (current positions) is within `r` of `c`, with the distance, by
+    /// id. O(darts).
     fn tets_in_ball(&self, c: Vec3, r: f64) -> Vec<(CellId, f64)> {
         let (map, x) = (self.body.map(), self.body.attrs().position());
         let mut out = Vec::new();
@@ -343,9 +344,9 @@ impl Scene {
             ids.sort_unstable();
             ids.dedup();
             let g = centroid(ids.iter().map(|&v| x[v]));
-            let d2 = (0..3).map(|k| (g[k] - c[k]).powi(2)).sum::<f64>();
-            if d2 <= r * r {
-                out.push((map.cell_id(3, d), d2));
+            let dist = topomech::mesh::distance(g, c);
+            if dist <= r {
+                out.push((map.cell_id(3, d), dist));
             }
         }
         out.sort_unstable_by_key(|&(id, _)| id);

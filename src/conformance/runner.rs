@@ -649,14 +649,9 @@ impl Runner {
     }
 }
 
-/// |v|, without overflow or underflow in the squares: the largest |component| is divided out
-/// first. 0 for the zero vector; ∞ or NaN when a component is. O(1).
+/// |v|, scale-safe ([`crate::mesh::distance`] from the origin). O(1).
 fn norm(v: Vec3) -> f64 {
-    let scale = v.iter().fold(0.0_f64, |m, c| m.max(c.abs()));
-    if !(scale > 0.0 && scale.is_finite()) {
-        return scale;
-    }
-    scale * v.iter().map(|c| (c / scale) * (c / scale)).sum::<f64>().sqrt()
+    crate::mesh::distance(v, [0.0; 3])
 }
 
 fn pair(a: u32, b: u32) -> [u32; 2] {

@@ -288,6 +288,30 @@ impl TriMeshReport {
     }
 }
 
+/// The mean of `points`, each divided by their count before the sum, so that no partial sum
+/// overflows (Σ p / n stays within the points' range: a sum first is ∞ for coordinates past
+/// `f64::MAX` / n). The origin for none. O(points).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mesh::centroid;
+/// assert_eq!(centroid(&[[0.0; 3], [2.0, 4.0, 6.0]]), [1.0, 2.0, 3.0]);
+/// let huge = f64::MAX / 2.0;
+/// assert_eq!(centroid(&[[huge; 3]; 4]), [huge; 3]); // a sum first would be ∞
+/// assert_eq!(centroid(&[]), [0.0; 3]);
+/// ```
+pub fn centroid(points: &[[f64; 3]]) -> [f64; 3] {
+    let n = points.len() as f64;
+    let mut c = [0.0; 3];
+    for p in points {
+        for k in 0..3 {
+            c[k] += p[k] / n;
+        }
+    }
+    c
+}
+
 /// |a − b|, with the components scaled by the largest before squaring, so that neither
 /// overflows nor underflows (a plain √(Σ dₖ²) is ∞ for a distance of 1e200, and a ball test
 /// Σ dₖ² ≤ r² is then ∞ ≤ ∞: true). NaN when a coordinate is NaN; ∞ only when the distance itself

@@ -123,26 +123,37 @@ fn conjugate_gradient_reaches_its_tolerance_or_fails() {
     }
 }
 
-/// Finding 73: `Simulation::update` and `tear_step` changed the projection (and tore the body)
-/// before the new stepper refused a NaN position, leaving a simulation that could not step
-/// even after the NaN was repaired. Both refuse first now, with nothing changed.
+/// Finding 73 (and 84, round 14): `Simulation::update` and `tear_step` changed the projection
+/// (and tore the body) before the new stepper refused a NaN position elsewhere, or an energy
+/// that overflows with finite positions; the simulation then refused every step ("made for 64
+/// slots, given 66") even after the state was repaired. The update now reads no state: it
+/// follows the topology and the next step refuses the state, with nothing changed, until it is
+/// repaired.
 #[test]
-fn update_and_tear_step_refuse_a_nan_state_before_changing_anything() {
+fn a_bad_state_never_leaves_the_simulation_half_updated() {
+    let unchanged = |body: &Body, x: &[[f64; 3]], v: &[[f64; 3]]| {
+        let same = |a: &[[f64; 3]], b: &[[f64; 3]]| {
+            a.iter().zip(b).all(|(p, q)| (0..3).all(|k| p[k].to_bits() == q[k].to_bits()))
+        };
+        same(body.attrs().position().as_slice(), x) && same(body.attrs().velocity().as_slice(), v)
+    };
+    // A NaN far from the tear: the tear is made and followed, the step refuses the NaN.
     let (points, tets) = kuhn_cube(3);
     let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
     let mut sim = Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Euler, 1e-4)).unwrap();
     body.attrs_mut().position_mut().as_mut_slice()[21][0] += 0.5; // stress vertex 21
     let good = body.attrs().position().as_slice()[63];
     body.attrs_mut().position_mut().as_mut_slice()[63] = [f64::NAN; 3];
-    let (version, cells) = (body.version(), body.map().count_cells().0);
-    let e = tear_step(&mut body, &mut sim, 1.0, 1).unwrap_err();
-    assert!(matches!(e, CutError::Sim(SimError::Step(StepError::BadInput(_)))), "{e}");
-    assert_eq!((body.version(), body.map().count_cells().0), (version, cells));
-    assert!(sim.projection.is_current(&body));
-    body.attrs_mut().position_mut().as_mut_slice()[63] = good; // repaired: everything works
     assert_eq!(tear_step(&mut body, &mut sim, 1.0, 1).unwrap().tears.len(), 1);
+    assert!(sim.projection.is_current(&body));
+    let (x, v) = (body.attrs().position().as_slice().to_vec(), body.attrs().velocity().as_slice().to_vec());
+    let e = sim.step(&mut body).unwrap_err();
+    assert!(matches!(e, SimError::Step(StepError::BadInput(ref s)) if s.contains("slot 63")), "{e}");
+    assert!(unchanged(&body, &x, &v) && sim.stepper.steps_done() == 0);
+    body.attrs_mut().position_mut().as_mut_slice()[63] = good; // repaired: everything works
     sim.step(&mut body).unwrap();
 
+    // The same through `update`.
     let (points, tets) = kuhn_cube(1);
     let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
     let mut sim = Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Euler, 1e-3)).unwrap();
@@ -150,12 +161,90 @@ fn update_and_tear_step_refuse_a_nan_state_before_changing_anything() {
     let cut = dissociate_face(&mut body, d).unwrap();
     let good = body.attrs().position().as_slice()[7];
     body.attrs_mut().position_mut().as_mut_slice()[7] = [f64::NAN; 3];
-    let before = sim.projection.clone();
-    assert!(matches!(sim.update(&mut body, &cut.touched), Err(SimError::Step(StepError::BadInput(_)))));
-    assert!(sim.projection.equivalent(&before).is_ok() && !sim.projection.is_current(&body));
-    body.attrs_mut().position_mut().as_mut_slice()[7] = good;
     sim.update(&mut body, &cut.touched).unwrap();
+    assert!(sim.projection.is_current(&body));
+    let (x, v) = (body.attrs().position().as_slice().to_vec(), body.attrs().velocity().as_slice().to_vec());
+    assert!(matches!(sim.step(&mut body), Err(SimError::Step(StepError::BadInput(_)))));
+    assert!(unchanged(&body, &x, &v));
+    body.attrs_mut().position_mut().as_mut_slice()[7] = good;
     sim.step(&mut body).unwrap();
+
+    // Finite positions whose energy overflows (round 14's reproducer): same.
+    let (points, tets) = kuhn_cube(2);
+    let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    let mut sim = Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Symplectic, 1e-3)).unwrap();
+    let rest = body.attrs().position().as_slice().to_vec();
+    for p in body.attrs_mut().position_mut().as_mut_slice() {
+        *p = p.map(|c| c * 1e160);
+    }
+    let inc = incise_plane(&mut body, &Plane { point: [0.5e160; 3], normal: [1.0, 0.0, 0.0] }).unwrap();
+    sim.update(&mut body, &inc.touched).unwrap();
+    let e = sim.step(&mut body).unwrap_err();
+    assert!(matches!(e, SimError::Step(StepError::BadInput(ref s)) if s.contains("energy scale")), "{e}");
+    let n = body.attrs().position().len();
+    let restored: Vec<[f64; 3]> = (0..n).map(|i| body.attrs().position().as_slice()[i].map(|c| c / 1e160)).collect();
+    body.attrs_mut().position_mut().as_mut_slice().copy_from_slice(&restored);
+    assert!(rest.len() <= n);
+    sim.step(&mut body).unwrap();
+}
+
+/// Finding 88 (round 14): a step refused for a NaN velocity had already zeroed the pinned
+/// vertices' velocities (the pin law applied before the check): the body is unchanged now.
+#[test]
+fn a_refused_step_changes_nothing() {
+    let (points, tets) = kuhn_cube(1);
+    let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    body.attrs_mut().pin_where(|_, p| p[2] == 0.0);
+    let mut sim = Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Euler, 1e-3)).unwrap();
+    body.attrs_mut().velocity_mut().as_mut_slice()[0] = [5.0, 0.0, 0.0]; // vertex 0 is pinned
+    body.attrs_mut().velocity_mut().as_mut_slice()[7] = [f64::NAN, 0.0, 0.0];
+    assert!(matches!(sim.step(&mut body), Err(SimError::Step(StepError::BadInput(_)))));
+    assert_eq!(body.attrs().velocity().as_slice()[0], [5.0, 0.0, 0.0]);
+    body.attrs_mut().velocity_mut().as_mut_slice()[7] = [0.0; 3];
+    sim.step(&mut body).unwrap();
+    assert_eq!(body.attrs().velocity().as_slice()[0], [0.0; 3]); // the pin law, once the step runs
+}
+
+/// Finding 85 (round 14): `tear_vertex` formed face normals without scaling: past 2^256 the
+/// squared length overflowed (every normal 0: the smallest dart won, not the face closest to
+/// ±direction), past 2^512 the normals were NaN and skipped (an empty fan, `Ok`). The fan is
+/// now the same at every scale.
+#[test]
+fn tearing_chooses_the_same_fan_at_every_scale() {
+    let fan_at = |e: i32| {
+        let (points, tets) = kuhn_cube(2);
+        let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+        let s = 2f64.powi(e);
+        for p in body.attrs_mut().position_mut().as_mut_slice() {
+            *p = p.map(|c| c * s);
+        }
+        let tear = tear_vertex(&mut body, CellId(13), [0.3, 0.2, 1.0], None).unwrap();
+        (tear.fan, tear.split)
+    };
+    let reference = fan_at(0);
+    assert!(!reference.0.is_empty() && reference.1);
+    for e in [-1000, -300, 100, 256, 300, 510, 520, 530, 1000] {
+        assert_eq!(fan_at(e), reference, "scale 2^{e}");
+    }
+}
+
+/// Finding 86 (round 14): `measure_cut`'s zone summed the face's points before dividing, so
+/// for coordinates past `f64::MAX` / 3 the centroid was ∞ and every face counted as outside
+/// (`measured` 0, `Ok`); the CLI's ball and the demo's did the same. The centroid divides first.
+#[test]
+fn the_zone_test_holds_for_huge_coordinates() {
+    for s in [1.0, 8e307] {
+        let (points, tets) = kuhn_cube(2);
+        let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+        for p in body.attrs_mut().position_mut().as_mut_slice() {
+            *p = p.map(|c| c * s);
+        }
+        let plane = Plane { point: [s, 0.0, 0.0], normal: [1.0, 0.0, 0.0] };
+        let inc = incise_plane(&mut body, &plane).unwrap();
+        assert_eq!(inc.cut_faces(), 8);
+        let zone = Some(([s; 3], 1.5 * s)); // every face centroid is within √2 s
+        assert_eq!(measure_cut(&body, &inc, &plane, zone).unwrap().measured, 8, "scale {s:e}");
+    }
 }
 
 /// Finding 79: the runaway test was off when the start energy scale was 0 (at rest, no

@@ -5,8 +5,10 @@
 //! `check` exits with 0 when every vector replays, 1 when one mismatches (or breaks a law, or is
 //! refused by [`Vector::check_fields`](topomech::conformance::Vector::check_fields), or its name
 //! is not its file stem), 2 when a file cannot be read or parsed (wrong format or version) or the
-//! directory holds none, and 3 when every vector
-//! passed but the report could not be written (stdout closed or failing, a broken pipe included).
+//! directory holds none, and 3 when every vector passed but the report could not be written
+//! (a write to stdout failed: a pipe whose reader has gone, a full device). A stdout that was
+//! closed before the process started (`>&-`) is not seen: Rust's runtime opens /dev/null in its
+//! place, so the report is discarded and the status is the vectors' own.
 //! A write error does not stop the check: every vector is still replayed, and the status is the
 //! worst vector's when one failed. Report lines show control characters escaped (`\n`, `\u{1b}`),
 //! so no path or message can start a line of its own.

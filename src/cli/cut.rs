@@ -245,9 +245,9 @@ fn tets_in_ball(body: &Body, c: Vec3, r: f64) -> Vec<u32> {
         let mut ids: Vec<CellId> = map.cell_darts(3, d).into_iter().map(|x| map.vertex_id(x)).collect();
         ids.sort_unstable();
         ids.dedup();
-        let n = ids.len() as f64;
-        let g = [0, 1, 2].map(|k| ids.iter().map(|v| rest[*v][k]).sum::<f64>() / n);
-        // Scaled distance: Σ dₖ² and r² overflow to ∞ ≤ ∞ for a far ball (finding 80).
+        let pts: Vec<Vec3> = ids.iter().map(|&v| rest[v]).collect();
+        let g = topomech::mesh::centroid(&pts); // divided first: no overflow for huge coordinates
+                                                // Scaled distance: Σ dₖ² and r² overflow to ∞ ≤ ∞ for a far ball (finding 80).
         if topomech::mesh::distance(g, c) <= r {
             out.push(map.cell_id(3, d).0);
         }

@@ -322,6 +322,15 @@ impl Stepper {
     /// assert!(bad.to_string().starts_with("cannot step this input: start position of slot 0"), "{bad}");
     /// ```
     pub fn new(config: StepConfig, sys: &SpringSystem, x: &[Vec3], v: &[Vec3]) -> Result<Self, StepError> {
+        let mut stepper = Stepper::with_buffers(config, sys)?;
+        stepper.reset_energy_scale(sys, x, v)?;
+        Ok(stepper)
+    }
+
+    /// A stepper for `sys` whose runaway test has no energy scale yet: the caller must take one
+    /// with [`Stepper::reset_energy_scale`] before the first step (the simulation does, at its
+    /// next step). Checks the configuration and the system, not a state. O(slots + springs).
+    pub(crate) fn with_buffers(config: StepConfig, sys: &SpringSystem) -> Result<Self, StepError> {
         if !(config.dt.is_finite() && config.dt > 0.0) {
             return Err(StepError::BadTimeStep(config.dt));
         }
@@ -337,13 +346,12 @@ impl Stepper {
             return Err(StepError::BadParameter { name: "cg_tolerance", value: tol, allowed: "a number in (0, 1)" });
         }
         check_system(sys).map_err(StepError::BadInput)?;
-        let energy_scale = start_energy_scale(sys, x, v)?;
         let (n, s) = (sys.slots(), sys.springs());
         let z = |len| vec![[0.0; 3]; len];
         Ok(Stepper {
             config,
             step: 0,
-            energy_scale,
+            energy_scale: f64::NAN,
             sf: z(s),
             ys: vec![SlotState::default(); n],
             acc: z(n),
@@ -574,6 +582,10 @@ impl Stepper {
         self.check_shape(sys)?;
         check_len(sys, x)?;
         check_len(sys, v)?;
+        if self.energy_scale.is_nan() {
+            // Only a crate-internal `with_buffers` stepper lacks it; never step without the test.
+            return Err(StepError::BadInput("the runaway test has no energy scale yet (reset_energy_scale)".into()));
+        }
         match self.config.integrator {
             Integrator::Euler => self.euler(sys, x, v),
             Integrator::Symplectic => self.symplectic(sys, x, v),
@@ -834,7 +846,7 @@ fn check_system(sys: &SpringSystem) -> Result<(), String> {
 }
 
 /// What makes the start state unsteppable: a non-finite position or velocity. O(slots).
-pub(super) fn check_start(x: &[Vec3], v: &[Vec3]) -> Result<(), String> {
+fn check_start(x: &[Vec3], v: &[Vec3]) -> Result<(), String> {
     for (name, values) in [("position", x), ("velocity", v)] {
         if let Some((i, p)) = values.iter().enumerate().find(|(_, p)| !p.iter().all(|c| c.is_finite())) {
             return Err(format!("start {name} of slot {i} is {p:?} (must be finite)"));
@@ -852,7 +864,8 @@ fn start_energy_scale(sys: &SpringSystem, x: &[Vec3], v: &[Vec3]) -> Result<f64,
     let scale = energy_scale(sys, x, v);
     if !scale.is_finite() {
         return Err(StepError::BadInput(format!(
-            "the start energy (kinetic + elastic + M |g| D) is {scale:e}: the runaway test needs a finite one"
+            "the start energy scale (kinetic + elastic + M |g| D, or Σ ½ k L² when that is 0) is {scale:e}: \
+             the runaway test needs a finite one"
         )));
     }
     Ok(scale)

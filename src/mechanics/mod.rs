@@ -150,6 +150,9 @@ pub struct Simulation {
     /// The body's position epoch (`Mechanics::position_epoch`) at which the energy scale was
     /// last taken.
     position_epoch: u64,
+    /// Whether the stepper's energy scale was taken from the body's state (false after
+    /// [`Simulation::update`], which follows the topology only: the next step takes it).
+    scale_taken: bool,
 }
 
 impl Simulation {
@@ -190,7 +193,7 @@ impl Simulation {
             &mech.position.as_slice()[..slots],
             &mech.velocity.as_slice()[..slots],
         )?;
-        let mut sim = Simulation { projection, stepper, velocity_epoch: 0, position_epoch: 0 };
+        let mut sim = Simulation { projection, stepper, velocity_epoch: 0, position_epoch: 0, scale_taken: true };
         sim.hold_fixed(body);
         sim.record_epochs(body);
         Ok(sim)
@@ -228,15 +231,16 @@ impl Simulation {
         }
         let mech = body.attrs();
         let written = mech.velocity_epoch != self.velocity_epoch || mech.position_epoch != self.position_epoch;
-        if pins_changed || written {
-            self.hold_fixed(body);
+        if pins_changed || written || !self.scale_taken {
             // Energy put in by hand is a new start, not a blow-up (and a body started at rest
-            // would otherwise keep a stale scale). On an error the epochs stay unrecorded, so
-            // the next call checks again.
+            // would otherwise keep a stale scale). Taken before the pinned velocities are
+            // zeroed (it counts free slots only), so that on an error the body is unchanged and
+            // the epochs stay unrecorded: the next call checks again.
             let slots = self.projection.system.slots();
-            let mech = body.attrs();
             let (x, v) = (&mech.position.as_slice()[..slots], &mech.velocity.as_slice()[..slots]);
             self.stepper.reset_energy_scale(&self.projection.system, x, v)?;
+            self.scale_taken = true;
+            self.hold_fixed(body);
             self.record_epochs(body);
         }
         Ok(())
@@ -334,14 +338,16 @@ impl Simulation {
     }
 
     /// Follows topological changes incrementally ([`Projection::update`] with `touched`), then
-    /// re-sizes the stepper's buffers (a new [`Stepper`]: the step counter and the energy scale
-    /// of the runaway test restart). The projection part is O(touched cells · degree); the new
-    /// stepper costs O(slots + springs) (its buffers and energy scale) until `Stepper` can grow
-    /// its buffers in place.
+    /// re-sizes the stepper's buffers (a new [`Stepper`]: the step counter restarts, and the
+    /// energy scale of the runaway test is taken from the state at the next step, which refuses
+    /// a NaN or infinite state or energy scale with nothing changed). It reads the topology,
+    /// masses and pins, never the positions or velocities, so no state can make it fail halfway.
+    /// The projection part is O(touched cells · degree); the new stepper costs O(slots + springs)
+    /// (its buffers) until `Stepper` can grow its buffers in place.
     ///
     /// # Errors
-    /// As [`Simulation::new`]; [`StepError::BadInput`] for a NaN or infinite position or velocity
-    /// of a vertex id, before anything changes (the new stepper could not start from it).
+    /// [`SimError::OtherBody`] if the simulation was built for another body (nothing changes);
+    /// otherwise only a system the stepper cannot take ([`StepError::BadInput`]: a bug).
     ///
     /// # Examples
     ///
@@ -362,16 +368,10 @@ impl Simulation {
     /// ```
     pub fn update(&mut self, body: &mut Body, touched: &TouchedCells) -> Result<(), SimError> {
         self.check_body(body)?;
-        // The new stepper refuses a non-finite state: refused here, before the projection changes.
-        check_state_finite(body)?;
         self.projection.update(body, touched);
-        let config = *self.stepper.config();
-        let slots = self.projection.system.slots();
         self.hold_fixed(body);
-        let mech = body.attrs();
-        let (x, v) = (&mech.position.as_slice()[..slots], &mech.velocity.as_slice()[..slots]);
-        self.stepper = Stepper::new(config, &self.projection.system, x, v)?;
-        self.record_epochs(body);
+        self.stepper = Stepper::with_buffers(*self.stepper.config(), &self.projection.system)?;
+        self.scale_taken = false;
         Ok(())
     }
 
@@ -482,16 +482,6 @@ impl Simulation {
 }
 
 /// The larger of a and b, NaN if either is NaN (unlike [`f64::max`], which drops a NaN). O(1).
-/// [`StepError::BadInput`] naming the first vertex id (live or not: every id is a slot of the
-/// projection) whose position or velocity is NaN or infinite: the state a new stepper starts
-/// from. O(vertex ids).
-pub(crate) fn check_state_finite(body: &Body) -> Result<(), SimError> {
-    let slots = body.map().cell_id_bound(0);
-    let mech = body.attrs();
-    let (x, v) = (&mech.position.as_slice()[..slots], &mech.velocity.as_slice()[..slots]);
-    integrate::check_start(x, v).map_err(|e| SimError::Step(StepError::BadInput(e)))
-}
-
 fn nan_max(a: f64, b: f64) -> f64 {
     if a.is_nan() || b.is_nan() {
         f64::NAN

@@ -100,7 +100,7 @@ pub fn measure_cut(
         ids.sort_unstable();
         ids.dedup();
         let pts: Vec<[f64; 3]> = ids.iter().map(|&v| mech.position[v]).collect();
-        let c = [0, 1, 2].map(|k| pts.iter().map(|p| p[k]).sum::<f64>() / pts.len() as f64);
+        let c = crate::mesh::centroid(&pts); // divided first: no overflow for huge coordinates
         if let Some((centre, r)) = zone {
             // Scaled distance: (Σ dₖ²) and r² overflow to ∞ ≤ ∞ for far zones (finding 80).
             let inside = crate::mesh::distance(c, centre) <= r; // false for a NaN distance

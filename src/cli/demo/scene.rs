@@ -354,17 +354,7 @@ impl Scene {
     }
 }
 
-/// The mean of `points` (the origin for none). O(points).
+/// The mean of `points` (the origin for none; [`topomech::mesh::centroid`]). O(points).
 pub fn centroid(points: impl Iterator<Item = Vec3>) -> Vec3 {
-    let (mut sum, mut n) = ([0.0; 3], 0usize);
-    for p in points {
-        for k in 0..3 {
-            sum[k] += p[k];
-        }
-        n += 1;
-    }
-    if n == 0 {
-        return sum;
-    }
-    sum.map(|s| s / n as f64)
+    topomech::mesh::centroid(&points.collect::<Vec<_>>())
 }

@@ -87,6 +87,11 @@ fn an_expected_float_that_is_not_finite_is_refused_naming_its_step_and_field() {
                 assert!(matches!(err, ConformanceError::NotFinite { .. }), "{step:?} {field} {bad}: {err}");
                 assert_eq!((err.step(), err.field()), (step, Some(field)), "{err}");
                 assert!(err.to_string().contains(field) && err.to_string().contains("not finite"), "{err}");
+                if field == "component_masses" {
+                    // The message names the element: the last component mass.
+                    let last = e_len(&v, step) - 1;
+                    assert!(err.to_string().contains(&format!("component_masses[{last}]")), "{err}");
+                }
             }
         }
     }
@@ -96,6 +101,14 @@ fn an_expected_float_that_is_not_finite_is_refused_naming_its_step_and_field() {
     v.initial.total_stiffness = f64::NEG_INFINITY;
     v.initial.component_masses = vec![f64::INFINITY];
     assert!(replay_in(&v, root()).is_err());
+}
+
+/// The number of component masses expected at `step` (`None`: the initial state).
+fn e_len(v: &topomech::conformance::Vector, step: Option<usize>) -> usize {
+    match step {
+        None => v.initial.component_masses.len(),
+        Some(k) => v.steps[k].expect.component_masses.len(),
+    }
 }
 
 /// The tolerance lies in 0 ..= MAX_TOLERANCE: inside, a vector replays; outside (a tolerance of 1

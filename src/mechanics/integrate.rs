@@ -1089,6 +1089,23 @@ mod tests {
     use super::*;
     use crate::mechanics::SystemError;
 
+    /// The energy scale is exactly kinetic + elastic + M |g| D, and Σ ½ k L² when that is 0.
+    #[test]
+    fn energy_scale_is_its_documented_sum() {
+        let mut sys = SpringSystem::default();
+        sys.set_gravity([0.0, 0.0, -10.0]).unwrap();
+        sys.push_slot(1.0, false, 0.0).unwrap();
+        sys.push_slot(3.0, false, 0.0).unwrap();
+        sys.push_spring([0, 1], 5.0, 10.0, 0.0).unwrap(); // at its rest length below: no elastic energy
+        let x = vec![[0.0; 3], [3.0, 4.0, 0.0]]; // D = 5
+        let v = vec![[1.0, 0.0, 0.0], [0.0; 3]]; // kinetic ½
+        assert_eq!(energy_scale(&sys, &x, &v), 0.5 + 4.0 * 10.0 * 5.0);
+        sys.set_gravity([0.0; 3]).unwrap();
+        assert_eq!(energy_scale(&sys, &x, &[[0.0; 3]; 2]), 0.5 * 10.0 * 25.0); // Σ ½ k L²
+        let stretched = vec![[0.0; 3], [9.0, 12.0, 0.0]]; // l = 15: ½ k (l − L)² = 500
+        assert_eq!(energy_scale(&sys, &stretched, &[[0.0; 3]; 2]), 500.0);
+    }
+
     /// A chain of `n` unit masses on springs, the first pinned, hanging under gravity.
     fn chain(n: usize) -> (SpringSystem, Vec<Vec3>, Vec<Vec3>) {
         let mut sys = SpringSystem::default();

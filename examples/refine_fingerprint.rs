@@ -12,6 +12,7 @@
 use std::hash::{DefaultHasher, Hash, Hasher};
 
 use topomech::generate::{disk_fan, grid_triangles, kuhn_cube, SplitMix64};
+use topomech::mechanics::{Body, Material};
 use topomech::subdivide::{LeveledMap, TetMasses};
 use topomech::{CellId, GMap};
 
@@ -63,8 +64,9 @@ fn run_2d(name: &str, points: Vec<[f64; 3]>, tris: &[[u32; 3]], levels: &[u8], f
 }
 
 fn run_3d(name: &str, points: Vec<[f64; 3]>, tets: &[[u32; 4]], levels: &[u8], full: bool) {
-    let (map, _) = GMap::<3>::from_tets(points.len(), tets).expect("the tets build");
-    let mut m = LeveledMap::new(map, points);
+    // Positions by vertex id (a point whose tets form several fans is several vertices).
+    let (body, _) = Body::from_tets(&points, tets, Material::default()).expect("the tets build");
+    let mut m = LeveledMap::new(body.map().clone(), body.attrs().position().as_slice().to_vec());
     let mut masses = TetMasses::from_density(&m, 1.0).expect("tets");
     let mut text = String::new();
     for &level in levels {

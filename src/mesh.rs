@@ -339,6 +339,119 @@ pub fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
     s * (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt()
 }
 
+/// The larger of `a` and `b`, NaN if either is NaN ([`f64::max`] drops a NaN, so a fold of
+/// magnitudes with it reports a lost state as its other values). For `fold(0.0, nan_max)` over
+/// magnitudes: 0 for none. O(1).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mesh::nan_max;
+/// assert_eq!([3.0, 7.0, 5.0].into_iter().fold(0.0, nan_max), 7.0);
+/// assert!([3.0, f64::NAN, 5.0].into_iter().fold(0.0, nan_max).is_nan()); // f64::max gives 5
+/// ```
+pub fn nan_max(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.max(b)
+    }
+}
+
+/// The midpoint of `a` and `b`, ½(a + b) per coordinate, and ½a + ½b where a + b overflows (both
+/// are the correctly rounded midpoint for normal numbers, so the bits are the same wherever the
+/// first is finite). NaN in, NaN out. O(1).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mesh::midpoint;
+/// assert_eq!(midpoint([0.0, 1.0, -2.0], [2.0, 2.0, 2.0]), [1.0, 1.5, 0.0]);
+/// let big = f64::MAX;
+/// assert_eq!(midpoint([big; 3], [big / 2.0; 3]), [0.75 * big; 3]); // a + b would be ∞
+/// ```
+pub fn midpoint(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [0, 1, 2].map(|k| {
+        let sum = a[k] + b[k];
+        if sum.is_finite() {
+            0.5 * sum
+        } else {
+            0.5 * a[k] + 0.5 * b[k]
+        }
+    })
+}
+
+/// Extents (largest coordinate differences) of 2⁻²⁵⁰ to 2²⁵⁰, exactly: their products up to
+/// the fourth power (a face normal times a difference, squared lengths, volumes) neither
+/// overflow nor underflow, so [`fit_for_products`] leaves them as they are.
+pub(crate) const PLAIN_EXTENT: std::ops::RangeInclusive<f64> = 5.527147875260445e-76..=1.8092513943330656e75;
+
+/// `x` · 2^`e`, exact unless the result over- or underflows (in at most two steps: one power of
+/// two is normal only up to 2^±1022). O(1).
+pub(crate) fn times_pow2(mut x: f64, mut e: i64) -> f64 {
+    while e != 0 {
+        let step = e.clamp(-1022, 1022);
+        x *= f64::from_bits(((1023 + step) as u64) << 52);
+        e -= step;
+    }
+    x
+}
+
+/// The largest coordinate range of `points`, max over k of (max pₖ − min pₖ); ∞ when that
+/// range is past `f64::MAX`. O(points).
+fn coordinate_extent(points: &[[f64; 3]]) -> f64 {
+    (0..3)
+        .map(|k| {
+            let (lo, hi) =
+                points.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| (l.min(p[k]), h.max(p[k])));
+            hi - lo
+        })
+        .fold(0.0, f64::max)
+}
+
+/// e with 2^e ≤ x < 2^(e+1), for a finite x > 0, read from the bits (exact, subnormals
+/// included). O(1).
+fn binary_exponent(x: f64) -> i64 {
+    let biased = ((x.to_bits() >> 52) & 0x7ff) as i64;
+    if biased == 0 {
+        binary_exponent(x * 2f64.powi(64)) - 64 // subnormal: 2^64 x is normal
+    } else {
+        biased - 1023
+    }
+}
+
+/// Prepares finite `points` for products of their differences (volumes, squared lengths,
+/// distances) that neither overflow nor underflow: when their extent is outside
+/// [`PLAIN_EXTENT`], translates them to the first point (which becomes the origin) and scales
+/// them by a power of two so that the extent is in [1, 2) (an extent past `f64::MAX` is
+/// quartered first). Returns k, the points now being (p − p₀) · 2^k: lengths changed by 2^k,
+/// volumes by 2^3k (ratios of volumes and the order of lengths are kept; a length computed on
+/// the fitted points is the true one times 2^k). Inside the range, or for an extent of 0 or
+/// NaN, nothing changes (the same bits as before) and k = 0. The scaling is exact; the
+/// translation rounds each difference once. O(points).
+pub(crate) fn fit_for_products(points: &mut [[f64; 3]]) -> i64 {
+    let extent = coordinate_extent(points);
+    if extent == 0.0 || PLAIN_EXTENT.contains(&extent) || extent.is_nan() || points.is_empty() {
+        return 0;
+    }
+    let (base, quarter) = (points[0], extent.is_infinite());
+    for p in points.iter_mut() {
+        for k in 0..3 {
+            p[k] = if quarter { 0.25 * p[k] - 0.25 * base[k] } else { p[k] - base[k] };
+        }
+    }
+    let quartered = if quarter { -2 } else { 0 };
+    let extent = coordinate_extent(points);
+    if extent == 0.0 || !extent.is_finite() {
+        return quartered;
+    }
+    let k = -binary_exponent(extent);
+    for p in points.iter_mut() {
+        *p = p.map(|c| times_pow2(c, k));
+    }
+    quartered + k
+}
+
 /// Signed volume of the tetrahedron `(a, b, c, d)`: `det[b - a, c - a, d - a] / 6`.
 ///
 /// Positive when `d` lies on the side of the plane `(a, b, c)` towards which
@@ -358,7 +471,14 @@ pub fn signed_volume(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> f64 
     dot(cross(sub(b, a), sub(c, a)), sub(d, a)) / 6.0
 }
 
-/// Area of the triangle `(a, b, c)` (always `>= 0`). O(1).
+/// Area of the triangle `(a, b, c)` (always `>= 0`), `½|(b − a) × (c − a)|`. O(1).
+///
+/// Edge vectors whose components lie between about 2⁻²⁵⁰ and 2²⁵⁰ (every ordinary triangle) are
+/// used as they are. Outside that range they are first scaled by a power of two (exact) to
+/// components in [1, 2), and the area scaled back, so that neither the cross product nor its
+/// square underflows or overflows: legs of 1e-90 give 5e-181, not 0, and legs of 1e80 give
+/// 5e159, not ∞. The result is ∞ only when the area itself is past `f64::MAX` (and 0 only when it
+/// is below the smallest subnormal, or the triangle is flat); NaN when a coordinate is.
 ///
 /// # Examples
 ///
@@ -367,16 +487,66 @@ pub fn signed_volume(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> f64 
 ///
 /// assert_eq!(triangle_area([0.0; 3], [3.0, 0.0, 0.0], [0.0, 4.0, 0.0]), 6.0);
 /// assert_eq!(triangle_area([0.0; 3], [1.0; 3], [2.0; 3]), 0.0); // collinear
+/// assert_eq!(triangle_area([0.0; 3], [1e-90, 0.0, 0.0], [0.0, 1e-90, 0.0]), 0.5 * 1e-90 * 1e-90);
+/// assert_eq!(triangle_area([0.0; 3], [1e80, 0.0, 0.0], [0.0, 1e80, 0.0]), 0.5 * 1e80 * 1e80);
+/// assert_eq!(triangle_area([-f64::MAX, 0.0, 0.0], [f64::MAX, 0.0, 0.0], [0.0, f64::MAX, 0.0]), f64::INFINITY);
 /// ```
 pub fn triangle_area(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
-    0.5 * norm(cross(sub(b, a), sub(c, a)))
+    /// 2^k for k in −1074..=1023, exact.
+    fn pow2(k: i64) -> f64 {
+        if k >= -1022 {
+            f64::from_bits(((k + 1023) as u64) << 52)
+        } else {
+            f64::from_bits(1u64 << (k + 1074))
+        }
+    }
+    /// x · 2^k in steps that each stay in the range of `pow2`.
+    fn times_pow2(mut x: f64, mut k: i64) -> f64 {
+        while k != 0 {
+            let step = k.clamp(-1000, 1000);
+            x *= pow2(step);
+            k -= step;
+        }
+        x
+    }
+    fn largest(u: [f64; 3], v: [f64; 3]) -> f64 {
+        u.iter().chain(&v).fold(0.0_f64, |m, x| m.max(x.abs()))
+    }
+    let (u, v) = (sub(b, a), sub(c, a));
+    let plain = 0.5 * norm(cross(u, v));
+    let m = largest(u, v);
+    if m == 0.0 || PLAIN_EXTENT.contains(&m) || [a, b, c].iter().flatten().any(|x| x.is_nan()) {
+        return plain;
+    }
+    // A difference past f64::MAX: the corners are quartered first (the area by 1/16).
+    let (u, v, quartered) = if m.is_finite() {
+        (u, v, 0)
+    } else {
+        let quarter = |p: [f64; 3]| [0, 1, 2].map(|k| 0.25 * p[k] - 0.25 * a[k]);
+        (quarter(b), quarter(c), 4)
+    };
+    let m = largest(u, v);
+    if !m.is_finite() {
+        return plain;
+    }
+    let e = m.log2().floor() as i64;
+    let scaled = |w: [f64; 3]| w.map(|x| times_pow2(x, -e));
+    let area = 0.5 * norm(cross(scaled(u), scaled(v)));
+    times_pow2(area, 2 * e + quartered)
 }
 
+/// The longest distance between two of `corners`: `|p − q|` as it is when the components of
+/// `p − q` lie between about 2⁻²⁵⁰ and 2²⁵⁰ (every ordinary cell, bit for bit), the scale-safe
+/// [`distance`] outside that range (a plain square root of the sum of squares is ∞ for edges of
+/// 1e155, and loses the digits of edges below 1e-154). O(corners²).
 fn longest_edge(corners: &[[f64; 3]]) -> f64 {
     let mut longest = 0.0_f64;
     for (i, &p) in corners.iter().enumerate() {
         for &q in &corners[i + 1..] {
-            longest = longest.max(norm(sub(p, q)));
+            let d = sub(p, q);
+            let m = d.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+            let length = if m == 0.0 || PLAIN_EXTENT.contains(&m) { norm(d) } else { distance(p, q) };
+            longest = longest.max(length);
         }
     }
     longest
@@ -898,7 +1068,9 @@ impl TetMesh {
 impl TriMesh {
     /// Checks the mesh: `Err` for a defect that makes it unusable, otherwise the list of
     /// warnings (zero-area triangles, unreferenced points). See the table in the
-    /// [module docs](self). O(P + T).
+    /// [module docs](self). The zero-area test is scale-invariant at every scale: a well-shaped
+    /// triangle with legs of 1e-90 or 1e155, or corners ±`f64::MAX` apart, is not zero-area.
+    /// O(P + T).
     ///
     /// # Errors
     /// [`MeshError::Empty`], [`MeshError::TooManyPoints`], [`MeshError::NonFiniteCoordinate`],
@@ -926,7 +1098,11 @@ impl TriMesh {
         check_cells(CellKind::Triangle, &self.triangles, n, &[])?;
         let mut report = TriMeshReport::default();
         for (i, t) in self.triangles.iter().enumerate() {
-            let c = t.map(|v| self.points[v as usize]);
+            let mut c = t.map(|v| self.points[v as usize]);
+            // Scale-invariant: a triangle outside the ordinary range of sizes is first brought to
+            // a size of about 1 by a power of two (ordinary triangles are kept bit for bit), so
+            // neither 2A nor l² underflows (legs of 1e-90) or overflows (legs of 1e155: ∞ ≤ ∞).
+            fit_for_products(&mut c);
             let two_a = 2.0 * triangle_area(c[0], c[1], c[2]);
             if two_a <= DEGENERACY_TOLERANCE * longest_edge(&c).powi(2) {
                 report.zero_area_triangles.push(i);
@@ -936,7 +1112,12 @@ impl TriMesh {
         Ok(report)
     }
 
-    /// Sum of the triangle areas. O(T).
+    /// Sum of the triangle areas ([`triangle_area`], safe from under- and overflow when the
+    /// area is representable). O(T).
+    ///
+    /// ∞ when a triangle's area, or the sum, is past `f64::MAX` (corners ±`f64::MAX` apart, say:
+    /// [`TriMesh::check`] still finds such a triangle well shaped, not zero-area); NaN for a NaN
+    /// coordinate.
     ///
     /// # Errors
     /// [`MeshError::IndexOutOfRange`] naming the first corner past the points.
@@ -1043,6 +1224,42 @@ fn morton_code(p: [f64; 3], lo: [f64; 3], hi: [f64; 3]) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `nan_max` is the maximum, except that a NaN on either side wins; a fold from 0 over
+    /// nothing is 0 (closes a survivor of the thirty-second mutation sample).
+    #[test]
+    fn nan_max_keeps_a_nan_and_is_the_maximum_otherwise() {
+        assert_eq!((nan_max(1.0, 2.5), nan_max(2.5, 1.0), nan_max(-3.0, 0.0)), (2.5, 2.5, 0.0));
+        assert!(nan_max(f64::NAN, 1.0).is_nan() && nan_max(1.0, f64::NAN).is_nan());
+        assert_eq!([3.0, 7.0, 5.0].into_iter().fold(0.0, nan_max), 7.0);
+        assert!([3.0, f64::NAN, 5.0].into_iter().fold(0.0, nan_max).is_nan());
+        assert_eq!(std::iter::empty::<f64>().fold(0.0, nan_max), 0.0);
+    }
+
+    /// `fit_for_products` keeps ordinary points bit for bit, and brings huge, tiny and
+    /// past-`f64::MAX` extents to about 1 keeping the ratio of volumes.
+    #[test]
+    fn fitting_keeps_plain_points_and_volume_ratios() {
+        let unit = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, 0.5]];
+        let mut same = unit;
+        fit_for_products(&mut same);
+        assert_eq!(same, unit);
+        let ratio = |p: &[[f64; 3]]| signed_volume(p[0], p[1], p[2], p[4]) / signed_volume(p[0], p[1], p[2], p[3]);
+        for (scale, shift) in
+            [(1e110, 0.0), (1e-200, 0.0), (1e-200, 3e-200), (2f64.powi(1000), -(2f64.powi(1020))), (2e-310, 0.0)]
+        {
+            let mut p = unit.map(|q| q.map(|c| c * scale + shift));
+            fit_for_products(&mut p);
+            let extent = coordinate_extent(&p);
+            assert!((1.0..2.0).contains(&extent), "{scale} {shift}: extent {extent}");
+            assert!((ratio(&p) - 0.5).abs() < 1e-12, "{scale} {shift}: {}", ratio(&p));
+        }
+        let mut wide = [[-f64::MAX, 0.0, 0.0], [f64::MAX, 0.0, 0.0], [0.0, 1e300, 0.0], [0.0, 0.0, 1e300]];
+        fit_for_products(&mut wide);
+        assert!(wide.iter().flatten().all(|c| c.is_finite()) && coordinate_extent(&wide) < 2.0);
+        assert!(signed_volume(wide[0], wide[1], wide[2], wide[3]) > 0.0);
+        assert_eq!(midpoint([f64::MAX; 3], [-f64::MAX; 3]), [0.0; 3]);
+    }
 
     fn unit_tet() -> TetMesh {
         TetMesh {

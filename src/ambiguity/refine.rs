@@ -94,7 +94,7 @@ impl RefinedModel {
         if self.positions.len() <= m as usize {
             self.positions.resize(m as usize + 1, [0.0; 3]);
         }
-        self.positions[m as usize] = [0, 1, 2].map(|k| 0.5 * (a[k] + b[k]));
+        self.positions[m as usize] = crate::mesh::midpoint(a, b);
         self.midpoint.insert(key, m);
         m
     }

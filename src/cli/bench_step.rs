@@ -52,7 +52,8 @@ pub struct OrderBenchArgs {
     /// Steps per batch.
     #[arg(long, default_value_t = 3, allow_negative_numbers = true)]
     pub batch: usize,
-    /// Print one JSON object (the keys of [`OrderJson`]).
+    /// Print one JSON object: zorder_step_us, rcm_step_us, rcm_2_threads_step_us,
+    /// rcm_over_zorder, speedup_2_threads, rcm_ns_per_spring, springs, vertices, kernel.
     #[arg(long)]
     pub json: bool,
 }

@@ -284,7 +284,8 @@ fn finish(
         )?;
         writeln!(out, "boundary faces {} -> {}", bc.boundary_faces, ac.boundary_faces)?;
         writeln!(out, "components     {} -> {}", bc.components, ac.components)?;
-        writeln!(out, "total mass     {} -> {} (removed {})", b.total_mass, a.total_mass, a.removed_mass)?;
+        let mass = [b.total_mass, a.total_mass, a.removed_mass].map(super::number);
+        writeln!(out, "total mass     {} -> {} (removed {})", mass[0], mass[1], mass[2])?;
         writeln!(out, "valid {}  conservation {}", a.valid, a.conservation_ok)?;
     }
     Ok(())

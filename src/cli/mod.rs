@@ -260,14 +260,28 @@ pub(crate) fn named(path: &Path, message: String) -> String {
     }
 }
 
-/// The larger of a and b, NaN if either is NaN ([`f64::max`] drops a NaN, which would report a
-/// lost state as its other values). For `fold(0.0, nan_max)` over magnitudes. O(1).
-pub(crate) fn nan_max(a: f64, b: f64) -> f64 {
-    if a.is_nan() || b.is_nan() {
-        f64::NAN
-    } else {
-        a.max(b)
+/// `x` for a human-readable table: the shortest decimal that reads back as `x` when
+/// 10⁻⁴ ≤ |x| < 10¹⁵ (or x is 0, ±∞ or NaN), else the same digits in exponent form (`{}` alone
+/// writes 10³⁰⁰ with 301 digits). O(1).
+pub(crate) fn number(x: f64) -> String {
+    match plain(x) {
+        true => format!("{x}"),
+        false => format!("{x:e}"),
     }
+}
+
+/// `x` rounded to `places` decimals for a human-readable table, in exponent form with `places`
+/// decimals outside 10⁻⁴ ≤ |x| < 10¹⁵ (as [`number`]). O(1).
+pub(crate) fn rounded(x: f64, places: usize) -> String {
+    match plain(x) {
+        true => format!("{x:.places$}"),
+        false => format!("{x:.places$e}"),
+    }
+}
+
+/// Whether `x` reads well as a plain decimal: 0, ±∞, NaN, or 10⁻⁴ ≤ |x| < 10¹⁵. O(1).
+fn plain(x: f64) -> bool {
+    x == 0.0 || !x.is_finite() || (1e-4..1e15).contains(&x.abs())
 }
 
 /// One number of a command-line value: NaN and ±∞ are refused with the value named (they
@@ -298,16 +312,27 @@ pub fn print_warnings(loaded: &Loaded) {
 
 #[cfg(test)]
 mod tests {
-    use super::nan_max;
+    use super::{number, rounded};
 
-    /// `nan_max` is the maximum, except that a NaN on either side wins; a fold from 0 over
-    /// nothing is 0 (closes a survivor of the thirty-second mutation sample).
+    /// Table numbers: plain decimals in the everyday range, exponent form outside it, and each
+    /// reads back as the same f64.
     #[test]
-    fn nan_max_keeps_a_nan_and_is_the_maximum_otherwise() {
-        assert_eq!((nan_max(1.0, 2.5), nan_max(2.5, 1.0), nan_max(-3.0, 0.0)), (2.5, 2.5, 0.0));
-        assert!(nan_max(f64::NAN, 1.0).is_nan() && nan_max(1.0, f64::NAN).is_nan());
-        assert_eq!([3.0, 7.0, 5.0].into_iter().fold(0.0, nan_max), 7.0);
-        assert!([3.0, f64::NAN, 5.0].into_iter().fold(0.0, nan_max).is_nan());
-        assert_eq!(std::iter::empty::<f64>().fold(0.0, nan_max), 0.0);
+    fn numbers_are_short_and_read_back_exactly() {
+        assert_eq!((number(0.0), number(2.5), number(-1234.5)), ("0".into(), "2.5".into(), "-1234.5".into()));
+        assert_eq!((number(1e300), number(-1e-7), number(1e15)), ("1e300".into(), "-1e-7".into(), "1e15".into()));
+        assert_eq!((number(1e-4), number(999999999999999.0)), ("0.0001".into(), "999999999999999".into()));
+        assert_eq!((number(f64::NAN), number(f64::INFINITY)), ("NaN".into(), "inf".into()));
+        for x in [1.0 / 3.0, 7.25e18, 3.0e-300, f64::MAX, f64::MIN_POSITIVE, 5e-324] {
+            assert_eq!(number(x).parse::<f64>().unwrap(), x);
+            assert!(number(x).len() <= 24, "{x}: {}", number(x));
+        }
+    }
+
+    /// Rounded numbers keep their decimals in range and switch to exponent form outside it.
+    #[test]
+    fn rounded_numbers_switch_to_exponent_form_outside_the_plain_range() {
+        assert_eq!((rounded(0.0123456789, 6), rounded(2.0, 3)), ("0.012346".into(), "2.000".into()));
+        assert_eq!((rounded(1e300, 6), rounded(1.5e-9, 2)), ("1.000000e300".into(), "1.50e-9".into()));
+        assert_eq!(rounded(f64::NAN, 6), "NaN");
     }
 }

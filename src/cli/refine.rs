@@ -59,7 +59,9 @@ pub struct RefineArgs {
     /// directory.
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Print one JSON object (keys of [`RefineJson`]).
+    /// Print one JSON object: volumes, darts, tets_per_level, subdivided_per_level, valid,
+    /// mu_order_ok, levels_valid, total_mass_before, total_mass_after, total_vertex_mass_after,
+    /// refine_ms, and the keys of --conforming, --cut and --springs.
     #[arg(long)]
     pub json: bool,
 }
@@ -355,8 +357,10 @@ fn write_table(out: &mut dyn Write, r: &RefineJson) -> std::io::Result<()> {
     let residual = (r.total_mass_after - r.total_mass_before) / r.total_mass_before.abs().max(f64::MIN_POSITIVE);
     writeln!(
         out,
-        "  {:<26}{:.9} -> {:.9} (relative {residual:.1e})",
-        "total mass", r.total_mass_before, r.total_mass_after
+        "  {:<26}{} -> {} (relative {residual:.1e})",
+        "total mass",
+        super::number(r.total_mass_before),
+        super::number(r.total_mass_after)
     )?;
     writeln!(out, "  {:<26}{:.3} ms", "refine time", r.refine_ms)?;
     if let (Some(b), Some(a)) = (r.springs_before, r.springs_after) {
@@ -369,7 +373,7 @@ fn write_table(out: &mut dyn Write, r: &RefineJson) -> std::io::Result<()> {
     if let (Some(fb), Some(fa)) = (r.cut_faces_before, r.cut_faces_after) {
         let (zb, za) = (r.cut_zone_faces_before.unwrap_or(0), r.cut_zone_faces_after.unwrap_or(0));
         writeln!(out, "  {:<26}{fb} -> {fa} (in the zone {zb} -> {za})", "cut faces")?;
-        let f = |x: Option<f64>| x.map_or("none".to_string(), |v| format!("{v:.6}"));
+        let f = |x: Option<f64>| x.map_or("none".to_string(), |v| super::rounded(v, 6));
         writeln!(
             out,
             "  {:<26}max {} -> {}, mean {} -> {}",

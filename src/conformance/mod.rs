@@ -281,7 +281,8 @@ impl ConformanceError {
 
 impl Vector {
     /// Parses a vector; `origin` names the text in errors. The envelope (`format`, `version`) is
-    /// checked before the rest, so a file of another format or version says so. O(text).
+    /// checked before the rest, so a file of another format or version says so. A key given twice
+    /// in one object, at any depth, is refused (JSON leaves its meaning open). O(text).
     ///
     /// # Errors
     /// [`ConformanceError::Json`], [`ConformanceError::Format`], [`ConformanceError::Version`].
@@ -302,7 +303,9 @@ impl Vector {
         if version.as_u64() != Some(u64::from(VERSION)) {
             return Err(ConformanceError::Version { origin: origin.to_string(), found: version.to_string() });
         }
-        let v: Vector = serde_json::from_value(value).map_err(json)?;
+        // Decoded again from the text, not from `value` (whose maps keep the last of two equal
+        // keys): a key given twice, at any depth, is refused.
+        let v: Vector = serde_json::from_str(text).map_err(json)?;
         v.check_fields_from(origin)?;
         Ok(v)
     }

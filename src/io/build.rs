@@ -2,11 +2,9 @@
 //! types, and the per-record checks that can name a line (duplicate tags, non-finite
 //! coordinates, repeated vertices, undefined node tags).
 
-use std::path::Path;
-
 use std::collections::hash_map::Entry;
-
-use rustc_hash::FxHashMap;
+use std::collections::HashMap;
+use std::path::Path;
 
 use super::{Location, ReadError};
 use crate::mesh::{TetMesh, TriMesh};
@@ -18,8 +16,20 @@ pub(crate) enum ElementUse {
     Tet,
     /// A linear triangle: kept as a boundary triangle.
     Triangle,
-    /// A point, line or surface element other than a linear triangle: ignored.
+    /// A point, line or surface element other than a linear triangle (or, in a surface read,
+    /// any volume element): ignored, once its node tags are found defined.
     Skip,
+}
+
+/// What a read makes: the volume mesh ([`TetMesh`]: tetrahedra, other volume elements are an
+/// error) or the surface ([`TriMesh`]: triangles; volume elements of every type are skipped).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub(crate) enum Target {
+    /// A tet mesh.
+    #[default]
+    Volume,
+    /// A triangle mesh.
+    Surface,
 }
 
 /// A known Gmsh element type.
@@ -66,20 +76,22 @@ const GMSH_TYPES: [(i64, u8, usize, &str); 31] = [
     (31, 3, 56, "56-node fifth-order tetrahedron"),
 ];
 
-/// Classifies Gmsh element type `t` found at `at`.
+/// Classifies Gmsh element type `t` found at `at` for a read of `target`.
 ///
 /// # Errors
 /// [`ReadError::UnknownElementType`] for a type outside 1..=31;
-/// [`ReadError::UnsupportedElementType`] for a volume element other than the 4-node
-/// tetrahedron (dropping it would silently leave a hole in the volume).
-pub(crate) fn gmsh_element_kind(path: &Path, at: Location, t: i64) -> Result<ElementKind, ReadError> {
+/// [`ReadError::UnsupportedElementType`], in a volume read, for a volume element other than the
+/// 4-node tetrahedron (dropping it would silently leave a hole in the volume). A surface read
+/// skips every volume element.
+pub(crate) fn gmsh_element_kind(path: &Path, at: Location, t: i64, target: Target) -> Result<ElementKind, ReadError> {
     let Some(&(_, dim, nodes, name)) = GMSH_TYPES.iter().find(|e| e.0 == t) else {
         return Err(ReadError::UnknownElementType { path: path.to_path_buf(), at, element_type: t });
     };
-    let usage = match (t, dim) {
-        (4, _) => ElementUse::Tet,
-        (2, _) => ElementUse::Triangle,
-        (_, 3) => {
+    let usage = match (t, dim, target) {
+        (_, 3, Target::Surface) => ElementUse::Skip,
+        (4, _, _) => ElementUse::Tet,
+        (2, _, _) => ElementUse::Triangle,
+        (_, 3, _) => {
             return Err(ReadError::UnsupportedElementType { path: path.to_path_buf(), at, element_type: t, name })
         }
         _ => ElementUse::Skip,
@@ -87,20 +99,109 @@ pub(crate) fn gmsh_element_kind(path: &Path, at: Location, t: i64) -> Result<Ele
     Ok(ElementKind { nodes, usage })
 }
 
+/// No point: an empty slot of [`TagIndex::dense`] (point indices are below `u32::MAX`).
+const NO_POINT: u32 = u32::MAX;
+
+/// Node tag → point index. Tags below a bound proportional to the number of nodes (Gmsh and
+/// TetGen number their nodes 1..n or 0..n−1, sometimes with gaps) are looked up in a vector
+/// indexed by the tag; the first tag past the bound moves every entry to a hash table with
+/// std's randomly keyed SipHash. A file cannot choose tags that collide in it (FxHash, which
+/// this replaced, is invertible: tags `(C + i)·K⁻¹` all fell in one bucket and made every
+/// reader quadratic). Either way a lookup is O(1) expected, and the vector holds at most
+/// `4·max(n, reserved) + 1024` entries.
+#[derive(Debug, Default)]
+struct TagIndex {
+    /// `dense[tag]`: the point index of `tag`, or [`NO_POINT`]; empty once `hashed` is used.
+    dense: Vec<u32>,
+    /// All entries, once a tag was too large for `dense`.
+    hashed: Option<HashMap<u64, u32>>,
+    /// Points reserved by the reader (bounded by the file size).
+    reserved: usize,
+}
+
+impl TagIndex {
+    /// The largest number of `dense` slots for `points` points read so far.
+    fn dense_limit(&self, points: usize) -> usize {
+        self.reserved.max(points.saturating_add(1)).saturating_mul(4).saturating_add(1024)
+    }
+
+    fn reserve(&mut self, total: usize) {
+        self.reserved = self.reserved.max(total);
+        if let Some(map) = &mut self.hashed {
+            map.reserve(total.saturating_sub(map.len()));
+        }
+    }
+
+    fn get(&self, tag: u64) -> Option<u32> {
+        match &self.hashed {
+            Some(map) => map.get(&tag).copied(),
+            None => usize::try_from(tag).ok().and_then(|t| self.dense.get(t)).copied().filter(|&i| i != NO_POINT),
+        }
+    }
+
+    /// Records `tag → i` (the `points`-th point); false when `tag` is already there.
+    fn insert(&mut self, tag: u64, i: u32, points: usize) -> bool {
+        if self.hashed.is_none() {
+            match usize::try_from(tag) {
+                Ok(t) if t < self.dense_limit(points) => {
+                    if t >= self.dense.len() {
+                        self.dense.resize(t + 1, NO_POINT);
+                    }
+                    if self.dense[t] != NO_POINT {
+                        return false;
+                    }
+                    self.dense[t] = i;
+                    return true;
+                }
+                _ => {
+                    let mut map = HashMap::with_capacity(self.reserved.max(points + 1));
+                    let dense = std::mem::take(&mut self.dense);
+                    map.extend(
+                        dense.into_iter().enumerate().filter(|&(_, i)| i != NO_POINT).map(|(t, i)| (t as u64, i)),
+                    );
+                    self.hashed = Some(map);
+                }
+            }
+        }
+        let Some(map) = &mut self.hashed else { return false };
+        match map.entry(tag) {
+            Entry::Occupied(_) => false,
+            Entry::Vacant(slot) => {
+                slot.insert(i);
+                true
+            }
+        }
+    }
+}
+
 /// Collects points (by file tag) and cells, checking each record as it comes.
 #[derive(Debug, Default)]
 pub(crate) struct MeshBuilder {
     points: Vec<[f64; 3]>,
     tags: Vec<u64>,
-    index: FxHashMap<u64, u32>,
+    index: TagIndex,
     tets: Vec<[u32; 4]>,
     triangles: Vec<[u32; 3]>,
+    target: Target,
 }
 
 impl MeshBuilder {
-    /// An empty builder.
+    /// An empty builder for a volume read.
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// An empty builder for a read of `target`.
+    pub fn for_target(target: Target) -> Self {
+        MeshBuilder { target, ..Self::default() }
+    }
+
+    /// Classifies Gmsh element type `t` found at `at` for this read (see [`gmsh_element_kind`]).
+    ///
+    /// # Errors
+    /// `UnknownElementType`, `UnsupportedElementType`.
+    pub fn element_kind(&self, path: &Path, at: Location, t: i64) -> Result<ElementKind, ReadError> {
+        gmsh_element_kind(path, at, t, self.target)
     }
 
     /// Number of points so far.
@@ -112,14 +213,31 @@ impl MeshBuilder {
     pub fn reserve_points(&mut self, n: usize) {
         self.points.reserve(n);
         self.tags.reserve(n);
-        self.index.reserve(n);
+        self.index.reserve(self.points.len().saturating_add(n));
     }
 
-    /// Adds the point with file tag `tag`.
+    /// Adds the point with file tag `tag`, whose record is at `at`.
     ///
     /// # Errors
     /// `DuplicateNode`, `NonFiniteCoordinate`, `TooManyNodes`.
     pub fn add_node(&mut self, path: &Path, at: Location, tag: u64, xyz: [f64; 3]) -> Result<(), ReadError> {
+        self.add_node_split(path, at, at, tag, xyz)
+    }
+
+    /// Adds the point with file tag `tag`, for a format that stores the tag (at `tag_at`) apart
+    /// from the coordinates (at `at`): a duplicate tag is reported at `tag_at`, everything else
+    /// at `at`.
+    ///
+    /// # Errors
+    /// `DuplicateNode`, `NonFiniteCoordinate`, `TooManyNodes`.
+    pub fn add_node_split(
+        &mut self,
+        path: &Path,
+        tag_at: Location,
+        at: Location,
+        tag: u64,
+        xyz: [f64; 3],
+    ) -> Result<(), ReadError> {
         if !xyz.iter().all(|c| c.is_finite()) {
             return Err(ReadError::NonFiniteCoordinate { path: path.to_path_buf(), at, tag, coords: xyz });
         }
@@ -129,11 +247,8 @@ impl MeshBuilder {
         if i == u32::MAX {
             return Err(too_many(path, at));
         }
-        match self.index.entry(tag) {
-            Entry::Occupied(_) => return Err(ReadError::DuplicateNode { path: path.to_path_buf(), at, tag }),
-            Entry::Vacant(slot) => {
-                slot.insert(i);
-            }
+        if !self.index.insert(tag, i, self.points.len()) {
+            return Err(ReadError::DuplicateNode { path: path.to_path_buf(), at: tag_at, tag });
         }
         self.points.push(xyz);
         self.tags.push(tag);
@@ -152,7 +267,7 @@ impl MeshBuilder {
         let mut out = [0u32; N];
         for k in 0..N {
             let tag = tags.get(k).copied().unwrap_or(0);
-            let index = *self.index.get(&tag).ok_or_else(|| ReadError::UndefinedNode {
+            let index = self.index.get(tag).ok_or_else(|| ReadError::UndefinedNode {
                 path: path.to_path_buf(),
                 at,
                 element,
@@ -166,7 +281,8 @@ impl MeshBuilder {
         Ok(out)
     }
 
-    /// Adds element `element` (file tag) with node tags `nodes` according to `usage`.
+    /// Adds element `element` (file tag) with node tags `nodes` according to `usage`. Every
+    /// node tag must be defined, also those of a skipped element.
     ///
     /// # Errors
     /// `UndefinedNode`, `RepeatedVertex` (for tets and triangles only).
@@ -187,7 +303,11 @@ impl MeshBuilder {
                 let t = self.resolve::<3>(path, at, element, nodes)?;
                 self.triangles.push(t);
             }
-            ElementUse::Skip => {}
+            ElementUse::Skip => {
+                if let Some(&tag) = nodes.iter().find(|&&tag| self.index.get(tag).is_none()) {
+                    return Err(ReadError::UndefinedNode { path: path.to_path_buf(), at, element, tag });
+                }
+            }
         }
         Ok(())
     }
@@ -248,19 +368,53 @@ mod tests {
     #[test]
     fn element_kinds() {
         let p = Path::new("x");
-        let tet = gmsh_element_kind(p, at(), 4).unwrap();
+        let tet = gmsh_element_kind(p, at(), 4, Target::Volume).unwrap();
         assert_eq!((tet.nodes, tet.usage), (4, ElementUse::Tet));
-        assert_eq!(gmsh_element_kind(p, at(), 2).unwrap().usage, ElementUse::Triangle);
-        assert_eq!(gmsh_element_kind(p, at(), 15).unwrap().usage, ElementUse::Skip);
-        assert_eq!(gmsh_element_kind(p, at(), 3).unwrap().nodes, 4);
+        assert_eq!(gmsh_element_kind(p, at(), 2, Target::Volume).unwrap().usage, ElementUse::Triangle);
+        assert_eq!(gmsh_element_kind(p, at(), 15, Target::Volume).unwrap().usage, ElementUse::Skip);
+        assert_eq!(gmsh_element_kind(p, at(), 3, Target::Volume).unwrap().nodes, 4);
         for t in [5, 6, 7, 11, 12, 13, 14, 17, 18, 19, 29, 30, 31] {
-            let e = gmsh_element_kind(p, at(), t).unwrap_err();
+            let e = gmsh_element_kind(p, at(), t, Target::Volume).unwrap_err();
             assert!(matches!(e, ReadError::UnsupportedElementType { .. }), "{t}");
         }
         for t in [0, -1, 32, 93, i64::MAX] {
-            let e = gmsh_element_kind(p, at(), t).unwrap_err();
+            let e = gmsh_element_kind(p, at(), t, Target::Volume).unwrap_err();
+            assert!(matches!(e, ReadError::UnknownElementType { .. }), "{t}");
+            let e = gmsh_element_kind(p, at(), t, Target::Surface).unwrap_err();
             assert!(matches!(e, ReadError::UnknownElementType { .. }), "{t}");
         }
+        // A surface read skips every volume element, the linear tetrahedron included.
+        for t in [4, 5, 6, 7, 11, 12, 13, 14, 17, 18, 19, 29, 30, 31] {
+            let kind = gmsh_element_kind(p, at(), t, Target::Surface).unwrap();
+            assert_eq!(kind.usage, ElementUse::Skip, "{t}");
+            assert_eq!(kind.nodes, gmsh_element_kind(p, at(), t, Target::Surface).unwrap().nodes);
+        }
+        assert_eq!(gmsh_element_kind(p, at(), 2, Target::Surface).unwrap().usage, ElementUse::Triangle);
+        assert_eq!(gmsh_element_kind(p, at(), 11, Target::Surface).unwrap().nodes, 10);
+    }
+
+    /// Small tags are indexed densely, a large one moves every entry to the hash table; both
+    /// find every tag and refuse a duplicate.
+    #[test]
+    fn tag_index_is_dense_then_hashed() {
+        let mut index = TagIndex::default();
+        index.reserve(3);
+        for (i, tag) in [7u64, 0, 1030].into_iter().enumerate() {
+            assert!(index.insert(tag, i as u32, i));
+        }
+        assert!(index.hashed.is_none() && index.dense.len() == 1031);
+        assert!(!index.insert(0, 9, 3));
+        assert_eq!(
+            (index.get(7), index.get(0), index.get(1030), index.get(5), index.get(1 << 40)),
+            (Some(0), Some(1), Some(2), None, None)
+        );
+        assert!(index.insert(u64::MAX, 3, 3));
+        assert!(index.hashed.is_some() && index.dense.is_empty());
+        assert!(!index.insert(1030, 4, 4) && !index.insert(u64::MAX, 4, 4));
+        assert_eq!(
+            (index.get(7), index.get(0), index.get(1030), index.get(u64::MAX), index.get(5)),
+            (Some(0), Some(1), Some(2), Some(3), None)
+        );
     }
 
     #[test]
@@ -286,6 +440,8 @@ mod tests {
         let repeated = b.add_element(p, at(), 8, ElementUse::Triangle, &[5, 9, 5]);
         assert!(matches!(repeated, Err(ReadError::RepeatedVertex { element: 8, tag: 5, .. })));
         b.add_element(p, at(), 1, ElementUse::Skip, &[5, 9]).unwrap();
+        let skipped = b.add_element(p, at(), 3, ElementUse::Skip, &[5, 4]);
+        assert!(matches!(skipped, Err(ReadError::UndefinedNode { element: 3, tag: 4, .. })));
         b.add_element(p, at(), 2, ElementUse::Tet, &[70, 2, 9, 5]).unwrap();
         assert_eq!(b.point_count(), 4);
         let m = b.into_tet_mesh(p).unwrap();

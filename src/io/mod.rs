@@ -10,7 +10,9 @@
 //! Only linear tetrahedra (Gmsh type 4) make the volume. Triangles (type 2) are kept in
 //! [`TetMesh::boundary_triangles`] as a cross-check; points, lines and other surface elements
 //! are skipped; other volume elements (hexahedra, prisms, pyramids, higher-order tets) are an
-//! error, because dropping them would leave a hole.
+//! error, because dropping them would leave a hole. A surface read ([`read_tri_mesh`],
+//! [`parse_msh_tri`]) keeps the triangles and skips every other element, volume elements
+//! included. The node tags of a skipped element must be defined all the same.
 
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -26,7 +28,7 @@ mod obj;
 mod scan;
 mod tetgen;
 
-use build::MeshBuilder;
+use build::{MeshBuilder, Target};
 
 /// Where in a file a problem is.
 ///
@@ -324,9 +326,33 @@ fn extension(path: &Path) -> String {
     path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default()
 }
 
+/// The other file of a TetGen pair: `path` with extension `other` (`node` or `ele`), written in
+/// the case of `path`'s extension — `m.NODE` → `m.ELE`, `m.Node` → `m.Ele`, `m.node` → `m.ele`.
+/// When that file does not exist but the lowercase or the uppercase one does, that one. O(1)
+/// file-system queries.
+fn tetgen_sibling(path: &Path, other: &str) -> PathBuf {
+    let given = path.extension().map(|e| e.to_string_lossy().into_owned()).unwrap_or_default();
+    let upper = given.chars().all(|c| !c.is_ascii_lowercase());
+    let capitalised = !upper && given.chars().next().is_some_and(|c| c.is_ascii_uppercase());
+    let styled = if upper {
+        other.to_ascii_uppercase()
+    } else if capitalised {
+        other[..1].to_ascii_uppercase() + &other[1..]
+    } else {
+        other.to_string()
+    };
+    let candidates = [styled, other.to_string(), other.to_ascii_uppercase()];
+    let first = path.with_extension(&candidates[0]);
+    if first.exists() {
+        return first;
+    }
+    candidates[1..].iter().map(|e| path.with_extension(e)).find(|p| p.exists()).unwrap_or(first)
+}
+
 /// Reads a tetrahedral mesh, choosing the reader by extension and header: `.node` or `.ele`
-/// reads the TetGen pair (the other file has the same stem); anything else must be a Gmsh
-/// MSH file (v1, 2.x ASCII, or 4.1 ASCII/binary), recognised by its first line.
+/// (in any case) reads the TetGen pair — the given file, and the other one with the same stem
+/// and its extension in the same case (`m.NODE` pairs with `m.ELE`); anything else must be a
+/// Gmsh MSH file (v1, 2.x ASCII, or 4.1 ASCII/binary), recognised by its first line.
 ///
 /// Cost: O(file size) plus O(T) hashing; the whole file is held in memory.
 ///
@@ -346,7 +372,8 @@ fn extension(path: &Path) -> String {
 /// ```
 pub fn read_mesh(path: &Path) -> Result<TetMesh, ReadError> {
     match extension(path).as_str() {
-        "node" | "ele" => read_tetgen(&path.with_extension("node"), &path.with_extension("ele")),
+        "node" => read_tetgen(path, &tetgen_sibling(path, "ele")),
+        "ele" => read_tetgen(&tetgen_sibling(path, "node"), path),
         "obj" => Err(ReadError::UnknownFormat {
             path: path.to_path_buf(),
             reason: "OBJ holds a surface, not a volume; use read_tri_mesh".into(),
@@ -381,8 +408,9 @@ pub fn read_tetgen(node_path: &Path, ele_path: &Path) -> Result<TetMesh, ReadErr
 }
 
 /// Reads a triangle surface mesh: `.obj` with the OBJ reader, anything else as a Gmsh MSH file
-/// whose triangle elements (type 2) make the surface (tetrahedra, if any, are ignored).
-/// O(file size).
+/// whose triangle elements (type 2) make the surface. Volume elements of every type (linear or
+/// higher-order tetrahedra, hexahedra, ...), like points, lines and other surface elements, are
+/// skipped: only their node tags must be defined. O(file size).
 ///
 /// # Errors
 /// Any [`ReadError`]; [`ReadError::InvalidMesh`] when there is no triangle.
@@ -438,11 +466,11 @@ fn msh_version(bytes: &[u8], path: &Path) -> Result<MshVersion, ReadError> {
     }
 }
 
-fn parse_msh_records(bytes: &[u8], path: &Path) -> Result<MeshBuilder, ReadError> {
+fn parse_msh_records(bytes: &[u8], path: &Path, target: Target) -> Result<MeshBuilder, ReadError> {
     match msh_version(bytes, path)? {
-        MshVersion::V1 => msh1::parse(bytes, path),
-        MshVersion::V2 => msh22::parse(bytes, path),
-        MshVersion::V41 => msh41::parse(bytes, path),
+        MshVersion::V1 => msh1::parse(bytes, path, target),
+        MshVersion::V2 => msh22::parse(bytes, path, target),
+        MshVersion::V41 => msh41::parse(bytes, path, target),
     }
 }
 
@@ -466,14 +494,17 @@ fn parse_msh_records(bytes: &[u8], path: &Path) -> Result<MeshBuilder, ReadError
 /// assert!((mesh.total_volume().unwrap() - 1.0 / 6.0).abs() < 1e-15);
 /// ```
 pub fn parse_msh(bytes: &[u8], path: &Path) -> Result<TetMesh, ReadError> {
-    parse_msh_records(bytes, path)?.into_tet_mesh(path)
+    parse_msh_records(bytes, path, Target::Volume)?.into_tet_mesh(path)
 }
 
 /// Parses the bytes of a Gmsh MSH file into a triangle mesh made of its triangle elements;
-/// `path` is only used in errors. O(bytes).
+/// `path` is only used in errors. Every other element is skipped, volume elements of any type
+/// included (a degenerate or second-order tetrahedron is no error here), once its node tags are
+/// found defined. O(bytes).
 ///
 /// # Errors
-/// Any [`ReadError`] except `Io`; `InvalidMesh` when there is no triangle.
+/// Any [`ReadError`] except `Io` and `UnsupportedElementType`; `InvalidMesh` when there is no
+/// triangle; `UndefinedNode` for a node tag of any element that no node defines.
 ///
 /// # Examples
 ///
@@ -488,7 +519,7 @@ pub fn parse_msh(bytes: &[u8], path: &Path) -> Result<TetMesh, ReadError> {
 /// assert_eq!(mesh.total_area(), Ok(2.0));
 /// ```
 pub fn parse_msh_tri(bytes: &[u8], path: &Path) -> Result<TriMesh, ReadError> {
-    parse_msh_records(bytes, path)?.into_tri_mesh(path)
+    parse_msh_records(bytes, path, Target::Surface)?.into_tri_mesh(path)
 }
 
 /// Parses the bytes of a TetGen `.node` and `.ele` pair; the paths are only used in errors.

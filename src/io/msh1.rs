@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use super::build::MeshBuilder;
+use super::build::{MeshBuilder, Target};
 use super::msh22::{parse_sections, Dialect, ElementRecords};
 use super::scan::Scanner;
 use super::ReadError;
@@ -26,9 +26,9 @@ const MSH1: Dialect = Dialect {
     },
 };
 
-/// Parses an MSH v1 file into a builder.
-pub(crate) fn parse(data: &[u8], path: &Path) -> Result<MeshBuilder, ReadError> {
-    parse_sections(&mut Scanner::new(data, path), &MSH1)
+/// Parses an MSH v1 file into a builder for a read of `target`.
+pub(crate) fn parse(data: &[u8], path: &Path, target: Target) -> Result<MeshBuilder, ReadError> {
+    parse_sections(&mut Scanner::new(data, path), &MSH1, target)
 }
 
 /// The v1 fields between an element's type and its nodes: the physical and elementary regions

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use super::build::{bounded_count, gmsh_element_kind, MeshBuilder};
+use super::build::{bounded_count, MeshBuilder, Target};
 use super::scan::Scanner;
 use super::{shorten, ReadError};
 
@@ -64,18 +64,22 @@ fn tag_list(sc: &mut Scanner<'_>) -> Result<Option<u64>, ReadError> {
     Ok(None)
 }
 
-/// Parses an MSH 2.x ASCII file into a builder.
-pub(crate) fn parse(data: &[u8], path: &Path) -> Result<MeshBuilder, ReadError> {
+/// Parses an MSH 2.x ASCII file into a builder for a read of `target`.
+pub(crate) fn parse(data: &[u8], path: &Path, target: Target) -> Result<MeshBuilder, ReadError> {
     let mut sc = Scanner::new(data, path);
     parse_header(&mut sc)?;
-    parse_sections(&mut sc, &MSH22)
+    parse_sections(&mut sc, &MSH22, target)
 }
 
 /// The top-level loop of the Gmsh ASCII dialects: one node section (`tag x y z` records), then
 /// one element section laid out as `dialect.records`, both required, nodes first. O(bytes).
-pub(crate) fn parse_sections(sc: &mut Scanner<'_>, dialect: &Dialect) -> Result<MeshBuilder, ReadError> {
+pub(crate) fn parse_sections(
+    sc: &mut Scanner<'_>,
+    dialect: &Dialect,
+    target: Target,
+) -> Result<MeshBuilder, ReadError> {
     let path = sc.path();
-    let mut b = MeshBuilder::new();
+    let mut b = MeshBuilder::for_target(target);
     let (mut seen_nodes, mut seen_elements) = (false, false);
     let ([nodes, end_nodes], [elems, end_elems]) = (dialect.nodes, dialect.elements);
     while let Some(t) = sc.next_raw() {
@@ -169,7 +173,7 @@ fn element_records(sc: &mut Scanner<'_>, b: &mut MeshBuilder, layout: &ElementRe
         let type_at = sc.here();
         let element_type = sc.i64("an element type")?;
         let declared = (layout.fields)(sc)?;
-        let kind = gmsh_element_kind(path, type_at, element_type)?;
+        let kind = b.element_kind(path, type_at, element_type)?;
         if let Some(declared) = declared.filter(|&d| d != kind.nodes as u64) {
             let message = format!(
                 "element {tag} of type {element_type} declares {declared} nodes, but that type has {}",

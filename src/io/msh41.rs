@@ -6,7 +6,7 @@
 
 use std::path::Path;
 
-use super::build::{bounded_count, gmsh_element_kind, MeshBuilder};
+use super::build::{bounded_count, MeshBuilder, Target};
 use super::scan::Scanner;
 use super::{Location, ReadError};
 
@@ -87,11 +87,11 @@ impl<'a> Reader<'a> {
     }
 }
 
-/// Parses an MSH 4.1 file into a builder.
-pub(crate) fn parse(data: &[u8], path: &Path) -> Result<MeshBuilder, ReadError> {
+/// Parses an MSH 4.1 file into a builder for a read of `target`.
+pub(crate) fn parse(data: &[u8], path: &Path, target: Target) -> Result<MeshBuilder, ReadError> {
     let mut r = Reader { sc: Scanner::new(data, path), bin: None };
     parse_header(&mut r)?;
-    let mut b = MeshBuilder::new();
+    let mut b = MeshBuilder::for_target(target);
     let (mut seen_nodes, mut seen_elements) = (false, false);
     while let Some(t) = r.sc.next_raw() {
         let at = r.sc.location_of(&t);
@@ -234,7 +234,11 @@ fn parse_nodes(r: &mut Reader<'_>, b: &mut MeshBuilder) -> Result<(), ReadError>
     r.size_t("minimum node tag")?;
     r.size_t("maximum node tag")?;
     let mut found = 0u64;
-    let mut tags: Vec<u64> = Vec::new();
+    // Each tag with its line (text) or byte offset (binary): a duplicate is reported there, not
+    // at the coordinates.
+    let mut tags: Vec<(u64, usize)> = Vec::new();
+    let binary = r.bin.is_some();
+    let located = |n: usize| if binary { Location::Byte(n) } else { Location::Line(n) };
     for _ in 0..blocks {
         let dim_at = r.sc.here();
         let dim = r.int("entity dimension")?;
@@ -252,9 +256,10 @@ fn parse_nodes(r: &mut Reader<'_>, b: &mut MeshBuilder) -> Result<(), ReadError>
         tags.clear();
         tags.reserve(count);
         for _ in 0..count {
-            tags.push(r.size_t("node tag")?);
+            let (Location::Line(n) | Location::Byte(n)) = r.sc.here();
+            tags.push((r.size_t("node tag")?, n));
         }
-        for &tag in &tags {
+        for &(tag, tag_at) in &tags {
             let at = r.sc.here();
             let x = r.float("node x coordinate")?;
             let y = r.float("node y coordinate")?;
@@ -262,7 +267,7 @@ fn parse_nodes(r: &mut Reader<'_>, b: &mut MeshBuilder) -> Result<(), ReadError>
             for _ in 0..extra {
                 r.float("node parametric coordinate")?;
             }
-            b.add_node(path, at, tag, [x, y, z])?;
+            b.add_node_split(path, located(tag_at), at, tag, [x, y, z])?;
         }
         found = found.saturating_add(count as u64);
     }
@@ -299,7 +304,7 @@ fn parse_elements(r: &mut Reader<'_>, b: &mut MeshBuilder) -> Result<(), ReadErr
         r.int("entity tag")?;
         let type_at = r.sc.here();
         let element_type = r.int("element type")?;
-        let kind = gmsh_element_kind(path, type_at, element_type)?;
+        let kind = b.element_kind(path, type_at, element_type)?;
         let at = r.sc.here();
         let count = r.size_t("number of elements in the block")?;
         let per_element = (kind.nodes + 1) * r.size_t_bytes().max(2);

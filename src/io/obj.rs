@@ -41,13 +41,31 @@ fn number<T: std::str::FromStr>(
     std::str::from_utf8(raw).ok().and_then(|s| s.parse().ok()).ok_or_else(|| garbage(path, line, raw, expected))
 }
 
-/// Resolves one face corner (`i`, `i/t`, `i//n`, `i/t/n`) to a 1-based vertex number.
-fn corner(path: &Path, line: usize, raw: &[u8], vertices: u64) -> Result<u64, ReadError> {
+/// Resolves one face corner (`i`, `i/t`, `i//n`, `i/t/n`) of face `face` to a 1-based vertex
+/// number, `vertices` being the number of vertices read so far.
+///
+/// # Errors
+/// `Garbage` for an index that is not an integer; `Malformed`, naming the index as written, for
+/// 0 or a negative index that counts back past the first vertex.
+fn corner(path: &Path, line: usize, face: u64, raw: &[u8], vertices: u64) -> Result<u64, ReadError> {
     let index_part = raw.split(|&b| b == b'/').next().unwrap_or(&[]);
     let i: i64 = number(path, line, Some(index_part), "a vertex index")?;
     let resolved = if i < 0 { i128::from(vertices) + 1 + i128::from(i) } else { i128::from(i) };
-    // 0 and numbers before the first vertex become tag 0, which is never defined.
-    Ok(u64::try_from(resolved.max(0)).unwrap_or(0))
+    match u64::try_from(resolved) {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => {
+            let why = if i == 0 {
+                "OBJ vertex indices start at 1 (or count back from -1)".to_string()
+            } else {
+                format!("it counts back past the first vertex ({vertices} vertices read so far)")
+            };
+            Err(ReadError::Malformed {
+                path: path.to_path_buf(),
+                at: Location::Line(line),
+                message: format!("face {face}: vertex index {i} refers to no vertex: {why}"),
+            })
+        }
+    }
 }
 
 /// Parses an OBJ file into a builder whose node tags are the 1-based vertex numbers.
@@ -75,9 +93,10 @@ pub(crate) fn parse(data: &[u8], path: &Path) -> Result<MeshBuilder, ReadError> 
                         message: format!("face with {} corners: only triangles are supported", corners.len()),
                     });
                 };
-                let n = b.point_count() as u64;
-                let tri = [corner(path, line, p, n)?, corner(path, line, q, n)?, corner(path, line, r, n)?];
-                faces.push((line, faces.len() as u64 + 1, tri));
+                let (n, face) = (b.point_count() as u64, faces.len() as u64 + 1);
+                let tri =
+                    [corner(path, line, face, p, n)?, corner(path, line, face, q, n)?, corner(path, line, face, r, n)?];
+                faces.push((line, face, tri));
             }
             _ => {}
         }

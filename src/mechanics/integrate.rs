@@ -442,6 +442,13 @@ impl Stepper {
         Ok(())
     }
 
+    /// Whether the runaway test has its energy scale (every public constructor takes it; only a
+    /// crate-internal [`Stepper::with_buffers`] stepper waits for
+    /// [`Stepper::reset_energy_scale`]). O(1).
+    pub(crate) fn has_energy_scale(&self) -> bool {
+        !self.energy_scale.is_nan()
+    }
+
     /// [`StepError::OtherSystem`] unless `sys` has the slot and spring counts the buffers were
     /// made for. O(1).
     fn check_shape(&self, sys: &SpringSystem) -> Result<(), StepError> {
@@ -582,7 +589,7 @@ impl Stepper {
         self.check_shape(sys)?;
         check_len(sys, x)?;
         check_len(sys, v)?;
-        if self.energy_scale.is_nan() {
+        if !self.has_energy_scale() {
             // Only a crate-internal `with_buffers` stepper lacks it; never step without the test.
             return Err(StepError::BadInput("the runaway test has no energy scale yet (reset_energy_scale)".into()));
         }

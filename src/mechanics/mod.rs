@@ -150,9 +150,6 @@ pub struct Simulation {
     /// The body's position epoch (`Mechanics::position_epoch`) at which the energy scale was
     /// last taken.
     position_epoch: u64,
-    /// Whether the stepper's energy scale was taken from the body's state (false after
-    /// [`Simulation::update`], which follows the topology only: the next step takes it).
-    scale_taken: bool,
 }
 
 impl Simulation {
@@ -193,7 +190,7 @@ impl Simulation {
             &mech.position.as_slice()[..slots],
             &mech.velocity.as_slice()[..slots],
         )?;
-        let mut sim = Simulation { projection, stepper, velocity_epoch: 0, position_epoch: 0, scale_taken: true };
+        let mut sim = Simulation { projection, stepper, velocity_epoch: 0, position_epoch: 0 };
         sim.hold_fixed(body);
         sim.record_epochs(body);
         Ok(sim)
@@ -231,7 +228,7 @@ impl Simulation {
         }
         let mech = body.attrs();
         let written = mech.velocity_epoch != self.velocity_epoch || mech.position_epoch != self.position_epoch;
-        if pins_changed || written || !self.scale_taken {
+        if pins_changed || written || !self.stepper.has_energy_scale() {
             // Energy put in by hand is a new start, not a blow-up (and a body started at rest
             // would otherwise keep a stale scale). Taken before the pinned velocities are
             // zeroed (it counts free slots only), so that on an error the body is unchanged and
@@ -239,7 +236,6 @@ impl Simulation {
             let slots = self.projection.system.slots();
             let (x, v) = (&mech.position.as_slice()[..slots], &mech.velocity.as_slice()[..slots]);
             self.stepper.reset_energy_scale(&self.projection.system, x, v)?;
-            self.scale_taken = true;
             self.hold_fixed(body);
             self.record_epochs(body);
         }
@@ -370,8 +366,8 @@ impl Simulation {
         self.check_body(body)?;
         self.projection.update(body, touched);
         self.hold_fixed(body);
+        // Follows the topology only: the new stepper has no energy scale, the next step takes it.
         self.stepper = Stepper::with_buffers(*self.stepper.config(), &self.projection.system)?;
-        self.scale_taken = false;
         Ok(())
     }
 
@@ -435,7 +431,7 @@ impl Simulation {
         Ok((0..self.projection.system.slots())
             .filter(|&v| self.projection.dart_of_vertex(v).is_some())
             .map(|v| geom::norm(geom::sub(m.position.as_slice()[v], m.rest_position.as_slice()[v])))
-            .fold(0.0, nan_max))
+            .fold(0.0, crate::mesh::nan_max))
     }
 
     /// Evaluates the forces on every vertex at the body's current positions and velocities
@@ -478,14 +474,5 @@ impl Simulation {
             }
         }
         Ok(())
-    }
-}
-
-/// The larger of a and b, NaN if either is NaN (unlike [`f64::max`], which drops a NaN). O(1).
-fn nan_max(a: f64, b: f64) -> f64 {
-    if a.is_nan() || b.is_nan() {
-        f64::NAN
-    } else {
-        a.max(b)
     }
 }

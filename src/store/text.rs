@@ -104,38 +104,83 @@ fn encode_levels(s: &mut String, l: &LevelParts, live: &[bool]) {
     }
 }
 
-/// The significant lines of a text file (blank lines and `#` comments skipped), with numbers.
+/// The significant lines of a text file (blank lines and `#` comments skipped), with numbers,
+/// read lazily: nothing is allocated per line (an index of every line would cost a dozen times
+/// the size of a file of short lines).
+#[derive(Clone, Copy)]
 struct Lines<'a> {
-    lines: Vec<(usize, &'a str)>,
-    pos: usize,
+    text: &'a str,
+    /// Byte offset of the next unread raw line.
+    offset: usize,
+    /// 1-based number of that line.
+    line: usize,
+    /// `(offset, line, taken)` before the last [`Lines::next`], for [`Lines::back`].
+    before: (usize, usize, usize),
+    /// Significant lines taken so far.
+    taken: usize,
+    /// Significant lines in the whole text.
+    total: usize,
+    /// Characters of all significant lines, trimmed.
+    chars: usize,
     /// Line number just past the last line (for "truncated" errors).
     end_line: usize,
 }
 
 impl<'a> Lines<'a> {
     fn new(text: &'a str) -> Self {
-        let mut end_line = 1;
-        let mut lines = Vec::new();
-        for (k, line) in text.lines().enumerate() {
-            end_line = k + 2;
-            let t = line.trim();
-            if !t.is_empty() && !t.starts_with('#') {
-                lines.push((k + 1, t));
-            }
+        let mut lines =
+            Lines { text, offset: 0, line: 1, before: (0, 1, 0), taken: 0, total: 0, chars: 0, end_line: 1 };
+        let mut all = lines;
+        while let Some((_, t)) = all.next_line() {
+            lines.total += 1;
+            lines.chars += t.len();
         }
-        Lines { lines, pos: 0, end_line }
+        lines.end_line = text.lines().count() + 1;
+        lines
     }
 
+    /// The next significant line, trimmed, with its number; `None` at the end.
+    fn next_line(&mut self) -> Option<(usize, &'a str)> {
+        while self.offset < self.text.len() {
+            let rest = &self.text[self.offset..];
+            let (raw, step) = match rest.find('\n') {
+                Some(i) => (&rest[..i], i + 1),
+                None => (rest, rest.len()),
+            };
+            let no = self.line;
+            self.offset += step;
+            self.line += 1;
+            let t = raw.trim();
+            if !t.is_empty() && !t.starts_with('#') {
+                return Some((no, t));
+            }
+        }
+        None
+    }
+
+    /// Significant lines not yet taken. O(1).
     fn remaining(&self) -> usize {
-        self.lines.len() - self.pos
+        self.total - self.taken
+    }
+
+    /// The next significant line without taking it.
+    fn peek(&self) -> Option<(usize, &'a str)> {
+        let mut ahead = *self;
+        ahead.next_line()
+    }
+
+    /// Puts back the line the last [`Lines::next`] took.
+    fn back(&mut self) {
+        (self.offset, self.line, self.taken) = self.before;
     }
 
     /// The next line split into tokens, whose first token must be `keyword` (unless empty).
     fn next(&mut self, keyword: &str, expected: &str) -> Result<(usize, Vec<&'a str>), StoreError> {
-        let Some(&(no, line)) = self.lines.get(self.pos) else {
+        self.before = (self.offset, self.line, self.taken);
+        let Some((no, line)) = self.next_line() else {
             return Err(StoreError::Truncated { at: Where::Line(self.end_line), expected: expected.into() });
         };
-        self.pos += 1;
+        self.taken += 1;
         let tokens: Vec<&str> = line.split_whitespace().collect();
         if !keyword.is_empty() && tokens.first() != Some(&keyword) {
             return Err(syntax(no, format!("expected {expected}, found {:?}", first_chars(line))));
@@ -190,7 +235,7 @@ pub(super) fn decode(bytes: &[u8]) -> Result<Document, StoreError> {
     let mechanics = match head.first() {
         Some(&"mechanics") => Some(decode_mechanics(&mut lines, no, &head)?),
         _ => {
-            lines.pos -= 1;
+            lines.back();
             None
         }
     };
@@ -202,13 +247,13 @@ pub(super) fn decode(bytes: &[u8]) -> Result<Document, StoreError> {
         }
         Some(&"levels") => Some(decode_levels(&mut lines, no, &head, &map)?),
         _ => {
-            lines.pos -= 1;
+            lines.back();
             None
         }
     };
     let (no, end) = lines.next("end", "\"end\" (the sections are mechanics, then levels)")?;
     arity(&end, 1, no, "end")?;
-    if let Some(&(extra, _)) = lines.lines.get(lines.pos) {
+    if let Some((extra, _)) = lines.peek() {
         return Err(StoreError::TrailingData { at: Where::Line(extra) });
     }
     if !text.ends_with('\n') {
@@ -247,11 +292,25 @@ fn decode_map(lines: &mut Lines<'_>) -> Result<(u32, RawMap), StoreError> {
     }
     let dead = u64::from(capacity) - live_count;
     // Every dead slot is a token of the free-darts line: bounded by the file size.
-    let limit = (lines.lines.iter().map(|l| l.1.len()).sum::<usize>() / 2) as u64;
+    let limit = (lines.chars / 2) as u64;
     if capacity == UNSET || dead > limit {
         return Err(StoreError::BadCount { at: Where::Line(no), what: "dead dart slots", count: dead, limit });
     }
-    let cap = capacity as usize;
+    // The arrays hold every slot, live or dead: they are allocated only when the free-darts line
+    // after the dart lines lists as many slots as the counts leave dead, so that their size is
+    // bounded by what the file holds (a lying count with no such line allocates nothing; the
+    // dart lines are then read only for their errors, which come first as always).
+    let listed = {
+        let mut ahead = *lines;
+        (0..live_count).all(|_| ahead.next_line().is_some())
+            && ahead.next_line().is_some_and(|(_, line)| {
+                let mut tokens = line.split_whitespace();
+                tokens.next() == Some("free-darts")
+                    && tokens.next().is_some_and(|count| count.parse::<u64>() == Ok(dead))
+                    && tokens.count() as u64 == dead
+            })
+    };
+    let cap = if listed { capacity as usize } else { 0 };
     let mut alpha: Vec<u32> = (0..cap as u32).flat_map(|d| std::iter::repeat_n(d, n1)).collect();
     let mut cell = vec![UNSET; cap * n1];
     let mut prev: Option<u32> = None;
@@ -278,8 +337,11 @@ fn decode_map(lines: &mut Lines<'_>) -> Result<(u32, RawMap), StoreError> {
             if a >= u64::from(capacity) {
                 return Err(StoreError::DartOutOfRange { at: Where::Line(no), dart: a, capacity: capacity.into() });
             }
-            alpha[d as usize * n1 + i] = a as u32;
-            cell[d as usize * n1 + i] = int32(t[n1 + 2 + i], no, "cell id")?;
+            let c = int32(t[n1 + 2 + i], no, "cell id")?;
+            if listed {
+                alpha[d as usize * n1 + i] = a as u32;
+                cell[d as usize * n1 + i] = c;
+            }
         }
     }
     let (no, f) = lines.next("free-darts", "\"free-darts COUNT IDS…\"")?;
@@ -288,6 +350,8 @@ fn decode_map(lines: &mut Lines<'_>) -> Result<(u32, RawMap), StoreError> {
         let what = "free dart slots (capacity − live)";
         return Err(StoreError::BadCount { at: Where::Line(no), what, count: free_darts.len() as u64, limit: dead });
     }
+    // The look-ahead saw this very line: keyword, count = dead, and that many ids.
+    debug_assert!(listed, "the free-darts line was accepted but not seen ahead");
     let mut ids = Vec::with_capacity(n1);
     for i in 0..n1 {
         let (no, c) = lines.next("cell-ids", "\"cell-ids DIM NEXT COUNT IDS…\"")?;

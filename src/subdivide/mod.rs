@@ -135,7 +135,10 @@ pub struct Mu {
     pub tet: u8,
 }
 
-/// Errors of the subdivision operations. The map is unchanged when one is returned.
+/// Errors of the subdivision operations. The map (and the masses, springs and points that go
+/// with it) is unchanged when one is returned, with one documented exception: a multi-level
+/// refinement (`refine_around`, and the CLI's levels) that meets [`SubdivideError::DartLimit`] at
+/// a later level keeps the levels it finished.
 ///
 /// # Examples
 ///

@@ -227,7 +227,7 @@ impl<const N: usize> LeveledMap<N> {
                 if self.points.len() <= v {
                     self.points.resize(v + 1, [0.0; 3]);
                 }
-                self.points[v] = [0, 1, 2].map(|k| 0.5 * (pa[k] + pb[k]));
+                self.points[v] = crate::mesh::midpoint(pa, pb);
             }
         }
         self.max_level = self.max_level.max(self.op.level);

@@ -224,7 +224,8 @@ impl TetMasses {
     }
 }
 
-/// Distance from `p` to the segment [a, b]. O(1).
+/// Distance from `p` to the segment [a, b]; finite for coordinate differences in
+/// [2⁻²⁵⁰, 2²⁵⁰] ([`tet_distance`] scales its input there first). O(1).
 fn segment_distance(p: [f64; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
     let ab = sub(b, a);
     let len2 = dot(ab, ab);
@@ -234,7 +235,8 @@ fn segment_distance(p: [f64; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
 }
 
 /// Distance from `p` to the closed triangle (a, b, c): the distance to its plane when the
-/// projection falls inside, else the distance to the nearest side. O(1).
+/// projection falls inside, else the distance to the nearest side; for coordinate differences in
+/// [2⁻²⁵⁰, 2²⁵⁰], as [`segment_distance`]. O(1).
 fn triangle_distance(p: [f64; 3], [a, b, c]: [[f64; 3]; 3]) -> f64 {
     let n = cross(sub(b, a), sub(c, a));
     let nn = dot(n, n);
@@ -264,7 +266,11 @@ pub(super) fn share(m: f64, v: f64, total: f64) -> f64 {
 
 /// Distance from `p` to the closed tetrahedron with corners `t`: 0 inside, else the distance to
 /// the nearest face; NaN when a coordinate of `p` or `t` is NaN (not the infinity a minimum
-/// that skips NaN would give). O(1).
+/// that skips NaN would give). At any scale of finite coordinates: when the largest coordinate
+/// difference is outside [2⁻²⁵⁰, 2²⁵⁰] (squares of products of differences would over- or
+/// underflow), the corners are translated to `p` and scaled by one power of two, and the distance
+/// is scaled back (∞ only for a distance past `f64::MAX`); inside that range nothing is
+/// translated or scaled (the same bits as the plain computation). O(1).
 ///
 /// # Examples
 ///
@@ -274,11 +280,27 @@ pub(super) fn share(m: f64, v: f64, total: f64) -> f64 {
 /// assert_eq!(tet_distance([0.1, 0.1, 0.1], t), 0.0);
 /// assert!((tet_distance([0.0, 0.0, -3.0], t) - 3.0).abs() < 1e-12);
 /// assert!(tet_distance([f64::NAN, 0.0, 0.0], t).is_nan());
+/// let huge = t.map(|c| c.map(|x| x * 1e110)); // squared differences would overflow
+/// assert_eq!(tet_distance([1e109; 3], huge), 0.0);
+/// assert!((tet_distance([2e200, 0.0, 0.0], t) / 2e200 - 1.0).abs() < 1e-15);
 /// ```
 pub fn tet_distance(p: [f64; 3], t: [[f64; 3]; 4]) -> f64 {
     if p.iter().chain(t.iter().flatten()).any(|c| c.is_nan()) {
         return f64::NAN;
     }
+    if p.iter().chain(t.iter().flatten()).any(|c| c.is_infinite()) {
+        return plain_tet_distance(p, t); // as before: ∞ or NaN, decided by the plain formula
+    }
+    // p first: a fitted p is the origin. Nothing moves for a plain extent (k = 0).
+    let mut points = [p, t[0], t[1], t[2], t[3]];
+    let k = crate::mesh::fit_for_products(&mut points);
+    let [p, t @ ..] = points;
+    crate::mesh::times_pow2(plain_tet_distance(p, t), -k)
+}
+
+/// [`tet_distance`] without scaling: finite results for coordinate differences in
+/// [2⁻²⁵⁰, 2²⁵⁰]. O(1).
+fn plain_tet_distance(p: [f64; 3], t: [[f64; 3]; 4]) -> f64 {
     let faces = [[t[1], t[2], t[3]], [t[0], t[3], t[2]], [t[0], t[1], t[3]], [t[0], t[2], t[1]]];
     let vol = crate::mesh::signed_volume(t[0], t[1], t[2], t[3]);
     // Each face is listed so that the opposite corner gives the sign of −vol: p is inside when it
@@ -428,13 +450,15 @@ impl LeveledMap<3> {
         masses.check_cover(self)?;
         let parent = masses.check_mass(self.map.cell_id(3, d))?;
         let children = self.subdivide_tet(d, level)?;
-        let volumes: Vec<f64> = children.iter().map(|&c| self.tet_volume(c).map(f64::abs)).collect::<Result<_, _>>()?;
+        let volumes = self.volumes_of_children(&children)?;
         let total: f64 = volumes.iter().sum();
         masses.mass.resize(self.map.cell_id_bound(3).max(masses.mass.len()), 0.0);
         let mut given = 0.0;
         for (k, &c) in children.iter().enumerate() {
             let share = if k + 1 == children.len() {
-                parent - given
+                // The rest, so that the sum is the parent's; ≥ 0 (a child of a nearly flat
+                // parent may come out of zero computed volume, the others' shares a few ulps over).
+                (parent - given).max(0.0)
             } else if total > 0.0 {
                 share(parent, volumes[k], total)
             } else {
@@ -446,6 +470,23 @@ impl LeveledMap<3> {
         Ok(children)
     }
 
+    /// |volume| of each of the eight `children` of a subdivided tet, up to one common factor
+    /// (`mesh::fit_for_products`: 1 unless a volume would under- or overflow), so that their
+    /// ratios are finite for any finite corners. O(1).
+    ///
+    /// Errors: those of [`Self::tet_vertices`] and of the corner positions (not met for the
+    /// children of a tet whose corners have finite positions: their corners are those and the
+    /// finite midpoints of its edges).
+    fn volumes_of_children(&self, children: &[DartId; 8]) -> Result<[f64; 8], SubdivideError> {
+        let mut pos = [[0.0; 3]; 32];
+        for (k, &c) in children.iter().enumerate() {
+            pos[4 * k..4 * k + 4].copy_from_slice(&self.corner_positions(self.tet_vertices(c)?)?);
+        }
+        crate::mesh::fit_for_products(&mut pos);
+        Ok([0, 1, 2, 3, 4, 5, 6, 7]
+            .map(|k| crate::mesh::signed_volume(pos[4 * k], pos[4 * k + 1], pos[4 * k + 2], pos[4 * k + 3]).abs()))
+    }
+
     /// Refines the zone of the ball B(center, radius) up to level `levels` (module docs): for
     /// L = max(1, k)..=levels, every tet with μt = L − 1 meeting the ball is subdivided at level L,
     /// its mass shared by [`Self::subdivide_tet_with_mass`]. When the ball holds every vertex and
@@ -454,12 +495,17 @@ impl LeveledMap<3> {
     /// ([`Self::refine_around_per_op`]). Returns the count per level and the mass totals.
     /// O(Σ_L (volumes + refined · touched)); O(darts) per bulk level.
     ///
-    /// Errors: those of [`Self::subdivide_tet`] (the map keeps the operations done before it);
-    /// those of [`TetMasses::check`] before any change;
-    /// [`SubdivideError::LevelTooHigh`] for `levels` above [`super::MAX_LEVEL`];
-    /// [`SubdivideError::BadBall`] for a non-finite centre or radius or a negative radius and
-    /// [`SubdivideError::DartLimit`] for a level over the dart limit (both before any change at
-    /// that level).
+    /// Errors: [`SubdivideError::LevelTooHigh`] for `levels` above [`super::MAX_LEVEL`],
+    /// [`SubdivideError::BadBall`] for a non-finite centre or radius or a negative radius and those
+    /// of [`TetMasses::check`], before any change; at a level, [`SubdivideError::DartLimit`] for a
+    /// level over the dart limit and the refusals of [`Self::subdivide_tet_with_mass`] for any tet
+    /// of its zone (e.g. [`SubdivideError::AlreadyAtLevel`] for an unsplit face that a finer
+    /// neighbour, split at a skipped level, brought to μf = L), all checked on the whole level
+    /// before its first split, so an error leaves the map and the masses as the levels before it
+    /// left them. For a map made by the operations that is unchanged, except after a
+    /// [`SubdivideError::DartLimit`] at a level after the first (the levels before stay done):
+    /// every other refusal comes at the first level the call refines (after a level L, a tet at
+    /// μt = L has only unsplit faces, with μf ≤ L, and finite corners).
     ///
     /// ```
     /// use topomech::subdivide::{LeveledMap, TetMasses};
@@ -537,7 +583,7 @@ impl LeveledMap<3> {
                 before = Some(masses.total(self));
             }
             after = None;
-            per_level[level as usize] = self.refine_level_per_op(level, center, radius, masses)?;
+            per_level[level as usize] = self.refine_level_per_op(level, levels, center, radius, masses)?;
         }
         Ok(Refinement {
             subdivided_per_level: per_level,
@@ -546,20 +592,117 @@ impl LeveledMap<3> {
         })
     }
 
-    /// Subdivides, op by op, every tet with μt = level − 1 meeting the ball. Returns the count.
+    /// Subdivides, op by op, every tet with μt = level − 1 meeting the ball (the last level being
+    /// `levels`). Returns the count. All or nothing: every refusal is made by
+    /// [`Self::check_level`] before the first split.
     fn refine_level_per_op(
         &mut self,
         level: u8,
+        levels: u8,
         center: [f64; 3],
         radius: f64,
         masses: &mut TetMasses,
     ) -> Result<usize, SubdivideError> {
-        let zone = self.zone_tets(level - 1, center, radius)?;
-        self.check_zone_limit(level, zone.len())?;
+        let zone = self.check_level(level, levels, center, radius, masses)?;
         for &d in &zone {
             self.subdivide_tet_with_mass(d, level, masses)?;
         }
         Ok(zone.len())
+    }
+
+    /// The zone of one op-by-op level of [`Self::refine_around`] (the tets at μt = level − 1 meeting
+    /// the ball), once everything that could refuse during the level, or at the start of the next
+    /// one short of [`SubdivideError::DartLimit`], has been checked on the map as it is: the zone
+    /// itself ([`Self::zone_tets`]), the dart limit, every zone tet ([`Self::check_zone`]) and,
+    /// when `level` < `levels`, the corners of the tets already at μt = level before it (the
+    /// next level's zone looks at them; the tets the level makes have the corners of their
+    /// parents and finite midpoints). So the level is all or nothing, and an error at a later
+    /// level can only be the dart limit: the tets at μt = L after a level L have unsplit faces
+    /// with μf ≤ L only, which every zone check accepts (see [`Self::check_zone`]). O(darts +
+    /// Σ zone volumes).
+    pub(super) fn check_level(
+        &self,
+        level: u8,
+        levels: u8,
+        center: [f64; 3],
+        radius: f64,
+        masses: &TetMasses,
+    ) -> Result<Vec<DartId>, SubdivideError> {
+        let zone = self.zone_tets(level - 1, center, radius)?;
+        self.check_zone_limit(level, zone.len())?;
+        self.check_zone(level, &zone, masses)?;
+        if level < levels {
+            self.zone_tets(level, center, radius)?;
+        }
+        Ok(zone)
+    }
+
+    /// The refusals [`Self::subdivide_tet_with_mass`] at `level` would make for the tets of `zone`
+    /// (one dart each, all at μt = level − 1, as [`Self::zone_tets`] gives them), made on the map
+    /// as it is, before any of them is split: the mass entries, the tet's volume (live dart,
+    /// corners at its level, finite corner positions), its faces (the checks of
+    /// [`Self::subdivide_tet`]: each a triangle, unsplit or a child of one 1→4 split with single
+    /// inner sides, else `FaceRefinedTooFar`; an unsplit face with μf ≥ level is `AlreadyAtLevel`)
+    /// and the finite positions of the vertices that become corners of its children (the flat
+    /// vertices reused as midpoints, the corners of its split faces). O(Σ zone volumes).
+    ///
+    /// Why it suffices: splitting zone tets in any order at `level` cannot make another zone tet N
+    /// refuse once every one has passed here.
+    /// - A tet of μt = t has, at its creation (or at level 0), only unsplit faces, all with μf ≥ t
+    ///   (`set_tet_levels`; a parent refuses a face refined twice, so a child never starts with a
+    ///   split face); a face is split only at a level above its μf. So every split face of a zone
+    ///   tet was split at `level` itself (the operations before came at levels ≤ `level`), and its
+    ///   children carry μf = `level` on both sides (`set_child_levels` walks the α3 side too).
+    /// - Splitting a zone tet T first splits its unsplit faces F at `level`. For N behind F, F was
+    ///   either unsplit (now split once at `level`: three corner children and a centre whose
+    ///   corners are N's, single new inner sides; `check_tet_faces` accepts it, and F is no longer
+    ///   among the unsplit faces μf is checked on) or a child of a split face of N; the latter
+    ///   would refine N's face twice, but then F carries μf = `level` by the first point, and T
+    ///   was refused here. The sides of F without a flat vertex are split: for N they are sides
+    ///   of an unsplit face (flats allowed) or outer half-sides of a split child (allowed); an
+    ///   inner side of N's split child was made at `level` with faces of μf = `level` only, so it
+    ///   is no side of T's unsplit F (μf < `level`).
+    /// - Then μf (and μa) are raised to `level` on the faces of T's children: T's split faces and
+    ///   their children seen from N, never one that stays unsplit for N with μf < `level`.
+    /// - N's corners are read at μt = level − 1 (`alpha_at`), which operations at `level` do not
+    ///   change; no dart becomes free; N's volume id, mass and corner positions stay; the
+    ///   midpoints created meanwhile get finite positions (midpoints of finite corners).
+    fn check_zone(&self, level: u8, zone: &[DartId], masses: &TetMasses) -> Result<(), SubdivideError> {
+        masses.check_cover(self)?;
+        for &d in zone {
+            self.tet_volume(d)?;
+            masses.check_mass(self.map.cell_id(3, d))?;
+            self.check_zone_tet(d, level)?;
+        }
+        Ok(())
+    }
+
+    /// The face checks of [`Self::check_zone`] for the tet of `d`, in the order
+    /// [`Self::subdivide_tet`] makes them (the same faces and the same first error), then the
+    /// positions of the corners of its children that are not its own corners. O(volume).
+    fn check_zone_tet(&self, d: DartId, level: u8) -> Result<(), SubdivideError> {
+        let corners = self.tet_corners(d, self.mu[d.index()].tet)?;
+        let mut midpoints = Vec::new();
+        let unsplit = self.check_tet_faces_visiting(d, &corners, |sides, is_corner| {
+            for (s, &corner) in sides.iter().zip(is_corner) {
+                if !corner {
+                    midpoints.push(self.map.vertex_id(s.start).0);
+                } else if is_corner.iter().all(|&c| c) {
+                    // The flat vertex the split of this unsplit face takes as the midpoint of
+                    // the side (`side_midpoint`: the one of lowest dart level), if any.
+                    let oldest = s.flats.iter().min_by_key(|(a, _)| self.dart_level[a.index()]);
+                    midpoints.extend(oldest.map(|&(a, _)| self.map.vertex_id(a).0));
+                }
+            }
+        })?;
+        if let Some(&f) = unsplit.iter().find(|f| self.mu[f.index()].face >= level) {
+            let cell_level = self.mu[f.index()].face;
+            return Err(SubdivideError::AlreadyAtLevel { dart: f, dim: 2, cell_level, level });
+        }
+        for v in midpoints {
+            self.corner_positions([v; 4])?;
+        }
+        Ok(())
     }
 
     /// Refuses a ball with a non-finite centre or a radius that is not a finite number ≥ 0. O(1).
@@ -583,10 +726,11 @@ impl LeveledMap<3> {
         self.ball_holds_all(center, radius) && self.all_tets_at(level - 1)
     }
 
-    /// Whether every stored vertex position lies in the closed ball (then every tet meets it).
-    /// O(points).
+    /// Whether every stored vertex position lies in the closed ball (then every tet meets it), by
+    /// the scale-safe [`crate::mesh::distance`] (with squared differences, a vertex 1e200 from the
+    /// centre was at ∞, outside a ball of radius 2e200). O(points).
     fn ball_holds_all(&self, center: [f64; 3], radius: f64) -> bool {
-        let inside = |p: &[f64; 3]| dot(sub(*p, center), sub(*p, center)).sqrt() <= radius;
+        let inside = |p: &[f64; 3]| crate::mesh::distance(*p, center) <= radius;
         if self.points.is_empty() {
             return inside(&[0.0; 3]);
         }

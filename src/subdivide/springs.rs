@@ -775,9 +775,14 @@ impl LeveledMechanics {
     /// bulk path for a level where the ball holds everything, with the same springs up to rounding).
     /// O(Σ_L (volumes + refined · touched)).
     ///
-    /// Errors: those of [`Self::subdivide_tet`] (the operations before the error stay done, map and
-    /// coupling in step); [`SubdivideError::LevelTooHigh`] for `levels` above the maximum. With
-    /// `expensive-checks`, [`Self::check`] runs once at the end (not after each tet).
+    /// Errors: [`SubdivideError::LevelTooHigh`] for `levels` above the maximum,
+    /// [`SubdivideError::BadBall`] and those of the coupling's sync check before any change; at a
+    /// level, those of [`LeveledMap::refine_around`] (the dart limit and the refusals of
+    /// [`Self::subdivide_tet`] for any tet of its zone), all checked on the whole level before its
+    /// first split: an error leaves the map, the springs and the masses as the levels before it
+    /// left them (for a map made by the operations unchanged, except after a
+    /// [`SubdivideError::DartLimit`] at a level after the first; map and coupling in step either
+    /// way). With `expensive-checks`, [`Self::check`] runs once at the end (not after each tet).
     ///
     /// # Examples
     ///
@@ -810,8 +815,8 @@ impl LeveledMechanics {
                 per_level[level as usize] = count;
                 continue;
             }
-            let zone = m.zone_tets(level - 1, center, radius)?;
-            m.check_zone_limit(level, zone.len())?;
+            // Every refusal of the level before its first split (map, springs and masses unchanged).
+            let zone = m.check_level(level, levels, center, radius, &self.masses)?;
             for d in zone {
                 self.split_tet(m, d, level)?;
                 per_level[level as usize] += 1;
@@ -904,7 +909,7 @@ impl LeveledMechanics {
         let n = m.map().cell_id_bound(0).max(v as usize + 1);
         self.position.resize(n, [0.0; 3]);
         self.velocity.resize(n, [0.0; 3]);
-        let mean = |x: &[Vec3]| [0, 1, 2].map(|k| 0.5 * (x[a as usize][k] + x[b as usize][k]));
+        let mean = |x: &[Vec3]| crate::mesh::midpoint(x[a as usize], x[b as usize]);
         let (x, u) = (mean(&self.position), mean(&self.velocity));
         self.position[v as usize] = x;
         self.velocity[v as usize] = u;

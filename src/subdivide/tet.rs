@@ -13,6 +13,7 @@
 //! boundary darts had across the inner edges of the split faces (recorded at the new level, so
 //! the coarser levels keep them).
 
+use super::tri::Side;
 use super::{LeveledMap, Mu, SubdivideError};
 use crate::gmap::{with_stamps, AlphaMask, DartId};
 use rustc_hash::FxHashMap;
@@ -74,6 +75,11 @@ pub(super) fn child_tets(diag: u8) -> Vec<[u8; 4]> {
 /// positions before ids so that every refinement path (op by op or bulk, whatever order it numbers
 /// the midpoints in) makes the same choice; ids only decide between coincident midpoints. O(1).
 pub(super) fn choose_diagonal(pos: &[[f64; 3]; 6], vid: &[u32; 6]) -> u8 {
+    // Squared lengths of huge or tiny diagonals would be ∞ or 0 for all three: compared on one
+    // common scale (the same bits for ordinary sizes).
+    let mut fitted = *pos;
+    crate::mesh::fit_for_products(&mut fitted);
+    let pos = &fitted;
     let key = |l: u8| {
         let (i, j) = ((l - 4) as usize, (opposite(l) - 4) as usize);
         let (p, q) = (pos[i], pos[j]);
@@ -236,6 +242,18 @@ impl LeveledMap<3> {
     /// tet corners) or a child of one 1→4 split whose inner sides are single edges, and returns
     /// one dart of each unsplit face.
     fn check_tet_faces(&self, d: DartId, corners: &[u32; 4]) -> Result<Vec<DartId>, SubdivideError> {
+        self.check_tet_faces_visiting(d, corners, |_, _| {})
+    }
+
+    /// [`Self::check_tet_faces`], calling `visit(sides, is_corner)` with the sides of each face
+    /// that passed its own checks and whether each side starts at a corner (the zone pre-check
+    /// of `refine_around` reads the midpoints there). O(volume).
+    pub(super) fn check_tet_faces_visiting(
+        &self,
+        d: DartId,
+        corners: &[u32; 4],
+        mut visit: impl FnMut(&[Side], &[bool]),
+    ) -> Result<Vec<DartId>, SubdivideError> {
         let mut unsplit = Vec::new();
         let (mut corner_children, mut centers) = (0usize, 0usize);
         for f in self.volume_faces(d) {
@@ -253,6 +271,7 @@ impl LeveledMap<3> {
                     return Err(SubdivideError::FaceRefinedTooFar { dart: f });
                 }
             }
+            visit(&sides, &is_corner);
         }
         let split = 4 - unsplit.len().min(4);
         if unsplit.len() > 4 || corner_children != 3 * split || centers != split {

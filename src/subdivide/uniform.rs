@@ -557,7 +557,7 @@ impl<const N: usize> LeveledMap<N> {
         let mut mid_vid = [0u32; 6];
         for (k, &(x, y)) in pr.iter().enumerate() {
             let (a, b) = (corner[x as usize], corner[y as usize]);
-            pos[k] = [0, 1, 2].map(|i| 0.5 * (a[i] + b[i]));
+            pos[k] = crate::mesh::midpoint(a, b);
             // Ids only break ties between coincident midpoints; any per-edge number will do.
             mid_vid[k] = self.map.cell_id(1, DartId(lab[t0.pair_parent[k] as usize])).0;
         }
@@ -749,7 +749,7 @@ impl<const N: usize> LeveledMap<N> {
             self.edge_splits.push(super::EdgeSplit { vertex: v, ends: [a, b], edge, halves });
             if !self.points.is_empty() {
                 let (pa, pb) = (self.vertex_pos(a), self.vertex_pos(b));
-                self.points[v as usize] = [0, 1, 2].map(|k| 0.5 * (pa[k] + pb[k]));
+                self.points[v as usize] = crate::mesh::midpoint(pa, pb);
             }
         }
     }
@@ -810,7 +810,7 @@ impl LeveledMap<3> {
             let mut given = 0.0;
             for (c, &v) in volumes.iter().enumerate() {
                 let share = if c + 1 == volumes.len() {
-                    m - given
+                    (m - given).max(0.0) // the rest, ≥ 0 (as in `subdivide_tet_with_mass`)
                 } else if total > 0.0 {
                     super::region::share(m, v, total)
                 } else {
@@ -828,16 +828,19 @@ impl LeveledMap<3> {
         Ok(Refinement { subdivided_per_level: per_level, total_mass_before: before, total_mass_after: after })
     }
 
-    /// |volume| of each child of a refined parent, from the corner positions and the midpoints.
+    /// |volume| of each child of a refined parent, from the corner positions and the midpoints,
+    /// up to one common factor (`mesh::fit_for_products`: 1 unless a volume would under- or
+    /// overflow).
     fn child_volumes(&self, tp: &Template, darts: &[u32]) -> [f64; 8] {
         let mut pos = [[0.0; 3]; 10];
         for x in 0..4 {
             pos[x] = self.vertex_pos(self.map.vertex_id(DartId(darts[tp.corner_parent[x] as usize])).0);
         }
         for (k, &(x, y)) in tp.pairs.iter().enumerate() {
-            let (a, b) = (pos[x as usize], pos[y as usize]);
-            pos[4 + k] = [0, 1, 2].map(|i| 0.5 * (a[i] + b[i]));
+            pos[4 + k] = crate::mesh::midpoint(pos[x as usize], pos[y as usize]);
         }
+        // Only the ratios are used: one common scale keeps them finite for any finite corners.
+        crate::mesh::fit_for_products(&mut pos);
         let mut out = [0.0; 8];
         for (c, set) in tp.children.iter().enumerate() {
             let p = set.map(|l| pos[l as usize]);

@@ -183,7 +183,7 @@ pub fn simulate_refined(
     let max_displacement = (0..sys.slots().min(rest.len()))
         .filter(|&v| sys.mass()[v] > 0.0)
         .map(|v| dist(mech.position[v], rest[v]))
-        .fold(0.0, crate::cli::nan_max);
+        .fold(0.0, topomech::mesh::nan_max);
     Ok(RefinedSim {
         steps,
         slots: sys.slots(),

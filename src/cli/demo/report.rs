@@ -83,7 +83,7 @@ pub fn scene_row(scene: &Scene, run: &StageRun) -> StageRow {
         mass_residual: Some(ch.last.mass),
         stiffness_sum: Some(total_stiffness(body)),
         stiffness_residual: Some(ch.last.stiffness),
-        max_stress: stress.map(|stress| stress.iter().map(|s| s.magnitude).fold(0.0, crate::cli::nan_max)),
+        max_stress: stress.map(|stress| stress.iter().map(|s| s.magnitude).fold(0.0, topomech::mesh::nan_max)),
         max_displacement: scene.sim.max_displacement(body).ok(),
         checks_passed: ch.passed,
         ..counts_row(run.name, body.map(), run)

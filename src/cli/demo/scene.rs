@@ -286,7 +286,7 @@ impl Scene {
     pub fn tear_threshold(&self) -> Result<f64, DemoError> {
         let stress =
             cut::principal_stress(&self.body, &self.sim).map_err(|source| DemoError::Sim { stage: "tear", source })?;
-        Ok(TEAR_FRACTION * stress.iter().map(|s| s.magnitude).fold(0.0, crate::cli::nan_max))
+        Ok(TEAR_FRACTION * stress.iter().map(|s| s.magnitude).fold(0.0, topomech::mesh::nan_max))
     }
 
     /// Removes the tets whose centroid (current positions) lies within [`REMOVAL_RADIUS`] of the

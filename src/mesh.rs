@@ -423,8 +423,10 @@ fn binary_exponent(x: f64) -> i64 {
 /// Prepares finite `points` for products of their differences (volumes, squared lengths,
 /// distances) that neither overflow nor underflow: when their extent is outside
 /// [`PLAIN_EXTENT`], translates them to the first point (which becomes the origin) and scales
-/// them by a power of two so that the extent is in [1, 2) (an extent past `f64::MAX` is
-/// quartered first). Returns k, the points now being (p − p₀) · 2^k: lengths changed by 2^k,
+/// them by a power of two so that the extent is in [2²⁴⁹, 2²⁵⁰), the top of the plain range (an
+/// extent past `f64::MAX` is quartered first): a huge extent is scaled down no further than
+/// needed, so short differences beside it (a needle's width) keep as many binary orders of
+/// magnitude above underflow as they can. Returns k, the points now being (p − p₀) · 2^k: lengths changed by 2^k,
 /// volumes by 2^3k (ratios of volumes and the order of lengths are kept; a length computed on
 /// the fitted points is the true one times 2^k). Inside the range, or for an extent of 0 or
 /// NaN, nothing changes (the same bits as before) and k = 0. The scaling is exact; the
@@ -445,7 +447,7 @@ pub(crate) fn fit_for_products(points: &mut [[f64; 3]]) -> i64 {
     if extent == 0.0 || !extent.is_finite() {
         return quartered;
     }
-    let k = -binary_exponent(extent);
+    let k = 249 - binary_exponent(extent);
     for p in points.iter_mut() {
         *p = p.map(|c| times_pow2(c, k));
     }
@@ -474,10 +476,10 @@ pub fn signed_volume(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> f64 
 /// Area of the triangle `(a, b, c)` (always `>= 0`), `½|(b − a) × (c − a)|`. O(1).
 ///
 /// Edge vectors whose components lie between about 2⁻²⁵⁰ and 2²⁵⁰ (every ordinary triangle) are
-/// used as they are. Outside that range they are first scaled by a power of two (exact) to
-/// components in [1, 2), and the area scaled back, so that neither the cross product nor its
-/// square underflows or overflows: legs of 1e-90 give 5e-181, not 0, and legs of 1e80 give
-/// 5e159, not ∞. The result is ∞ only when the area itself is past `f64::MAX` (and 0 only when it
+/// used as they are. Otherwise each edge vector is first scaled by its own power of two (exact)
+/// to components below 2, and the area scaled back, so that neither the cross product nor its
+/// square underflows or overflows: legs of 1e-90 give 5e-181, not 0, legs of 1e80 give 5e159,
+/// not ∞, and legs of 1e200 and 1e-200 give 0.5. The result is ∞ only when the area itself is past `f64::MAX` (and 0 only when it
 /// is below the smallest subnormal, or the triangle is flat); NaN when a coordinate is.
 ///
 /// # Examples
@@ -489,50 +491,33 @@ pub fn signed_volume(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> f64 
 /// assert_eq!(triangle_area([0.0; 3], [1.0; 3], [2.0; 3]), 0.0); // collinear
 /// assert_eq!(triangle_area([0.0; 3], [1e-90, 0.0, 0.0], [0.0, 1e-90, 0.0]), 0.5 * 1e-90 * 1e-90);
 /// assert_eq!(triangle_area([0.0; 3], [1e80, 0.0, 0.0], [0.0, 1e80, 0.0]), 0.5 * 1e80 * 1e80);
+/// assert_eq!(triangle_area([0.0; 3], [1e200, 0.0, 0.0], [0.0, 1e-200, 0.0]), 0.5); // a needle
 /// assert_eq!(triangle_area([-f64::MAX, 0.0, 0.0], [f64::MAX, 0.0, 0.0], [0.0, f64::MAX, 0.0]), f64::INFINITY);
 /// ```
 pub fn triangle_area(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
-    /// 2^k for k in −1074..=1023, exact.
-    fn pow2(k: i64) -> f64 {
-        if k >= -1022 {
-            f64::from_bits(((k + 1023) as u64) << 52)
-        } else {
-            f64::from_bits(1u64 << (k + 1074))
-        }
-    }
-    /// x · 2^k in steps that each stay in the range of `pow2`.
-    fn times_pow2(mut x: f64, mut k: i64) -> f64 {
-        while k != 0 {
-            let step = k.clamp(-1000, 1000);
-            x *= pow2(step);
-            k -= step;
-        }
-        x
-    }
-    fn largest(u: [f64; 3], v: [f64; 3]) -> f64 {
-        u.iter().chain(&v).fold(0.0_f64, |m, x| m.max(x.abs()))
-    }
+    let largest = |w: [f64; 3]| w.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    let plain_range = |m: f64| m == 0.0 || PLAIN_EXTENT.contains(&m);
     let (u, v) = (sub(b, a), sub(c, a));
     let plain = 0.5 * norm(cross(u, v));
-    let m = largest(u, v);
-    if m == 0.0 || PLAIN_EXTENT.contains(&m) || [a, b, c].iter().flatten().any(|x| x.is_nan()) {
+    if (plain_range(largest(u)) && plain_range(largest(v))) || [a, b, c].iter().flatten().any(|x| x.is_nan()) {
         return plain;
     }
     // A difference past f64::MAX: the corners are quartered first (the area by 1/16).
-    let (u, v, quartered) = if m.is_finite() {
+    let (u, v, quartered) = if largest(u).is_finite() && largest(v).is_finite() {
         (u, v, 0)
     } else {
         let quarter = |p: [f64; 3]| [0, 1, 2].map(|k| 0.25 * p[k] - 0.25 * a[k]);
         (quarter(b), quarter(c), 4)
     };
-    let m = largest(u, v);
-    if !m.is_finite() {
+    if !(largest(u).is_finite() && largest(v).is_finite()) {
         return plain;
     }
-    let e = m.log2().floor() as i64;
-    let scaled = |w: [f64; 3]| w.map(|x| times_pow2(x, -e));
-    let area = 0.5 * norm(cross(scaled(u), scaled(v)));
-    times_pow2(area, 2 * e + quartered)
+    // Each edge by its own power of two (a needle's short edge must not underflow beside the
+    // long one): |u × v| = 2^(eu + ev) |u' × v'| with u', v' of components below 2.
+    let exponent = |w: [f64; 3]| if largest(w) == 0.0 { 0 } else { binary_exponent(largest(w)) };
+    let (eu, ev) = (exponent(u), exponent(v));
+    let (u, v) = (u.map(|x| times_pow2(x, -eu)), v.map(|x| times_pow2(x, -ev)));
+    times_pow2(0.5 * norm(cross(u, v)), eu + ev + quartered)
 }
 
 /// The longest distance between two of `corners`: `|p − q|` as it is when the components of
@@ -1251,12 +1236,12 @@ mod tests {
             let mut p = unit.map(|q| q.map(|c| c * scale + shift));
             fit_for_products(&mut p);
             let extent = coordinate_extent(&p);
-            assert!((1.0..2.0).contains(&extent), "{scale} {shift}: extent {extent}");
+            assert!((2f64.powi(249)..2f64.powi(250)).contains(&extent), "{scale} {shift}: extent {extent}");
             assert!((ratio(&p) - 0.5).abs() < 1e-12, "{scale} {shift}: {}", ratio(&p));
         }
         let mut wide = [[-f64::MAX, 0.0, 0.0], [f64::MAX, 0.0, 0.0], [0.0, 1e300, 0.0], [0.0, 0.0, 1e300]];
         fit_for_products(&mut wide);
-        assert!(wide.iter().flatten().all(|c| c.is_finite()) && coordinate_extent(&wide) < 2.0);
+        assert!(wide.iter().flatten().all(|c| c.is_finite()) && coordinate_extent(&wide) < 2f64.powi(250));
         assert!(signed_volume(wide[0], wide[1], wide[2], wide[3]) > 0.0);
         assert_eq!(midpoint([f64::MAX; 3], [-f64::MAX; 3]), [0.0; 3]);
     }

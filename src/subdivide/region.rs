@@ -230,7 +230,13 @@ fn segment_distance(p: [f64; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
     let ab = sub(b, a);
     let len2 = dot(ab, ab);
     let t = if len2 > 0.0 { (dot(sub(p, a), ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
-    let q = [a[0] + t * ab[0], a[1] + t * ab[1], a[2] + t * ab[2]];
+    // The ends exactly: a + 1·(b − a) need not be b (for a needle's end 2⁻²⁵⁰ times its length
+    // from the origin, it lost that end's coordinate).
+    let q = match t {
+        0.0 => a,
+        1.0 => b,
+        _ => [a[0] + t * ab[0], a[1] + t * ab[1], a[2] + t * ab[2]],
+    };
     dot(sub(p, q), sub(p, q)).sqrt()
 }
 
@@ -305,7 +311,12 @@ fn plain_tet_distance(p: [f64; 3], t: [[f64; 3]; 4]) -> f64 {
     let vol = crate::mesh::signed_volume(t[0], t[1], t[2], t[3]);
     // Each face is listed so that the opposite corner gives the sign of −vol: p is inside when it
     // is on that side (or on the plane) of all four faces.
-    let same_side = |f: &[[f64; 3]; 3]| crate::mesh::signed_volume(f[0], f[1], f[2], p) * vol <= 0.0;
+    // Signs compared, not multiplied: a product of two volumes (a sixth power of the lengths)
+    // underflows to 0 for tets of edge 1e-54 already, and 0 ≤ 0 put every point inside.
+    let same_side = |f: &[[f64; 3]; 3]| {
+        let s = crate::mesh::signed_volume(f[0], f[1], f[2], p);
+        s == 0.0 || (s < 0.0) != (vol < 0.0)
+    };
     if vol != 0.0 && faces.iter().all(same_side) {
         return 0.0;
     }

@@ -426,11 +426,11 @@ fn binary_exponent(x: f64) -> i64 {
 /// them by a power of two so that the extent is in [2²⁴⁹, 2²⁵⁰), the top of the plain range (an
 /// extent past `f64::MAX` is quartered first): a huge extent is scaled down no further than
 /// needed, so short differences beside it (a needle's width) keep as many binary orders of
-/// magnitude above underflow as they can. Returns k, the points now being (p − p₀) · 2^k: lengths changed by 2^k,
-/// volumes by 2^3k (ratios of volumes and the order of lengths are kept; a length computed on
-/// the fitted points is the true one times 2^k). Inside the range, or for an extent of 0 or
-/// NaN, nothing changes (the same bits as before) and k = 0. The scaling is exact; the
-/// translation rounds each difference once. O(points).
+/// magnitude above underflow as they can. Returns k, the points now being (p − p₀) · 2^k:
+/// lengths changed by 2^k, volumes by 2^3k (ratios of volumes and the order of lengths are
+/// kept; a length computed on the fitted points is the true one times 2^k). Inside the range,
+/// or for an extent of 0 or NaN, nothing changes (the same bits as before) and k = 0. The
+/// scaling is exact; the translation rounds each difference once. O(points).
 pub(crate) fn fit_for_products(points: &mut [[f64; 3]]) -> i64 {
     let extent = coordinate_extent(points);
     if extent == 0.0 || PLAIN_EXTENT.contains(&extent) || extent.is_nan() || points.is_empty() {
@@ -479,8 +479,9 @@ pub fn signed_volume(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> f64 
 /// used as they are. Otherwise each edge vector is first scaled by its own power of two (exact)
 /// to components below 2, and the area scaled back, so that neither the cross product nor its
 /// square underflows or overflows: legs of 1e-90 give 5e-181, not 0, legs of 1e80 give 5e159,
-/// not ∞, and legs of 1e200 and 1e-200 give 0.5. The result is ∞ only when the area itself is past `f64::MAX` (and 0 only when it
-/// is below the smallest subnormal, or the triangle is flat); NaN when a coordinate is.
+/// not ∞, and legs of 1e200 and 1e-200 give 0.5. The result is ∞ only when the area itself is
+/// past `f64::MAX` (and 0 only when it is below the smallest subnormal, or the triangle is
+/// flat); NaN when a coordinate is.
 ///
 /// # Examples
 ///
@@ -1085,7 +1086,7 @@ impl TriMesh {
         for (i, t) in self.triangles.iter().enumerate() {
             let mut c = t.map(|v| self.points[v as usize]);
             // Scale-invariant: a triangle outside the ordinary range of sizes is first brought to
-            // a size of about 1 by a power of two (ordinary triangles are kept bit for bit), so
+            // a size just below 2^250 by a power of two (ordinary ones are kept bit for bit), so
             // neither 2A nor l² underflows (legs of 1e-90) or overflows (legs of 1e155: ∞ ≤ ∞).
             fit_for_products(&mut c);
             let two_a = 2.0 * triangle_area(c[0], c[1], c[2]);

@@ -302,6 +302,23 @@ impl TriMeshReport {
 /// assert_eq!(centroid(&[]), [0.0; 3]);
 /// ```
 pub fn centroid(points: &[[f64; 3]]) -> [f64; 3] {
+    centroid_of(points.iter().copied())
+}
+
+/// [`centroid`] of points given by an iterator that knows its length, so that a caller holding
+/// ids rather than points needs no buffer. Same law and cost: each point divided by the count
+/// before the sum; the origin for none. O(points), no allocation.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mesh::{centroid, centroid_of};
+/// let x = [[0.0; 3], [2.0, 4.0, 6.0], [9.0; 3]];
+/// let ids = [0usize, 1];
+/// assert_eq!(centroid_of(ids.iter().map(|&i| x[i])), centroid(&x[..2]));
+/// assert_eq!(centroid_of(std::iter::empty()), [0.0; 3]);
+/// ```
+pub fn centroid_of(points: impl ExactSizeIterator<Item = [f64; 3]>) -> [f64; 3] {
     let n = points.len() as f64;
     let mut c = [0.0; 3];
     for p in points {

@@ -21,11 +21,12 @@ use std::time::Instant;
 
 use indicatif::ProgressBar;
 use topomech::mechanics::{Body, Integrator, StepConfig, StepError, Stepper, Vec3};
+use topomech::mesh::centroid_of;
 use topomech::subdivide::{EdgeKey, LeveledMap, LeveledMechanics, TetMasses};
 use topomech::surface::Surface;
 use topomech::{AlphaMask, CellId, DartId, GMap};
 
-use super::scene::{centroid, SceneConfig, StageRun};
+use super::scene::{SceneConfig, StageRun};
 use super::DemoError;
 
 /// The level the incision zone is refined to.
@@ -285,7 +286,7 @@ fn volume_centroid(map: &GMap<3>, positions: &[Vec3], d: DartId) -> Vec3 {
     let mut ids: Vec<CellId> = map.orbit(d, AlphaMask::cell(3, 3)).into_iter().map(|x| map.vertex_id(x)).collect();
     ids.sort_unstable();
     ids.dedup();
-    centroid(ids.iter().map(|v| positions.get(v.index()).copied().unwrap_or([0.0; 3])))
+    centroid_of(ids.iter().map(|v| positions.get(v.index()).copied().unwrap_or([0.0; 3])))
 }
 
 fn vertex_index(s: &mut Surface, index: &mut [u32], positions: &[Vec3], v: CellId) -> u32 {

@@ -19,6 +19,7 @@ use std::time::Instant;
 use indicatif::ProgressBar;
 use topomech::cut::{self, CutError, Plane};
 use topomech::mechanics::{Body, Integrator, Material, PinSpec, Simulation, StepConfig, TouchedCells, Vec3};
+use topomech::mesh::centroid_of;
 use topomech::{AlphaMask, CellId, DartId};
 
 use super::checks::Checker;
@@ -276,7 +277,7 @@ impl Scene {
         let mut ids: Vec<CellId> = map.orbit(d, AlphaMask::of(&[0, 1])).into_iter().map(|x| map.vertex_id(x)).collect();
         ids.sort_unstable();
         ids.dedup();
-        centroid(ids.iter().map(|&v| self.body.attrs().position()[v]))
+        centroid_of(ids.iter().map(|&v| self.body.attrs().position()[v]))
     }
 
     /// The tear threshold: [`TEAR_FRACTION`] of the largest vertex stress now. O(springs + slots).
@@ -343,7 +344,7 @@ impl Scene {
             let mut ids: Vec<CellId> = map.cell_darts(3, d).into_iter().map(|y| map.vertex_id(y)).collect();
             ids.sort_unstable();
             ids.dedup();
-            let g = centroid(ids.iter().map(|&v| x[v]));
+            let g = centroid_of(ids.iter().map(|&v| x[v]));
             let dist = topomech::mesh::distance(g, c);
             if dist <= r {
                 out.push((map.cell_id(3, d), dist));
@@ -352,9 +353,4 @@ impl Scene {
         out.sort_unstable_by_key(|&(id, _)| id);
         out
     }
-}
-
-/// The mean of `points` (the origin for none; [`topomech::mesh::centroid`]). O(points).
-pub fn centroid(points: impl Iterator<Item = Vec3>) -> Vec3 {
-    topomech::mesh::centroid(&points.collect::<Vec<_>>())
 }

@@ -334,7 +334,9 @@ impl SplitMix64 {
         z ^ (z >> 31)
     }
 
-    /// A number in 0..n (n > 0).
+    /// A number in 0..max(n, 1): uniform up to a bias of n / 2⁶⁴ (the remainder of one 64-bit
+    /// draw), and 0 for n = 0 — the range is taken as at least {0} so that the call is total
+    /// (no division by zero). O(1).
     ///
     /// # Examples
     ///
@@ -345,9 +347,10 @@ impl SplitMix64 {
     /// let rolls: Vec<usize> = (0..600).map(|_| rng.below(6)).collect();
     /// assert!(rolls.iter().all(|&r| r < 6));
     /// assert!((0..6).all(|face| rolls.contains(&face))); // every value turns up
+    /// assert_eq!(rng.below(0), 0); // the empty range is taken as {0}
     /// ```
     pub fn below(&mut self, n: usize) -> usize {
-        (self.next_u64() % n as u64) as usize
+        (self.next_u64() % (n as u64).max(1)) as usize
     }
 }
 

@@ -403,6 +403,10 @@ pub fn midpoint(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 /// overflow nor underflow, so [`fit_for_products`] leaves them as they are.
 pub(crate) const PLAIN_EXTENT: std::ops::RangeInclusive<f64> = 5.527147875260445e-76..=1.8092513943330656e75;
 
+/// 2⁻¹⁰⁰⁰: a cross product whose largest component is below this may have lost terms to
+/// underflow ([`triangle_area`] then scales its edges first).
+const CROSS_FLOOR: f64 = 9.332636185032189e-302;
+
 /// `x` · 2^`e`, exact unless the result over- or underflows (in at most two steps: one power of
 /// two is normal only up to 2^±1022). O(1).
 pub(crate) fn times_pow2(mut x: f64, mut e: i64) -> f64 {
@@ -428,7 +432,7 @@ fn coordinate_extent(points: &[[f64; 3]]) -> f64 {
 
 /// e with 2^e ≤ x < 2^(e+1), for a finite x > 0, read from the bits (exact, subnormals
 /// included). O(1).
-fn binary_exponent(x: f64) -> i64 {
+pub(crate) fn binary_exponent(x: f64) -> i64 {
     let biased = ((x.to_bits() >> 52) & 0x7ff) as i64;
     if biased == 0 {
         binary_exponent(x * 2f64.powi(64)) - 64 // subnormal: 2^64 x is normal
@@ -493,10 +497,14 @@ pub fn signed_volume(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> f64 
 /// Area of the triangle `(a, b, c)` (always `>= 0`), `½|(b − a) × (c − a)|`. O(1).
 ///
 /// Edge vectors whose components lie between about 2⁻²⁵⁰ and 2²⁵⁰ (every ordinary triangle) are
-/// used as they are. Otherwise each edge vector is first scaled by its own power of two (exact)
-/// to components below 2, and the area scaled back, so that neither the cross product nor its
+/// used as they are. Otherwise the cross product is taken as it is when none of its products
+/// overflowed or underflowed (its largest component finite and at least 2⁻¹⁰⁰⁰), with a
+/// scale-safe norm; only when it did is each edge vector first scaled by its own power of two
+/// (exact) to components below 2, and the area scaled back. So neither the cross product nor its
 /// square underflows or overflows: legs of 1e-90 give 5e-181, not 0, legs of 1e80 give 5e159,
-/// not ∞, and legs of 1e200 and 1e-200 give 0.5. The result is ∞ only when the area itself is
+/// not ∞, legs of 1e200 and 1e-200 give 0.5, and a needle (0, 0, 0), (1e200, 0, 0),
+/// (1e200, 1e-120, 0) gives 5e79 (a component 2⁻⁶⁶⁵ times its edge's largest is not lost to a
+/// scaling). The result is ∞ only when the area itself is
 /// past `f64::MAX` (and 0 only when it is below the smallest subnormal, or the triangle is
 /// flat); NaN when a coordinate is.
 ///
@@ -510,6 +518,7 @@ pub fn signed_volume(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> f64 
 /// assert_eq!(triangle_area([0.0; 3], [1e-90, 0.0, 0.0], [0.0, 1e-90, 0.0]), 0.5 * 1e-90 * 1e-90);
 /// assert_eq!(triangle_area([0.0; 3], [1e80, 0.0, 0.0], [0.0, 1e80, 0.0]), 0.5 * 1e80 * 1e80);
 /// assert_eq!(triangle_area([0.0; 3], [1e200, 0.0, 0.0], [0.0, 1e-200, 0.0]), 0.5); // a needle
+/// assert_eq!(triangle_area([0.0; 3], [1e200, 0.0, 0.0], [1e200, 1e-120, 0.0]), 5e79);
 /// assert_eq!(triangle_area([-f64::MAX, 0.0, 0.0], [f64::MAX, 0.0, 0.0], [0.0, f64::MAX, 0.0]), f64::INFINITY);
 /// ```
 pub fn triangle_area(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
@@ -519,6 +528,13 @@ pub fn triangle_area(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
     let plain = 0.5 * norm(cross(u, v));
     if (plain_range(largest(u)) && plain_range(largest(v))) || [a, b, c].iter().flatten().any(|x| x.is_nan()) {
         return plain;
+    }
+    // The cross product itself is right when none of its products overflowed and its largest
+    // component is far above the underflow threshold (a product lost there is below 2⁻⁷⁴ of
+    // it); only its norm needs care (2·|w/4| = ½|w|, exact quartering).
+    let w = cross(u, v);
+    if w.iter().all(|x| x.is_finite()) && largest(w) >= CROSS_FLOOR {
+        return 2.0 * distance(w.map(|x| 0.25 * x), [0.0; 3]);
     }
     // A difference past f64::MAX: the corners are quartered first (the area by 1/16).
     let (u, v, quartered) = if largest(u).is_finite() && largest(v).is_finite() {

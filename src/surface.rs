@@ -18,7 +18,8 @@
 //! assert!((s.enclosed_volume().unwrap() - 8.0).abs() < 1e-12);
 //! ```
 
-use crate::mechanics::geom::{cross, dot, norm, sub};
+use crate::mechanics::geom::{cross, dot, sub};
+use crate::mesh::{fit_for_products, times_pow2, triangle_area};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -80,6 +81,17 @@ pub enum SurfaceError {
         /// The number of vertices (`positions.len()`).
         vertices: usize,
     },
+    /// A vertex position is NaN or infinite (the fields of [`Surface`] are public): no measure
+    /// or OBJ file of it would be meaningful, and the OBJ reader refuses such a file.
+    #[error("surface vertex {vertex} (vertex id {id}) has a non-finite position {position:?}")]
+    NonFinitePosition {
+        /// The vertex's index in `positions`.
+        vertex: usize,
+        /// Its id (`Surface::vertex_ids`), or `u32::MAX` if the surface has none for it.
+        id: u32,
+        /// The position.
+        position: Vec3,
+    },
     /// The OBJ file could not be written (the cause names the file or its temporary sibling).
     #[error("cannot write the surface OBJ file {}: {source}", .path.display())]
     Write {
@@ -92,10 +104,11 @@ pub enum SurfaceError {
 
 /// An indexed triangle mesh: the boundary of a solid.
 ///
-/// Invariants (kept by the constructors of this module; the fields are public, so
-/// [`Surface::check`] checks the first, and the measures and OBJ writers call it): every index
-/// of `triangles` is `< positions.len()`; every surface vertex is used by some triangle (the vertex array is
-/// compacted); `vertex_ids.len() == positions.len()` and `face_volumes.len() == triangles.len()`;
+/// Invariants (kept by the constructors of this module for finite input; the fields are public,
+/// so [`Surface::check`] checks the first two, and the measures and OBJ writers call it): every
+/// index of `triangles` is `< positions.len()`; every position is finite; every surface vertex
+/// is used by some triangle (the vertex array is compacted); `vertex_ids.len() ==
+/// positions.len()` and `face_volumes.len() == triangles.len()`;
 /// each triangle is oriented outward, i.e. its normal (b − a) × (c − a) points away from the
 /// fourth vertex of the tetrahedron behind it (measured at rest for a body).
 ///
@@ -236,8 +249,12 @@ pub fn boundary_surface_of_tets(points: &[Vec3], tets: &[[u32; 4]]) -> Result<Su
 }
 
 /// Sign of the apex `q[3]` relative to the plane of the triangle `q[0..3]` oriented by its normal:
-/// positive when the apex is in front, i.e. the triangle faces inward.
-fn apex_side(q: [Vec3; 4]) -> f64 {
+/// positive when the apex is in front, i.e. the triangle faces inward. The triple product is a
+/// cube of the lengths, so it is taken on the points fitted by [`fit_for_products`] (moved to
+/// `q[0]` and scaled by a power of two): the same sign at edge lengths 1e-200 and 1e200 as at 1
+/// (and the plain product, bit for bit, where the lengths need no scaling). O(1).
+fn apex_side(mut q: [Vec3; 4]) -> f64 {
+    fit_for_products(&mut q);
     let n = cross(sub(q[1], q[0]), sub(q[2], q[0]));
     let s = dot(n, sub(q[3], q[0]));
     if s > 0.0 {
@@ -282,13 +299,15 @@ impl Builder {
 }
 
 impl Surface {
-    /// Checks that every triangle corner is an index into `positions`, the invariant the
-    /// measures ([`Surface::area`], [`Surface::enclosed_volume`]) and the OBJ writers
-    /// ([`Surface::to_obj`], [`Surface::write_obj`]) rely on; they call it first. O(triangles).
+    /// Checks that every triangle corner is an index into `positions` and that every position is
+    /// finite, the invariants the measures ([`Surface::area`], [`Surface::enclosed_volume`]) and
+    /// the OBJ writers ([`Surface::to_obj`], [`Surface::write_obj`]) rely on; they call it first.
+    /// O(triangles + vertices).
     ///
     /// # Errors
     /// [`SurfaceError::VertexOutOfRange`] naming the first triangle, corner and index past the
-    /// vertices.
+    /// vertices; then [`SurfaceError::NonFinitePosition`] naming the first vertex with a NaN or
+    /// infinite coordinate.
     ///
     /// # Examples
     ///
@@ -303,6 +322,10 @@ impl Surface {
     ///     s.check(),
     ///     Err(SurfaceError::VertexOutOfRange { triangle: 1, corner: 0, index: 4, vertices: 4 })
     /// ));
+    /// s.triangles[1][0] = 0;
+    /// s.positions[2][1] = f64::NAN; // surface vertex 2 is point s.vertex_ids[2] of the mesh
+    /// let Err(SurfaceError::NonFinitePosition { vertex: 2, id, .. }) = s.check() else { panic!() };
+    /// assert_eq!(id, s.vertex_ids[2]);
     /// ```
     pub fn check(&self) -> Result<(), SurfaceError> {
         let vertices = self.positions.len();
@@ -310,6 +333,12 @@ impl Surface {
             if let Some((corner, &index)) = tri.iter().enumerate().find(|(_, &i)| i as usize >= vertices) {
                 return Err(SurfaceError::VertexOutOfRange { triangle, corner, index, vertices });
             }
+        }
+        if let Some((vertex, &position)) =
+            self.positions.iter().enumerate().find(|(_, p)| p.iter().any(|c| !c.is_finite()))
+        {
+            let id = self.vertex_ids.get(vertex).copied().unwrap_or(u32::MAX);
+            return Err(SurfaceError::NonFinitePosition { vertex, id, position });
         }
         Ok(())
     }
@@ -334,14 +363,17 @@ impl Surface {
         }))
     }
 
-    /// The signed volume enclosed by the triangles, Σ a·(b × c) / 6 (divergence theorem). For a
-    /// closed, outward-oriented surface it is the volume of the solid; it is independent of the
-    /// origin only when the surface is closed. +0.0 for no triangles. O(triangles), including the
-    /// index check.
+    /// The signed volume enclosed by the triangles, Σ (a − o)·((b − o) × (c − o)) / 6 with `o`
+    /// the first vertex (divergence theorem). For a closed, outward-oriented surface it is the
+    /// volume of the solid, whatever `o` (for an open one it depends on `o`). Measured from a
+    /// vertex, it does not depend on where the surface is: a unit cube at 1e9 encloses 1. The
+    /// products are taken on the vertices fitted by a power of two (as `mesh` does for tets), so
+    /// the result is ∞ or 0 only when the volume itself is past f64::MAX or below the smallest
+    /// f64. +0.0 for no triangles. O(vertices + triangles), including the check.
     ///
     /// # Errors
-    /// [`SurfaceError::VertexOutOfRange`] naming the first triangle corner past the vertices
-    /// (see [`Surface::check`]).
+    /// As [`Surface::check`]: [`SurfaceError::VertexOutOfRange`] naming the first triangle corner
+    /// past the vertices, [`SurfaceError::NonFinitePosition`] naming a non-finite vertex.
     ///
     /// # Examples
     ///
@@ -357,16 +389,24 @@ impl Surface {
     /// ```
     pub fn enclosed_volume(&self) -> Result<f64, SurfaceError> {
         self.check()?;
-        let p = |i: u32| self.positions[i as usize];
+        let mut fitted = self.positions.clone();
+        // Moved to the first vertex and scaled by 2^k when the extent needs it (k = 0: as is).
+        let k = fit_for_products(&mut fitted);
+        let o = fitted.first().copied().unwrap_or_default();
+        let p = |i: u32| sub(fitted[i as usize], o);
+        let triple = |&[a, b, c]: &[u32; 3]| dot(p(a), cross(p(b), p(c)));
         // A fold from +0.0, not `sum` (which starts at −0.0): no triangles measure +0.0.
-        Ok(self.triangles.iter().map(|&[a, b, c]| dot(p(a), cross(p(b), p(c)))).fold(0.0, |sum, v| sum + v) / 6.0)
+        let sum = self.triangles.iter().map(triple).fold(0.0, |sum, v| sum + v);
+        Ok(times_pow2(sum / 6.0, -3 * k))
     }
 
-    /// Total area of the triangles, +0.0 for none. O(triangles), including the index check.
+    /// Total area of the triangles, each by the scale-safe [`crate::mesh::triangle_area`] (a
+    /// cube of side 1e-90 measures 6e-180, one of side 1e80 6e160), +0.0 for none.
+    /// O(vertices + triangles), including the check.
     ///
     /// # Errors
-    /// [`SurfaceError::VertexOutOfRange`] naming the first triangle corner past the vertices
-    /// (see [`Surface::check`]).
+    /// As [`Surface::check`]: [`SurfaceError::VertexOutOfRange`] naming the first triangle corner
+    /// past the vertices, [`SurfaceError::NonFinitePosition`] naming a non-finite vertex.
     ///
     /// # Examples
     ///
@@ -384,18 +424,20 @@ impl Surface {
     pub fn area(&self) -> Result<f64, SurfaceError> {
         self.check()?;
         let p = |i: u32| self.positions[i as usize];
-        let area = |&[a, b, c]: &[u32; 3]| norm(cross(sub(p(b), p(a)), sub(p(c), p(a)))) / 2.0;
+        let area = |&[a, b, c]: &[u32; 3]| triangle_area(p(a), p(b), p(c));
         // A fold from +0.0, not `sum` (which starts at −0.0): no triangles measure +0.0.
         Ok(self.triangles.iter().map(area).fold(0.0, |sum, a| sum + a))
     }
 
     /// The surface as Wavefront OBJ text: a comment header, one `v x y z` line per vertex
     /// (shortest round-trip decimal form), one `f i j k` line per triangle (1-based indices, in
-    /// the triangle's outward orientation). O(vertices + triangles), including the index check.
+    /// the triangle's outward orientation), which [`crate::io::parse_obj`] reads back bit for bit.
+    /// O(vertices + triangles), including the check.
     ///
     /// # Errors
-    /// [`SurfaceError::VertexOutOfRange`] naming the first triangle corner past the vertices
-    /// (see [`Surface::check`]): a face with no vertex is not written.
+    /// As [`Surface::check`]: [`SurfaceError::VertexOutOfRange`] naming the first triangle corner
+    /// past the vertices (a face with no vertex is not written), [`SurfaceError::NonFinitePosition`]
+    /// naming a NaN or infinite vertex (which the OBJ reader would refuse).
     ///
     /// # Examples
     ///
@@ -432,8 +474,9 @@ impl Surface {
     /// then a rename: see [`crate::store::write_atomically`]). O(vertices + triangles).
     ///
     /// # Errors
-    /// [`SurfaceError::VertexOutOfRange`] as [`Surface::to_obj`], checked before anything is
-    /// written (no file is created or replaced); [`SurfaceError::Write`] naming `path`.
+    /// [`SurfaceError::VertexOutOfRange`] and [`SurfaceError::NonFinitePosition`] as
+    /// [`Surface::to_obj`], checked before anything is written (no file is created or replaced);
+    /// [`SurfaceError::Write`] naming `path`.
     ///
     /// # Examples
     ///

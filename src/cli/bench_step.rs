@@ -17,7 +17,7 @@ use topomech::load;
 use topomech::mechanics::{FlatModel, Integrator, Material, PinSpec, Simulation, StepConfig, Stepper};
 use topomech::mesh::TetMesh;
 
-use super::simulate::median;
+use super::simulate::{median, StepTimes};
 use super::{build_body, other, print_report, print_warnings, CliError};
 
 /// Arguments of `topomech bench`.
@@ -237,7 +237,7 @@ fn run_step(args: StepBenchArgs) -> Result<(), CliError> {
     let config = StepConfig::new(args.integrator, dt);
     let mut sim = Simulation::new(&mut body, gravity, config).map_err(other)?;
     let mut stepper = Stepper::new(config, &flat.system, &flat.position, &flat.velocity).map_err(other)?;
-    let (mut map_t, mut flat_t) = (Vec::with_capacity(args.rounds), Vec::with_capacity(args.rounds));
+    let (mut map_t, mut flat_t) = (StepTimes::new(args.rounds as u64), StepTimes::new(args.rounds as u64));
     let batch = args.batch.max(1);
     for _ in 0..args.rounds.max(1) {
         let start = Instant::now();
@@ -251,7 +251,7 @@ fn run_step(args: StepBenchArgs) -> Result<(), CliError> {
         }
         flat_t.push(start.elapsed().as_secs_f64() * 1e6 / batch as f64);
     }
-    let (map_us, flat_us) = (median(&mut map_t), median(&mut flat_t));
+    let (map_us, flat_us) = (map_t.median(), flat_t.median());
     let report = BenchJson {
         map_step_us: map_us,
         flat_step_us: flat_us,

@@ -101,7 +101,7 @@ fn law_name(f: &Finding) -> &'static str {
         Finding::Map(v) => map_law_name(v),
         Finding::Conservation(_) => "conservation",
         Finding::Level(LevelPartsError::Law(e)) => match e {
-            LevelError::MuOrder { .. } => "mu_order",
+            LevelError::MuOrder { .. } | LevelError::AboveMaxLevel { .. } => "mu_order",
             LevelError::MuNotConstant { .. } => "mu_constant",
             LevelError::NotClosed { .. } => "level_closed",
             LevelError::InvalidLevel { .. } | LevelError::InvalidMap(_) => "level_valid",
@@ -149,8 +149,14 @@ fn violation_darts(v: &InvariantViolation) -> Vec<u32> {
 
 fn level_darts(e: &LevelPartsError) -> Vec<u32> {
     match e {
-        LevelPartsError::DartLevelAboveMax { dart, .. } | LevelPartsError::BadHistory { dart, .. } => vec![dart.0],
-        LevelPartsError::Law(LevelError::MuOrder { dart, .. } | LevelError::FlatFlag { dart, .. }) => vec![dart.0],
+        LevelPartsError::DartLevelAboveMax { dart, .. }
+        | LevelPartsError::MuAboveMax { dart, .. }
+        | LevelPartsError::BadHistory { dart, .. } => vec![dart.0],
+        LevelPartsError::Law(
+            LevelError::MuOrder { dart, .. }
+            | LevelError::AboveMaxLevel { dart, .. }
+            | LevelError::FlatFlag { dart, .. },
+        ) => vec![dart.0],
         LevelPartsError::Law(LevelError::MuNotConstant { dart, other, .. }) => vec![dart.0, other.0],
         LevelPartsError::Law(LevelError::NotClosed { dart, image, .. }) => vec![dart.0, image.0],
         LevelPartsError::Law(LevelError::InvalidLevel { source: v, .. } | LevelError::InvalidMap(v)) => {

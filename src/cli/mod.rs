@@ -76,9 +76,10 @@ pub(crate) fn build_body(path: &Path, mesh: &TetMesh, material: Material) -> Res
 /// of the points of the tet or the point at fault, when the mesh knows them. O(1).
 pub(crate) fn model_error(path: &Path, mesh: &TetMesh, source: ModelError) -> CliError {
     let points: Vec<u32> = match &source {
-        ModelError::DegenerateTet { tet } | ModelError::Overflow { tet, .. } => {
-            mesh.tets.get(*tet).map_or(Vec::new(), |t| t.to_vec())
-        }
+        ModelError::DegenerateTet { tet }
+        | ModelError::Overflow { tet, .. }
+        | ModelError::VolumeUnderflow { tet, .. }
+        | ModelError::MassTooSmall { tet, .. } => mesh.tets.get(*tet).map_or(Vec::new(), |t| t.to_vec()),
         ModelError::NonFinitePoint { point, .. } => vec![*point as u32],
         _ => Vec::new(),
     };

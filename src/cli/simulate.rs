@@ -164,7 +164,7 @@ fn simulate(args: &SimulateArgs, parallel: bool) -> Result<(), CliError> {
     let mut frames = FrameWriter::new(args, &body)?;
     frames.maybe_write(0, &body)?;
     let bar = progress_bar(args.steps);
-    let mut times = Vec::with_capacity(args.steps as usize);
+    let mut times = StepTimes::new(args.steps);
     for step in 1..=args.steps {
         let start = Instant::now();
         sim.step(&mut body).map_err(other)?;
@@ -177,7 +177,7 @@ fn simulate(args: &SimulateArgs, parallel: bool) -> Result<(), CliError> {
         steps: args.steps,
         dt: args.dt,
         integrator: args.integrator.name(),
-        step_us_median: median(&mut times),
+        step_us_median: times.median(),
         total_mass: body.total_vertex_mass(),
         kinetic_energy: sim.kinetic_energy(&body).map_err(other)?,
         max_displacement: sim.max_displacement(&body).map_err(other)?,
@@ -219,6 +219,56 @@ fn progress_bar(steps: u64) -> ProgressBar {
         bar.set_style(style);
     }
     bar
+}
+
+/// Times of a run's steps (or rounds), kept for their median in bounded memory: at most
+/// [`StepTimes::CAP`] of them. While a run is short every time is kept; when the sample fills,
+/// every other kept time is dropped and from then on only every second (fourth, …) time is
+/// taken, so the sample stays evenly spaced over the run whatever its length (a user's
+/// `--steps 1e12` costs no more memory than 2¹⁶ steps). O(1) amortized per push.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepTimes {
+    kept: Vec<f64>,
+    stride: u64,
+    seen: u64,
+}
+
+impl StepTimes {
+    /// The most times kept.
+    pub const CAP: usize = 1 << 16;
+
+    /// An empty sample; reserves room for `expected` times, at most [`StepTimes::CAP`].
+    pub fn new(expected: u64) -> Self {
+        let room = usize::try_from(expected).unwrap_or(usize::MAX).min(Self::CAP);
+        StepTimes { kept: Vec::with_capacity(room), stride: 1, seen: 0 }
+    }
+
+    /// Adds the time of the next step: kept when its index is a multiple of the stride.
+    pub fn push(&mut self, t: f64) {
+        if self.seen % self.stride == 0 {
+            self.kept.push(t);
+            if self.kept.len() == Self::CAP {
+                let mut k = 0;
+                self.kept.retain(|_| {
+                    k += 1;
+                    k % 2 == 1
+                });
+                self.stride *= 2;
+            }
+        }
+        self.seen += 1;
+    }
+
+    /// The median of the kept times; 0 for none.
+    pub fn median(&mut self) -> f64 {
+        median(&mut self.kept)
+    }
+}
+
+impl Default for StepTimes {
+    fn default() -> Self {
+        StepTimes::new(0)
+    }
 }
 
 /// Median of `v` (sorts it); 0 for an empty slice.
@@ -278,5 +328,38 @@ impl FrameWriter {
 
     fn pvd(&self) -> Option<PathBuf> {
         self.series.as_ref().map(Series::pvd_path)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A short run keeps every time: the median is the plain median.
+    #[test]
+    fn step_times_keep_a_short_run_whole() {
+        let mut t = StepTimes::new(5);
+        for x in [5.0, 1.0, 4.0, 2.0, 3.0] {
+            t.push(x);
+        }
+        assert_eq!(t.kept, vec![5.0, 1.0, 4.0, 2.0, 3.0]);
+        assert_eq!(t.median(), 3.0);
+    }
+
+    /// A long run keeps at most CAP times, evenly spaced: step k is kept iff k is a multiple of
+    /// the stride, so the median of 0, 1, …, n−1 stays near (n−1)/2.
+    #[test]
+    fn step_times_stay_bounded_and_evenly_spaced() {
+        let n = 3 * StepTimes::CAP as u64 + 5;
+        let mut t = StepTimes::new(u64::MAX); // reserves CAP, not 2⁶⁴ slots
+        assert!(t.kept.capacity() <= StepTimes::CAP);
+        for k in 0..n {
+            t.push(k as f64);
+        }
+        assert!(t.kept.len() < StepTimes::CAP);
+        assert_eq!(t.stride, 4);
+        assert!(t.kept.iter().enumerate().all(|(j, &x)| x == (j as u64 * t.stride) as f64));
+        let m = t.median();
+        assert!((m - (n - 1) as f64 / 2.0).abs() <= t.stride as f64, "median {m} of 0..{n}");
     }
 }

@@ -392,6 +392,17 @@ pub trait CellRules<const N: usize> {
         Ok(())
     }
 
+    /// Whether the rules can keep their laws through an i-unsew of `d` (the cells it splits get
+    /// the split rules), asked before the map changes. The default accepts every unsew. O(1)
+    /// typically.
+    ///
+    /// # Errors
+    /// `Self::Error` naming what the split could not keep; the unsew is then refused.
+    fn check_unsew(&self, map: &GMap<N>, i: usize, d: DartId) -> Result<(), Self::Error> {
+        let _ = (map, i, d);
+        Ok(())
+    }
+
     /// Checks the attributes against the map (laws such as conservation). O(model) typically.
     ///
     /// # Errors
@@ -470,11 +481,11 @@ pub enum EmbedError<E: std::error::Error + 'static> {
     /// The topological operation was refused; map and attributes are unchanged.
     #[error(transparent)]
     Sew(#[from] SewError),
-    /// The rules cannot keep their laws through the operation ([`CellRules::check_sew`]); map
-    /// and attributes are unchanged.
+    /// The rules cannot keep their laws through the operation ([`CellRules::check_sew`],
+    /// [`CellRules::check_unsew`]); map and attributes are unchanged.
     #[error("{op} of {dart} refused: {source}")]
     Refused {
-        /// "sew".
+        /// "sew" or "unsew".
         op: &'static str,
         /// The dart the operation was called with.
         dart: DartId,
@@ -776,6 +787,11 @@ impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
     /// assert!(body.check().is_ok());
     /// ```
     pub fn unsew(&mut self, i: usize, d: DartId) -> Result<CellChanges, EmbedError<E::Error>> {
+        self.attrs.check_unsew(&self.map, i, d).map_err(|source| EmbedError::Refused {
+            op: "unsew",
+            dart: d,
+            source,
+        })?;
         let changes = self.map.unsew_dyn(i, d)?;
         self.apply(&changes);
         self.after("unsew", d)?;

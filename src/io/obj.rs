@@ -42,14 +42,18 @@ fn number<T: std::str::FromStr>(
 }
 
 /// Resolves one face corner (`i`, `i/t`, `i//n`, `i/t/n`) of face `face` to a 1-based vertex
-/// number, `vertices` being the number of vertices read so far.
+/// number, `vertices` being the number of vertices read so far (an index past them is left to
+/// the builder, once the whole file is read: faces may name vertices defined later).
 ///
 /// # Errors
-/// `Garbage` for an index that is not an integer; `Malformed`, naming the index as written, for
-/// 0 or a negative index that counts back past the first vertex.
+/// `Garbage`, naming the corner as written, for an index that is not an integer; `Malformed`,
+/// naming the index as written, for 0 or a negative index that counts back past the first
+/// vertex.
 fn corner(path: &Path, line: usize, face: u64, raw: &[u8], vertices: u64) -> Result<u64, ReadError> {
     let index_part = raw.split(|&b| b == b'/').next().unwrap_or(&[]);
-    let i: i64 = number(path, line, Some(index_part), "a vertex index")?;
+    // A bad index is named by the corner as written ("/3", not the empty part before the slash).
+    let i: i64 = number(path, line, Some(index_part), "a vertex index")
+        .map_err(|_| garbage(path, line, raw, "a vertex index"))?;
     let resolved = if i < 0 { i128::from(vertices) + 1 + i128::from(i) } else { i128::from(i) };
     match u64::try_from(resolved) {
         Ok(n) if n >= 1 => Ok(n),

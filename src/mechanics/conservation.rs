@@ -145,6 +145,17 @@ pub enum ConservationError {
         /// The distance between their rest positions.
         distance: f64,
     },
+    /// A 0-unsew would leave an edge (a spring) with one vertex for both ends: a spring cannot
+    /// lose an end, so no rest length or stiffness could follow it. Raised before the unsew
+    /// ([`crate::embedding::CellRules::check_unsew`]), which is then refused; bodies are cut by
+    /// dissociating faces (3-unsews), which split springs into parallel ones instead.
+    #[error("0-unsewing {dart} would cut the spring of its edge {edge} into ends with no length (a body's edges cannot lose a vertex; cut by 3-unsews)")]
+    UnsewEdge {
+        /// The dart the unsew was called with.
+        dart: DartId,
+        /// Its edge.
+        edge: CellId,
+    },
 }
 
 /// What the volume-centred scatter recomputes.

@@ -48,6 +48,8 @@ impl FlatModel {
     /// What [`crate::mechanics::Body::from_tets`] refuses, so that the oracle and the body are
     /// built from the same inputs: [`ModelError::BadMaterial`], [`ModelError::Build`] for a bad
     /// index or repeated point, [`ModelError::DegenerateTet`] for a zero-volume tet,
+    /// [`ModelError::VolumeUnderflow`] for a tet whose volume is not 0 but below the normal f64
+    /// range, [`ModelError::MassTooSmall`] for a mass with no finite inverse,
     /// [`ModelError::NonFinitePoint`], [`ModelError::Overflow`] when a volume or a total (mass,
     /// stiffness, damping) overflows f64; and [`ModelError::BadGravity`] for a non-finite gravity,
     /// [`ModelError::PinCount`] for a pin list that is neither empty nor one flag per point.

@@ -54,3 +54,83 @@ pub(crate) fn tet_volume(a: Vec3, b: Vec3, c: Vec3, d: Vec3) -> f64 {
 pub(crate) fn close(a: f64, b: f64, rel: f64) -> bool {
     (a - b).abs() <= rel * a.abs().max(b.abs()).max(f64::MIN_POSITIVE)
 }
+
+/// (m, e) with x = m · 2^e and 1 ≤ |m| < 2 for a finite non-zero x (subnormals included), read
+/// from the bits (exact); (x, 0) for 0, ∞ and NaN. O(1).
+pub(crate) fn split_exponent(x: f64) -> (f64, i64) {
+    if x == 0.0 || !x.is_finite() {
+        return (x, 0);
+    }
+    let (x, shift) = if x.abs() < f64::MIN_POSITIVE { (x * 2f64.powi(64), -64) } else { (x, 0) };
+    let biased = ((x.to_bits() >> 52) & 0x7ff) as i64;
+    let mantissa = f64::from_bits((x.to_bits() & !(0x7ff << 52)) | (1023 << 52));
+    (mantissa, biased - 1023 + shift)
+}
+
+/// a · b / l² · 2^e with no intermediate overflow or underflow: the product and quotient are
+/// taken on the mantissas (in (1/4, 4)), the exponents are added, and the result is scaled once
+/// ([`crate::mesh::times_pow2`]), so it is ∞ or 0 only when the value itself is past `f64::MAX`
+/// or below the smallest subnormal. For finite a, b and a finite l ≠ 0. O(1).
+pub(crate) fn ratio_pow2(a: f64, b: f64, l: f64, e: i64) -> f64 {
+    let [(ma, ea), (mb, eb), (ml, el)] = [a, b, l].map(split_exponent);
+    crate::mesh::times_pow2(ma * mb / (ml * ml), ea + eb - 2 * el + e)
+}
+
+/// The rest length |b − a|: √(Σ dₖ²) as it is (the same bits as before) when the largest
+/// difference is 0 or within [`crate::mesh::PLAIN_EXTENT`], where the squares neither overflow
+/// nor underflow, else the scale-safe [`crate::mesh::distance`] (∞ only for a length past
+/// `f64::MAX`). O(1).
+pub(crate) fn rest_length(a: Vec3, b: Vec3) -> f64 {
+    let d = sub(b, a);
+    let largest = d.iter().fold(0.0f64, |m, c| m.max(c.abs()));
+    if largest == 0.0 || crate::mesh::PLAIN_EXTENT.contains(&largest) {
+        norm(d)
+    } else {
+        crate::mesh::distance(b, a)
+    }
+}
+
+/// Whether the tet with corners `c` has exactly zero volume, decided on its corners fitted by
+/// [`crate::mesh::fit_for_products`] (the corners as they are for ordinary extents), so that a
+/// tiny or huge regular tet, whose volume under- or overflows f64, is not called flat. O(1).
+pub(crate) fn is_flat(c: [Vec3; 4]) -> bool {
+    let mut f = c;
+    crate::mesh::fit_for_products(&mut f);
+    tet_volume(f[0], f[1], f[2], f[3]) == 0.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn split_exponent_is_exact_for_normals_and_subnormals() {
+        assert_eq!(split_exponent(12.0), (1.5, 3));
+        assert_eq!(split_exponent(-0.75), (-1.5, -1));
+        assert_eq!(split_exponent(5e-324), (1.0, -1074));
+        assert_eq!(split_exponent(f64::MAX).1, 1023);
+        assert_eq!(split_exponent(0.0), (0.0, 0));
+    }
+
+    #[test]
+    fn ratio_pow2_has_no_intermediate_overflow() {
+        assert!((ratio_pow2(1e300, 1e100, 1e100, 0) / 1e200 - 1.0).abs() < 1e-15); // E·V = ∞ on its own
+        assert_eq!(ratio_pow2(3.0, 4.0, 2.0, 1), 6.0);
+        assert!((ratio_pow2(1e-300, 1e-300, 1e-300, 0) / 1.0 - 1.0).abs() < 1e-15);
+        assert_eq!(ratio_pow2(f64::MAX, 4.0, 1.0, 0), f64::INFINITY);
+    }
+
+    #[test]
+    fn rest_length_is_plain_in_range_and_scale_safe_outside() {
+        assert_eq!(rest_length([0.0; 3], [3.0, 4.0, 0.0]), 5.0);
+        assert_eq!(rest_length([0.0; 3], [3e160, 4e160, 0.0]), 5e160);
+        assert_eq!(rest_length([0.0; 3], [3e-160, 4e-160, 0.0]), 5e-160);
+    }
+
+    #[test]
+    fn is_flat_decides_on_fitted_corners() {
+        let s = 1e-110;
+        assert!(!is_flat([[0.0; 3], [s, 0.0, 0.0], [0.0, s, 0.0], [0.0, 0.0, s]]));
+        assert!(is_flat([[0.0; 3], [s, 0.0, 0.0], [0.0, s, 0.0], [s, s, 0.0]]));
+    }
+}

@@ -115,11 +115,24 @@ pub enum ModelError {
         /// Its coordinates.
         coords: Vec3,
     },
-    /// A tetrahedron of zero volume would make a massless, infinitely stiff element.
+    /// A tetrahedron of zero volume would make a massless, infinitely stiff element. Decided
+    /// exactly on its corners fitted to a common scale (`mesh::fit_for_products`), so a regular
+    /// tet whose volume merely underflows f64 is not one ([`ModelError::VolumeUnderflow`]).
     #[error("tetrahedron {tet} has zero volume")]
     DegenerateTet {
         /// Tet index (= volume id).
         tet: usize,
+    },
+    /// A tetrahedron that is not flat (its volume is not zero on its corners fitted to a common
+    /// scale) but whose volume, as an f64, is below the normal range (about 2.2e-308: a regular
+    /// tet of edge 1e-103 or less). A model stores rest volumes and measures masses and stiffnesses
+    /// on them, so such a volume would be 0 or lose its precision: refused, not called flat.
+    #[error("tetrahedron {tet} has volume {volume:e}, below the normal range of f64 (coordinates too small for a stored rest volume; it is not flat)")]
+    VolumeUnderflow {
+        /// Tet index (= volume id).
+        tet: usize,
+        /// Its volume as computed in f64 (0 or subnormal).
+        volume: f64,
     },
     /// A sum of the model overflows f64 from this tet on: its volume, the total mass or the total
     /// stiffness (coordinates, density or Young's modulus too large). Every vertex mass and spring
@@ -1033,7 +1046,13 @@ impl Mechanics {
     }
 }
 
-/// Law 2's per-tet term: k_{t,e} = E·|V|/L², zero for a zero-length edge. O(1).
+/// Law 2's per-tet term: k_{t,e} = E·|V|/L², zero for a zero-length edge (or E = 0, V = 0). O(1).
+///
+/// Computed as (E·|V|)/(L·L) when both products are normal numbers (every ordinary input: the
+/// same bits as ever); otherwise, for finite inputs, on the mantissas with the exponents added
+/// (`geom::ratio_pow2`, crate-private), so that E·|V| overflowing or L² under- or overflowing does not
+/// make a finite k infinite or zero: k is ∞ or 0 only when it is itself past `f64::MAX` or below
+/// the smallest subnormal.
 ///
 /// # Examples
 ///
@@ -1043,13 +1062,44 @@ impl Mechanics {
 /// assert_eq!(stiffness_contribution(1000.0, 0.5, 2.0), 125.0); // E·V/L²
 /// assert_eq!(stiffness_contribution(1000.0, -0.5, 2.0), 125.0); // |V|
 /// assert_eq!(stiffness_contribution(1000.0, 0.5, 0.0), 0.0); // a zero-length edge carries nothing
+/// let k = stiffness_contribution(1e300, 1e15, 1e5); // E·V alone is past f64::MAX
+/// assert!((k / 1e305 - 1.0).abs() < 1e-15);
 /// ```
 pub fn stiffness_contribution(young: f64, volume: f64, rest_length: f64) -> f64 {
-    if rest_length > 0.0 {
-        young * volume.abs() / (rest_length * rest_length)
-    } else {
-        0.0
+    if rest_length.is_nan() || rest_length <= 0.0 || young == 0.0 || volume == 0.0 {
+        return 0.0;
     }
+    let (ev, ll) = (young * volume.abs(), rest_length * rest_length);
+    let finite = young.is_finite() && volume.is_finite() && rest_length.is_finite();
+    if !finite || (ev.is_normal() && ll.is_normal()) {
+        return ev / ll;
+    }
+    super::geom::ratio_pow2(young, volume.abs(), rest_length, 0)
+}
+
+/// The corner pairs of a tet, in the order of [`tet_stiffnesses`].
+pub(crate) const TET_PAIRS: [(usize, usize); 6] = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
+
+/// Law 2's six terms of the tet with corners `c` (no volume stored): k_{t,e} = E·|V|/L_e² for the
+/// corner pairs of [`TET_PAIRS`], with L_e = [`super::geom::rest_length`]. For ordinary extents
+/// (`mesh::fit_for_products` leaves the corners as they are) V is the plain determinant and each
+/// term is [`stiffness_contribution`] (the same bits as ever); otherwise V and L_e are measured on
+/// the fitted corners (volumes times 2^3k, lengths times 2^k) and E·V/L² is scaled back by 2^−k,
+/// so a regular tet of edge 1e-110, whose volume underflows f64, gets its finite terms. O(1).
+pub(crate) fn tet_stiffnesses(young: f64, c: [Vec3; 4]) -> [f64; 6] {
+    let mut f = c;
+    let k = crate::mesh::fit_for_products(&mut f);
+    let volume = dot(cross(sub(f[1], f[0]), sub(f[2], f[0])), sub(f[3], f[0])) / 6.0;
+    TET_PAIRS.map(|(i, j)| {
+        if k == 0 {
+            return stiffness_contribution(young, volume, super::geom::rest_length(c[i], c[j]));
+        }
+        let length = crate::mesh::distance(f[j], f[i]);
+        if length.is_nan() || length <= 0.0 || young == 0.0 || volume == 0.0 {
+            return 0.0;
+        }
+        super::geom::ratio_pow2(young, volume.abs(), length, -k)
+    })
 }
 
 /// The distinct values of `ids`, sorted.
@@ -1124,6 +1174,15 @@ impl CellRules<3> for Mechanics {
                 let distance = norm(sub(p, q));
                 return Err(ConservationError::SewApart { dart: x, other: y, vertex: vx, other_vertex: vy, distance });
             }
+        }
+        Ok(())
+    }
+
+    /// A 0-unsew would give an edge's two ends one vertex (law 3 has no rest length for it):
+    /// refused. 1-, 2- and 3-unsews split vertices, edges and faces with their rules. O(1).
+    fn check_unsew(&self, map: &GMap<3>, i: usize, d: DartId) -> Result<(), ConservationError> {
+        if i == 0 && map.contains(d) && !map.is_free(0, d) {
+            return Err(ConservationError::UnsewEdge { dart: d, edge: map.cell_id(1, d) });
         }
         Ok(())
     }
@@ -1253,20 +1312,25 @@ impl ModelTotals {
     /// Adds tet `t` (its corners and volume) to the totals.
     ///
     /// # Errors
-    /// [`ModelError::DegenerateTet`] for a zero volume, [`ModelError::MassTooSmall`] when a
-    /// quarter of the tet's mass has no finite inverse (every vertex mass is at least the quarter
-    /// of one of its tets' masses, so this keeps every 1/m_v finite), [`ModelError::Overflow`]
-    /// when the volume or a total is no longer finite. O(1).
+    /// [`ModelError::DegenerateTet`] for a zero volume (decided on the corners fitted by
+    /// `mesh::fit_for_products`, exactly), [`ModelError::VolumeUnderflow`] for a tet that is not
+    /// flat but whose volume is below the normal range of f64 (the model stores rest volumes),
+    /// [`ModelError::MassTooSmall`] when a quarter of the tet's mass has no finite inverse (every
+    /// vertex mass is at least the quarter of one of its tets' masses, so this keeps every 1/m_v
+    /// finite), [`ModelError::Overflow`] when the volume or a total is no longer finite. O(1).
     pub(crate) fn add(&mut self, t: usize, c: [Vec3; 4], volume: f64, m: &Material) -> Result<(), ModelError> {
-        if volume == 0.0 {
+        if volume == 0.0 && super::geom::is_flat(c) {
             return Err(ModelError::DegenerateTet { tet: t });
+        }
+        if volume.is_finite() && !volume.is_normal() {
+            return Err(ModelError::VolumeUnderflow { tet: t, volume });
         }
         let mass = m.density * volume;
         if !(4.0 / mass.abs()).is_finite() {
             return Err(ModelError::MassTooSmall { tet: t, mass });
         }
         self.mass += m.density * volume;
-        for (i, j) in [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)] {
+        for (i, j) in TET_PAIRS {
             self.stiffness += stiffness_contribution(m.young, volume, norm(sub(c[j], c[i])));
         }
         let totals = [("volume", volume), ("total mass", self.mass), ("total stiffness", self.stiffness)];
@@ -1301,7 +1365,8 @@ impl Embedded<3, Mechanics> {
     /// O(T log T).
     ///
     /// # Errors
-    /// [`ModelError`]: bad material, non-finite point, zero-volume tet, a volume or total (mass,
+    /// [`ModelError`]: bad material, non-finite point, zero-volume tet, a tet whose volume is below
+    /// the normal range of f64 ([`ModelError::VolumeUnderflow`]), a volume or total (mass,
     /// stiffness, damping) that overflows f64, or a build error.
     ///
     /// # Examples

@@ -51,7 +51,10 @@ impl Colormap {
         std::array::from_fn(|k| (a[k] as f64 + f * (b[k] as f64 - a[k] as f64)).round() as u8)
     }
 
-    /// The colour of `value` on the scale `lo..=hi` (the middle colour when `lo == hi`). O(1).
+    /// The colour of `value` on the scale `lo..=hi` (the middle colour when `lo == hi`), i.e. of
+    /// `t = (value − lo) / (hi − lo)`, for any finite ends: when `hi − lo` is past f64::MAX
+    /// (e.g. `-1e308..=1e308`) both differences are taken of halves, which is exact save in the
+    /// subnormal range. O(1).
     ///
     /// # Examples
     ///
@@ -62,9 +65,14 @@ impl Colormap {
     /// assert_eq!(m.color_in(15.0, 10.0, 20.0), m.color(0.5));
     /// assert_eq!(m.color_in(99.0, 10.0, 20.0), m.color(1.0)); // clamped
     /// assert_eq!(m.color_in(3.0, 4.0, 4.0), m.color(0.5)); // empty scale: the middle colour
+    /// assert_eq!(m.color_in(0.0, -f64::MAX, f64::MAX), m.color(0.5)); // a span past f64::MAX
     /// ```
     pub fn color_in(self, value: f64, lo: f64, hi: f64) -> [u8; 3] {
-        let t = if hi > lo { (value - lo) / (hi - lo) } else { 0.5 };
+        if hi <= lo || hi.is_nan() || lo.is_nan() {
+            return self.color(0.5);
+        }
+        let span = hi - lo;
+        let t = if span.is_finite() { (value - lo) / span } else { (value / 2.0 - lo / 2.0) / (hi / 2.0 - lo / 2.0) };
         self.color(t)
     }
 }

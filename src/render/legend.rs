@@ -6,16 +6,19 @@ use super::{Colormap, Image};
 const INK: [u8; 3] = [20, 20, 20];
 
 /// Draws the bar for `map` on `lo..=hi` into `image`; does nothing if the image is too small
-/// (under 48 × 48 pixels). O(bar area + text).
+/// (under 48 × 48 pixels). The font pixel is 1/160 of the shorter side, so a tall, narrow
+/// picture gets a bar as a square one of its width does. O(bar area + text).
 pub(super) fn draw(image: &mut Image, map: Colormap, lo: f64, hi: f64) {
     let (w, h) = (image.width, image.height);
     if w < 48 || h < 48 {
         return;
     }
-    let px = (h / 160).max(1); // font pixel size
+    let px = (w.min(h) / 160).max(1); // font pixel size
     let bar_w = (w / 40).max(4);
-    let x1 = w - 2 * px - 1; // exclusive right edge, inside a small margin
-    let x0 = x1 - bar_w;
+    // Exclusive right edge, inside a small margin; no bar if it would not fit (it always does
+    // from 48 pixels wide, but no difference here is left unchecked).
+    let Some(x1) = w.checked_sub(2 * px + 1) else { return };
+    let Some(x0) = x1.checked_sub(bar_w) else { return };
     let (y0, y1) = (h / 5, h - h / 5);
     for y in y0..y1 {
         let t = (y1 - 1 - y) as f64 / (y1 - 1 - y0).max(1) as f64;

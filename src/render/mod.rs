@@ -37,7 +37,7 @@ pub use colormap::Colormap;
 
 use crate::mechanics::Vec3;
 use crate::surface::Surface;
-use raster::{cross, dot, norm, sub, Target, View};
+use raster::{cross, direction, dot, fitted, norm, scaled_norm, sub, unit, Target, View};
 
 /// The largest image [`render`] and [`Image::new`] accept, in pixels (a bound on the buffers
 /// they allocate: 3 bytes per pixel for the picture, 8 more for the depth buffer of [`render`]).
@@ -113,6 +113,12 @@ pub enum RenderError {
         /// The value.
         value: f64,
     },
+    /// A [`Style::ambient`] that is NaN or outside [0, 1].
+    #[error("style ambient {ambient} is not a share of the light in [0, 1]")]
+    BadAmbient {
+        /// The value asked for.
+        ambient: f64,
+    },
     /// A colour scale whose ends are not finite or are reversed.
     #[error("colour scale range ({lo}, {hi}) must be finite with lo <= hi")]
     BadRange {
@@ -146,7 +152,9 @@ pub enum RenderError {
 /// view follows from the aspect ratio).
 ///
 /// Invariant checked by [`render`] (a [`RenderError::BadCamera`] otherwise): finite coordinates,
-/// `eye != target`, `up` not parallel to the view direction, `0 < fov_y_deg < 180`.
+/// `eye != target` with `target − eye` finite, `up` not parallel to the view direction,
+/// `0 < fov_y_deg < 180`. Lengths do not matter: an eye 1e-170 or 1e150 from its target, or an
+/// `up` of length 1e-200, is as good as one of length 1.
 ///
 /// # Examples
 ///
@@ -195,8 +203,13 @@ impl Camera {
     /// `up` is +z, or +y when `view_dir` is within about 8° of the z axis. Compute it once (e.g.
     /// from the rest shape) to keep the camera fixed over an animation. O(1).
     ///
-    /// A zero or non-finite `view_dir` or box gives a camera that [`render`] refuses; a box of
-    /// zero size is framed as if its radius were 1.
+    /// Any finite box of positive size is framed, from 1e-300 to 1e300 wide: the centre is
+    /// `min/2 + max/2` where `min + max` would overflow, and the radius is measured without
+    /// overflow or underflow of its squares. A zero or non-finite `view_dir` or box gives a camera
+    /// that [`render`] refuses; a box of zero size is framed as if its radius were 1. The eye
+    /// stands about 4 radii from the centre, so for a box whose half-diagonal is past about
+    /// f64::MAX / 5 (or a centre that close to ±f64::MAX) its coordinates overflow to ±∞ and
+    /// [`render`] refuses the camera as not finite.
     ///
     /// ```
     /// use topomech::render::Camera;
@@ -206,18 +219,29 @@ impl Camera {
     /// assert!(c.eye[1] < 0.0 && c.eye[0] == 1.0 && c.eye[2] == 1.0);
     /// ```
     pub fn fit(min: Vec3, max: Vec3, view_dir: Vec3) -> Camera {
-        let target = std::array::from_fn(|k| (min[k] + max[k]) / 2.0);
-        let radius = match norm(sub(max, min)) / 2.0 {
+        let target = crate::mesh::midpoint(min, max);
+        let radius = match half_diagonal(min, max) {
             r if r > 0.0 => r,
             _ => 1.0,
         };
         let half_fov = (Self::FIT_FOV_Y_DEG / 2.0).to_radians();
         let distance = 1.05 * radius / half_fov.sin();
-        let len = norm(view_dir);
-        let dir = view_dir.map(|c| c / len);
+        let dir = unit(view_dir);
         let eye = std::array::from_fn(|k| target[k] - distance * dir[k]);
         let up = if dir[2].abs() < 0.99 { [0.0, 0.0, 1.0] } else { [0.0, 1.0, 0.0] };
         Camera { eye, target, up, fov_y_deg: Self::FIT_FOV_Y_DEG }
+    }
+}
+
+/// Half the length of the diagonal of the box `min..max`, for any finite box (∞ or NaN for a
+/// non-finite one); bit for bit `|max − min| / 2` where its squares neither overflow nor
+/// underflow. O(1).
+fn half_diagonal(min: Vec3, max: Vec3) -> f64 {
+    let d = sub(max, min);
+    if d.iter().all(|c| c.is_finite()) {
+        scaled_norm(d) / 2.0
+    } else {
+        scaled_norm(std::array::from_fn(|k| max[k] / 2.0 - min[k] / 2.0))
     }
 }
 
@@ -478,7 +502,8 @@ impl Shading {
 pub struct Style {
     /// Colour where no triangle is seen.
     pub background: [u8; 3],
-    /// Share of the light that does not depend on the angle, in [0, 1].
+    /// Share of the light that does not depend on the angle, in [0, 1] ([`render_styled`]
+    /// refuses any other value, NaN included, with [`RenderError::BadAmbient`]).
     pub ambient: f64,
     /// Draw a colour bar with its minimum and maximum on the right (per-scalar shading only).
     pub legend: bool,
@@ -531,9 +556,11 @@ pub fn render(
 /// Cost: O(width · height + triangles + Σ clamped screen bounding boxes).
 ///
 /// # Errors
-/// [`RenderError::BadSize`], [`RenderError::BadCamera`], [`RenderError::BadTriangle`],
-/// [`RenderError::NonFinitePosition`], and for the shading [`RenderError::ValueCount`],
-/// [`RenderError::BadRange`], [`RenderError::NonFiniteValue`]. Nothing is drawn on error.
+/// [`RenderError::BadSize`], [`RenderError::BadCamera`], [`RenderError::BadAmbient`],
+/// [`RenderError::BadTriangle`], [`RenderError::NonFinitePosition`], and for the shading
+/// [`RenderError::ValueCount`], [`RenderError::BadRange`], [`RenderError::NonFiniteValue`], in
+/// that order. Nothing is drawn on error; the size, the camera and the ambient share are checked
+/// before anything is allocated.
 ///
 /// # Examples
 ///
@@ -559,10 +586,13 @@ pub fn render_styled(
 ) -> Result<Image, RenderError> {
     check_size(width, height)?;
     let view = View::new(camera)?;
+    let ambient = style.ambient;
+    if !(0.0..=1.0).contains(&ambient) {
+        return Err(RenderError::BadAmbient { ambient });
+    }
     check_surface(surface)?;
     let colors = shading.colors(surface.triangles.len())?;
     let mut image = Image::new(width, height, style.background)?;
-    let ambient = if style.ambient.is_finite() { style.ambient.clamp(0.0, 1.0) } else { 0.3 };
     let mut target = Target::new(&mut image);
     for (tri, &base) in surface.triangles.iter().zip(&colors) {
         let p = tri.map(|i| surface.positions[i as usize]);
@@ -576,11 +606,15 @@ pub fn render_styled(
 }
 
 /// |cos θ| between the triangle's normal and the direction to the eye, times 0.8 when the eye
-/// sees its back; 0 for a degenerate triangle.
+/// sees its back; 0 for a degenerate triangle. Scale-free: each edge, the normal and the
+/// direction to the eye are brought to components near 1 by a power of two first, so a
+/// triangle of edge 1e-150 or 1e150 is lit as one of edge 1 (bit for bit, where the plain
+/// products neither overflow nor underflow). O(1).
 fn headlight(p: [Vec3; 3], eye: Vec3) -> f64 {
-    let n = cross(sub(p[1], p[0]), sub(p[2], p[0]));
-    let centroid = std::array::from_fn(|k| (p[0][k] + p[1][k] + p[2][k]) / 3.0);
-    let to_eye = sub(eye, centroid);
+    let (u, _) = fitted(direction(p[0], p[1]));
+    let (v, _) = fitted(direction(p[0], p[2]));
+    let (n, _) = fitted(cross(u, v));
+    let (to_eye, _) = fitted(direction(centroid(p), eye));
     let denom = norm(n) * norm(to_eye);
     if denom == 0.0 || !denom.is_finite() {
         return 0.0;
@@ -591,6 +625,19 @@ fn headlight(p: [Vec3; 3], eye: Vec3) -> f64 {
     } else {
         -0.8 * cos
     }
+}
+
+/// The centroid of a triangle, `(a + b + c) / 3`, or `a/3 + b/3 + c/3` where the sum would
+/// overflow. O(1).
+fn centroid(p: [Vec3; 3]) -> Vec3 {
+    std::array::from_fn(|k| {
+        let sum = p[0][k] + p[1][k] + p[2][k];
+        if sum.is_finite() {
+            sum / 3.0
+        } else {
+            p[0][k] / 3.0 + p[1][k] / 3.0 + p[2][k] / 3.0
+        }
+    })
 }
 
 /// [`RenderError::BadSize`] unless both sides are positive and the image has at most

@@ -2,6 +2,7 @@
 
 pub(crate) use crate::mechanics::geom::{cross, dot, norm, scale, sub};
 use crate::mechanics::Vec3;
+use crate::mesh::{binary_exponent, times_pow2};
 
 use super::{Image, RenderError};
 
@@ -28,21 +29,27 @@ impl View {
         if !(camera.fov_y_deg > 0.0 && camera.fov_y_deg < 180.0) {
             return bad("the vertical field of view must be in (0, 180) degrees");
         }
-        let to_target = sub(camera.target, camera.eye);
-        let distance = norm(to_target);
-        if distance == 0.0 {
+        if camera.eye == camera.target {
             return bad("the eye is at the target");
         }
-        let forward = scale(to_target, 1.0 / distance);
-        let side = cross(forward, camera.up);
+        let to_target = sub(camera.target, camera.eye);
+        if !to_target.iter().all(|c| c.is_finite()) {
+            return bad("the eye is so far from the target that their difference is past f64::MAX");
+        }
+        // Both vectors by a power of two (exact): a distance of 1e-170 or 1e170 has a direction.
+        let (to_target, e) = fitted(to_target);
+        let (camera_up, _) = fitted(camera.up);
+        let length = norm(to_target);
+        let forward = scale(to_target, 1.0 / length);
+        let side = cross(forward, camera_up);
         let side_len = norm(side);
-        if side_len <= 1e-9 * norm(camera.up) || side_len == 0.0 {
+        if side_len <= 1e-9 * norm(camera_up) || side_len == 0.0 {
             return bad("the up vector is zero or parallel to the view direction");
         }
         let right = scale(side, 1.0 / side_len);
         let up = cross(right, forward);
         let focal = 1.0 / (camera.fov_y_deg.to_radians() / 2.0).tan();
-        Ok(View { eye: camera.eye, right, up, forward, focal, near: 1e-4 * distance })
+        Ok(View { eye: camera.eye, right, up, forward, focal, near: times_pow2(1e-4 * length, e) })
     }
 
     /// Camera coordinates: (right, up, depth in front of the eye).
@@ -53,6 +60,45 @@ impl View {
 
     pub(crate) fn eye(&self) -> Vec3 {
         self.eye
+    }
+}
+
+/// `v` · 2^−e with its largest |component| in [1, 2), and e; `(v, 0)` for a zero or non-finite
+/// largest component. Exact (a power of two), so a direction, a ratio or a sign read from the
+/// result is the one of `v`, computed as if no product of its components could overflow or
+/// underflow (and bit for bit the plain one where none does). O(1).
+pub(crate) fn fitted(v: Vec3) -> (Vec3, i64) {
+    let largest = v.iter().fold(0.0_f64, |m, c| m.max(c.abs()));
+    if largest == 0.0 || !largest.is_finite() {
+        return (v, 0);
+    }
+    let e = binary_exponent(largest);
+    (v.map(|c| times_pow2(c, -e)), e)
+}
+
+/// |v| without overflow or underflow of the squares: ∞ only when |v| is past f64::MAX, and the
+/// plain `norm(v)` bit for bit where its squares stay normal. O(1).
+pub(crate) fn scaled_norm(v: Vec3) -> f64 {
+    let (u, e) = fitted(v);
+    times_pow2(norm(u), e)
+}
+
+/// `v / |v|` for any finite nonzero `v` (NaN components for a zero or non-finite one), bit for
+/// bit `v / norm(v)` where that does not overflow or underflow. O(1).
+pub(crate) fn unit(v: Vec3) -> Vec3 {
+    let (u, _) = fitted(v);
+    let length = norm(u);
+    u.map(|c| c / length)
+}
+
+/// `to − from`, or, when that is past f64::MAX, `to/2 − from/2` (the same direction, half the
+/// length): a direction for any two finite points. O(1).
+pub(crate) fn direction(from: Vec3, to: Vec3) -> Vec3 {
+    let d = sub(to, from);
+    if d.iter().all(|c| c.is_finite()) {
+        d
+    } else {
+        std::array::from_fn(|k| to[k] / 2.0 - from[k] / 2.0)
     }
 }
 

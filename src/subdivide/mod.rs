@@ -166,6 +166,19 @@ pub enum SubdivideError {
         /// The map's current maximum level.
         max_level: u8,
     },
+    /// A refinement's ball meets a tet it cannot reach: `refine_around` runs its levels from the
+    /// map's max level k (≥ 2 here) and each level L takes the tets at μt = L − 1, so a tet at
+    /// μt < k − 1 would stay coarse inside the ball. Split it first by a level skip,
+    /// `subdivide_tet(dart, k)` (its children are at μt = k), then refine.
+    #[error("the ball meets the tet of {dart} at μt = {mu_tet}, which refine_around cannot reach on a map at max level {max_level} (its levels take the tets at μt = L − 1 from L = {max_level}): subdivide it at level {max_level} first")]
+    ZoneBelowLevel {
+        /// A dart of the coarsest such tet.
+        dart: DartId,
+        /// Its μt.
+        mu_tet: u8,
+        /// The map's max level.
+        max_level: u8,
+    },
     /// The level is above [`MAX_LEVEL`].
     #[error("level {0} is above the maximum {MAX_LEVEL}")]
     LevelTooHigh(u8),
@@ -330,6 +343,20 @@ pub enum LevelError {
         dart: DartId,
         /// Its levels.
         mu: Mu,
+    },
+    /// A dart's creation level or its μa (hence μf, μt) is above the map's maximum level k:
+    /// no operation makes one (every split at level L ≤ k sets μ ≤ L), and a refinement would
+    /// skip such cells at every level up to k.
+    #[error("{dart}: dart level {level}, μa = {} above the max level {max_level}", .mu.edge)]
+    AboveMaxLevel {
+        /// The dart.
+        dart: DartId,
+        /// Its creation level.
+        level: u8,
+        /// Its levels.
+        mu: Mu,
+        /// The map's maximum level.
+        max_level: u8,
     },
     /// A resolution level differs between two darts of one cell of the finest level.
     #[error("μ of the {dim}-cell differs between {dart} ({a}) and {other} ({b})")]
@@ -806,10 +833,11 @@ impl<const N: usize> LeveledMap<N> {
         Ok(LevelView { map: out, darts })
     }
 
-    /// Checks the level laws on the finest map: μt ≤ μf ≤ μa at every dart, μa constant on
-    /// edges, μf on faces, μt on volumes, dart levels ≤ max level. O(darts · n).
+    /// Checks the level laws on the finest map: μt ≤ μf ≤ μa at every dart, dart levels and μa
+    /// ≤ max level, μa constant on edges, μf on faces, μt on volumes. O(darts · n).
     ///
-    /// Errors: the first [`LevelError::MuOrder`] or [`LevelError::MuNotConstant`] found.
+    /// Errors: the first [`LevelError::MuOrder`], [`LevelError::AboveMaxLevel`] or
+    /// [`LevelError::MuNotConstant`] found.
     ///
     /// # Examples
     ///
@@ -826,8 +854,12 @@ impl<const N: usize> LeveledMap<N> {
     pub fn check_levels(&self) -> Result<(), LevelError> {
         for d in self.map.darts() {
             let mu = self.mu[d.index()];
-            if !(mu.tet <= mu.face && mu.face <= mu.edge) || self.dart_level[d.index()] > self.max_level {
+            if !(mu.tet <= mu.face && mu.face <= mu.edge) {
                 return Err(LevelError::MuOrder { dart: d, mu });
+            }
+            let level = self.dart_level[d.index()];
+            if level > self.max_level || mu.edge > self.max_level {
+                return Err(LevelError::AboveMaxLevel { dart: d, level, mu, max_level: self.max_level });
             }
             for j in 0..=N {
                 let e = self.map.alpha_dyn(j, d);

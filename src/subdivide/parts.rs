@@ -126,6 +126,17 @@ pub enum LevelPartsError {
         /// The map's maximum level.
         max_level: u8,
     },
+    /// A dart's μa is above the maximum level (μf and μt above it break the μ order, a law
+    /// checked after the records).
+    #[error("{dart}: μa = {} is above the max level {max_level}", .mu.edge)]
+    MuAboveMax {
+        /// The dart.
+        dart: DartId,
+        /// Its levels.
+        mu: Mu,
+        /// The map's maximum level.
+        max_level: u8,
+    },
     /// A history entry is malformed: j > n, level above the max level, `old` not a dart slot,
     /// levels out of order, or a second change of one αj at one level.
     #[error("{dart}: history entry {index} (level {}, α{}, old {}) {reason}", .entry.level, .entry.j, .entry.old)]
@@ -176,6 +187,9 @@ pub fn record_errors<const N: usize>(map: &GMap<N>, parts: &LevelParts, limit: u
         let rec = &parts.darts[d.index()];
         if rec.level > parts.max_level {
             out.push(LevelPartsError::DartLevelAboveMax { dart: d, level: rec.level, max_level: parts.max_level });
+        }
+        if rec.mu.edge > parts.max_level {
+            out.push(LevelPartsError::MuAboveMax { dart: d, mu: rec.mu, max_level: parts.max_level });
         }
         for (index, &entry) in rec.history.iter().enumerate() {
             if let Some(reason) = history_problem::<N>(&rec.history[..index], entry, parts.max_level, cap) {
@@ -241,7 +255,7 @@ impl<const N: usize> LeveledMap<N> {
     ///
     /// # Errors
     /// The first of [`record_errors`] ([`LevelPartsError::WrongLength`], `MaxLevelTooHigh`,
-    /// `DartLevelAboveMax`, `BadHistory`), then [`LevelPartsError::Law`] with the first level law
+    /// `DartLevelAboveMax`, `MuAboveMax`, `BadHistory`), then [`LevelPartsError::Law`] with the first level law
     /// broken: a level not closed or not an involution at some dart, then (from
     /// [`Self::check_all`]) the finest map invalid, μ order or constancy, a level not a valid
     /// G-map, a flat flag other than the one the levels and history determine

@@ -22,6 +22,18 @@ use super::{LeveledMap, SubdivideError};
 use crate::gmap::{CellId, DartId};
 use crate::mechanics::geom::{cross, dot, sub};
 
+/// ρ · |V| of the tet with finite corners `p`: plain for ordinary extents, else on the fitted
+/// corners scaled back ([`TetMasses::from_density`]). O(1).
+fn density_mass(density: f64, mut p: [[f64; 3]; 4]) -> f64 {
+    let k = crate::mesh::fit_for_products(&mut p);
+    let volume = crate::mesh::signed_volume(p[0], p[1], p[2], p[3]).abs();
+    if k == 0 {
+        density * volume
+    } else {
+        crate::mechanics::geom::ratio_pow2(density, volume, 1.0, -3 * k)
+    }
+}
+
 /// One mass per volume id of a [`LeveledMap<3>`] (index = volume cell id).
 ///
 /// # Examples
@@ -74,10 +86,16 @@ pub struct Refinement {
 impl TetMasses {
     /// Masses ρ · |V_t| from the positions of the map's vertices. O(darts).
     ///
+    /// The product is formed scale-safely: for ordinary extents as ρ · |V| (the same bits as
+    /// ever), otherwise from the volume of the corners fitted by `mesh::fit_for_products` (V times
+    /// 2^3k) scaled back by 2^−3k on the mantissas, so that V under- or overflowing f64 on its own
+    /// does not make a representable mass 0 or ∞ (ρ = 1e300 at edge 1e-110, ρ = 1e-100 at edge
+    /// 1e110).
+    ///
     /// Errors: [`SubdivideError::BadDensity`] unless the density is finite and > 0;
     /// [`SubdivideError::NotATetrahedron`] if a volume does not have 4 vertices;
     /// [`SubdivideError::NoPosition`] for a vertex without a position;
-    /// [`SubdivideError::MassOverflow`] when a mass or their sum overflows (what
+    /// [`SubdivideError::MassOverflow`] when a mass or their sum is past `f64::MAX` (what
     /// [`Self::check`] refuses).
     ///
     /// # Examples
@@ -106,7 +124,7 @@ impl TetMasses {
         let map = m.map();
         let mut mass = vec![0.0; map.cell_id_bound(3)];
         for d in map.one_dart_per_cell(3) {
-            mass[map.cell_id(3, d).index()] = density * m.tet_volume(d)?.abs();
+            mass[map.cell_id(3, d).index()] = density_mass(density, m.corner_positions(m.tet_vertices(d)?)?);
         }
         let total = mass.iter().sum::<f64>();
         if !total.is_finite() {
@@ -504,12 +522,16 @@ impl LeveledMap<3> {
     /// every tet is at level L − 1, level L is done by the bulk [`Self::refine_uniform`] (same
     /// result, numbering aside); otherwise, or if it refuses, op by op
     /// ([`Self::refine_around_per_op`]). Returns the count per level and the mass totals.
+    /// After `Ok`, every tet of the finest map that meets the ball has μt = `levels`: a tet at
+    /// μt < k − 1 meeting it could only be refined by an operation below the max level k, which
+    /// the level order forbids, so such a ball is refused (below) rather than left coarse.
     /// O(Σ_L (volumes + refined · touched)); O(darts) per bulk level.
     ///
     /// Errors: [`SubdivideError::LevelTooHigh`] for `levels` above [`super::MAX_LEVEL`],
-    /// [`SubdivideError::BadBall`] for a non-finite centre or radius or a negative radius and those
-    /// of [`TetMasses::check`], before any change; at a level, [`SubdivideError::DartLimit`] for a
-    /// level over the dart limit and the refusals of [`Self::subdivide_tet_with_mass`] for any tet
+    /// [`SubdivideError::BadBall`] for a non-finite centre or radius or a negative radius, those
+    /// of [`TetMasses::check`], and [`SubdivideError::ZoneBelowLevel`] (the tet of lowest such μt)
+    /// when the ball meets a tet at μt < k − 1, before any change; at a level,
+    /// [`SubdivideError::DartLimit`] for a level over the dart limit and the refusals of [`Self::subdivide_tet_with_mass`] for any tet
     /// of its zone (e.g. [`SubdivideError::AlreadyAtLevel`] for an unsplit face that a finer
     /// neighbour, split at a skipped level, brought to μf = L), all checked on the whole level
     /// before its first split, so an error leaves the map and the masses as the levels before it
@@ -577,6 +599,7 @@ impl LeveledMap<3> {
         self.check_op_level(levels)?;
         Self::check_ball(center, radius)?;
         masses.check(self)?;
+        self.check_unreachable_zone(center, radius)?;
         // Mass totals: a bulk level reports them (Σ over every volume), so O(darts) sweeps are
         // only made around per-op levels.
         let (mut before, mut after) = (None, None);
@@ -714,6 +737,29 @@ impl LeveledMap<3> {
             self.corner_positions([v; 4])?;
         }
         Ok(())
+    }
+
+    /// Refuses a refinement whose ball meets a tet it cannot reach: with k the map's max level, the
+    /// levels run from max(1, k), and level L takes the tets at μt = L − 1, so a tet at
+    /// μt < max(1, k) − 1 would stay coarse (it would need an operation at level μt + 1 < k, which
+    /// the level order forbids: operations never go back in level). Refused with
+    /// [`SubdivideError::ZoneBelowLevel`] naming the tet of lowest such μt, before any change.
+    /// Nothing to check for k ≤ 1. O(1), or O(darts) for k ≥ 2.
+    pub(super) fn check_unreachable_zone(&self, center: [f64; 3], radius: f64) -> Result<(), SubdivideError> {
+        if self.max_level < 2 {
+            return Ok(());
+        }
+        let mut lowest: Option<(DartId, u8)> = None;
+        for d in self.map.one_dart_per_cell(3) {
+            let mu = self.mu[d.index()].tet;
+            if mu < self.max_level - 1 && lowest.is_none_or(|(_, l)| mu < l) && self.tet_in_ball(d, center, radius)? {
+                lowest = Some((d, mu));
+            }
+        }
+        match lowest {
+            Some((dart, mu_tet)) => Err(SubdivideError::ZoneBelowLevel { dart, mu_tet, max_level: self.max_level }),
+            None => Ok(()),
+        }
     }
 
     /// Refuses a ball with a non-finite centre or a radius that is not a finite number ≥ 0. O(1).

@@ -39,8 +39,8 @@ use std::collections::{BTreeMap, BTreeSet};
 
 use super::{EdgeSplit, LeveledMap, Refinement, SubdivideError, TetMasses};
 use crate::gmap::{AlphaMask, DartId, GMap};
-use crate::mechanics::geom::{norm, sub, Vec3};
-use crate::mechanics::model::stiffness_contribution;
+use crate::mechanics::geom::{is_flat, ratio_pow2, rest_length, Vec3};
+use crate::mechanics::model::tet_stiffnesses;
 use crate::mechanics::{Material, SpringSystem};
 
 /// The six corner pairs of a tet, in the order of [`EdgeKey`] arrays of a tet.
@@ -239,13 +239,42 @@ pub enum CouplingError {
     #[error(transparent)]
     Material(crate::mechanics::ModelError),
     /// A level-0 tet has zero volume: it would get no mass and no stiffness (a
-    /// [`crate::mechanics::Body`] refuses it too).
+    /// [`crate::mechanics::Body`] refuses it too). Decided exactly on its corners fitted to a
+    /// common scale, so a tiny regular tet whose volume underflows f64 is not one.
     #[error("volume {volume} (dart {dart}) has zero volume")]
     DegenerateTet {
         /// The volume cell id.
         volume: u32,
         /// A dart of it.
         dart: DartId,
+    },
+    /// A spring of a level-0 tet would hold a value past `f64::MAX`: its rest length (coordinates
+    /// too far apart), or its stiffness or damping once this tet's term of law 2 is added (Young's
+    /// modulus or the damping factor too large for the geometry). As [`crate::mechanics::Body`]
+    /// refuses the same input ([`crate::mechanics::ModelError::Overflow`]); refused before the
+    /// coupling exists.
+    #[error("volume {volume}: the {quantity} of the spring of {edge} is {value:e}, past the range of f64 (coordinates, Young's modulus or damping too large)")]
+    Overflow {
+        /// The volume cell id of the tet whose term made it overflow.
+        volume: u32,
+        /// The edge of the spring.
+        edge: EdgeKey,
+        /// "rest length", "stiffness" or "damping".
+        quantity: &'static str,
+        /// Its value (infinite or NaN).
+        value: f64,
+    },
+    /// A split could make a spring's stiffness or damping pass `f64::MAX`: the halves of a split
+    /// spring take 2k and 2c, and the children of a 1→8 add law 2's terms to their new edges.
+    /// `bound` bounds every value the operation (or, for [`LeveledMechanics::refine_around`], the
+    /// whole level) would store ([`LeveledMechanics::subdivide_tet`] states it); refused when it
+    /// comes within a factor 1 + 2⁻⁴⁰ of `f64::MAX`, before the map changes.
+    #[error("splitting at {dart} could make a spring stiffness or damping of {bound:e}, past the range of f64")]
+    SplitOverflow {
+        /// A dart of the tet (or edge, or face) whose split makes the bound largest.
+        dart: DartId,
+        /// The bound on the values the split would store.
+        bound: f64,
     },
     /// The flat system would hold a value the step loop cannot use: a non-finite gravity, or a
     /// spring value set out of range through [`LeveledMechanics::spring_mut`]
@@ -322,12 +351,17 @@ impl LeveledMechanics {
     /// The coupling of a level-0 map: masses ρ·V_t, springs from law 2 (k_e = Σ_{t ∋ e} E V_t / L_e²
     /// over the tets whose volume holds the edge cell e, c_e = β k_e, L_e the rest distance), at rest
     /// with zero velocity. Two edge cells joining the same vertices get a spring each, from their own
-    /// tets. O(darts + E log E).
+    /// tets. L_e and E V_t / L_e² are measured scale-safely (on corners fitted to a common scale
+    /// when a tet's extent is outside 2^±250; the plain formulas, same bits, inside), so a spring is
+    /// ∞ only when its value is. O(darts + E log E).
     ///
     /// Errors: [`CouplingError::NotLevelZero`], [`CouplingError::NoGeometry`],
     /// [`CouplingError::Material`] (a material a [`crate::mechanics::Body`] refuses too),
-    /// [`CouplingError::DegenerateTet`], [`SubdivideError::NonFinitePosition`], and the errors of
-    /// [`LeveledMap::tet_vertices`] for a volume that is not a tet.
+    /// [`CouplingError::DegenerateTet`] (decided exactly on fitted corners: a regular tet of edge
+    /// 1e-110 is none), [`CouplingError::Overflow`] for a rest length, stiffness or damping past
+    /// `f64::MAX`, [`SubdivideError::MassOverflow`] for masses summing past it,
+    /// [`SubdivideError::NonFinitePosition`], and the errors of [`LeveledMap::tet_vertices`] for a
+    /// volume that is not a tet.
     ///
     /// # Examples
     ///
@@ -386,16 +420,23 @@ impl LeveledMechanics {
         crate::mechanics::model::check_material(&material).map_err(CouplingError::Material)?;
         let nv = m.map().cell_id_bound(0);
         let level0_tet = |d: DartId| {
-            // Finite positions and a non-zero volume (NoPosition was settled by check_start).
-            if m.tet_volume(d)? == 0.0 {
+            // Finite positions (NoPosition was settled by check_start) and a non-zero volume,
+            // decided on fitted corners (a regular tet of edge 1e-110 has a volume below f64).
+            m.tet_volume(d)?;
+            let t = tet_edges(m, d)?;
+            if is_flat(t.corners.map(|v| m.points()[v as usize])) {
                 return Err(CouplingError::DegenerateTet { volume: m.map().cell_id(3, d).0, dart: d });
             }
-            Ok(tet_edges(m, d)?)
+            Ok((m.map().cell_id(3, d).0, t))
         };
         let tets0 = m.map().one_dart_per_cell(3).into_iter().map(level0_tet).collect::<Result<Vec<_>, _>>()?;
+        let total_mass = masses.total(m);
+        if !total_mass.is_finite() {
+            return Err(SubdivideError::MassOverflow { total: total_mass }.into());
+        }
         let mut mech = LeveledMechanics {
             material,
-            total_mass: masses.total(m),
+            total_mass,
             masses,
             position: m.points()[..nv].to_vec(),
             velocity: vec![[0.0; 3]; nv],
@@ -407,10 +448,10 @@ impl LeveledMechanics {
             applied: m.edge_split_log().len(),
             followed: m.version(),
         };
-        for t in &tets0 {
-            mech.add_tet(m, t);
+        for (volume, t) in &tets0 {
+            mech.add_tet(m, t, *volume)?;
         }
-        mech.tets0 = tets0;
+        mech.tets0 = tets0.into_iter().map(|(_, t)| t).collect();
         Ok(mech)
     }
 
@@ -621,18 +662,81 @@ impl LeveledMechanics {
         self.roots.get(&e).copied()
     }
 
-    /// Adds law 2's contribution of the tet `t` to its edges that are not halves.
-    fn add_tet(&mut self, m: &LeveledMap<3>, t: &Tet0) {
+    /// Adds law 2's contribution of the tet `t` (volume id `volume`) to its edges that are not
+    /// halves, measured scale-safely ([`tet_stiffnesses`], [`rest_length`]). O(log E).
+    ///
+    /// Errors: [`CouplingError::Overflow`] for a spring value past `f64::MAX` (the springs before
+    /// it changed: [`Self::build`] drops the coupling; for the children of a split the checks
+    /// before the split make it unreachable, [`Self::check_split_headroom`]).
+    fn add_tet(&mut self, m: &LeveledMap<3>, t: &Tet0, volume: u32) -> Result<(), CouplingError> {
         let p = t.corners.map(|v| m.points()[v as usize]);
-        let volume = crate::mesh::signed_volume(p[0], p[1], p[2], p[3]);
-        for (&(i, j), e) in PAIRS.iter().zip(t.edges) {
+        let terms = tet_stiffnesses(self.material.young, p);
+        for ((&(i, j), e), k) in PAIRS.iter().zip(t.edges).zip(terms) {
             let Some(e) = e.filter(|e| !self.halves.contains(e)) else { continue };
-            let rest = norm(sub(p[j], p[i]));
-            let k = stiffness_contribution(self.material.young, volume, rest);
+            let rest = rest_length(p[i], p[j]);
             let s = self.springs.entry(e).or_insert(Spring { rest, stiffness: 0.0, damping: 0.0 });
             s.stiffness += k;
             s.damping += self.material.damping * k;
+            let values = [("rest length", s.rest), ("stiffness", s.stiffness), ("damping", s.damping)];
+            if let Some((quantity, value)) = values.into_iter().find(|(_, v)| !v.is_finite()) {
+                return Err(CouplingError::Overflow { volume, edge: e, quantity, value });
+            }
         }
+        Ok(())
+    }
+
+    /// The largest stiffness or damping of the springs on the edges of the live `darts`.
+    /// O(darts · log E).
+    fn largest_spring(&self, m: &LeveledMap<3>, darts: &[DartId]) -> f64 {
+        let map = m.map();
+        let springs =
+            darts.iter().filter(|&&x| map.contains(x)).filter_map(|&x| self.springs.get(&EdgeKey::of(map, x)));
+        springs.fold(0.0, |a, s| a.max(s.stiffness).max(s.damping))
+    }
+
+    /// A bound of the stiffness and damping terms that the children of a 1→8 split of the tet of
+    /// `d` add ([`children_term_bound`] times max(1, β)); 0 for a tet the map refuses to split
+    /// for its geometry (no such dart, no finite corner positions). O(volume).
+    fn children_bound(&self, m: &LeveledMap<3>, d: DartId) -> f64 {
+        if m.tet_volume(d).is_err() {
+            return 0.0;
+        }
+        let Ok(corners) = m.tet_vertices(d) else { return 0.0 };
+        let p = corners.map(|v| m.points()[v as usize]);
+        children_term_bound(self.material.young, p) * self.material.damping.max(1.0)
+    }
+
+    /// Refuses splitting 1→8, at one level and in any order, the tets of `zone` (one dart each)
+    /// when a spring value could pass `f64::MAX`, before the map changes. With A the largest
+    /// stiffness or damping on the edges of the zone's tets and B the largest bound of a child's
+    /// term ([`Self::children_bound`]), every value the level stores is at most 2A + 8B: a half
+    /// takes 2k or 2c of a spring that existed before the level (≤ 2A); a new edge of a child is
+    /// an inner edge of a face, which takes at most three terms from the children on each side
+    /// (the corner child and two tets around the diagonal) over its value before the level
+    /// (≤ A, or 0 for an edge made at this level), or the diagonal, which takes four. The rest
+    /// lengths stay finite: a child's edges are no longer than its parent's, and the level-0
+    /// ones were checked by [`Self::build`]; masses are shares of finite masses. Refused with
+    /// [`CouplingError::SplitOverflow`] when 2A + 8B, with a margin of 2⁻⁴⁰ for the rounding of
+    /// the children's terms, is not finite. O(Σ zone volumes · log E).
+    fn check_split_headroom(&self, m: &LeveledMap<3>, zone: &[DartId]) -> Result<(), CouplingError> {
+        let (mut a, mut b, mut worst) = (0.0f64, 0.0f64, None);
+        for &d in zone.iter().filter(|&&d| m.map().contains(d)) {
+            let at = self.largest_spring(m, &m.map().orbit(d, AlphaMask::of(&[0, 1, 2])));
+            let bt = self.children_bound(m, d);
+            let own = 2.0 * at + 8.0 * bt;
+            if worst.is_none_or(|(w, _)| own > w || own.is_nan()) {
+                worst = Some((own, d));
+            }
+            (a, b) = (a.max(at), b.max(bt));
+        }
+        refuse_past_max(worst.map(|(_, d)| d), 2.0 * a + 8.0 * b)
+    }
+
+    /// Refuses splitting the edges of the live `darts` (an edge split or a face split 1→4: the
+    /// halves take 2k and 2c, new inner edges k = 0) when a half's value would pass `f64::MAX`.
+    /// O(darts · log E).
+    fn check_halves_headroom(&self, m: &LeveledMap<3>, darts: &[DartId]) -> Result<(), CouplingError> {
+        refuse_past_max(darts.first().copied(), 2.0 * self.largest_spring(m, darts))
     }
 
     /// Errors unless every vertex insertion of the map was followed and the coupling holds one
@@ -653,6 +757,42 @@ impl LeveledMechanics {
     }
 }
 
+/// [`CouplingError::SplitOverflow`] at `dart` unless `bound` · (1 + 2⁻⁴⁰) is finite. O(1).
+fn refuse_past_max(dart: Option<DartId>, bound: f64) -> Result<(), CouplingError> {
+    match dart {
+        Some(dart) if !(bound * (1.0 + 2f64.powi(-40))).is_finite() => {
+            Err(CouplingError::SplitOverflow { dart, bound })
+        }
+        _ => Ok(()),
+    }
+}
+
+/// A bound of law 2's terms E·|V_c|/L_c² that the eight children of a 1→8 split of the tet with
+/// corners `p` add to their edges that are not halves. Every child has the volume V/8 (midpoint
+/// subdivision); those edges are inner edges of the faces, each half as long as a parent edge,
+/// and the diagonal, one of the three segments joining the midpoints of opposite edges: none is
+/// shorter than the shortest of these. The children's volumes are computed from other corners,
+/// so they may exceed V/8 by rounding, by a few ulps of ℓ³ (ℓ the longest parent edge): 2⁻⁴⁵ ℓ³
+/// is added. Measured on the corners fitted by `mesh::fit_for_products` and scaled back, so it
+/// neither overflows nor underflows before the result does. ∞ for a segment of length 0. O(1).
+fn children_term_bound(young: f64, p: [Vec3; 4]) -> f64 {
+    if young == 0.0 {
+        return 0.0;
+    }
+    let mut f = p;
+    let k = crate::mesh::fit_for_products(&mut f);
+    let volume = crate::mesh::signed_volume(f[0], f[1], f[2], f[3]).abs();
+    let edges = PAIRS.map(|(i, j)| crate::mesh::distance(f[i], f[j]));
+    let mid = |(i, j): (usize, usize)| crate::mesh::midpoint(f[i], f[j]);
+    let segments = [(0, 5), (1, 4), (2, 3)].map(|(x, y)| crate::mesh::distance(mid(PAIRS[x]), mid(PAIRS[y])));
+    let longest = edges.iter().fold(0.0f64, |a, &e| a.max(e));
+    let shortest = edges.iter().map(|e| e / 2.0).chain(segments).fold(f64::INFINITY, f64::min);
+    if shortest.is_nan() || shortest <= 0.0 {
+        return f64::INFINITY;
+    }
+    ratio_pow2(young, volume / 8.0 + 2f64.powi(-45) * longest.powi(3), shortest, -k)
+}
+
 /// Errors unless `m` is at level 0 and has a rest position for every vertex id. O(1).
 fn check_start(m: &LeveledMap<3>) -> Result<(), CouplingError> {
     if m.max_level() != 0 {
@@ -669,9 +809,10 @@ impl LeveledMechanics {
     /// interpolated (module docs). Returns the map's result. O(edge · n + log E).
     ///
     /// Errors: [`CouplingError::OutOfSync`], [`CouplingError::StateCount`] (another map's
-    /// coupling), [`CouplingError::Unfollowed`] (the map was changed alone), the map's refusals
-    /// (all four: both unchanged), or [`CouplingError::NoSpring`] (the map changed; a tampered
-    /// coupling).
+    /// coupling), [`CouplingError::Unfollowed`] (the map was changed alone),
+    /// [`CouplingError::SplitOverflow`] when a half's 2k or 2c would pass `f64::MAX`, the map's
+    /// refusals (all five: both unchanged), or [`CouplingError::NoSpring`] (the map changed; a
+    /// tampered coupling).
     ///
     /// # Examples
     ///
@@ -694,6 +835,7 @@ impl LeveledMechanics {
     /// ```
     pub fn split_edge(&mut self, m: &mut LeveledMap<3>, d: DartId, level: u8) -> Result<DartId, CouplingError> {
         self.in_sync(m)?;
+        self.check_halves_headroom(m, &[d])?;
         let mid = m.split_edge(d, level)?;
         self.follow(m, &[], &[])?;
         self.expensive_check(m);
@@ -728,6 +870,9 @@ impl LeveledMechanics {
         level: u8,
     ) -> Result<[DartId; 4], CouplingError> {
         self.in_sync(m)?;
+        if m.map().contains(d) {
+            self.check_halves_headroom(m, &m.map().orbit(d, AlphaMask::of(&[0, 1])))?;
+        }
         let faces = m.subdivide_triangle(d, level)?;
         self.follow(m, &faces, &[])?;
         self.expensive_check(m);
@@ -738,7 +883,11 @@ impl LeveledMechanics {
     /// on the new edges and law 2's contributions of the eight children (module docs).
     /// O(volume + touched + log E).
     ///
-    /// Errors: as [`Self::split_edge`].
+    /// Errors: as [`Self::split_edge`]; [`CouplingError::SplitOverflow`] when a value the split
+    /// would store could pass `f64::MAX`: with A the largest stiffness or damping on the tet's
+    /// edges and B a bound of its children's terms of law 2 times max(1, β), every stored value
+    /// is at most 2A + 8B, refused when that is not finite (with a margin of 2⁻⁴⁰), before the
+    /// map changes.
     ///
     /// # Examples
     ///
@@ -765,6 +914,14 @@ impl LeveledMechanics {
     /// [`Self::subdivide_tet`] without the expensive check.
     fn split_tet(&mut self, m: &mut LeveledMap<3>, d: DartId, level: u8) -> Result<[DartId; 8], CouplingError> {
         self.in_sync(m)?;
+        self.check_split_headroom(m, &[d])?;
+        self.split_followed(m, d, level)
+    }
+
+    /// [`Self::split_tet`] without the headroom check ([`Self::refine_around`] made it for the
+    /// whole level).
+    fn split_followed(&mut self, m: &mut LeveledMap<3>, d: DartId, level: u8) -> Result<[DartId; 8], CouplingError> {
+        self.in_sync(m)?;
         let children = m.subdivide_tet_with_mass(d, level, &mut self.masses)?;
         self.follow(m, &[], &children)?;
         Ok(children)
@@ -773,16 +930,22 @@ impl LeveledMechanics {
     /// [`LeveledMap::refine_around`] through [`Self::subdivide_tet`]: level by level, every tet with
     /// μt = L − 1 meeting the ball B(center, radius) is split 1→8 with its springs and masses (by the
     /// bulk path for a level where the ball holds everything, with the same springs up to rounding).
-    /// O(Σ_L (volumes + refined · touched)).
+    /// The levels run from max(1, k), k the map's max level; after `Ok`, every tet of the finest
+    /// map that meets the ball has μt = `levels` (a ball meeting a tet the levels cannot reach is
+    /// refused, as by [`LeveledMap::refine_around`]). O(Σ_L (volumes + refined · touched)).
     ///
     /// Errors: [`SubdivideError::LevelTooHigh`] for `levels` above the maximum,
-    /// [`SubdivideError::BadBall`] and those of the coupling's sync check before any change; at a
-    /// level, those of [`LeveledMap::refine_around`] (the dart limit and the refusals of
-    /// [`Self::subdivide_tet`] for any tet of its zone), all checked on the whole level before its
+    /// [`SubdivideError::BadBall`], those of the coupling's sync check, and
+    /// [`SubdivideError::ZoneBelowLevel`] for a ball meeting a tet at μt < k − 1 (it would need an
+    /// operation below the max level), before any change; at a level, those of
+    /// [`LeveledMap::refine_around`] (the dart limit and the refusals of [`Self::subdivide_tet`] for
+    /// any tet of its zone) and [`CouplingError::SplitOverflow`] (the bound of
+    /// [`Self::subdivide_tet`] over the whole zone), all checked on the whole level before its
     /// first split: an error leaves the map, the springs and the masses as the levels before it
     /// left them (for a map made by the operations unchanged, except after a
-    /// [`SubdivideError::DartLimit`] at a level after the first; map and coupling in step either
-    /// way). With `expensive-checks`, [`Self::check`] runs once at the end (not after each tet).
+    /// [`SubdivideError::DartLimit`] or a [`CouplingError::SplitOverflow`] at a level after the
+    /// first; map and coupling in step either way). With `expensive-checks`, [`Self::check`] runs
+    /// once at the end (not after each tet).
     ///
     /// # Examples
     ///
@@ -808,6 +971,7 @@ impl LeveledMechanics {
         m.check_op_level(levels)?;
         LeveledMap::check_ball(center, radius)?;
         self.in_sync(m)?;
+        m.check_unreachable_zone(center, radius)?;
         let before = self.masses.total(m);
         let mut per_level = vec![0; levels as usize + 1];
         for level in m.max_level().max(1)..=levels {
@@ -817,8 +981,9 @@ impl LeveledMechanics {
             }
             // Every refusal of the level before its first split (map, springs and masses unchanged).
             let zone = m.check_level(level, levels, center, radius, &self.masses)?;
+            self.check_split_headroom(m, &zone)?;
             for d in zone {
-                self.split_tet(m, d, level)?;
+                self.split_followed(m, d, level)?;
                 per_level[level as usize] += 1;
             }
         }
@@ -843,6 +1008,8 @@ impl LeveledMechanics {
             return Ok(None);
         }
         self.in_sync(m)?;
+        // The per-op path would make the same check on the same zone (every tet).
+        self.check_split_headroom(m, &m.map().one_dart_per_cell(3))?;
         let Ok(r) = m.refine_uniform(level, &mut self.masses) else { return Ok(None) };
         let children = m.map().one_dart_per_cell(3);
         self.follow(m, &[], &children)?;
@@ -869,13 +1036,13 @@ impl LeveledMechanics {
         for d in region {
             let e = EdgeKey::of(m.map(), d);
             if e.a != e.b {
-                let rest = norm(sub(m.points()[e.b as usize], m.points()[e.a as usize]));
+                let rest = rest_length(m.points()[e.a as usize], m.points()[e.b as usize]);
                 self.springs.entry(e).or_insert(Spring { rest, stiffness: 0.0, damping: 0.0 });
             }
         }
         for &c in children {
             let t = tet_edges(m, c)?;
-            self.add_tet(m, &t);
+            self.add_tet(m, &t, m.map().cell_id(3, c).0)?;
         }
         Ok(())
     }

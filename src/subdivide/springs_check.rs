@@ -9,12 +9,13 @@
 //! 1. the coupling followed every vertex insertion of the map, and has a state for every vertex;
 //! 2. every edge cell of the finest map has exactly one spring, under its key (its cell id and the
 //!    vertex ids of its ends), and every spring is an edge cell of the finest map;
-//! 3. L_s = |P_a − P_b| on the rest positions;
+//! 3. L_s = |P_a − P_b| on the rest positions (measured scale-safely: a length of 1e200 is not ∞);
 //! 4. series: along every root (an edge cell split when it was not a half), the chain of finest
 //!    springs has Σ 1/k_i = 1/k_root, Σ 1/c_i = 1/c_root and Σ L_i = L_root;
 //! 5. every spring that is not a half of a split: k = Σ_{t ∋ e} E V_t / L_e² over the level-0 tets
 //!    and the finest tets of level μt ≥ 1 whose volume holds the edge cell e between two of its
-//!    corners, and c = β k;
+//!    corners, and c = β k (each term measured on corners fitted to a common scale when the tet's
+//!    extent is outside the ordinary range, so a tet of edge 1e-110 has its finite terms);
 //! 6. Σ_t m_t equals its value when the coupling was built, and every vertex mass gathered from the
 //!    volumes around the vertex (m_v = Σ m_t / n_t) equals the scatter of
 //!    [`LeveledMechanics::vertex_masses`], so Σ_v m_v = Σ_t m_t.
@@ -23,11 +24,11 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
-use super::springs::{tet_edges, volume_vertices, EdgeKey, Tet0, PAIRS};
+use super::springs::{tet_edges, volume_vertices, EdgeKey, Tet0};
 use super::{LeveledMap, LeveledMechanics};
 use crate::gmap::AlphaMask;
-use crate::mechanics::geom::{norm, sub};
-use crate::mechanics::model::stiffness_contribution;
+use crate::mechanics::geom::rest_length;
+use crate::mechanics::model::tet_stiffnesses;
 
 /// Relative tolerance of every comparison of [`LeveledMechanics::check`].
 const TOLERANCE: f64 = 1e-12;
@@ -224,7 +225,7 @@ impl LeveledMechanics {
             edges.insert(e);
             let (a, b, edge) = (e.a, e.b, e.id);
             let s = self.springs.get(&e).ok_or(SpringLawError::MissingSpring { a, b, edge })?;
-            let measured = norm(sub(m.points()[b as usize], m.points()[a as usize]));
+            let measured = rest_length(m.points()[a as usize], m.points()[b as usize]);
             if !close(s.rest, measured) {
                 return Err(SpringLawError::RestLength { a, b, edge, stored: s.rest, measured });
             }
@@ -281,11 +282,9 @@ impl LeveledMechanics {
     fn check_tet_law(&self, m: &LeveledMap<3>) -> Result<(), SpringLawError> {
         let mut expected: BTreeMap<EdgeKey, f64> = BTreeMap::new();
         let mut add = |t: &Tet0| {
-            let p = t.corners.map(|v| m.points()[v as usize]);
-            let volume = crate::mesh::signed_volume(p[0], p[1], p[2], p[3]);
-            for (&(i, j), e) in PAIRS.iter().zip(t.edges) {
+            let terms = tet_stiffnesses(self.material.young, t.corners.map(|v| m.points()[v as usize]));
+            for (e, k) in t.edges.into_iter().zip(terms) {
                 if let Some(e) = e {
-                    let k = stiffness_contribution(self.material.young, volume, norm(sub(p[j], p[i])));
                     *expected.entry(e).or_insert(0.0) += k;
                 }
             }

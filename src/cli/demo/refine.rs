@@ -28,6 +28,7 @@ use topomech::{AlphaMask, CellId, DartId, GMap};
 
 use super::scene::{SceneConfig, StageRun};
 use super::DemoError;
+use crate::cli::simulate::StepTimes;
 
 /// The level the incision zone is refined to.
 pub const LEVEL: u8 = 1;
@@ -169,7 +170,7 @@ pub fn simulate_refined(
     let step_error = |step| move |source| DemoError::RefinedStep { step, source };
     let config_step = StepConfig::new(Integrator::Symplectic, config.dt);
     let mut stepper = Stepper::new(config_step, &sys, &mech.position, &mech.velocity).map_err(step_error(0))?;
-    let mut times = Vec::with_capacity(steps as usize);
+    let mut times = StepTimes::new(steps);
     for step in 1..=steps {
         let t = Instant::now();
         stepper.step(&sys, &mut mech.position, &mut mech.velocity).map_err(step_error(step))?;
@@ -190,7 +191,7 @@ pub fn simulate_refined(
         slots: sys.slots(),
         springs: sys.springs(),
         pinned: fixed.iter().filter(|&&f| f).count(),
-        step_us_median: crate::cli::simulate::median(&mut times),
+        step_us_median: times.median(),
         max_displacement,
         kinetic_energy,
         checks: SIM_CHECKS,

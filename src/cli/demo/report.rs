@@ -10,7 +10,7 @@ use topomech::mechanics::Vec3;
 use super::checks::{total_mass, total_stiffness};
 use super::refine::{Refined, RefinedSim};
 use super::scene::{Scene, StageRun};
-use crate::cli::simulate::median;
+
 use crate::cli::{CellCensus, InfoJson};
 
 /// One stage of the summary (JSON keys in this order). For the refinement, the mass is Σ tet mass
@@ -62,7 +62,7 @@ fn counts_row(stage: &'static str, map: &GMap<3>, run: &StageRun) -> StageRow {
         stiffness_sum: None,
         stiffness_residual: None,
         steps: run.steps,
-        step_us_median: median(&mut times),
+        step_us_median: times.median(),
         operations: run.operations,
         cut_faces: run.cut_faces,
         operation_ms: run.operation_us / 1e3,

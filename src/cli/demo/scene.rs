@@ -25,6 +25,7 @@ use topomech::{AlphaMask, CellId, DartId};
 use super::checks::Checker;
 use super::output::Output;
 use super::DemoError;
+use crate::cli::simulate::StepTimes;
 
 /// Fraction of the longest extent pinned at its low end.
 pub const PIN_FRACTION: f64 = 0.12;
@@ -90,8 +91,8 @@ pub struct StageRun {
     pub name: &'static str,
     /// Time steps made.
     pub steps: u64,
-    /// Wall time of each step (or each refinement operation) in µs.
-    pub step_us: Vec<f64>,
+    /// Wall time of each step (or each refinement operation) in µs, a bounded sample.
+    pub step_us: StepTimes,
     /// Operations made: faces cut, vertices torn, tets removed, tets refined.
     pub operations: usize,
     /// Faces dissociated by the stage.
@@ -352,5 +353,51 @@ impl Scene {
         }
         out.sort_unstable_by_key(|&(id, _)| id);
         out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The tets in a ball are those whose corner mean lies within its radius, with that distance
+    /// (against a brute-force pass over the input tets; at rest, positions are the input points).
+    #[test]
+    fn tets_in_ball_are_the_tets_whose_centroid_is_inside() {
+        let (points, tets) = topomech::generate::kuhn_cube(3);
+        let scene = Scene::new(&points, &tets, 1).unwrap();
+        // Radii off the lattice of centroid distances (multiples of 1/12 per coordinate), so that
+        // no distance is within rounding of a radius.
+        for (c, r) in [([0.5; 3], 0.3137), ([0.0; 3], 0.5071), ([1.0, 0.2, 0.7], 0.4523), ([9.0; 3], 1.0)] {
+            let mut expected: Vec<f64> = tets
+                .iter()
+                .map(|t| topomech::mesh::distance(topomech::mesh::centroid(&t.map(|v| points[v as usize])), c))
+                .filter(|&d| d <= r)
+                .collect();
+            let mut got: Vec<f64> = scene.tets_in_ball(c, r).into_iter().map(|(_, d)| d).collect();
+            expected.sort_by(f64::total_cmp);
+            got.sort_by(f64::total_cmp);
+            assert_eq!(got.len(), expected.len(), "ball {c:?}, {r}");
+            assert!(got.iter().zip(&expected).all(|(a, b)| (a - b).abs() < 1e-12), "ball {c:?}, {r}: {got:?}");
+        }
+    }
+
+    /// A face's centroid is the mean of its three corners.
+    #[test]
+    fn face_centroid_is_the_mean_of_the_corners() {
+        let (points, tets) = topomech::generate::kuhn_cube(1);
+        let scene = Scene::new(&points, &tets, 1).unwrap();
+        let map = scene.body.map();
+        for d in map.one_dart_per_cell(2) {
+            let mut ids: Vec<CellId> =
+                map.orbit(d, AlphaMask::of(&[0, 1])).into_iter().map(|x| map.vertex_id(x)).collect();
+            ids.sort_unstable();
+            ids.dedup();
+            assert_eq!(ids.len(), 3);
+            let x = scene.body.attrs().position();
+            let mean = [0, 1, 2].map(|k| ids.iter().map(|&v| x[v][k]).sum::<f64>() / 3.0);
+            let got = scene.face_centroid(d);
+            assert!((0..3).all(|k| (got[k] - mean[k]).abs() < 1e-15), "{got:?} vs {mean:?}");
+        }
     }
 }

@@ -1186,3 +1186,22 @@ pub(super) fn volume_vertices(m: &LeveledMap<3>, t: DartId) -> Vec<u32> {
     vs.dedup();
     vs
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The refusal keeps a margin of 2⁻⁴⁰ below `f64::MAX` (a bound within it could still
+    /// overflow by the rounding of the children's terms), and never refuses without a dart.
+    #[test]
+    fn refuse_past_max_keeps_its_margin() {
+        let d = Some(DartId(3));
+        assert!(refuse_past_max(d, 1e300).is_ok());
+        assert!(refuse_past_max(d, f64::MAX * (1.0 - 2f64.powi(-30))).is_ok());
+        let near = f64::MAX * (1.0 - 2f64.powi(-45));
+        assert_eq!(refuse_past_max(d, near), Err(CouplingError::SplitOverflow { dart: DartId(3), bound: near }));
+        assert!(refuse_past_max(d, f64::INFINITY).is_err());
+        assert!(refuse_past_max(d, f64::NAN).is_err());
+        assert!(refuse_past_max(None, f64::INFINITY).is_ok());
+    }
+}

@@ -219,3 +219,23 @@ fn f125_refine_around_refuses_a_ball_it_cannot_refine() {
     mech.check(&m).unwrap();
     m.check_all().unwrap();
 }
+
+/// Finding 125's error names a tet of the *lowest* μt in the ball (a survivor of the 36th
+/// mutation sample picked the highest): tets A, B, C far apart, A refined to level 3, B to
+/// level 1 (μt = 1 < k − 1 = 2), C left at 0; a ball over B and C names C, μt = 0.
+#[test]
+fn zone_below_level_names_the_coarsest_tet() {
+    let (map, _) = GMap::<3>::from_tets(12, &[[0, 1, 2, 3], [4, 5, 6, 7], [8, 9, 10, 11]]).unwrap();
+    let unit = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    let pts: Vec<[f64; 3]> = (0..3).flat_map(|k| unit.map(|p| [p[0] + 10.0 * k as f64, p[1], p[2]])).collect();
+    let mut m = LeveledMap::new(map, pts);
+    let mut masses = TetMasses::from_density(&m, 1.0).unwrap();
+    m.refine_around([10.1, 0.1, 0.1], 0.0, 1, &mut masses).unwrap(); // B to level 1
+    m.refine_around([0.1; 3], 0.0, 3, &mut masses).unwrap(); // A to level 3
+    assert_eq!(m.max_level(), 3);
+    let e = m.refine_around([15.0, 0.1, 0.1], 5.5, 3, &mut masses).unwrap_err();
+    let SubdivideError::ZoneBelowLevel { dart, mu_tet, max_level: 3 } = e else { panic!("{e}") };
+    assert_eq!(mu_tet, 0, "{e}");
+    let corner = m.points()[m.tet_vertices(dart).unwrap()[0] as usize];
+    assert!(corner[0] >= 19.0, "{dart} is not in C: {corner:?}");
+}

@@ -239,3 +239,24 @@ fn zone_below_level_names_the_coarsest_tet() {
     let corner = m.points()[m.tet_vertices(dart).unwrap()[0] as usize];
     assert!(corner[0] >= 19.0, "{dart} is not in C: {corner:?}");
 }
+
+/// A survivor of the 36th mutation sample (`2.0 * at + 8.0 * bt` read as `2.0 * at + 8.0 + bt` in
+/// the per-tet bound): a refused refinement names the tet whose own bound 2A + 8B is the largest.
+/// A sliver (a square of diagonals 1.41, 0.1 apart) has children's terms far above its springs
+/// (its inner segment is 0.1 long); a regular-ish tet three times larger has the stiffer springs.
+/// With B counted once instead of eight times the larger tet would be named.
+#[test]
+fn split_overflow_names_the_tet_with_the_largest_bound() {
+    let (map, _) = GMap::<3>::from_tets(8, &[[0, 1, 2, 3], [4, 5, 6, 7]]).unwrap();
+    let h = 0.1;
+    let mut pts = vec![[0.0, 0.0, 0.0], [1.0, 1.0, 0.0], [1.0, 0.0, h], [0.0, 1.0, h]];
+    pts.extend([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]].map(|p| p.map(|c| 10.0 + 3.0 * c)));
+    let mut m = LeveledMap::new(map, pts);
+    let mut mech = LeveledMechanics::new(&m, Material { young: 1e308, ..Material::default() }).unwrap();
+    let (version, darts) = (m.version(), m.map().dart_count());
+    let e = mech.refine_around(&mut m, [5.0; 3], 100.0, 1).unwrap_err();
+    let CouplingError::SplitOverflow { dart, .. } = e else { panic!("{e}") };
+    let corners = m.tet_vertices(dart).unwrap();
+    assert!(corners.iter().all(|&v| v < 4), "named the larger tet: {corners:?}");
+    assert_eq!((m.version(), m.map().dart_count()), (version, darts));
+}

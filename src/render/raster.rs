@@ -204,4 +204,18 @@ mod tests {
         assert_eq!(two_behind.len(), 3);
         assert!(two_behind.iter().all(|p| p[2] >= near));
     }
+
+    /// A direction between finite points is finite and points from `from` to `to`: the plain
+    /// difference where it is finite, half of it where that overflows (a survivor of the 36th
+    /// mutation sample read the fallback as `to/2 + from/2`).
+    #[test]
+    fn direction_is_finite_and_points_from_to() {
+        assert_eq!(direction([1.0, 2.0, 3.0], [4.0, 0.0, 3.0]), [3.0, -2.0, 0.0]);
+        let (a, b) = ([-1.5e308, 1e308, 0.0], [1.5e308, -1e308, 2.0]);
+        assert_eq!(direction(a, b), [1.5e308, -1e308, 1.0]);
+        assert_eq!(direction(b, a), [-1.5e308, 1e308, -1.0]);
+        let u = unit(direction(a, b));
+        let expected = unit([1.5, -1.0, 0.0]);
+        assert!((0..3).all(|k| (u[k] - expected[k]).abs() < 1e-15), "{u:?}");
+    }
 }

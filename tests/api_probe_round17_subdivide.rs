@@ -176,27 +176,31 @@ fn two_tets_first_at_level_2() -> (LeveledMap<3>, TetMasses) {
     (m, masses)
 }
 
-/// Finding 125: `refine_around` never returns `Ok` with a tet of its ball left below its levels.
-/// A ball meeting a tet at μt < k − 1 (k the map's max level), which no operation may refine any
-/// more (levels never go back), is refused before any change, on the plain and the coupled path
-/// alike; a ball meeting only reachable tets is refined to every level.
+/// Every tet of the finest map meeting the ball B(c, r) is at μt = `level`.
+fn ball_at_level(m: &LeveledMap<3>, c: [f64; 3], r: f64, level: u8) -> bool {
+    m.map().one_dart_per_cell(3).into_iter().all(|d| !m.tet_in_ball(d, c, r).unwrap() || m.mu(d).tet == level)
+}
+
+/// Finding 125 and its follow-up: `refine_around` never returns `Ok` with a tet of its ball left
+/// below its levels. A ball meeting a tet at μt < k − 1 (k the map's max level), which the levels
+/// L = k.. cannot reach one at a time, first catches it up by a level skip (split at level k),
+/// on the plain, the per-op and the coupled path alike; mass is conserved.
 #[test]
-fn f125_refine_around_refuses_a_ball_it_cannot_refine() {
-    let (mut m, mut masses) = two_tets_first_at_level_2();
-    let (version, before) = (m.version(), masses.clone());
-    let e = m.refine_around([10.1, 0.1, 0.1], 0.0, 3, &mut masses).unwrap_err();
-    let SubdivideError::ZoneBelowLevel { dart, mu_tet: 0, max_level: 2 } = e else { panic!("{e}") };
-    assert!(m.tet_in_ball(dart, [10.1, 0.1, 0.1], 0.0).unwrap(), "{dart} is not in the ball");
-    assert_eq!((m.version(), &masses), (version, &before));
-    let e = m.refine_around_per_op([10.1, 0.1, 0.1], 0.0, 3, &mut masses).unwrap_err();
-    assert_eq!(e, SubdivideError::ZoneBelowLevel { dart, mu_tet: 0, max_level: 2 });
-    // The first tet's zone is reachable: every tet meeting the ball ends at μt = 3.
-    let r = m.refine_around([0.1; 3], 0.0, 3, &mut masses).unwrap();
-    assert_eq!(r.subdivided_per_level[3], 1);
-    for d in m.map().one_dart_per_cell(3) {
-        if m.tet_in_ball(d, [0.1; 3], 0.0).unwrap() {
-            assert_eq!(m.mu(d).tet, 3);
-        }
+fn f125_refine_around_catches_up_a_tet_below_its_levels() {
+    let far = [10.1, 0.1, 0.1];
+    for per_op in [false, true] {
+        let (mut m, mut masses) = two_tets_first_at_level_2();
+        let before: f64 = masses.total(&m);
+        let r = if per_op {
+            m.refine_around_per_op(far, 0.0, 3, &mut masses).unwrap()
+        } else {
+            m.refine_around(far, 0.0, 3, &mut masses).unwrap()
+        };
+        assert_eq!(r.subdivided_per_level[2], 1, "the catch-up: {r:?}");
+        assert!(r.subdivided_per_level[3] >= 1, "{r:?}");
+        assert!(ball_at_level(&m, far, 0.0, 3));
+        assert!((r.total_mass_before - before).abs() <= 1e-15 && (r.total_mass_after / before - 1.0).abs() < 1e-12);
+        m.check_all().unwrap();
     }
 
     let (map, _) = GMap::<3>::from_tets(8, &[[0, 1, 2, 3], [4, 5, 6, 7]]).unwrap();
@@ -205,26 +209,17 @@ fn f125_refine_around_refuses_a_ball_it_cannot_refine() {
     let mut m = LeveledMap::new(map, pts);
     let mut mech = LeveledMechanics::new(&m, Material::default()).unwrap();
     mech.refine_around(&mut m, [0.1; 3], 0.0, 2).unwrap();
-    let version = m.version();
-    let e = mech.refine_around(&mut m, [10.1, 0.1, 0.1], 0.0, 3).unwrap_err();
-    let CouplingError::Subdivide(SubdivideError::ZoneBelowLevel { dart, mu_tet: 0, max_level: 2 }) = e else {
-        panic!("{e}")
-    };
-    assert_eq!(m.version(), version);
-    mech.check(&m).unwrap();
-    // The way on the error names: a level skip of that tet, then the refinement reaches it.
-    mech.subdivide_tet(&mut m, dart, 2).unwrap();
-    let r = mech.refine_around(&mut m, [10.1, 0.1, 0.1], 0.0, 3).unwrap();
-    assert_eq!(r.subdivided_per_level[3], 1);
+    let r = mech.refine_around(&mut m, far, 0.0, 3).unwrap();
+    assert_eq!(r.subdivided_per_level[2], 1, "{r:?}");
+    assert!(ball_at_level(&m, far, 0.0, 3));
     mech.check(&m).unwrap();
     m.check_all().unwrap();
 }
 
-/// Finding 125's error names a tet of the *lowest* μt in the ball (a survivor of the 36th
-/// mutation sample picked the highest): tets A, B, C far apart, A refined to level 3, B to
-/// level 1 (μt = 1 < k − 1 = 2), C left at 0; a ball over B and C names C, μt = 0.
+/// The catch-up reaches every μt below k − 1 at once: tets A, B, C far apart, A refined to
+/// level 3, B to level 1, C left at 0; a ball over B and C ends with every tet in it at μt = 3.
 #[test]
-fn zone_below_level_names_the_coarsest_tet() {
+fn catch_up_reaches_tets_of_several_levels() {
     let (map, _) = GMap::<3>::from_tets(12, &[[0, 1, 2, 3], [4, 5, 6, 7], [8, 9, 10, 11]]).unwrap();
     let unit = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
     let pts: Vec<[f64; 3]> = (0..3).flat_map(|k| unit.map(|p| [p[0] + 10.0 * k as f64, p[1], p[2]])).collect();
@@ -233,11 +228,47 @@ fn zone_below_level_names_the_coarsest_tet() {
     m.refine_around([10.1, 0.1, 0.1], 0.0, 1, &mut masses).unwrap(); // B to level 1
     m.refine_around([0.1; 3], 0.0, 3, &mut masses).unwrap(); // A to level 3
     assert_eq!(m.max_level(), 3);
-    let e = m.refine_around([15.0, 0.1, 0.1], 5.5, 3, &mut masses).unwrap_err();
-    let SubdivideError::ZoneBelowLevel { dart, mu_tet, max_level: 3 } = e else { panic!("{e}") };
-    assert_eq!(mu_tet, 0, "{e}");
-    let corner = m.points()[m.tet_vertices(dart).unwrap()[0] as usize];
-    assert!(corner[0] >= 19.0, "{dart} is not in C: {corner:?}");
+    let (c, r) = ([15.0, 0.1, 0.1], 5.5);
+    let tets_in_ball = |m: &LeveledMap<3>| {
+        m.map().one_dart_per_cell(3).into_iter().filter(|&d| m.tet_in_ball(d, c, r).unwrap()).count()
+    };
+    let coarse = tets_in_ball(&m);
+    let out = m.refine_around(c, r, 3, &mut masses).unwrap();
+    assert!(ball_at_level(&m, c, r, 3));
+    assert!(out.subdivided_per_level[3] >= coarse, "{out:?}");
+    assert!((out.total_mass_after / out.total_mass_before - 1.0).abs() < 1e-12);
+    m.check_all().unwrap();
+}
+
+/// The catch-up is all or nothing: tets T1 = (0,1,2,3) and T2 = (1,2,3,4) share a face; T2 is
+/// refined twice next to it, so the shared face is refined twice and T1 can no longer be split.
+/// A ball over T1 and a far tet F (both at μt = 0 < k − 1) is refused (`FaceRefinedTooFar`),
+/// and the map and the masses are what they were, even if F was split first.
+#[test]
+fn catch_up_refused_leaves_everything_unchanged() {
+    let (map, _) = GMap::<3>::from_tets(9, &[[4, 1, 2, 3], [0, 1, 2, 3], [5, 6, 7, 8]]).unwrap();
+    let pts = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [1.0, 1.0, 1.0],
+        [-20.0, 0.0, 0.0],
+        [-19.0, 0.0, 0.0],
+        [-20.0, 1.0, 0.0],
+        [-20.0, 0.0, 1.0],
+    ];
+    let mut m = LeveledMap::new(map, pts);
+    let mut masses = TetMasses::from_density(&m, 1.0).unwrap();
+    let shared_face_centre = [1.0 / 3.0; 3];
+    let near = [shared_face_centre[0] + 0.01, shared_face_centre[1] + 0.01, shared_face_centre[2] + 0.01];
+    m.refine_around(near, 0.0, 2, &mut masses).unwrap();
+    assert_eq!(m.max_level(), 2);
+    let (version, darts, before) = (m.version(), m.map().dart_count(), masses.clone());
+    let e = m.refine_around([-9.0, 0.2, 0.2], 11.5, 2, &mut masses).unwrap_err();
+    assert!(matches!(e, SubdivideError::FaceRefinedTooFar { .. }), "{e}");
+    assert_eq!((m.version(), m.map().dart_count(), &masses), (version, darts, &before));
+    m.check_all().unwrap();
 }
 
 /// A survivor of the 36th mutation sample (`2.0 * at + 8.0 * bt` read as `2.0 * at + 8.0 + bt` in

@@ -61,10 +61,8 @@ pub(crate) fn split_exponent(x: f64) -> (f64, i64) {
     if x == 0.0 || !x.is_finite() {
         return (x, 0);
     }
-    let (x, shift) = if x.abs() < f64::MIN_POSITIVE { (x * 2f64.powi(64), -64) } else { (x, 0) };
-    let biased = ((x.to_bits() >> 52) & 0x7ff) as i64;
-    let mantissa = f64::from_bits((x.to_bits() & !(0x7ff << 52)) | (1023 << 52));
-    (mantissa, biased - 1023 + shift)
+    let e = crate::mesh::binary_exponent(x.abs());
+    (crate::mesh::times_pow2(x, -e), e)
 }
 
 /// a · b / l² · 2^e with no intermediate overflow or underflow: the product and quotient are

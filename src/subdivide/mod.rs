@@ -166,19 +166,6 @@ pub enum SubdivideError {
         /// The map's current maximum level.
         max_level: u8,
     },
-    /// A refinement's ball meets a tet it cannot reach: `refine_around` runs its levels from the
-    /// map's max level k (≥ 2 here) and each level L takes the tets at μt = L − 1, so a tet at
-    /// μt < k − 1 would stay coarse inside the ball. Split it first by a level skip,
-    /// `subdivide_tet(dart, k)` (its children are at μt = k), then refine.
-    #[error("the ball meets the tet of {dart} at μt = {mu_tet}, which refine_around cannot reach on a map at max level {max_level} (its levels take the tets at μt = L − 1 from L = {max_level}): subdivide it at level {max_level} first")]
-    ZoneBelowLevel {
-        /// A dart of the coarsest such tet.
-        dart: DartId,
-        /// Its μt.
-        mu_tet: u8,
-        /// The map's max level.
-        max_level: u8,
-    },
     /// The level is above [`MAX_LEVEL`].
     #[error("level {0} is above the maximum {MAX_LEVEL}")]
     LevelTooHigh(u8),

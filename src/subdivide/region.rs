@@ -522,15 +522,19 @@ impl LeveledMap<3> {
     /// every tet is at level L − 1, level L is done by the bulk [`Self::refine_uniform`] (same
     /// result, numbering aside); otherwise, or if it refuses, op by op
     /// ([`Self::refine_around_per_op`]). Returns the count per level and the mass totals.
-    /// After `Ok`, every tet of the finest map that meets the ball has μt = `levels`: a tet at
-    /// μt < k − 1 meeting it could only be refined by an operation below the max level k, which
-    /// the level order forbids, so such a ball is refused (below) rather than left coarse.
+    /// After `Ok`, every tet of the finest map that meets the ball has μt = `levels`. A tet at
+    /// μt < k − 1 meeting the ball (k the max level, k ≥ 2) cannot be reached one level at a
+    /// time (that would take an operation below level k, which the level order forbids): such
+    /// tets are first caught up by a level skip, split 1→8 at level k (their children at
+    /// μt = k; counted at level k), and the whole call is then all or nothing (the map and the
+    /// masses are copied first, O(darts) memory, and put back on any error).
     /// O(Σ_L (volumes + refined · touched)); O(darts) per bulk level.
     ///
     /// Errors: [`SubdivideError::LevelTooHigh`] for `levels` above [`super::MAX_LEVEL`],
     /// [`SubdivideError::BadBall`] for a non-finite centre or radius or a negative radius, those
-    /// of [`TetMasses::check`], and [`SubdivideError::ZoneBelowLevel`] (the tet of lowest such μt)
-    /// when the ball meets a tet at μt < k − 1, before any change; at a level,
+    /// of [`TetMasses::check`], before any change; in a catch-up, the dart limit and the refusals
+    /// of [`Self::subdivide_tet_with_mass`] (e.g. [`SubdivideError::FaceRefinedTooFar`] for a tet
+    /// whose face a finer neighbour refined twice), the map and masses put back; at a level,
     /// [`SubdivideError::DartLimit`] for a level over the dart limit and the refusals of [`Self::subdivide_tet_with_mass`] for any tet
     /// of its zone (e.g. [`SubdivideError::AlreadyAtLevel`] for an unsplit face that a finer
     /// neighbour, split at a skipped level, brought to μf = L), all checked on the whole level
@@ -587,7 +591,9 @@ impl LeveledMap<3> {
     }
 
     /// [`Self::refine_around`] (`bulk`: a level may go through [`Self::refine_uniform`]) or
-    /// [`Self::refine_around_per_op`] (not `bulk`).
+    /// [`Self::refine_around_per_op`] (not `bulk`). With a catch-up (a ball meeting tets at
+    /// μt < k − 1), the whole call is all or nothing: the map and the masses are copied first
+    /// and put back on any error.
     fn refine_zone(
         &mut self,
         center: [f64; 3],
@@ -599,15 +605,42 @@ impl LeveledMap<3> {
         self.check_op_level(levels)?;
         Self::check_ball(center, radius)?;
         masses.check(self)?;
-        self.check_unreachable_zone(center, radius)?;
+        let skipped = self.skipped_zone(center, radius)?;
+        if skipped.is_empty() {
+            return self.refine_levels(center, radius, levels, masses, bulk, None);
+        }
+        self.check_zone_limit(self.max_level, skipped.len())?;
+        let saved = (self.clone(), masses.clone());
+        let before = masses.total(self);
+        let result = self
+            .catch_up(&skipped, masses)
+            .and_then(|()| self.refine_levels(center, radius, levels, masses, bulk, Some((skipped.len(), before))));
+        if result.is_err() {
+            (*self, *masses) = saved;
+        }
+        result
+    }
+
+    /// The levels max(1, k)..=`levels` of [`Self::refine_zone`], after the catch-up (its count,
+    /// at level k, and the mass total before it) if there was one.
+    fn refine_levels(
+        &mut self,
+        center: [f64; 3],
+        radius: f64,
+        levels: u8,
+        masses: &mut TetMasses,
+        bulk: bool,
+        caught_up: Option<(usize, f64)>,
+    ) -> Result<Refinement, SubdivideError> {
         // Mass totals: a bulk level reports them (Σ over every volume), so O(darts) sweeps are
         // only made around per-op levels.
-        let (mut before, mut after) = (None, None);
+        let (mut before, mut after) = (caught_up.map(|(_, m)| m), None);
         let mut per_level = vec![0; levels as usize + 1];
+        per_level[self.max_level as usize] = caught_up.map_or(0, |(count, _)| count);
         for level in self.max_level.max(1)..=levels {
             if bulk && self.bulk_applies(center, radius, level) {
                 if let Ok(r) = self.refine_uniform(level, masses) {
-                    per_level[level as usize] = r.subdivided_per_level[level as usize];
+                    per_level[level as usize] += r.subdivided_per_level[level as usize];
                     before.get_or_insert(r.total_mass_before);
                     after = Some(r.total_mass_after);
                     continue;
@@ -617,7 +650,7 @@ impl LeveledMap<3> {
                 before = Some(masses.total(self));
             }
             after = None;
-            per_level[level as usize] = self.refine_level_per_op(level, levels, center, radius, masses)?;
+            per_level[level as usize] += self.refine_level_per_op(level, levels, center, radius, masses)?;
         }
         Ok(Refinement {
             subdivided_per_level: per_level,
@@ -739,27 +772,33 @@ impl LeveledMap<3> {
         Ok(())
     }
 
-    /// Refuses a refinement whose ball meets a tet it cannot reach: with k the map's max level, the
-    /// levels run from max(1, k), and level L takes the tets at μt = L − 1, so a tet at
-    /// μt < max(1, k) − 1 would stay coarse (it would need an operation at level μt + 1 < k, which
-    /// the level order forbids: operations never go back in level). Refused with
-    /// [`SubdivideError::ZoneBelowLevel`] naming the tet of lowest such μt, before any change.
-    /// Nothing to check for k ≤ 1. O(1), or O(darts) for k ≥ 2.
-    pub(super) fn check_unreachable_zone(&self, center: [f64; 3], radius: f64) -> Result<(), SubdivideError> {
+    /// One dart of every tet meeting the ball that the levels of a refinement cannot reach one
+    /// level at a time: with k the map's max level, the levels run from max(1, k) and level L
+    /// takes the tets at μt = L − 1, so a tet at μt < k − 1 needs a level skip (an operation at
+    /// level k). Empty for k ≤ 1. O(1), or O(darts) for k ≥ 2.
+    pub(super) fn skipped_zone(&self, center: [f64; 3], radius: f64) -> Result<Vec<DartId>, SubdivideError> {
+        let mut out = Vec::new();
         if self.max_level < 2 {
-            return Ok(());
+            return Ok(out);
         }
-        let mut lowest: Option<(DartId, u8)> = None;
         for d in self.map.one_dart_per_cell(3) {
-            let mu = self.mu[d.index()].tet;
-            if mu < self.max_level - 1 && lowest.is_none_or(|(_, l)| mu < l) && self.tet_in_ball(d, center, radius)? {
-                lowest = Some((d, mu));
+            if self.mu[d.index()].tet < self.max_level - 1 && self.tet_in_ball(d, center, radius)? {
+                out.push(d);
             }
         }
-        match lowest {
-            Some((dart, mu_tet)) => Err(SubdivideError::ZoneBelowLevel { dart, mu_tet, max_level: self.max_level }),
-            None => Ok(()),
+        Ok(out)
+    }
+
+    /// The catch-up of a refinement at max level k ≥ 2: every tet of `zone` (a
+    /// [`Self::skipped_zone`]) subdivided 1→8 at level k by a level skip (its children at
+    /// μt = k), its mass shared by [`Self::subdivide_tet_with_mass`]. Not all or nothing on its
+    /// own (a split may refuse for what an earlier split of the zone did to a face it shares,
+    /// a face then refined twice): [`Self::refine_zone`] keeps a copy. O(Σ zone volumes).
+    fn catch_up(&mut self, zone: &[DartId], masses: &mut TetMasses) -> Result<(), SubdivideError> {
+        for &d in zone {
+            self.subdivide_tet_with_mass(d, self.max_level, masses)?;
         }
+        Ok(())
     }
 
     /// Refuses a ball with a non-finite centre or a radius that is not a finite number ≥ 0. O(1).

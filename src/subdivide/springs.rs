@@ -931,13 +931,15 @@ impl LeveledMechanics {
     /// μt = L − 1 meeting the ball B(center, radius) is split 1→8 with its springs and masses (by the
     /// bulk path for a level where the ball holds everything, with the same springs up to rounding).
     /// The levels run from max(1, k), k the map's max level; after `Ok`, every tet of the finest
-    /// map that meets the ball has μt = `levels` (a ball meeting a tet the levels cannot reach is
-    /// refused, as by [`LeveledMap::refine_around`]). O(Σ_L (volumes + refined · touched)).
+    /// map that meets the ball has μt = `levels` (tets at μt < k − 1 in the ball are first caught
+    /// up by a level skip at level k, as by [`LeveledMap::refine_around`]; the call is then all or
+    /// nothing: map and coupling are copied first and put back on any error).
+    /// O(Σ_L (volumes + refined · touched)).
     ///
     /// Errors: [`SubdivideError::LevelTooHigh`] for `levels` above the maximum,
-    /// [`SubdivideError::BadBall`], those of the coupling's sync check, and
-    /// [`SubdivideError::ZoneBelowLevel`] for a ball meeting a tet at μt < k − 1 (it would need an
-    /// operation below the max level), before any change; at a level, those of
+    /// [`SubdivideError::BadBall`], those of the coupling's sync check, before any change; in a
+    /// catch-up, the dart limit, [`CouplingError::SplitOverflow`] and the refusals of
+    /// [`Self::subdivide_tet`] (map and coupling put back); at a level, those of
     /// [`LeveledMap::refine_around`] (the dart limit and the refusals of [`Self::subdivide_tet`] for
     /// any tet of its zone) and [`CouplingError::SplitOverflow`] (the bound of
     /// [`Self::subdivide_tet`] over the whole zone), all checked on the whole level before its
@@ -971,12 +973,38 @@ impl LeveledMechanics {
         m.check_op_level(levels)?;
         LeveledMap::check_ball(center, radius)?;
         self.in_sync(m)?;
-        m.check_unreachable_zone(center, radius)?;
+        let skipped = m.skipped_zone(center, radius)?;
         let before = self.masses.total(m);
+        if skipped.is_empty() {
+            return self.refine_levels(m, center, radius, levels, (0, before));
+        }
+        m.check_zone_limit(m.max_level(), skipped.len())?;
+        self.check_split_headroom(m, &skipped)?;
+        let saved = (m.clone(), self.clone());
+        let result = self
+            .catch_up(m, &skipped)
+            .and_then(|()| self.refine_levels(m, center, radius, levels, (skipped.len(), before)));
+        if result.is_err() {
+            (*m, *self) = saved;
+        }
+        result
+    }
+
+    /// The levels max(1, k)..=`levels` of [`Self::refine_around`], after a catch-up of `caught_up`
+    /// = (tets split at level k, the mass total before the call).
+    fn refine_levels(
+        &mut self,
+        m: &mut LeveledMap<3>,
+        center: [f64; 3],
+        radius: f64,
+        levels: u8,
+        (caught_up, before): (usize, f64),
+    ) -> Result<Refinement, CouplingError> {
         let mut per_level = vec![0; levels as usize + 1];
+        per_level[m.max_level() as usize] = caught_up;
         for level in m.max_level().max(1)..=levels {
             if let Some(count) = self.refine_level_in_bulk(m, center, radius, level)? {
-                per_level[level as usize] = count;
+                per_level[level as usize] += count;
                 continue;
             }
             // Every refusal of the level before its first split (map, springs and masses unchanged).
@@ -990,6 +1018,18 @@ impl LeveledMechanics {
         self.expensive_check(m);
         let after = self.masses.total(m);
         Ok(Refinement { subdivided_per_level: per_level, total_mass_before: before, total_mass_after: after })
+    }
+
+    /// The catch-up of [`Self::refine_around`] on a map at max level k ≥ 2 (see
+    /// [`LeveledMap::refine_around`]): every tet of `zone` (the tets at μt < k − 1 meeting the
+    /// ball) split 1→8 at level k with its springs and masses. Not all or nothing on its own
+    /// (a split may refuse for what an earlier one did to a shared face): the caller keeps a
+    /// copy. O(Σ zone volumes · log E).
+    fn catch_up(&mut self, m: &mut LeveledMap<3>, zone: &[DartId]) -> Result<(), CouplingError> {
+        for &d in zone {
+            self.split_followed(m, d, m.max_level())?;
+        }
+        Ok(())
     }
 
     /// One level of [`Self::refine_around`] by the map's bulk path ([`LeveledMap::refine_uniform`])

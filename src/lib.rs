@@ -49,6 +49,7 @@ pub mod store;
 pub mod subdivide;
 pub mod surface;
 pub mod vtk;
+mod wide;
 
 #[doc = include_str!("../docs/TUTORIAL.md")]
 pub mod tutorial {}

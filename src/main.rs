@@ -12,13 +12,15 @@
 //!
 //! Exit status 0 on success, 1 with one line `topomech: error: …` on stderr when the input is bad
 //! (the message names the file and, when the reader knows it, the line), 2 for a bad command line.
+//! `check` and `conformance check` have statuses of their own (see their `--help`): a verdict
+//! is never lost to a failed write of the report.
 
 mod cli;
 
 use std::io::Write;
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 use cli::CliError;
 
@@ -53,7 +55,8 @@ enum Command {
     Tear(cli::cut::TearArgs),
     /// Refine the tets meeting a ball 1→8, level by level, sharing their masses (seed 004).
     Refine(cli::refine::RefineArgs),
-    /// Validate a `.tmap`/`.tmapb` map file and list each broken law (exit 0 valid, 1 broken, 2 unreadable).
+    /// Validate a `.tmap`/`.tmapb` map file and list each broken law (exit 0 valid, 1 broken, 2 unreadable,
+    /// 3 valid but the report could not be written to stdout).
     Check(cli::check::CheckArgs),
     /// Conformance vectors: `generate DIR` writes the standard set, `check FILE_OR_DIR` replays (exit 1 mismatch, 2 unreadable).
     Conformance(cli::conformance::ConformanceArgs),
@@ -77,8 +80,30 @@ impl Command {
     }
 }
 
+/// `cmd` with every single-valued option that takes negative numbers (`allow_negative_numbers`)
+/// also taking values that start with a hyphen, in every subcommand: clap's test for a negative
+/// number misses `-1e-4` and `-.5`, which then read as unknown flags (`unexpected argument '-1'`)
+/// instead of reaching the option's own value check. A flag written where the value belongs
+/// (`--dt --json`) is then that value, refused by the check. O(arguments).
+fn hyphen_numbers(cmd: clap::Command) -> clap::Command {
+    cmd.mut_args(|arg| {
+        let single = arg.get_num_args().is_none_or(|n| n.max_values() <= 1);
+        match arg.is_allow_negative_numbers_set() && single {
+            true => arg.allow_hyphen_values(true),
+            false => arg,
+        }
+    })
+    .mut_subcommands(hyphen_numbers)
+}
+
+/// The command line, parsed with [`hyphen_numbers`]; a usage error exits with status 2.
+fn parse() -> Cli {
+    let matches = hyphen_numbers(Cli::command()).get_matches();
+    Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit())
+}
+
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = parse();
     let command = cli.command.unwrap_or_else(|| Command::Demo(cli::demo::DemoArgs::default()));
     match command.run() {
         Ok(()) => ExitCode::SUCCESS,

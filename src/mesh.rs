@@ -164,6 +164,17 @@ pub enum MeshError {
         /// The file tag of that point, when known.
         tag: Option<u64>,
     },
+    /// Two tets have the same four corners: a volume listed twice overlaps itself (its copies
+    /// would sew into a closed two-tet component and double its mass).
+    #[error("duplicate tet: tets {first} and {second} have the same corners {corners:?}")]
+    DuplicateTet {
+        /// The lower tet id.
+        first: usize,
+        /// The other tet id.
+        second: usize,
+        /// Their corners as listed by `first`.
+        corners: [u32; 4],
+    },
     /// A coordinate is NaN or infinite.
     #[error("non-finite coordinate: point {point}{} is {coords:?}", tag_suffix(.tag))]
     NonFiniteCoordinate {
@@ -215,9 +226,10 @@ pub struct MeshReport {
     pub zero_volume_tets: Vec<usize>,
     /// Tets with negative signed volume (and not zero-volume): inverted orientation.
     pub inverted_tets: Vec<usize>,
-    /// Tets whose signed volume is not a finite number: finite coordinates so large (about
-    /// 1e102 apart) that the volume overflows f64. Neither zero-volume nor inverted can be told;
-    /// [`TetMesh::total_volume`] is then not finite and a body refuses them.
+    /// Tets whose volume is not a finite f64: finite coordinates so far apart (a regular tet of
+    /// edge about 1e103) that the volume itself is past `f64::MAX`. Listed here instead of as
+    /// zero-volume or inverted (the test is made with an unbounded exponent, so a flat one is
+    /// still zero-volume); [`TetMesh::total_volume`] is then not finite and a body refuses them.
     pub unmeasurable_tets: Vec<usize>,
     /// Points that no tet uses.
     pub unreferenced_points: Vec<usize>,
@@ -289,8 +301,10 @@ impl TriMeshReport {
 }
 
 /// The mean of `points`, each divided by their count before the sum, so that no partial sum
-/// overflows (Σ p / n stays within the points' range: a sum first is ∞ for coordinates past
-/// `f64::MAX` / n). The origin for none. O(points).
+/// overflows (a sum first is ∞ for coordinates past `f64::MAX` / n), and kept within the
+/// points' range per coordinate (the divisions round: 5e-324 / 3 is 0, so three points at
+/// 5e-324 would average to 0; the centroid of identical points is the point). The origin for
+/// none. O(points).
 ///
 /// # Examples
 ///
@@ -300,6 +314,7 @@ impl TriMeshReport {
 /// let huge = f64::MAX / 2.0;
 /// assert_eq!(centroid(&[[huge; 3]; 4]), [huge; 3]); // a sum first would be ∞
 /// assert_eq!(centroid(&[]), [0.0; 3]);
+/// assert_eq!(centroid(&[[5e-324; 3]; 3]), [5e-324; 3]); // each 5e-324 / 3 rounds to 0
 /// ```
 pub fn centroid(points: &[[f64; 3]]) -> [f64; 3] {
     centroid_of(points.iter().copied())
@@ -320,13 +335,26 @@ pub fn centroid(points: &[[f64; 3]]) -> [f64; 3] {
 /// ```
 pub fn centroid_of(points: impl ExactSizeIterator<Item = [f64; 3]>) -> [f64; 3] {
     let n = points.len() as f64;
-    let mut c = [0.0; 3];
+    if n == 0.0 {
+        return [0.0; 3];
+    }
+    let (mut c, mut lo, mut hi) = ([0.0; 3], [f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
     for p in points {
         for k in 0..3 {
             c[k] += p[k] / n;
+            (lo[k], hi[k]) = (lo[k].min(p[k]), hi[k].max(p[k]));
         }
     }
-    c
+    // The divisions round (5e-324 / 3 is 0): the mean is kept within the points' range.
+    [0, 1, 2].map(|k| {
+        if c[k] < lo[k] {
+            lo[k]
+        } else if c[k] > hi[k] {
+            hi[k]
+        } else {
+            c[k]
+        }
+    })
 }
 
 /// |a − b|, with the components scaled by the largest before squaring, so that neither
@@ -403,12 +431,8 @@ pub fn midpoint(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 /// overflow nor underflow, so [`fit_for_products`] leaves them as they are.
 pub(crate) const PLAIN_EXTENT: std::ops::RangeInclusive<f64> = 5.527147875260445e-76..=1.8092513943330656e75;
 
-/// 2⁻¹⁰⁰⁰: a cross product whose largest component is below this may have lost terms to
-/// underflow ([`triangle_area`] then scales its edges first).
-const CROSS_FLOOR: f64 = 9.332636185032189e-302;
-
-/// `x` · 2^`e`, exact unless the result over- or underflows (in at most two steps: one power of
-/// two is normal only up to 2^±1022). O(1).
+/// `x` · 2^`e`, exact unless the result over- or underflows (in steps of at most 2^±1022, the
+/// largest normal powers of two). O(|e| / 1022).
 pub(crate) fn times_pow2(mut x: f64, mut e: i64) -> f64 {
     while e != 0 {
         let step = e.clamp(-1022, 1022);
@@ -496,17 +520,15 @@ pub fn signed_volume(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> f64 
 
 /// Area of the triangle `(a, b, c)` (always `>= 0`), `½|(b − a) × (c − a)|`. O(1).
 ///
-/// Edge vectors whose components lie between about 2⁻²⁵⁰ and 2²⁵⁰ (every ordinary triangle) are
-/// used as they are. Otherwise the cross product is taken as it is when none of its products
-/// overflowed or underflowed (its largest component finite and at least 2⁻¹⁰⁰⁰), with a
-/// scale-safe norm; only when it did is each edge vector first scaled by its own power of two
-/// (exact) to components below 2, and the area scaled back. So neither the cross product nor its
-/// square underflows or overflows: legs of 1e-90 give 5e-181, not 0, legs of 1e80 give 5e159,
-/// not ∞, legs of 1e200 and 1e-200 give 0.5, and a needle (0, 0, 0), (1e200, 0, 0),
-/// (1e200, 1e-120, 0) gives 5e79 (a component 2⁻⁶⁶⁵ times its edge's largest is not lost to a
-/// scaling). The result is ∞ only when the area itself is
-/// past `f64::MAX` (and 0 only when it is below the smallest subnormal, or the triangle is
-/// flat); NaN when a coordinate is.
+/// The plain formula where it is safe: the cross product w of the edge vectors finite with its
+/// largest component between 2⁻⁵⁰⁰ and 2⁵⁰⁰ (every ordinary triangle: a product lost to
+/// underflow there is below 2⁻⁵²² of w, and the squares of w neither overflow nor underflow).
+/// Otherwise the same formula in wide floats (an `f64` mantissa with an unbounded exponent,
+/// the same rounding), so that neither the edge vectors, the cross product nor its squares
+/// over- or underflow: legs of 1e-90 give 5e-181, not 0, legs of 1e80 give 5e159, not ∞, a
+/// needle (0, 0, 0), (1, 0, 0), (1, 1e-200, 0) gives 5e-201. The result is ∞ only when the
+/// area itself is past `f64::MAX`, 0 only when it is below the smallest subnormal or the
+/// triangle is flat; NaN when a coordinate is.
 ///
 /// # Examples
 ///
@@ -519,39 +541,57 @@ pub fn signed_volume(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> f64 
 /// assert_eq!(triangle_area([0.0; 3], [1e80, 0.0, 0.0], [0.0, 1e80, 0.0]), 0.5 * 1e80 * 1e80);
 /// assert_eq!(triangle_area([0.0; 3], [1e200, 0.0, 0.0], [0.0, 1e-200, 0.0]), 0.5); // a needle
 /// assert_eq!(triangle_area([0.0; 3], [1e200, 0.0, 0.0], [1e200, 1e-120, 0.0]), 5e79);
+/// assert_eq!(triangle_area([0.0; 3], [1.0, 0.0, 0.0], [1.0, 1e-200, 0.0]), 5e-201);
 /// assert_eq!(triangle_area([-f64::MAX, 0.0, 0.0], [f64::MAX, 0.0, 0.0], [0.0, f64::MAX, 0.0]), f64::INFINITY);
 /// ```
 pub fn triangle_area(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
-    let largest = |w: [f64; 3]| w.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-    let plain_range = |m: f64| m == 0.0 || PLAIN_EXTENT.contains(&m);
-    let (u, v) = (sub(b, a), sub(c, a));
-    let plain = 0.5 * norm(cross(u, v));
-    if (plain_range(largest(u)) && plain_range(largest(v))) || [a, b, c].iter().flatten().any(|x| x.is_nan()) {
-        return plain;
+    let w = cross(sub(b, a), sub(c, a));
+    let largest = w.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    if SAFE_CROSS.contains(&largest) && w.iter().all(|x| x.is_finite()) {
+        return 0.5 * norm(w);
     }
-    // The cross product itself is right when none of its products overflowed and its largest
-    // component is far above the underflow threshold (a product lost there is below 2⁻⁷⁴ of
-    // it); only its norm needs care (2·|w/4| = ½|w|, exact quartering).
-    let w = cross(u, v);
-    if w.iter().all(|x| x.is_finite()) && largest(w) >= CROSS_FLOOR {
-        return 2.0 * distance(w.map(|x| 0.25 * x), [0.0; 3]);
-    }
-    // A difference past f64::MAX: the corners are quartered first (the area by 1/16).
-    let (u, v, quartered) = if largest(u).is_finite() && largest(v).is_finite() {
-        (u, v, 0)
+    crate::wide::twice_area(a, b, c).mul(crate::wide::Wide::new(0.5)).to_f64()
+}
+
+/// 2⁻⁵⁰⁰ to 2⁵⁰⁰: a cross product whose largest component lies here is right as computed and
+/// its squares neither overflow nor underflow ([`triangle_area`]).
+const SAFE_CROSS: std::ops::RangeInclusive<f64> = 3.054936363499605e-151..=3.273390607896142e150;
+
+/// How [`TetMesh::check`] classes a tet.
+enum TetShape {
+    Unmeasurable,
+    ZeroVolume,
+    Inverted,
+    Positive,
+}
+
+/// The class of the tet with corners `c`: unmeasurable when its volume is not a finite f64
+/// (past `f64::MAX`, or NaN), zero-volume when |6V| ≤ [`DEGENERACY_TOLERANCE`] · l³ (l its
+/// longest edge), else inverted for V < 0. Plain for ordinary corners
+/// (`mechanics::geom::plain_corners`: the same bits as ever), else in wide floats (an f64
+/// mantissa with an unbounded exponent), so the test stays scale-invariant where 6V or l³ under-
+/// or overflows f64: a regular tet of edge 1e-150 is not zero-volume. O(1).
+fn tet_shape(c: [[f64; 3]; 4]) -> TetShape {
+    use crate::wide::{difference, norm, six_volume, Wide};
+    let (six, small) = if crate::mechanics::geom::plain_corners(c) {
+        let six = 6.0 * signed_volume(c[0], c[1], c[2], c[3]);
+        (Wide::new(six), six.abs() <= DEGENERACY_TOLERANCE * longest_edge(&c).powi(3))
     } else {
-        let quarter = |p: [f64; 3]| [0, 1, 2].map(|k| 0.25 * p[k] - 0.25 * a[k]);
-        (quarter(b), quarter(c), 4)
+        let six = six_volume(c[0], c[1], c[2], c[3]);
+        let lengths = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)].map(|(i, j)| norm(difference(c[j], c[i])));
+        let l = lengths.iter().fold(lengths[0], |a, &x| if a.less_than(x) { x } else { a });
+        let bound = Wide::new(DEGENERACY_TOLERANCE).mul(l).mul(l).mul(l);
+        (six, !bound.less_than(six.abs()))
     };
-    if !(largest(u).is_finite() && largest(v).is_finite()) {
-        return plain;
+    if !six.is_finite() || !six.div(Wide::new(6.0)).to_f64().is_finite() {
+        TetShape::Unmeasurable
+    } else if small {
+        TetShape::ZeroVolume
+    } else if six.signum() < 0.0 {
+        TetShape::Inverted
+    } else {
+        TetShape::Positive
     }
-    // Each edge by its own power of two (a needle's short edge must not underflow beside the
-    // long one): |u × v| = 2^(eu + ev) |u' × v'| with u', v' of components below 2.
-    let exponent = |w: [f64; 3]| if largest(w) == 0.0 { 0 } else { binary_exponent(largest(w)) };
-    let (eu, ev) = (exponent(u), exponent(v));
-    let (u, v) = (u.map(|x| times_pow2(x, -eu)), v.map(|x| times_pow2(x, -ev)));
-    times_pow2(0.5 * norm(cross(u, v)), eu + ev + quartered)
 }
 
 /// The longest distance between two of `corners`: `|p − q|` as it is when the components of
@@ -619,6 +659,31 @@ fn check_cells<const N: usize>(
                 });
             }
         }
+    }
+    Ok(())
+}
+
+/// [`MeshError::DuplicateTet`] for the first pair of tets with the same corner set (the lowest
+/// second id, paired with the first tet of its corners). The sorted corners are packed into one
+/// `u128` key and the keys sorted (16 bytes per tet); only when two keys are equal are the tets
+/// looked for, in one pass. O(T log T).
+fn check_duplicate_tets(tets: &[[u32; 4]]) -> Result<(), MeshError> {
+    let key = |c: &[u32; 4]| {
+        let mut k = *c;
+        k.sort_unstable();
+        k.iter().fold(0u128, |acc, &v| acc << 32 | u128::from(v))
+    };
+    let mut keys: Vec<u128> = tets.iter().map(key).collect();
+    keys.sort_unstable();
+    if keys.windows(2).all(|w| w[0] != w[1]) {
+        return Ok(());
+    }
+    let mut first_of: rustc_hash::FxHashMap<u128, usize> = rustc_hash::FxHashMap::default();
+    for (t, c) in tets.iter().enumerate() {
+        if let Some(&first) = first_of.get(&key(c)) {
+            return Err(MeshError::DuplicateTet { first, second: t, corners: tets[first] });
+        }
+        first_of.insert(key(c), t);
     }
     Ok(())
 }
@@ -837,16 +902,15 @@ impl TetMesh {
         let n = self.points.len();
         check_cells(CellKind::Tet, &self.tets, n, &self.node_tags)?;
         check_cells(CellKind::BoundaryTriangle, &self.boundary_triangles, n, &self.node_tags)?;
+        check_duplicate_tets(&self.tets)?;
         let mut report = MeshReport::default();
         for (i, t) in self.tets.iter().enumerate() {
             let c = t.map(|v| self.points[v as usize]);
-            let six_v = 6.0 * signed_volume(c[0], c[1], c[2], c[3]);
-            if !six_v.is_finite() {
-                report.unmeasurable_tets.push(i);
-            } else if six_v.abs() <= DEGENERACY_TOLERANCE * longest_edge(&c).powi(3) {
-                report.zero_volume_tets.push(i);
-            } else if six_v < 0.0 {
-                report.inverted_tets.push(i);
+            match tet_shape(c) {
+                TetShape::Unmeasurable => report.unmeasurable_tets.push(i),
+                TetShape::ZeroVolume => report.zero_volume_tets.push(i),
+                TetShape::Inverted => report.inverted_tets.push(i),
+                TetShape::Positive => {}
             }
         }
         report.unreferenced_points = unreferenced(n, &self.tets);
@@ -900,7 +964,7 @@ impl TetMesh {
         check_in_range(CellKind::Tet, &self.tets, self.points.len())?;
         let volume = |t: &[u32; 4]| {
             let c = t.map(|v| self.points[v as usize]);
-            signed_volume(c[0], c[1], c[2], c[3]).abs()
+            crate::mechanics::geom::tet_volume(c[0], c[1], c[2], c[3])
         };
         Ok(self.tets.iter().map(volume).fold(0.0, |sum, v| sum + v))
     }

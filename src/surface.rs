@@ -18,8 +18,7 @@
 //! assert!((s.enclosed_volume().unwrap() - 8.0).abs() < 1e-12);
 //! ```
 
-use crate::mechanics::geom::{cross, dot, sub};
-use crate::mesh::{fit_for_products, times_pow2, triangle_area};
+use crate::mesh::triangle_area;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -92,8 +91,8 @@ pub enum SurfaceError {
         /// The position.
         position: Vec3,
     },
-    /// The OBJ file could not be written (the cause names the file or its temporary sibling).
-    #[error("cannot write the surface OBJ file {}: {source}", .path.display())]
+    /// The OBJ file could not be written (the cause names the file).
+    #[error("cannot write the surface OBJ file {source}")]
     Write {
         /// The file asked for.
         path: PathBuf,
@@ -250,20 +249,11 @@ pub fn boundary_surface_of_tets(points: &[Vec3], tets: &[[u32; 4]]) -> Result<Su
 
 /// Sign of the apex `q[3]` relative to the plane of the triangle `q[0..3]` oriented by its normal:
 /// positive when the apex is in front, i.e. the triangle faces inward. The triple product is a
-/// cube of the lengths, so it is taken on the points fitted by [`fit_for_products`] (moved to
-/// `q[0]` and scaled by a power of two): the same sign at edge lengths 1e-200 and 1e200 as at 1
-/// (and the plain product, bit for bit, where the lengths need no scaling). O(1).
-fn apex_side(mut q: [Vec3; 4]) -> f64 {
-    fit_for_products(&mut q);
-    let n = cross(sub(q[1], q[0]), sub(q[2], q[0]));
-    let s = dot(n, sub(q[3], q[0]));
-    if s > 0.0 {
-        1.0
-    } else if s < 0.0 {
-        -1.0
-    } else {
-        0.0
-    }
+/// cube of the lengths, so it is taken in wide floats (`crate::wide`: the plain product where
+/// nothing over- or underflows): the same sign at edge lengths 1e-200 and 1e200 as at 1, and for
+/// a sliver 1e200 wide and 1e-200 thick. O(1).
+fn apex_side(q: [Vec3; 4]) -> f64 {
+    crate::wide::six_volume(q[0], q[1], q[2], q[3]).signum()
 }
 
 /// Collects triangles over vertex ids and compacts the vertices on the fly.
@@ -367,9 +357,10 @@ impl Surface {
     /// the first vertex (divergence theorem). For a closed, outward-oriented surface it is the
     /// volume of the solid, whatever `o` (for an open one it depends on `o`). Measured from a
     /// vertex, it does not depend on where the surface is: a unit cube at 1e9 encloses 1. The
-    /// products are taken on the vertices fitted by a power of two (as `mesh` does for tets), so
-    /// the result is ∞ or 0 only when the volume itself is past f64::MAX or below the smallest
-    /// f64. +0.0 for no triangles. O(vertices + triangles), including the check.
+    /// products are taken in wide floats (an f64 mantissa with an unbounded exponent: the plain
+    /// bits where nothing over- or underflows), so the result is ∞ or 0 only when the volume
+    /// itself is past f64::MAX or below the smallest f64 (a sliver 1e200 wide and 1e-200 thick
+    /// encloses its 1.67e199). +0.0 for no triangles. O(vertices + triangles), including the check.
     ///
     /// # Errors
     /// As [`Surface::check`]: [`SurfaceError::VertexOutOfRange`] naming the first triangle corner
@@ -389,15 +380,15 @@ impl Surface {
     /// ```
     pub fn enclosed_volume(&self) -> Result<f64, SurfaceError> {
         self.check()?;
-        let mut fitted = self.positions.clone();
-        // Moved to the first vertex and scaled by 2^k when the extent needs it (k = 0: as is).
-        let k = fit_for_products(&mut fitted);
-        let o = fitted.first().copied().unwrap_or_default();
-        let p = |i: u32| sub(fitted[i as usize], o);
+        use crate::wide::{cross, difference, dot, Wide};
+        // Measured from the first vertex, in wide floats (the plain bits where nothing over- or
+        // underflows).
+        let o = self.positions.first().copied().unwrap_or_default();
+        let p = |i: u32| difference(self.positions[i as usize], o);
         let triple = |&[a, b, c]: &[u32; 3]| dot(p(a), cross(p(b), p(c)));
-        // A fold from +0.0, not `sum` (which starts at −0.0): no triangles measure +0.0.
-        let sum = self.triangles.iter().map(triple).fold(0.0, |sum, v| sum + v);
-        Ok(times_pow2(sum / 6.0, -3 * k))
+        // A fold from +0.0: no triangles measure +0.0.
+        let sum = self.triangles.iter().map(triple).fold(Wide::new(0.0), Wide::add);
+        Ok(sum.div(Wide::new(6.0)).to_f64())
     }
 
     /// Total area of the triangles, each by the scale-safe [`crate::mesh::triangle_area`] (a

@@ -196,7 +196,9 @@ impl Frame<'_> {
         Ok(s)
     }
 
-    /// Writes the frame to `path`. O(points + tets).
+    /// Writes the frame to `path`, atomically: through a temporary file beside it and a rename
+    /// ([`crate::store::write_atomically`]), so a failed write (a full disk) leaves an earlier
+    /// file at `path` whole. A device or a pipe (`/dev/null`) is written in place. O(points + tets).
     ///
     /// # Errors
     /// The errors of [`Frame::to_vtu`], checked before the file is created (nothing is written
@@ -265,10 +267,19 @@ fn xml_attribute(text: &str) -> std::borrow::Cow<'_, str> {
     out.into()
 }
 
+/// Writes `text` to `path` through [`crate::store::write_atomically`] (a temporary file and a
+/// rename: a failed write leaves the earlier file whole), or in place when `path` is a device or
+/// a pipe (renaming over `/dev/null` would replace the device by a file). O(text).
 fn write_file(path: &Path, text: &str) -> Result<(), VtkError> {
     let io = |source| VtkError::Io { path: path.to_path_buf(), source };
-    let mut f = std::fs::File::create(path).map_err(io)?;
-    f.write_all(text.as_bytes()).map_err(io)
+    if std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir()) {
+        let mut f = std::fs::OpenOptions::new().write(true).truncate(true).open(path).map_err(io)?;
+        return f.write_all(text.as_bytes()).map_err(io);
+    }
+    crate::store::write_atomically(path, text.as_bytes()).map_err(|e| match e {
+        crate::store::StoreError::Io { source, .. } => io(source),
+        other => io(std::io::Error::other(other.to_string())),
+    })
 }
 
 /// A `.pvd` collection being written: frames are recorded as they are saved.
@@ -330,8 +341,9 @@ impl Series {
         Ok(Series { dir: dir.to_path_buf(), stem: stem.to_string(), frames: Vec::new() })
     }
 
-    /// Writes `frame` as the next file, at simulated time `time`, and rewrites the `.pvd`.
-    /// O(frame + frames so far).
+    /// Writes `frame` as the next file, at simulated time `time`, and rewrites the `.pvd`; both
+    /// atomically (as [`Frame::write`]), so a failed write never leaves a truncated `.pvd` or
+    /// frame behind. O(frame + frames so far).
     ///
     /// # Errors
     /// [`VtkError::BadTime`] for a time that is not finite (nothing is written), and the errors

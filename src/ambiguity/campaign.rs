@@ -36,7 +36,8 @@ pub enum CampaignError {
     /// A cut failed on the g-map side.
     #[error(transparent)]
     Construct(#[from] ConstructError),
-    /// A cut failed on the indexed side.
+    /// The indexed model refuses the mesh ([`IndexedError::CoincidentTets`]: a duplicated tet),
+    /// or a cut failed on the indexed side.
     #[error(transparent)]
     Indexed(#[from] IndexedError),
     /// The mesh has fewer interior faces than cuts asked for.
@@ -227,6 +228,10 @@ pub struct KStats {
 /// Runs `sequences` random sequences of `k` cuts on the mesh. The first run with each symptom is
 /// returned too. O(sequences · (tets + k · fans + darts)).
 ///
+/// Errors: [`CampaignError::Build`] for a mesh that does not build, [`CampaignError::Indexed`]
+/// ([`IndexedError::CoincidentTets`]) for a duplicated tet, [`CampaignError::TooFewFaces`]; any
+/// other error is a bug.
+///
 /// # Examples
 ///
 /// ```
@@ -248,6 +253,8 @@ pub fn campaign_k(
     rng: &mut SplitMix64,
 ) -> Result<(KStats, Vec<Run>), CampaignError> {
     let (fresh, _) = GMap::<3>::from_tets(points, tets)?;
+    // A mesh the indexed model refuses (a duplicated tet) is refused before any sequence.
+    IndexedModel::new(points, tets)?;
     let faces = glued_faces(&fresh);
     if faces.len() < k {
         return Err(CampaignError::TooFewFaces { asked: k, faces: faces.len() });

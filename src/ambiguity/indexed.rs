@@ -92,9 +92,23 @@ pub enum IndexedError {
         /// Number of tets.
         tets: usize,
     },
-    /// The two tets do not share three points.
-    #[error("tets {0} and {1} share no face in the indexed model")]
+    /// The two tets do not share exactly three points (or are one tet).
+    #[error("tets {0} and {1} share no face (three points) in the indexed model")]
     NoSharedFace(u32, u32),
+    /// Two tets of the input have the same four points (a duplicated element): the model names a
+    /// face by its three points, so "the face between them" would be any of four. Refused by
+    /// [`IndexedModel::new`].
+    #[error(
+        "tets {first} and {second} have the same four points {points:?} (a duplicated tet): the indexed model names a face by its three points and cannot tell their four common faces apart"
+    )]
+    CoincidentTets {
+        /// The first of them, by index in the input.
+        first: usize,
+        /// The second (the first later tet with the same points).
+        second: usize,
+        /// The points of `second`, as listed.
+        points: [u32; 4],
+    },
     /// A tet names a point past the end.
     #[error("tet {tet} names point {point}, but the model has {points} points")]
     NoSuchPoint {
@@ -189,7 +203,9 @@ impl IndexedModel {
     /// A model of `tets` over `points` points. O(tets).
     ///
     /// # Errors
-    /// [`IndexedError::NoSuchPoint`] for the first tet naming a point past `points`.
+    /// [`IndexedError::NoSuchPoint`] for the first tet naming a point past `points`;
+    /// [`IndexedError::CoincidentTets`] for the first tet with the same four points as an earlier
+    /// one (in any order).
     ///
     /// # Examples
     ///
@@ -202,11 +218,21 @@ impl IndexedModel {
     /// assert_eq!(model.used_points(), 5);
     /// let e = IndexedModel::new(4, &[[0, 1, 2, 3], [1, 2, 3, 4]]).unwrap_err();
     /// assert_eq!(e, IndexedError::NoSuchPoint { tet: 1, point: 4, points: 4 });
+    /// // Tet 1 is tet 0 again (its points in another order): a duplicated element.
+    /// let e = IndexedModel::new(4, &[[0, 1, 2, 3], [1, 0, 3, 2]]).unwrap_err();
+    /// assert_eq!(e, IndexedError::CoincidentTets { first: 0, second: 1, points: [1, 0, 3, 2] });
     /// ```
     pub fn new(points: usize, tets: &[[u32; 4]]) -> Result<Self, IndexedError> {
         let mut around = vec![Vec::new(); points];
+        let mut first_with: rustc_hash::FxHashMap<[u32; 4], usize> = rustc_hash::FxHashMap::default();
         for (t, tet) in tets.iter().enumerate() {
             check_points(t, tet, points)?;
+            let mut key = *tet;
+            key.sort_unstable();
+            if let Some(&first) = first_with.get(&key) {
+                return Err(IndexedError::CoincidentTets { first, second: t, points: *tet });
+            }
+            first_with.insert(key, t);
             for &p in tet {
                 around[p as usize].push(t as u32);
             }

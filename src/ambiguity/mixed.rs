@@ -31,7 +31,7 @@ use crate::ambiguity::refine::RefinedModel;
 use crate::generate::SplitMix64;
 use crate::gmap::{AlphaMask, DartId, GMap};
 use crate::graph::{graph_of, graphs_isomorphic, GraphInvariant, GraphKind, Multiplicity};
-use crate::subdivide::{LevelView, LeveledMap, SubdivideError};
+use crate::subdivide::{LevelView, LeveledMap, SubdivideError, MAX_LEVEL};
 use crate::BuildError;
 
 /// Graphs with more nodes than this are not compared by VF2 (the pair is then *undecided*).
@@ -63,7 +63,8 @@ pub enum Op {
     Subdivide(u32),
 }
 
-/// Why a mixed sequence could not run (every case but `Build` is a bug of topomech).
+/// Why a mixed sequence could not run: `Build`, `Pinched`, `Degenerate` and `Indexed` with
+/// [`IndexedError::CoincidentTets`] are bad input; every other case is a bug of topomech.
 ///
 /// # Examples
 ///
@@ -85,7 +86,8 @@ pub enum MixedError {
     /// A g-map operation failed where it cannot.
     #[error(transparent)]
     Subdivide(#[from] SubdivideError),
-    /// An indexed cut failed where it cannot.
+    /// The indexed model refuses the mesh ([`IndexedError::CoincidentTets`]: a duplicated tet), or
+    /// an indexed cut failed where it cannot (a bug).
     #[error(transparent)]
     Indexed(#[from] IndexedError),
     /// A child of a subdivision has no g-map counterpart with the same corner positions (or only
@@ -188,8 +190,12 @@ pub struct MixedRun {
     pub cuts: usize,
     /// Subdivisions done on both models.
     pub subdivisions: usize,
-    /// Subdivisions the g-map refused (not done on either side).
+    /// Subdivisions refused (not done on either side): by the g-map (a face refined beyond one
+    /// step) or at the level cap.
     pub refused: usize,
+    /// Of those, subdivisions refused because the map was at level [`MAX_LEVEL`] already (every
+    /// subdivision opens a level).
+    pub refused_level_cap: usize,
     /// Cuts whose two volumes share no point triple in the tet list.
     pub cuts_inexpressible: usize,
     /// Cuts after which the two tets still shared their triple (the cut re-glued).
@@ -237,17 +243,53 @@ struct Sides {
     vol_dart: Vec<DartId>,
 }
 
-/// What a level looked like when it ended.
-struct Snapshot {
-    map: GMap<3>,
-    model: RefinedModel,
-    vol_dart: Vec<DartId>,
+impl Sides {
+    /// Both models of the input mesh, tet t standing for the volume of dart 24 t.
+    fn new(map: GMap<3>, points: &[[f64; 3]], tets: &[[u32; 4]]) -> Result<Self, MixedError> {
+        Ok(Sides {
+            lm: LeveledMap::new(map, points.to_vec()),
+            model: RefinedModel::new(points, tets)?,
+            vol_dart: (0..tets.len()).map(|t| DartId(24 * t as u32)).collect(),
+        })
+    }
+}
+
+impl MixedRun {
+    /// A run of `ops` with nothing counted yet.
+    fn empty(ops: &[Op]) -> Self {
+        MixedRun {
+            ops: ops.to_vec(),
+            cuts: 0,
+            subdivisions: 0,
+            refused: 0,
+            refused_level_cap: 0,
+            cuts_inexpressible: 0,
+            cuts_lost: 0,
+            skeleton_cuts: 0,
+            skeleton_violations: 0,
+            finest: Compare::default(),
+            levels: Vec::new(),
+            level_law: true,
+            gmap_valid: true,
+        }
+    }
 }
 
 /// Runs `ops` on both models built from the mesh. O(ops · (mesh + darts)) plus one comparison
 /// per level (each O(tets + darts · n) and a VF2 when maps differ but graph invariants agree).
 ///
-/// Errors: [`MixedError::Build`] / [`MixedError::Pinched`] for a bad mesh, and
+/// Memory: O(mesh + darts + ops), independent of the number of levels. The comparison at level i
+/// needs both models as they were when level i ended; they are not kept (a copy per level was
+/// O(levels × darts)) but recomputed: after the run, the ops are replayed once on fresh models
+/// (the ops are deterministic), and each level is compared when the replay reaches its end, so
+/// at most two states (the final one and the replayed one) are alive at a time. The replay
+/// doubles the cost of the ops, not of the comparisons.
+///
+/// A subdivision past level [`MAX_LEVEL`] is refused and counted (`refused` and
+/// `refused_level_cap`), like one the g-map refuses for a face refined too far.
+///
+/// Errors: [`MixedError::Build`] / [`MixedError::Pinched`] for a bad mesh,
+/// [`MixedError::Indexed`] ([`IndexedError::CoincidentTets`]) for a duplicated tet, and
 /// [`MixedError::Degenerate`] for a tet of zero volume or with a non-finite corner when `ops`
 /// subdivide; the other variants are bugs.
 ///
@@ -272,50 +314,81 @@ pub fn run_ops(points: &[[f64; 3]], tets: &[[u32; 4]], ops: &[Op]) -> Result<Mix
     if ops.iter().any(|op| matches!(op, Op::Subdivide(_))) {
         check_volumes(points, tets)?;
     }
-    let mut s = Sides {
-        lm: LeveledMap::new(map, points.to_vec()),
-        model: RefinedModel::new(points, tets)?,
-        vol_dart: (0..tets.len()).map(|t| DartId(24 * t as u32)).collect(),
-    };
-    let mut run = MixedRun {
-        ops: ops.to_vec(),
-        cuts: 0,
-        subdivisions: 0,
-        refused: 0,
-        cuts_inexpressible: 0,
-        cuts_lost: 0,
-        skeleton_cuts: 0,
-        skeleton_violations: 0,
-        finest: Compare::default(),
-        levels: Vec::new(),
-        level_law: true,
-        gmap_valid: true,
-    };
-    let mut snapshots: Vec<Snapshot> = Vec::new();
-    for &op in ops {
+    let mut s = Sides::new(map, points, tets)?;
+    let mut run = MixedRun::empty(ops);
+    // The index of the op whose subdivision ended level i, for every level i below the finest.
+    let mut level_ends: Vec<usize> = Vec::new();
+    for (j, &op) in ops.iter().enumerate() {
         match op {
-            Op::Cut(i) => cut(&mut s, i, &mut run)?,
-            Op::Subdivide(i) => subdivide(&mut s, i, &mut run, &mut snapshots)?,
+            Op::Cut(i) => cut(&mut s, i, &mut run, true)?,
+            Op::Subdivide(i) => {
+                if subdivide(&mut s, i, &mut run)? {
+                    level_ends.push(j);
+                }
+            }
         }
     }
     run.gmap_valid = s.lm.check_all().is_ok();
-    for (level, snap) in snapshots.iter().enumerate() {
-        let level = level as u8;
-        let view = s.lm.level(level).map_err(|e| MixedError::Level(level, e.to_string()))?;
-        let mut index: FxHashMap<u32, DartId> = FxHashMap::default();
-        for (k, d) in view.darts.iter().enumerate() {
-            index.insert(d.0, DartId(k as u32));
-        }
-        run.level_law &= level_matches(&view, &snap.map);
-        let vol: Option<Vec<DartId>> = snap.vol_dart.iter().map(|d| index.get(&d.0).copied()).collect();
-        let vol = vol.ok_or_else(|| MixedError::Level(level, "a paired dart is not in B_i".into()))?;
-        let mut c = compare(&view.map, &vol, &snap.model)?;
-        c.level = level;
-        run.levels.push(c);
+    if !level_ends.is_empty() {
+        // The input again (built, not kept: no copy is alive during the first pass).
+        let (map, _) = GMap::<3>::from_tets(points.len(), tets)?;
+        compare_levels(&s, Sides::new(map, points, tets)?, ops, &level_ends, &mut run)?;
     }
     run.finest = compare(s.lm.map(), &s.vol_dart, &s.model)?;
     run.finest.level = s.lm.max_level();
     Ok(run)
+}
+
+/// Replays `ops` on `replay` (fresh models of the input) up to the last level end, and compares
+/// level i of the final leveled map (`done.lm`) with the replayed models when the replay reaches
+/// `level_ends[i]`, before that op's subdivision: the level law and [`compare`]. Memory: the
+/// replayed models, one level view and one comparison at a time.
+fn compare_levels(
+    done: &Sides,
+    mut replay: Sides,
+    ops: &[Op],
+    level_ends: &[usize],
+    run: &mut MixedRun,
+) -> Result<(), MixedError> {
+    let Some(&last) = level_ends.last() else { return Ok(()) };
+    // The counters of the replay are thrown away: the first pass counted.
+    let mut scratch = MixedRun::empty(&[]);
+    let mut ends = level_ends.iter().enumerate().peekable();
+    for (j, &op) in ops[..=last].iter().enumerate() {
+        let ended = ends.next_if(|&(_, &end)| end == j).map(|(level, _)| level);
+        if let Some(level) = ended {
+            let level = u8::try_from(level).map_err(|_| MixedError::Level(u8::MAX, "more levels than u8".into()))?;
+            let c = compare_level(done, &replay, level, run)?;
+            run.levels.push(c);
+        }
+        let subdivided = match op {
+            Op::Cut(i) => {
+                cut(&mut replay, i, &mut scratch, false)?;
+                false
+            }
+            Op::Subdivide(i) => subdivide(&mut replay, i, &mut scratch)?,
+        };
+        if subdivided != ended.is_some() {
+            return Err(MixedError::Level(replay.lm.max_level(), format!("the replay of op {j} diverged")));
+        }
+    }
+    Ok(())
+}
+
+/// Level `level` of `done.lm` against `snap`, the models as they were when that level ended: the
+/// level law (into `run.level_law`) and the comparison of G_i with the tet list.
+fn compare_level(done: &Sides, snap: &Sides, level: u8, run: &mut MixedRun) -> Result<Compare, MixedError> {
+    let view = done.lm.level(level).map_err(|e| MixedError::Level(level, e.to_string()))?;
+    let mut index: FxHashMap<u32, DartId> = FxHashMap::default();
+    for (k, d) in view.darts.iter().enumerate() {
+        index.insert(d.0, DartId(k as u32));
+    }
+    run.level_law &= level_matches(&view, snap.lm.map());
+    let vol: Option<Vec<DartId>> = snap.vol_dart.iter().map(|d| index.get(&d.0).copied()).collect();
+    let vol = vol.ok_or_else(|| MixedError::Level(level, "a paired dart is not in B_i".into()))?;
+    let mut c = compare(&view.map, &vol, &snap.model)?;
+    c.level = level;
+    Ok(c)
 }
 
 /// Whether G_i (`view`) is `snap`, the finest map as it was when level i ended: as many darts,
@@ -329,13 +402,15 @@ fn level_matches(view: &LevelView<3>, snap: &GMap<3>) -> bool {
         })
 }
 
-/// The first tet of zero or non-finite signed volume, as [`MixedError::Degenerate`]. O(tets).
+/// The first tet of zero signed volume or with a non-finite corner, as
+/// [`MixedError::Degenerate`]. The determinant is taken in wide floats (`crate::wide`), so a
+/// regular tet of edge 1e150 (volume past f64) or 1e-150 (below it) is not degenerate. O(tets).
 fn check_volumes(points: &[[f64; 3]], tets: &[[u32; 4]]) -> Result<(), MixedError> {
     for (tet, t) in tets.iter().enumerate() {
         let [a, b, c, d] = t.map(|v| points[v as usize]);
-        let volume = crate::mesh::signed_volume(a, b, c, d);
-        if volume == 0.0 || !volume.is_finite() {
-            return Err(MixedError::Degenerate { tet, volume });
+        let six = crate::wide::six_volume(a, b, c, d);
+        if six.is_zero() || !six.is_finite() {
+            return Err(MixedError::Degenerate { tet, volume: crate::wide::signed_volume(a, b, c, d) });
         }
     }
     Ok(())
@@ -360,7 +435,9 @@ pub fn glued_face_darts(map: &GMap<3>) -> Vec<DartId> {
     map.darts().filter(|&d| !map.is_free(3, d) && seen.insert(map.cell_id(2, d).0)).collect()
 }
 
-fn cut(s: &mut Sides, i: u32, run: &mut MixedRun) -> Result<(), MixedError> {
+/// Cuts the i-th glued face (modulo their number) on both sides and counts it in `run`; with
+/// `verify`, a skeleton pair is verified on maps of at most [`SKELETON_CHECK_DARTS`] darts.
+fn cut(s: &mut Sides, i: u32, run: &mut MixedRun, verify: bool) -> Result<(), MixedError> {
     let faces = glued_face_darts(s.lm.map());
     if faces.is_empty() {
         return Ok(());
@@ -372,7 +449,7 @@ fn cut(s: &mut Sides, i: u32, run: &mut MixedRun) -> Result<(), MixedError> {
     let tet = |x: DartId| tet_of.get(&map.cell_id(3, x).0).copied().ok_or(MixedError::NoModelTet(x));
     let (t1, t2) = (tet(d)?, tet(map.alpha::<3>(d))?);
     let before_counts = map.count_cells();
-    let before = (map.dart_count() <= SKELETON_CHECK_DARTS).then(|| map.clone());
+    let before = (verify && map.dart_count() <= SKELETON_CHECK_DARTS).then(|| map.clone());
     s.lm.unsew_face(d, s.lm.max_level())?;
     run.cuts += 1;
     let after = s.lm.map();
@@ -395,19 +472,24 @@ fn cut(s: &mut Sides, i: u32, run: &mut MixedRun) -> Result<(), MixedError> {
     Ok(())
 }
 
-fn subdivide(s: &mut Sides, i: u32, run: &mut MixedRun, snapshots: &mut Vec<Snapshot>) -> Result<(), MixedError> {
+/// Subdivides the i-th indexed tet (modulo their number) and its g-map volume at level
+/// max + 1; `Ok(false)` when refused (a face refined too far, or max = [`MAX_LEVEL`]), counted.
+fn subdivide(s: &mut Sides, i: u32, run: &mut MixedRun) -> Result<bool, MixedError> {
     let t = i % s.model.model.tets.len() as u32;
+    if s.lm.max_level() >= MAX_LEVEL {
+        run.refused += 1;
+        run.refused_level_cap += 1;
+        return Ok(false);
+    }
     let level = s.lm.max_level() + 1;
-    let before = Snapshot { map: s.lm.map().clone(), model: s.model.clone(), vol_dart: s.vol_dart.clone() };
     let kids = match s.lm.subdivide_tet(s.vol_dart[t as usize], level) {
         Ok(kids) => kids,
         Err(SubdivideError::FaceRefinedTooFar { .. }) => {
             run.refused += 1;
-            return Ok(());
+            return Ok(false);
         }
         Err(e) => return Err(e.into()),
     };
-    snapshots.push(before);
     let sets: Vec<Vec<[f64; 3]>> = kids.iter().map(|&k| volume_positions(&s.lm, k)).collect();
     let diagonal: Vec<[f64; 3]> =
         sets[4].iter().copied().filter(|p| sets[5..].iter().all(|set| set.contains(p))).collect();
@@ -424,7 +506,7 @@ fn subdivide(s: &mut Sides, i: u32, run: &mut MixedRun, snapshots: &mut Vec<Snap
         s.vol_dart[c as usize] = kids[k];
     }
     run.subdivisions += 1;
-    Ok(())
+    Ok(true)
 }
 
 /// The positions of the vertices of the volume of `d` (corners and inserted vertices).
@@ -580,8 +662,10 @@ pub struct MixedStats {
     pub cuts: usize,
     /// Subdivisions done.
     pub subdivisions: usize,
-    /// Subdivisions refused by the g-map.
+    /// Subdivisions refused (by the g-map, or at the level cap).
     pub refused: usize,
+    /// Of those, subdivisions refused at the level cap [`MAX_LEVEL`].
+    pub refused_level_cap: usize,
     /// Levels compared below the finest, in total.
     pub levels_compared: usize,
     /// Of those, levels where the indexed model could not represent G_i.
@@ -610,6 +694,7 @@ impl MixedStats {
         self.cuts += r.cuts;
         self.subdivisions += r.subdivisions;
         self.refused += r.refused;
+        self.refused_level_cap += r.refused_level_cap;
         self.levels_compared += r.levels.len();
         self.levels_ambiguous += r.levels.iter().filter(|c| c.ambiguous()).count();
         self.level_law_broken += usize::from(!r.level_law);
@@ -773,6 +858,20 @@ mod tests {
         cut.unsew::<3>(d).expect("unsews");
         assert_eq!(cut.dart_count(), view.map.dart_count());
         assert!(!level_matches(&view, &cut));
+    }
+
+    /// Finding 136: every subdivision opens a level; once the map is at [`MAX_LEVEL`], one more
+    /// is refused and counted (both counters), not an error that ends the campaign.
+    #[test]
+    fn a_subdivision_at_the_level_cap_is_refused_and_counted() {
+        let (p, t) = cube();
+        let (map, _) = GMap::<3>::from_tets(p.len(), &t).expect("builds");
+        let mut s = Sides::new(map, &p, &t).expect("models");
+        s.lm.subdivide_tet(s.vol_dart[0], MAX_LEVEL).expect("an op may start at any level");
+        let mut run = MixedRun::empty(&[]);
+        assert!(!subdivide(&mut s, 3, &mut run).expect("refused, not an error"));
+        assert_eq!((run.subdivisions, run.refused, run.refused_level_cap), (0, 1, 1));
+        assert_eq!(s.model.model.tets.len(), t.len(), "nothing done on the indexed side");
     }
 
     #[test]

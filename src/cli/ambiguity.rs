@@ -28,8 +28,9 @@ pub struct AmbiguityArgs {
     /// Seed of the random cut sequences.
     #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     pub seed: u64,
-    /// Random sequences per number of cuts.
-    #[arg(long, default_value_t = 100, allow_negative_numbers = true)]
+    /// Random sequences per number of cuts (at least 1; no upper bound: the run takes as long
+    /// as asked).
+    #[arg(long, default_value_t = 100, value_parser = super::at_least_one, allow_negative_numbers = true)]
     pub sequences: usize,
     /// Also run the mixed campaign: sequences of K ops (K from --cuts), each a tet subdivision
     /// with probability P (in 0..=1) and a cut otherwise.
@@ -42,7 +43,9 @@ pub struct AmbiguityArgs {
     /// Also run the exhaustive search over small 2D and 3D complexes.
     #[arg(long)]
     pub catalogue: bool,
-    /// Write the test vectors (catalogue and shrunk campaign findings) as JSON files into DIR.
+    /// Write the test vectors (catalogue and shrunk campaign findings) as JSON files into DIR,
+    /// each atomically (a failed write leaves an earlier file whole; a name taken by a
+    /// directory is refused before any file is written).
     #[arg(long, value_name = "DIR")]
     pub write_vectors: Option<PathBuf>,
     /// Most tests per delta-debugging pass when shrinking a finding for --write-vectors.
@@ -153,7 +156,8 @@ pub fn run(args: AmbiguityArgs) -> Result<(), CliError> {
     let mut per_k = Vec::new();
     let mut firsts: Vec<(usize, Run)> = Vec::new();
     for &k in &args.cuts {
-        let (stats, runs) = campaign_k(points, tets, k, args.sequences, &mut rng).map_err(other)?;
+        let (stats, runs) = campaign_k(points, tets, k, args.sequences, &mut rng)
+            .map_err(|e| other(format!("{name}: the cut campaign cannot run: {e}")))?;
         per_k.push(stats);
         firsts.extend(runs.into_iter().map(|r| (k, r)));
     }
@@ -275,12 +279,11 @@ fn write_vectors(
     if let Some(c) = cat {
         vectors.extend(c.pairs.iter().cloned().map(|p| Vector::Pair(Box::new(p))));
     }
+    let mut files = Vec::with_capacity(vectors.len());
     for v in &vectors {
-        let file = dir.join(format!("{}.json", v.name()));
-        std::fs::write(&file, serde_json::to_string_pretty(v)? + "\n")
-            .map_err(|e| other(format!("cannot write {}: {e}", file.display())))?;
+        files.push((dir.join(format!("{}.json", v.name())), (serde_json::to_string_pretty(v)? + "\n").into_bytes()));
     }
-    Ok(())
+    super::write_files(&files).map_err(|(file, e)| other(format!("cannot write {}: {e}", file.display())))
 }
 
 fn write_table(out: &mut dyn Write, r: &AmbiguityJson) -> std::io::Result<()> {

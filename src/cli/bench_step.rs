@@ -18,7 +18,7 @@ use topomech::mechanics::{FlatModel, Integrator, Material, PinSpec, Simulation, 
 use topomech::mesh::TetMesh;
 
 use super::simulate::{median, StepTimes};
-use super::{build_body, other, print_report, print_warnings, CliError};
+use super::{at_least_one, build_body, other, print_report, print_warnings, CliError};
 
 /// Arguments of `topomech bench`.
 #[derive(Debug, Clone, clap::Args)]
@@ -46,11 +46,12 @@ pub struct OrderBenchArgs {
     /// euler, symplectic, rk4 or implicit.
     #[arg(long, default_value = "rk4")]
     pub integrator: Integrator,
-    /// Rounds (each times one batch of each variant, the first variant rotating).
-    #[arg(long, default_value_t = 9, allow_negative_numbers = true)]
+    /// Rounds (each times one batch of each variant, the first variant rotating); at least 1,
+    /// no upper bound (the run takes as long as asked).
+    #[arg(long, default_value_t = 9, value_parser = at_least_one, allow_negative_numbers = true)]
     pub rounds: usize,
-    /// Steps per batch.
-    #[arg(long, default_value_t = 3, allow_negative_numbers = true)]
+    /// Steps per batch; at least 1, no upper bound.
+    #[arg(long, default_value_t = 3, value_parser = at_least_one, allow_negative_numbers = true)]
     pub batch: usize,
     /// Print one JSON object: zorder_step_us, rcm_step_us, rcm_2_threads_step_us,
     /// rcm_over_zorder, speedup_2_threads, rcm_ns_per_spring, springs, vertices, kernel.
@@ -90,11 +91,12 @@ pub struct StepBenchArgs {
     /// euler, symplectic, rk4 or implicit.
     #[arg(long, default_value = "rk4")]
     pub integrator: Integrator,
-    /// Rounds (each times one batch of each model).
-    #[arg(long, default_value_t = 200, allow_negative_numbers = true)]
+    /// Rounds (each times one batch of each model); at least 1, no upper bound (the run takes
+    /// as long as asked).
+    #[arg(long, default_value_t = 200, value_parser = at_least_one, allow_negative_numbers = true)]
     pub rounds: usize,
-    /// Steps per batch.
-    #[arg(long, default_value_t = 50, allow_negative_numbers = true)]
+    /// Steps per batch; at least 1, no upper bound.
+    #[arg(long, default_value_t = 50, value_parser = at_least_one, allow_negative_numbers = true)]
     pub batch: usize,
     /// Print one JSON object: map_step_us, flat_step_us, ratio, springs, vertices, kernel.
     #[arg(long)]
@@ -183,7 +185,7 @@ fn order_report(args: OrderBenchArgs) -> Result<OrderJson, CliError> {
     let mut r1 = flat_case(&rcm, args.integrator, false)?;
     let mut r2 = flat_case(&rcm, args.integrator, true)?;
     let two = rayon::ThreadPoolBuilder::new().num_threads(2).build().map_err(other)?;
-    let batch = args.batch.max(1);
+    let batch = args.batch.max(1); // ≥ 1 from the command line; a struct built in code may hold 0
     let (mut zt, mut rt, mut r2t, mut ratio, mut speedup) = (vec![], vec![], vec![], vec![], vec![]);
     for round in 0..args.rounds.max(1) {
         // The variants take turns at going first, so that a bias of the position in the round
@@ -191,7 +193,7 @@ fn order_report(args: OrderBenchArgs) -> Result<OrderJson, CliError> {
         // loaded host) hits each alike.
         let mut t = [0.0; 3];
         for k in 0..3 {
-            let v = (round + k) % 3;
+            let v = (round % 3 + k) % 3; // no overflow on the last of usize::MAX rounds
             t[v] = match v {
                 0 => time_batch(&mut z1, batch)?,
                 1 => time_batch(&mut r1, batch)?,

@@ -2,7 +2,11 @@
 //! documented format (`docs/FILE_FORMAT.md`) and list each broken law with its darts.
 //!
 //! Exit status: 0 when every law holds, 1 when laws are broken (after printing them), 2 when the
-//! file cannot be read or decoded (one line `topomech: error: …` on stderr).
+//! file cannot be read or decoded (one line `topomech: error: …` on stderr), 3 when every law
+//! holds but the report could not be written to stdout (a pipe whose reader has gone, a full
+//! device; one line on stderr). A broken map exits with 1 whether or not its report was written:
+//! the status is the map's verdict first (`check m.tmap | head -1` never turns a broken map into
+//! 0, nor a failed write into "laws are broken").
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -27,12 +31,12 @@ pub struct CheckArgs {
     pub limit: usize,
 }
 
-/// Decodes the file, runs [`store::check_all_laws`], prints the report and exits with 0, 1 or 2
-/// (see the module docs). Cost: O(file size + darts · n²).
+/// Decodes the file, runs [`store::check_all_laws`], prints the report and exits with 0, 1, 2 or
+/// 3 (see the module docs). Cost: O(file size + darts · n²).
 ///
 /// # Errors
-/// [`CliError::Output`] when stdout fails; an unreadable file and a broken law end the process
-/// with status 2 and 1 instead of returning.
+/// None returned: an unreadable file, a broken law and a report that could not be written end
+/// the process with status 2, 1 and 3 instead of returning.
 pub fn run(args: CheckArgs) -> Result<(), CliError> {
     let doc = match store::read_document(&args.file) {
         Ok(doc) => doc,
@@ -45,11 +49,16 @@ pub fn run(args: CheckArgs) -> Result<(), CliError> {
     let darts = doc.map.capacity as usize - doc.map.free_darts.len();
     let levels = doc.levels.as_ref().map(|l| l.max_level);
     let value = json_report(&args, doc.map.dimension, darts, levels, &report);
-    print_report(args.json, &value, |out| write_table(out, &args, (doc.map.dimension, darts, levels), &report))?;
-    if !report.valid {
-        std::process::exit(1);
+    let printed =
+        print_report(args.json, &value, |out| write_table(out, &args, (doc.map.dimension, darts, levels), &report));
+    if let Err(e) = &printed {
+        let _ = writeln!(std::io::stderr(), "topomech: error: {e}");
     }
-    Ok(())
+    match (report.valid, printed) {
+        (false, _) => std::process::exit(1),
+        (true, Err(_)) => std::process::exit(3),
+        (true, Ok(())) => Ok(()),
+    }
 }
 
 fn write_table(

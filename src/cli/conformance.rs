@@ -31,7 +31,8 @@ pub struct ConformanceArgs {
 /// `generate` or `check`.
 #[derive(Debug, Clone, clap::Subcommand)]
 pub enum Action {
-    /// Write the standard set as DIR/NAME.json (review the diff before committing).
+    /// Write the standard set as DIR/NAME.json (review the diff before committing); each file
+    /// atomically, so a failed write leaves the earlier file whole.
     Generate {
         /// Output directory (created if missing).
         dir: PathBuf,
@@ -67,11 +68,12 @@ fn generate(dir: &Path, root: &Path) -> Result<(), CliError> {
     let vectors = standard::generate_all(root).map_err(|e| CliError::Other(Box::new(e)))?;
     std::fs::create_dir_all(dir)
         .map_err(|source| CliError::Other(Box::new(ConformanceError::Io { path: dir.to_path_buf(), source })))?;
+    let files: Vec<(PathBuf, Vec<u8>)> =
+        vectors.iter().map(|v| (dir.join(format!("{}.json", v.name)), v.to_json().into_bytes())).collect();
+    super::write_files(&files)
+        .map_err(|(path, source)| CliError::Other(Box::new(ConformanceError::Io { path, source })))?;
     let mut out = std::io::stdout().lock();
-    for v in &vectors {
-        let path = dir.join(format!("{}.json", v.name));
-        std::fs::write(&path, v.to_json())
-            .map_err(|source| CliError::Other(Box::new(ConformanceError::Io { path: path.clone(), source })))?;
+    for (v, (path, _)) in vectors.iter().zip(&files) {
         writeln!(out, "wrote {} ({} steps)", path.display(), v.steps.len())?;
     }
     writeln!(out, "review the changes (git diff {}) before committing them", dir.display())?;

@@ -14,7 +14,7 @@ use topomech::mechanics::{check_conservation, Body, Integrator, Material, Simula
 use topomech::vtk::{body_tets, Frame};
 use topomech::CellId;
 
-use super::{build_body, check_ids, other, parse_finite, print_warnings, CellCensus, CliError};
+use super::{at_least_one, build_body, check_ids, other, parse_finite, print_warnings, CellCensus, CliError};
 
 /// Options shared by the three subcommands.
 #[derive(Debug, Clone, clap::Args)]
@@ -49,14 +49,16 @@ pub struct CutArgs {
     pub sweep: Option<[f64; 3]>,
 }
 
-/// Arguments of `topomech remove`.
+/// Arguments of `topomech remove`: exactly one of `--tets` and `--sphere` (without either the
+/// command would remove nothing and report success).
 #[derive(Debug, Clone, clap::Args)]
+#[command(group(clap::ArgGroup::new("selector").required(true).args(["tets", "sphere"])))]
 pub struct RemoveArgs {
     /// Mesh, density, output.
     #[command(flatten)]
     pub common: CommonArgs,
     /// Tet ids to remove (0-based positions in the file), comma-separated; an id listed twice is
-    /// removed once.
+    /// removed once. Exactly one of --tets and --sphere is required.
     #[arg(long, value_delimiter = ',', conflicts_with = "sphere")]
     pub tets: Vec<u32>,
     /// Remove the tets whose centroid lies in the ball `X,Y,Z,R`.
@@ -85,8 +87,8 @@ pub struct TearArgs {
     /// Gravity along z (negative pulls down); large values stretch the body.
     #[arg(long, default_value_t = -200.0, allow_hyphen_values = true)]
     pub gravity_z: f64,
-    /// Vertices torn per step at most.
-    #[arg(long, default_value_t = 4, allow_negative_numbers = true)]
+    /// Vertices torn per step at most (at least 1: 0 would never tear).
+    #[arg(long, default_value_t = 4, value_parser = at_least_one, allow_negative_numbers = true)]
     pub per_step: usize,
 }
 

@@ -37,12 +37,14 @@ pub enum CliError {
         /// The first law found broken.
         violation: InvariantViolation,
     },
-    /// Writing to stdout failed (a closed pipe is not reported: see `main`).
+    /// Writing to stdout failed (a closed pipe is not reported: see `main`), while writing a
+    /// table or a JSON report alike.
     #[error("cannot write the output: {0}")]
     Output(#[from] std::io::Error),
-    /// The JSON report could not be encoded.
+    /// The JSON report could not be encoded (never an I/O error: `From<serde_json::Error>` makes
+    /// a failed write an [`CliError::Output`]).
     #[error("cannot encode the JSON report: {0}")]
-    Json(#[from] serde_json::Error),
+    Json(serde_json::Error),
     /// The mesh loaded, but the mass/spring model cannot stand on it (a zero-volume tet, a bad
     /// material): the message names the file and the element.
     #[error("{}: cannot build the mass/spring model: {source}{at}", .path.display())]
@@ -59,6 +61,19 @@ pub enum CliError {
     /// defined in the library, e.g. the mechanics).
     #[error(transparent)]
     Other(Box<dyn std::error::Error + Send + Sync>),
+}
+
+/// A serde_json error as the CLI reports it: a failed write of the JSON text (a full device, a
+/// closed pipe) is an [`CliError::Output`] with the write's own error kind, so that it is treated
+/// as every other output error (`main` exempts a closed pipe); anything else is
+/// [`CliError::Json`]. O(1).
+impl From<serde_json::Error> for CliError {
+    fn from(e: serde_json::Error) -> Self {
+        match e.io_error_kind() {
+            Some(_) => CliError::Output(e.into()),
+            None => CliError::Json(e),
+        }
+    }
 }
 
 /// [`CliError::Other`] from a library error or a message. O(1).
@@ -237,6 +252,31 @@ pub(crate) fn print_report(
     Ok(())
 }
 
+/// Writes each `(path, bytes)` through [`topomech::store::write_atomically`] (a temporary file
+/// beside it and a rename), so a failed write (a full disk) leaves the earlier file at that path
+/// whole, never truncated. Every path is checked before the first write: one that exists and is
+/// not a regular file (a directory, a device) is refused then, so such a run replaces nothing.
+/// A later write failing (the disk filling up) leaves the files before it new and the rest as
+/// they were. O(total bytes).
+///
+/// # Errors
+/// The path and the cause of the first refusal or failed write.
+pub(crate) fn write_files(files: &[(PathBuf, Vec<u8>)]) -> Result<(), (PathBuf, std::io::Error)> {
+    for (path, _) in files {
+        if std::fs::metadata(path).is_ok_and(|m| !m.is_file()) {
+            let why = std::io::Error::other("it exists and is not a regular file (nothing was written)");
+            return Err((path.clone(), why));
+        }
+    }
+    for (path, bytes) in files {
+        topomech::store::write_atomically(path, bytes).map_err(|e| match e {
+            topomech::store::StoreError::Io { source, .. } => (path.clone(), source),
+            other => (path.clone(), std::io::Error::other(other.to_string())),
+        })?;
+    }
+    Ok(())
+}
+
 /// Refuses the first of `ids` that is not below `n`, naming the flag, the id and the range
 /// (e.g. `--pin: vertex 547 does not exist: the mesh has 547 points (ids 0 to 546)`), so that a
 /// bad id is neither ignored nor reported as something else later. O(ids).
@@ -292,6 +332,16 @@ pub(crate) fn parse_finite(t: &str) -> Result<f64, String> {
         Ok(v) if v.is_finite() => Ok(v),
         Ok(v) => Err(format!("number {v} is not finite")),
         Err(e) => Err(format!("bad number {t:?}: {e}")),
+    }
+}
+
+/// A count of at least 1, for a flag whose 0 would run nothing (or be read as 1) while the report
+/// went on as if it had run: refused with the value named, as a usage error. O(1).
+pub(crate) fn at_least_one(s: &str) -> Result<usize, String> {
+    match s.trim().parse::<usize>() {
+        Ok(0) => Err("must be at least 1 (0 would run nothing)".into()),
+        Ok(n) => Ok(n),
+        Err(e) => Err(format!("{s:?} is not a count: {e}")),
     }
 }
 

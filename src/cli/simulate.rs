@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use topomech::load;
-use topomech::mechanics::{Body, Integrator, Material, PinSpec, Simulation, StepConfig, Vec3};
+use topomech::mechanics::{Body, Integrator, Material, PinSpec, Simulation, SpringSystem, StepConfig, Vec3};
 use topomech::mesh::TetMesh;
 use topomech::vtk::{body_tets, Frame, Series};
 
@@ -21,7 +21,8 @@ pub struct SimulateArgs {
     /// Number of time steps.
     #[arg(long, default_value_t = 1000, allow_negative_numbers = true)]
     pub steps: u64,
-    /// Time step (seconds). Explicit schemes need dt below about 2/ω_max (printed on stderr).
+    /// Time step (seconds). Explicit schemes need dt below a limit set by the stiffness and the
+    /// damping (about 2/ω_max when undamped); a warning on stderr names it when dt is past it.
     #[arg(long, default_value_t = 1e-4, allow_negative_numbers = true)]
     pub dt: f64,
     /// euler, symplectic, rk4 or implicit.
@@ -63,8 +64,10 @@ pub struct SimulateArgs {
     /// Write `frame_NNNNNN.vtu` files and the series `frame.pvd` (for ParaView) into this directory.
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Frames to write when --out is given (evenly spaced, the initial state included).
-    #[arg(long, default_value_t = 50, allow_negative_numbers = true)]
+    /// Frames to write after the initial state when --out is given, at least 1: the run's steps
+    /// split into N equal intervals, the state at the end of each written (the last at the final
+    /// step) after the initial one, so N + 1 files (fewer when --steps < N: one per step).
+    #[arg(long, default_value_t = 50, value_parser = parse_frames, allow_negative_numbers = true)]
     pub frames: u64,
     /// Print one JSON object: steps, dt, integrator, step_us_median, total_mass,
     /// kinetic_energy, max_displacement.
@@ -100,6 +103,18 @@ fn parse_pin_below(s: &str) -> Result<(usize, f64), String> {
         other => return Err(format!("axis must be x, y or z, got {other:?}")),
     };
     Ok((axis, parse_finite(value)?))
+}
+
+/// `--frames`: a whole number ≥ 1 (0 would write only the initial state, or nothing: refused, so
+/// that `--out` always gets the final state).
+fn parse_frames(s: &str) -> Result<u64, String> {
+    match s.trim().parse::<u64>() {
+        Ok(0) => {
+            Err("--frames must be at least 1 (frames after the initial state; leave out --out to write none)".into())
+        }
+        Ok(n) => Ok(n),
+        Err(_) => Err(format!("expected a whole number of frames, got {s:?}")),
+    }
 }
 
 /// Most worker threads `--threads` takes: far above the cores of any machine this runs on, and
@@ -153,13 +168,8 @@ fn simulate(args: &SimulateArgs, parallel: bool) -> Result<(), CliError> {
     let mut config = StepConfig::new(args.integrator, args.dt);
     config.parallel = parallel;
     let mut sim = Simulation::new(&mut body, args.gravity, config).map_err(other)?;
-    let omega = sim.projection.system().omega_max();
-    if args.integrator != Integrator::Implicit && omega * args.dt > 2.0 {
-        eprintln!(
-            "topomech: warning: dt = {:.3e} exceeds the explicit stability bound 2/ω_max = {:.3e}",
-            args.dt,
-            2.0 / omega
-        );
+    if let Some(warning) = stability_warning(args.integrator, args.dt, sim.projection.system()) {
+        eprintln!("topomech: warning: {warning}");
     }
     let mut frames = FrameWriter::new(args, &body)?;
     frames.maybe_write(0, &body)?;
@@ -206,6 +216,25 @@ fn print_summary(
             writeln!(out, "  {:<22}{}", "ParaView series", p.display())?;
         }
         Ok(())
+    })
+}
+
+/// The warning for a `dt` past the stability limit of an explicit `integrator` on `sys`
+/// ([`Integrator::stable_dt`] of [`SpringSystem::mode_bounds`]: the stiffness and the damping
+/// terms, docs/MECHANICS.md "Time step"); `None` when dt is within it or the scheme is implicit.
+/// O(springs + slots).
+pub fn stability_warning(integrator: Integrator, dt: f64, sys: &SpringSystem) -> Option<String> {
+    let b = sys.mode_bounds();
+    let limit = integrator.stable_dt(&b).filter(|&limit| dt > limit)?;
+    let modes = format!("ω_max = {:.3e} /s, damping rate c_max = {:.3e} /s", b.omega_max, b.damping_max);
+    Some(if limit > 0.0 {
+        format!(
+            "dt = {dt:.3e} exceeds the stability limit {limit:.3e} of {} on this system ({modes}): \
+             the run may blow up",
+            integrator.name()
+        )
+    } else {
+        format!("forward Euler is unstable at every dt on this system ({modes}, undamped modes): the run may blow up")
     })
 }
 
@@ -285,11 +314,18 @@ pub fn median(v: &mut [f64]) -> f64 {
     }
 }
 
-/// Writes evenly spaced frames of the body when `--out` is given.
+/// Writes the frames of `--frames N` when `--out` is given: frame j (j = 0…N) at step
+/// s_j = round(j · S / N) of an S-step run, so the initial state (j = 0) and the final one
+/// (j = N, s_N = S) are written and the others evenly spaced between; a step that several j round
+/// to (S < N) is written once. O(1) memory whatever N and S.
 struct FrameWriter {
     series: Option<Series>,
     tets: Vec<[u32; 4]>,
-    every: u64,
+    /// N (at most S, at least 1) and S.
+    frames: u64,
+    steps: u64,
+    /// The next j to write.
+    next: u64,
     dt: f64,
 }
 
@@ -300,15 +336,29 @@ impl FrameWriter {
             None => None,
         };
         let tets = if series.is_some() { body_tets(body) } else { Vec::new() };
-        let every = (args.steps / args.frames.max(1)).max(1);
-        Ok(FrameWriter { series, tets, every, dt: args.dt })
+        // N > S writes every step, as N = S does (the s_j are then 0, 1, …, S): taking N = S
+        // keeps the s_j strictly increasing, one j per frame.
+        let frames = args.frames.min(args.steps).max(1);
+        Ok(FrameWriter { series, tets, frames, steps: args.steps, next: 0, dt: args.dt })
     }
 
+    /// s_j = round(j · S / N) (halves up), in u128: j · S < 2¹²⁸ for any u64 j and S. ≤ S for j ≤ N.
+    fn step_of(&self, j: u64) -> u64 {
+        let (js, n) = (u128::from(j) * u128::from(self.steps), u128::from(self.frames));
+        let rounded = js / n + u128::from(2 * (js % n) >= n);
+        u64::try_from(rounded).unwrap_or(u64::MAX)
+    }
+
+    /// Writes the state of `step` when it is the next frame's step (steps come in order from 0).
     fn maybe_write(&mut self, step: u64, body: &Body) -> Result<(), CliError> {
-        let Some(series) = &mut self.series else { return Ok(()) };
-        if step % self.every != 0 {
+        if self.next > self.frames || self.step_of(self.next) != step {
             return Ok(());
         }
+        // Every j that rounds to this step is written now, once (only j = 0, 1 when S = 0).
+        while self.next <= self.frames && self.step_of(self.next) <= step {
+            self.next += 1;
+        }
+        let Some(series) = &mut self.series else { return Ok(()) };
         let m = body.attrs();
         let displacement: Vec<Vec3> = m
             .position()

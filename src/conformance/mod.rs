@@ -79,12 +79,14 @@ pub enum ConformanceError {
         /// What serde_json reported (with line and column).
         message: String,
     },
-    /// `format` is not [`FORMAT`].
-    #[error("{origin}: format is {found:?}, expected {FORMAT:?}")]
+    /// `format` is not [`FORMAT`], or missing.
+    #[error("{origin}: {found}, expected format {FORMAT:?}")]
     Format {
         /// The file (or `<memory>`).
         origin: String,
-        /// The format found.
+        /// What was found, in words: `format is "x"` (the value as JSON text: a string once
+        /// quoted, a number as written), `missing field \`format\``, with what the file is when
+        /// that is known (an ambiguity vector, a JSON array).
         found: String,
     },
     /// `version` is not [`VERSION`].
@@ -295,9 +297,8 @@ impl Vector {
     pub fn from_json(text: &str, origin: &str) -> Result<Vector, ConformanceError> {
         let json = |e: serde_json::Error| ConformanceError::Json { origin: origin.to_string(), message: e.to_string() };
         let value: serde_json::Value = serde_json::from_str(text).map_err(json)?;
-        let format = value.get("format").cloned().unwrap_or(serde_json::Value::Null);
-        if format.as_str() != Some(FORMAT) {
-            return Err(ConformanceError::Format { origin: origin.to_string(), found: format.to_string() });
+        if value.get("format").and_then(|f| f.as_str()) != Some(FORMAT) {
+            return Err(ConformanceError::Format { origin: origin.to_string(), found: format_found(&value) });
         }
         let version = value.get("version").cloned().unwrap_or(serde_json::Value::Null);
         if version.as_u64() != Some(u64::from(VERSION)) {
@@ -354,7 +355,8 @@ impl Vector {
 
     fn check_fields_from(&self, origin: &str) -> Result<(), ConformanceError> {
         if self.format != FORMAT {
-            return Err(ConformanceError::Format { origin: origin.to_string(), found: self.format.clone() });
+            let found = format!("format is {}", serde_json::Value::from(self.format.as_str()));
+            return Err(ConformanceError::Format { origin: origin.to_string(), found });
         }
         if self.version != VERSION {
             return Err(ConformanceError::Version { origin: origin.to_string(), found: self.version.to_string() });
@@ -446,6 +448,36 @@ impl Vector {
         let mut s = flatten_scalar_arrays(&pretty);
         s.push('\n');
         s
+    }
+}
+
+/// What a document whose `format` is not [`FORMAT`] holds there, in words for
+/// [`ConformanceError::Format`]: `format is "x"` (its JSON text), or the field missing, with what
+/// the document is when that is known: an ambiguity vector (`"type": "pair"` or `"indexed"`, as
+/// `topomech ambiguity --write-vectors` writes) or not a JSON object at all. O(1).
+fn format_found(value: &serde_json::Value) -> String {
+    use serde_json::Value;
+    let kind = match value {
+        Value::Object(map) => map.get("type").and_then(|t| t.as_str()),
+        Value::Array(_) => return "missing field `format`: the file holds a JSON array, not an object".into(),
+        Value::String(_) => return "missing field `format`: the file holds a JSON string, not an object".into(),
+        Value::Number(_) => return "missing field `format`: the file holds a JSON number, not an object".into(),
+        Value::Bool(_) | Value::Null => {
+            return format!("missing field `format`: the file holds {value}, not an object")
+        }
+    };
+    match (value.get("format"), kind) {
+        (Some(f), _) => {
+            let text = f.to_string();
+            let cut: String = text.chars().take(60).collect();
+            format!("format is {cut}{}", if cut.len() < text.len() { "…" } else { "" })
+        }
+        (None, Some("pair" | "indexed")) => {
+            "missing field `format`: this is an ambiguity vector (`topomech ambiguity --write-vectors`; \
+             `cargo test --test ambiguity_vectors` replays those), not a conformance vector"
+                .into()
+        }
+        (None, _) => "missing field `format`".into(),
     }
 }
 

@@ -303,23 +303,41 @@ fn read_file(path: &Path) -> Result<Vec<u8>, ReadError> {
     read_whole(path).map_err(|source| ReadError::Io { path: path.to_path_buf(), source })
 }
 
-/// The bytes of the file at `path`: a regular file or a pipe (`<(zcat mesh.msh.gz)`). A
-/// character or block device or a socket is refused with [`std::io::ErrorKind::InvalidInput`]
-/// before anything is read: `/dev/zero` or `/dev/urandom` never end, and reading one would fill
-/// the memory before failing. O(file).
+/// The bytes of the file at `path`: a regular file or an anonymous pipe (`<(zcat mesh.msh.gz)`,
+/// `zcat mesh.msh.gz | topomech info /dev/stdin`). Refused with [`std::io::ErrorKind::InvalidInput`]
+/// before the file is opened ([`refuse_special`]): a character or block device or a socket
+/// (`/dev/zero` or `/dev/urandom` never end, and reading one would fill the memory before
+/// failing) and a named pipe (FIFO) in the file system (opening it waits for a writer that may
+/// never come). O(file).
 pub(crate) fn read_whole(path: &Path) -> std::io::Result<Vec<u8>> {
+    refuse_special(path)?;
+    std::fs::read(path)
+}
+
+/// `Err(InvalidInput)` when `path` (followed through symbolic links) is a device, a socket or a
+/// named pipe: nothing that [`read_whole`] could read to an end without waiting for someone. An
+/// anonymous pipe (`/dev/fd/N`, `/dev/stdin` fed by `|`) is a FIFO too, but it has no name in
+/// the file system (its path does not canonicalize) and its writer exists: it is read. Nothing
+/// is opened. O(path length) file-system queries.
+fn refuse_special(path: &Path) -> std::io::Result<()> {
     #[cfg(unix)]
     {
         use std::os::unix::fs::FileTypeExt;
         let kind = std::fs::metadata(path)?.file_type();
+        let refuse = |why: &str| Err(std::io::Error::new(std::io::ErrorKind::InvalidInput, why.to_string()));
         if kind.is_char_device() || kind.is_block_device() || kind.is_socket() {
-            return Err(std::io::Error::new(
-                std::io::ErrorKind::InvalidInput,
-                "a device or socket, not a file (reading it might never end)",
-            ));
+            return refuse("a device or socket, not a file (reading it might never end)");
+        }
+        if kind.is_fifo() && std::fs::canonicalize(path).is_ok() {
+            return refuse(
+                "a named pipe (FIFO), not a file (opening it waits for a writer that may never come; \
+                 pipe it in instead: `cat FIFO | topomech … /dev/stdin`)",
+            );
         }
     }
-    std::fs::read(path)
+    #[cfg(not(unix))]
+    let _ = path;
+    Ok(())
 }
 
 fn extension(path: &Path) -> String {

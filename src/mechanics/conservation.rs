@@ -13,7 +13,7 @@
 use crate::gmap::DartSet;
 use crate::{AlphaMask, CellId, DartId, GMap};
 
-use super::geom::{close, norm, sub};
+use super::geom::close;
 use super::model::{distinct, stiffness_contribution, Mechanics};
 
 /// Relative tolerance of every conservation comparison.
@@ -298,8 +298,8 @@ fn scatter_one(map: &GMap<3>, mech: &Mechanics, darts: &[DartId], exp: &mut Expe
     }
     for e in distinct(darts.iter().map(|&x| map.cell_id(1, x))) {
         let x = darts.iter().copied().find(|&x| map.cell_id(1, x) == e).expect("edge of this volume");
-        let length =
-            norm(sub(mech.rest_position[map.vertex_id(map.alpha::<0>(x))], mech.rest_position[map.vertex_id(x)]));
+        let (a, b) = (mech.rest_position[map.vertex_id(x)], mech.rest_position[map.vertex_id(map.alpha::<0>(x))]);
+        let length = super::geom::rest_length(a, b);
         exp.edge_stiffness[e.index()] += stiffness_contribution(young, volume, length);
         exp.edge_dart[e.index()] = Some(x);
         exp.edge_length[e.index()] = length;

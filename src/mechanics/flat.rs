@@ -8,7 +8,7 @@
 //! the two differ exactly there.
 
 use super::force::SpringSystem;
-use super::geom::{norm, sub, tet_volume, Vec3};
+use super::geom::{rest_length, tet_volume, Vec3};
 use super::model::{check_material, stiffness_contribution, Material, ModelError, ModelTotals};
 use crate::build::BuildError;
 
@@ -97,7 +97,7 @@ impl FlatModel {
             }
             for (i, j) in [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)] {
                 let (a, b) = (tet[i].min(tet[j]), tet[i].max(tet[j]));
-                let l = norm(sub(points[b as usize], points[a as usize]));
+                let l = rest_length(points[a as usize], points[b as usize]);
                 contributions.push(((a as u64) << 32 | b as u64, stiffness_contribution(material.young, volume, l)));
             }
         }
@@ -113,7 +113,7 @@ impl FlatModel {
                 stiffness.push(k);
             }
         }
-        let rest = ends.iter().map(|&[a, b]| norm(sub(points[b as usize], points[a as usize]))).collect();
+        let rest = ends.iter().map(|&[a, b]| rest_length(points[a as usize], points[b as usize])).collect();
         let damping = stiffness.iter().map(|k| material.damping * k).collect();
         let viscosity = mass.iter().map(|m| material.viscosity * m).collect();
         let fixed: Vec<bool> = (0..n).map(|i| pinned.get(i).copied().unwrap_or(false)).collect();

@@ -1206,6 +1206,77 @@ impl SpringSystem {
         }
         w2.sqrt()
     }
+
+    /// Bounds on the modes of the system at rest, for the stable time step of an explicit scheme
+    /// ([`crate::mechanics::Integrator::stable_dt`]): ω_max as [`SpringSystem::omega_max`]; the
+    /// largest damping rate c_max = max_v (γ_v + Σ_{s ∋ v} 2 c_s) / m_v over free slots (every
+    /// mode's rate c = ν + β ω² is at most this, by the same argument as ω_max: xᵀCx =
+    /// Σ c_s ((x_a − x_b)·n)² ≤ Σ_v |x_v|² Σ_{s ∋ v} 2 c_s); the least spring ratio c_s / k_s
+    /// (β_min, over springs with k_s > 0 and a free end) and the least γ_v / m_v (ν_min, over free
+    /// slots), ∞ when there is none. O(springs + slots).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::SpringSystem;
+    ///
+    /// let mut sys = SpringSystem::default();
+    /// sys.push_slot(2.0, true, 0.0).unwrap(); // fixed: does not count
+    /// sys.push_slot(0.5, false, 1.5).unwrap(); // γ = 1.5, so γ/m = 3
+    /// sys.push_spring([0, 1], 1.0, 4.0, 0.02).unwrap(); // c/k = 0.005
+    /// let b = sys.mode_bounds();
+    /// assert_eq!(b.omega_max, 4.0); // √(2k / m)
+    /// assert_eq!(b.damping_max, (1.5 + 2.0 * 0.02) / 0.5);
+    /// assert_eq!((b.beta_min, b.nu_min), (0.005, 3.0));
+    /// ```
+    pub fn mode_bounds(&self) -> ModeBounds {
+        let (mut damping_max, mut nu_min): (f64, f64) = (0.0, f64::INFINITY);
+        for i in 0..self.slots() {
+            let w = self.inv_mass[i];
+            if w > 0.0 {
+                let c: f64 = self.incident(i).map(|(s, _)| 2.0 * self.damping[s]).sum();
+                damping_max = damping_max.max((self.viscosity[i] + c) * w);
+                nu_min = nu_min.min(self.viscosity[i] * w);
+            }
+        }
+        let free = |s: usize| self.ends[s].iter().any(|&v| self.inv_mass[v as usize] > 0.0);
+        let beta_min = (0..self.springs())
+            .filter(|&s| self.stiffness[s] > 0.0 && free(s))
+            .map(|s| self.damping[s] / self.stiffness[s])
+            .fold(f64::INFINITY, f64::min);
+        ModeBounds { omega_max: self.omega_max(), damping_max, beta_min, nu_min }
+    }
+}
+
+/// Bounds on the modes of a [`SpringSystem`] at rest ([`SpringSystem::mode_bounds`]), from which
+/// [`crate::mechanics::Integrator::stable_dt`] derives a stable time step. With the material law's
+/// damping (c_s = β k_s, γ_v = ν m_v) the damping is proportional, M⁻¹(C + Γ) = β M⁻¹K + ν, so the
+/// system splits into modes ẍ + c ẋ + ω² x = 0 with ω ≤ `omega_max` and c = ν + β ω² ≤
+/// `damping_max`, c/ω² ≥ `beta_min` + `nu_min`/ω_max² (docs/MECHANICS.md, "Time step").
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mechanics::{Integrator, SpringSystem};
+///
+/// let mut sys = SpringSystem::default();
+/// sys.push_slot(1.0, true, 0.0).unwrap();
+/// sys.push_slot(1.0, false, 0.0).unwrap();
+/// sys.push_spring([0, 1], 1.0, 50.0, 0.0).unwrap(); // undamped: ω_max = 10
+/// let b = sys.mode_bounds();
+/// assert_eq!((b.omega_max, b.damping_max), (10.0, 0.0));
+/// assert_eq!(Integrator::Symplectic.stable_dt(&b), Some(0.2)); // 2/ω_max
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ModeBounds {
+    /// ω_max ≥ every angular frequency.
+    pub omega_max: f64,
+    /// c_max ≥ every modal damping rate (1/s).
+    pub damping_max: f64,
+    /// β_min: the least damping-to-stiffness ratio c_s / k_s of a spring (s); ∞ for none.
+    pub beta_min: f64,
+    /// ν_min: the least viscosity-to-mass ratio γ_v / m_v of a free slot (1/s); ∞ for none.
+    pub nu_min: f64,
 }
 
 /// A fault of a [`SpringSystem`] or of the arrays given to it, naming the array, spring or slot.

@@ -45,9 +45,24 @@ pub(crate) fn norm(a: Vec3) -> f64 {
     dot(a, a).sqrt()
 }
 
-/// |det[b − a, c − a, d − a]| / 6: the unsigned volume of a tetrahedron.
+/// |det[b − a, c − a, d − a]| / 6: the unsigned volume of a tetrahedron. Plain for
+/// [`plain_corners`] (the same bits as ever), else in wide floats (`crate::wide`), so it is ∞ or
+/// 0 only when the volume itself is past `f64::MAX` or below the smallest subnormal (a sliver
+/// 1e200 wide and 1e-200 thick has 1.67e199, not ∞ or 0). O(1).
 pub(crate) fn tet_volume(a: Vec3, b: Vec3, c: Vec3, d: Vec3) -> f64 {
-    (dot(cross(sub(b, a), sub(c, a)), sub(d, a)) / 6.0).abs()
+    if plain_corners([a, b, c, d]) {
+        return (dot(cross(sub(b, a), sub(c, a)), sub(d, a)) / 6.0).abs();
+    }
+    crate::wide::signed_volume(a, b, c, d).abs()
+}
+
+/// Whether every component of the edge vectors c₁ − c₀, c₂ − c₀, c₃ − c₀ is 0 or has a
+/// magnitude in [`crate::mesh::PLAIN_EXTENT`] (2⁻²⁵⁰ to 2²⁵⁰): then no product of up to four of
+/// them (a volume, a squared length, a volume over a squared length) over- or underflows, and
+/// the plain formulas are exact up to their rounding. Every ordinary tet. O(1).
+pub(crate) fn plain_corners(c: [Vec3; 4]) -> bool {
+    let edges = [sub(c[1], c[0]), sub(c[2], c[0]), sub(c[3], c[0])];
+    edges.iter().flatten().all(|x| *x == 0.0 || crate::mesh::PLAIN_EXTENT.contains(&x.abs()))
 }
 
 /// Whether `a` and `b` agree to a relative tolerance `rel` (absolute below `f64::MIN_POSITIVE`).
@@ -88,13 +103,12 @@ pub(crate) fn rest_length(a: Vec3, b: Vec3) -> f64 {
     }
 }
 
-/// Whether the tet with corners `c` has exactly zero volume, decided on its corners fitted by
-/// [`crate::mesh::fit_for_products`] (the corners as they are for ordinary extents), so that a
-/// tiny or huge regular tet, whose volume under- or overflows f64, is not called flat. O(1).
+/// Whether the tet with corners `c` has exactly zero volume, its determinant taken in wide floats
+/// (`crate::wide`: the plain bits for ordinary corners, no over- or underflow otherwise), so that
+/// a tet whose volume under- or overflows f64 (tiny or huge, a needle 1e-170 thin beside a unit
+/// edge, a sliver 1e-200 thick and 1e200 wide) is not called flat. O(1).
 pub(crate) fn is_flat(c: [Vec3; 4]) -> bool {
-    let mut f = c;
-    crate::mesh::fit_for_products(&mut f);
-    tet_volume(f[0], f[1], f[2], f[3]) == 0.0
+    crate::wide::six_volume(c[0], c[1], c[2], c[3]).is_zero()
 }
 
 #[cfg(test)]

@@ -25,9 +25,13 @@ use std::str::FromStr;
 
 use rayon::prelude::*;
 
-use super::force::{Rec4, SlotState, SpringSystem, SumPlan, PARALLEL_CHUNK};
+use super::force::{ModeBounds, Rec4, SlotState, SpringSystem, SumPlan, PARALLEL_CHUNK};
 use super::geom::{dot, norm, sub, Vec3};
 use super::simd::{multiversion, Kernel};
+
+/// Radius of a left half-disc {|z| ≤ r, Re z ≤ 0} inside RK4's stability region
+/// |1 + z + z²/2 + z³/6 + z⁴/24| ≤ 1 (the largest such radius is about 2.61).
+const RK4_HALF_DISC: f64 = 2.6;
 
 /// The time integration scheme.
 ///
@@ -71,6 +75,56 @@ impl Integrator {
             Integrator::Symplectic => "symplectic",
             Integrator::Rk4 => "rk4",
             Integrator::Implicit => "implicit",
+        }
+    }
+
+    /// The largest time step at which this scheme is stable on every mode the bounds allow (None
+    /// for [`Integrator::Implicit`], stable at every step). A mode ẍ + c ẋ + ω² x = 0 (ω ≤ ω_max,
+    /// c ≤ c_max; see [`ModeBounds`] and docs/MECHANICS.md, "Time step"):
+    /// - symplectic Euler (v₁ = v₀ + h a(x₀, v₀), x₁ = x₀ + h v₁) has the step matrix
+    ///   [[1 − h²ω², h(1 − hc)], [−hω², 1 − hc]], trace 2 − h²ω² − hc and determinant 1 − hc; its
+    ///   eigenvalues stay in the unit disc iff h²ω² + 2hc ≤ 4, i.e. h ≤ 4 / (c + √(c² + 4ω²)).
+    ///   That limit falls as ω or c grows, so the worst corner (ω_max, c_max) bounds every mode:
+    ///   2/ω_max undamped, about 2/c_max when damping dominates. Exact for one mode;
+    /// - forward Euler needs |1 + hλ| ≤ 1 at both roots λ of λ² + cλ + ω² = 0: h ≤ c/ω² for an
+    ///   oscillating mode (c < 2ω) and h ≤ 2/c for an overdamped one; with c = ν + βω²,
+    ///   c/ω² ≥ β_min + ν_min/ω_max², so h ≤ min(β_min + ν_min/ω_max², 2/c_max) (0 for an
+    ///   undamped system: forward Euler amplifies every undamped oscillation);
+    /// - RK4's stability region holds the left half-disc of radius 2.6 (it reaches 2.83 on the
+    ///   imaginary axis and 2.79 on the real one), and every root has |λ| ≤ max(ω_max, c_max)
+    ///   (|λ| = ω when it oscillates, ≤ c when overdamped): h ≤ 2.6 / max(ω_max, c_max), a
+    ///   sufficient bound.
+    ///
+    /// ∞ when nothing bounds the step (no spring, no damping). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::force::ModeBounds;
+    /// use topomech::mechanics::Integrator;
+    ///
+    /// let undamped = ModeBounds { omega_max: 100.0, damping_max: 0.0, beta_min: 0.0, nu_min: 0.0 };
+    /// assert_eq!(Integrator::Symplectic.stable_dt(&undamped), Some(0.02)); // 2/ω_max
+    /// assert_eq!(Integrator::Euler.stable_dt(&undamped), Some(0.0)); // unstable at every dt
+    /// assert_eq!(Integrator::Implicit.stable_dt(&undamped), None);
+    /// // Stiffness-proportional damping β = 0.01 s: c = βω² = 100 at ω_max, and the damping term
+    /// // sets the limit, well below 2/ω_max.
+    /// let damped = ModeBounds { omega_max: 100.0, damping_max: 100.0, beta_min: 0.01, nu_min: 0.0 };
+    /// let h = Integrator::Symplectic.stable_dt(&damped).unwrap();
+    /// assert!((h - 4.0 / (100.0 + 50_000f64.sqrt())).abs() < 1e-15 && h < 0.013);
+    /// assert_eq!(Integrator::Euler.stable_dt(&damped), Some(0.01)); // β + 0/ω² and 2/c: 0.01, 0.02
+    /// ```
+    pub fn stable_dt(self, b: &ModeBounds) -> Option<f64> {
+        let (w, c) = (b.omega_max, b.damping_max);
+        let limit = |num: f64, den: f64| if den > 0.0 { num / den } else { f64::INFINITY };
+        match self {
+            Integrator::Symplectic => Some(limit(4.0, c + c.hypot(2.0 * w))),
+            Integrator::Euler => {
+                let oscillating = if w > 0.0 { b.beta_min + b.nu_min / (w * w) } else { f64::INFINITY };
+                Some(oscillating.min(limit(2.0, c)))
+            }
+            Integrator::Rk4 => Some(limit(RK4_HALF_DISC, w.max(c))),
+            Integrator::Implicit => None,
         }
     }
 }

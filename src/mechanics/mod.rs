@@ -26,7 +26,7 @@ pub mod simd;
 
 pub use conservation::{check_conservation, conservation_violations, ConservationError};
 pub use flat::FlatModel;
-pub use force::{IncidenceError, SpringSystem, SystemError};
+pub use force::{IncidenceError, ModeBounds, SpringSystem, SystemError};
 pub use geom::Vec3;
 pub use integrate::{Integrator, StepConfig, StepError, Stepper};
 pub use model::{Body, BodyError, Material, Mechanics, ModelError};

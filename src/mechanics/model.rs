@@ -1081,24 +1081,25 @@ pub fn stiffness_contribution(young: f64, volume: f64, rest_length: f64) -> f64 
 pub(crate) const TET_PAIRS: [(usize, usize); 6] = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
 
 /// Law 2's six terms of the tet with corners `c` (no volume stored): k_{t,e} = E·|V|/L_e² for the
-/// corner pairs of [`TET_PAIRS`], with L_e = [`super::geom::rest_length`]. For ordinary extents
-/// (`mesh::fit_for_products` leaves the corners as they are) V is the plain determinant and each
-/// term is [`stiffness_contribution`] (the same bits as ever); otherwise V and L_e are measured on
-/// the fitted corners (volumes times 2^3k, lengths times 2^k) and E·V/L² is scaled back by 2^−k,
-/// so a regular tet of edge 1e-110, whose volume underflows f64, gets its finite terms. O(1).
+/// corner pairs of [`TET_PAIRS`], with L_e = [`super::geom::rest_length`]. For ordinary corners
+/// ([`super::geom::plain_corners`]) V is the plain determinant and each term is
+/// [`stiffness_contribution`] (the same bits as ever); otherwise E·|V|/L² is taken in wide floats
+/// (`crate::wide`: an f64 mantissa, an unbounded exponent), so a tet whose volume under- or
+/// overflows f64 (edge 1e-110; a needle 1e-170 thin beside a unit edge; a sliver 1e200 wide and
+/// 1e-200 thick) gets its finite terms. O(1).
 pub(crate) fn tet_stiffnesses(young: f64, c: [Vec3; 4]) -> [f64; 6] {
-    let mut f = c;
-    let k = crate::mesh::fit_for_products(&mut f);
-    let volume = dot(cross(sub(f[1], f[0]), sub(f[2], f[0])), sub(f[3], f[0])) / 6.0;
+    if super::geom::plain_corners(c) {
+        let volume = dot(cross(sub(c[1], c[0]), sub(c[2], c[0])), sub(c[3], c[0])) / 6.0;
+        return TET_PAIRS.map(|(i, j)| stiffness_contribution(young, volume, super::geom::rest_length(c[i], c[j])));
+    }
+    use crate::wide::{difference, norm, six_volume, Wide};
+    let ev = Wide::new(young).mul(six_volume(c[0], c[1], c[2], c[3]).abs()).div(Wide::new(6.0));
     TET_PAIRS.map(|(i, j)| {
-        if k == 0 {
-            return stiffness_contribution(young, volume, super::geom::rest_length(c[i], c[j]));
-        }
-        let length = crate::mesh::distance(f[j], f[i]);
-        if length.is_nan() || length <= 0.0 || young == 0.0 || volume == 0.0 {
+        let length = norm(difference(c[j], c[i]));
+        if !length.is_positive() || young == 0.0 || ev.is_zero() {
             return 0.0;
         }
-        super::geom::ratio_pow2(young, volume.abs(), length, -k)
+        ev.div(length.mul(length)).to_f64()
     })
 }
 
@@ -1331,7 +1332,7 @@ impl ModelTotals {
         }
         self.mass += m.density * volume;
         for (i, j) in TET_PAIRS {
-            self.stiffness += stiffness_contribution(m.young, volume, norm(sub(c[j], c[i])));
+            self.stiffness += stiffness_contribution(m.young, volume, super::geom::rest_length(c[i], c[j]));
         }
         let totals = [("volume", volume), ("total mass", self.mass), ("total stiffness", self.stiffness)];
         let damping = ("total damping", m.damping * self.stiffness);
@@ -1553,7 +1554,7 @@ impl Mechanics {
     fn init_from_map(&mut self, map: &GMap<3>) {
         for d in map.one_dart_per_cell(1) {
             let rest = sub(self.rest_position[map.vertex_id(map.alpha::<0>(d))], self.rest_position[map.vertex_id(d)]);
-            self.edge_rest_length[map.cell_id(1, d)] = norm(rest);
+            self.edge_rest_length[map.cell_id(1, d)] = super::geom::rest_length([0.0; 3], rest);
             self.recompute_edge(map, d);
         }
         for d in map.one_dart_per_cell(0) {

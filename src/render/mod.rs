@@ -137,8 +137,8 @@ pub enum RenderError {
         /// Length of `rgb`.
         len: usize,
     },
-    /// The PNG file could not be written (the cause names the file or its temporary sibling).
-    #[error("cannot write the PNG file {}: {source}", .path.display())]
+    /// The PNG file could not be written (the cause names the file).
+    #[error("cannot write the PNG file {source}")]
     Write {
         /// The file asked for.
         path: PathBuf,

@@ -179,6 +179,10 @@ pub(super) fn decode(bytes: &[u8]) -> Result<Document, StoreError> {
     if flags & !(FLAG_MECHANICS | FLAG_LEVELS) != 0 {
         return Err(StoreError::Inconsistent { at: flags_at, message: format!("unknown flags {flags:#x}") });
     }
+    if flags & FLAG_MECHANICS != 0 && dim != 3 {
+        let message = format!("the mechanics flag needs a 3-G-map, the header says n = {dim}");
+        return Err(StoreError::Inconsistent { at: flags_at, message });
+    }
     if flags & FLAG_LEVELS != 0 && version < LEVELS_VERSION {
         let message = format!("the levels flag needs format version {LEVELS_VERSION}, the header says {version}");
         return Err(StoreError::Inconsistent { at: flags_at, message });

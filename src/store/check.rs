@@ -40,11 +40,13 @@ pub enum Finding {
         violation: InvariantViolation,
     },
     /// A document built or changed in memory that no decoder would return: the structural error
-    /// of [`RawMap::check`](super::RawMap::check), or a NaN or infinite attribute (the message of
-    /// the [`StoreError`](super::StoreError)). Nothing else is checked then.
+    /// of [`RawMap::check`](super::RawMap::check), mechanical attributes on a map whose dimension
+    /// is not 3, or a NaN or infinite attribute (the message of the
+    /// [`StoreError`](super::StoreError)). Nothing else is checked then.
     Structure(String),
-    /// A body whose material [`Body::from_tets`](crate::mechanics::Body::from_tets) refuses, or a
-    /// face whose boundary flag disagrees with the map (the message of the
+    /// A body whose material [`Body::from_tets`](crate::mechanics::Body::from_tets) refuses, a
+    /// volume whose Young's modulus is not the material's, or a face whose boundary flag disagrees
+    /// with the map (the message of the
     /// [`StoreError`](super::StoreError) that [`Document::into_body`] returns).
     BodyState(String),
 }
@@ -119,11 +121,15 @@ pub fn check_all_laws(doc: &Document, limit: usize) -> CheckReport {
     let mut out = Collector { findings: Vec::new(), limit, truncated: false };
     let raw = &doc.map;
     let non_finite = doc.mechanics.as_ref().and_then(|m| m.first_non_finite());
-    let structure = raw.check().err().or_else(|| {
-        non_finite.map(|(field, index)| super::StoreError::NonFinite { at: super::Where::Document, field, index })
+    let structure = raw.check().err().map(|e| e.to_string()).or_else(|| {
+        let dimension = doc.mechanics.as_ref().and_then(|_| super::mechanics_dimension(raw).err());
+        dimension.or_else(|| {
+            let at = super::Where::Document;
+            non_finite.map(|(field, index)| super::StoreError::NonFinite { at, field, index }.to_string())
+        })
     });
-    if let Some(e) = structure {
-        out.push(Finding::Structure(e.to_string()));
+    if let Some(message) = structure {
+        out.push(Finding::Structure(message));
         return CheckReport { valid: false, findings: out.findings, truncated: out.truncated };
     }
     let live = raw.live();

@@ -172,7 +172,7 @@ pub enum StoreError {
         source: std::io::Error,
     },
     /// The file starts with neither magic.
-    #[error("not a topomech map file: it starts with {found:?}, not {TEXT_MAGIC:?} or the binary magic")]
+    #[error("not a topomech map file: it starts with \"{found}\", not {TEXT_MAGIC:?} or the binary magic")]
     BadMagic {
         /// The first bytes, escaped.
         found: String,
@@ -468,8 +468,9 @@ impl Document {
     /// [`StoreError::NonFinite`] (at [`Where::Document`]) for a NaN or infinite attribute (which
     /// no decoder returns), [`StoreError::WrongDimension`], [`StoreError::BrokenLaw`],
     /// [`StoreError::Conservation`]; [`StoreError::Inconsistent`] (at [`Where::Document`]) for a
-    /// material [`Body::from_tets`] refuses, a face whose boundary flag disagrees with the map, or a
-    /// face normal that is neither zero nor (on a boundary face) of length 1.
+    /// material [`Body::from_tets`] refuses, a volume whose Young's modulus is not the material's
+    /// E, a face whose boundary flag disagrees with the map, or a face normal that is neither zero
+    /// nor (on a boundary face) of length 1.
     ///
     /// # Examples
     ///
@@ -503,8 +504,11 @@ impl Document {
 const NORMAL_TOLERANCE: f64 = 1e-9;
 
 /// What a body keeps besides the conservation laws and must still agree with: its material is
-/// one [`Body::from_tets`] accepts, each face's boundary flag says whether the face is α3-free in
-/// the map (the flag is derived from the map; a flipped one would make the surface and the
+/// one [`Body::from_tets`] accepts, the body is homogeneous (every live volume's Young's modulus
+/// E_t is the material's E, bit for bit: `from_tets` sets E_t = E and every split copies it, and
+/// the conservation laws check the springs against E_t, so this ties E to the springs as the
+/// mass law ties ρ to the tet masses), each face's boundary flag says whether the face is α3-free
+/// in the map (the flag is derived from the map; a flipped one would make the surface and the
 /// boundary forces wrong), and each face normal is zero or, on a boundary face, of length 1.
 /// (Normals are computed from the positions at the last topological change, so their directions
 /// are kept as stored.) O(darts).
@@ -512,6 +516,18 @@ pub(super) fn check_body_state(map: &GMap<3>, mech: &crate::mechanics::Mechanics
     mech.check_covers(map)?;
     let inconsistent = |message: String| StoreError::Inconsistent { at: Where::Document, message };
     crate::mechanics::model::check_material(mech.material()).map_err(|e| inconsistent(format!("material: {e}")))?;
+    let young = mech.material().young;
+    for d in map.one_dart_per_cell(3) {
+        let t = map.cell_id(3, d);
+        let e_t = mech.tet_young(t);
+        if e_t.to_bits() != young.to_bits() {
+            return Err(inconsistent(format!(
+                "volume {} has Young's modulus {e_t:?} but the material's E is {young:?} (a body is \
+                 homogeneous: every tet's springs are computed from E_t = E)",
+                t.0
+            )));
+        }
+    }
     for d in map.one_dart_per_cell(2) {
         let (f, free) = (map.cell_id(2, d), map.is_free(3, d));
         if mech.face_is_boundary(f) != free {
@@ -534,7 +550,8 @@ pub(super) fn check_body_state(map: &GMap<3>, mech: &crate::mechanics::Mechanics
 /// # Errors
 /// The structural errors of [`RawMap::check`] for a map no decoder would accept (it could not
 /// be read back; nothing is written); [`StoreError::Unrepresentable`] when an attribute is NaN or
-/// infinite or the levels part does not fit the map (it could not be read back either).
+/// infinite, mechanics are given for a map whose dimension is not 3, or the levels part does not
+/// fit the map (it could not be read back either).
 ///
 /// # Examples
 ///
@@ -552,6 +569,7 @@ pub(super) fn check_body_state(map: &GMap<3>, mech: &crate::mechanics::Mechanics
 pub fn encode(doc: &Document, format: Format) -> Result<Vec<u8>, StoreError> {
     doc.map.check()?;
     if let Some(m) = &doc.mechanics {
+        mechanics_dimension(&doc.map).map_err(|what| StoreError::Unrepresentable { what })?;
         m.check_finite().map_err(|what| StoreError::Unrepresentable { what })?;
     }
     if let Some(l) = &doc.levels {
@@ -561,6 +579,16 @@ pub fn encode(doc: &Document, format: Format) -> Result<Vec<u8>, StoreError> {
         Format::Text => text::encode(doc).into_bytes(),
         Format::Binary => binary::encode(doc),
     })
+}
+
+/// `Err(description)` when a map of this dimension cannot carry mechanics (only a 3-G-map can:
+/// the decoders refuse a mechanics section or flag for any other n). O(1).
+pub(super) fn mechanics_dimension(map: &RawMap) -> Result<(), String> {
+    if map.dimension == 3 {
+        Ok(())
+    } else {
+        Err(format!("mechanical attributes need a 3-G-map, the map has dimension {}", map.dimension))
+    }
 }
 
 /// `Err(description)` when the levels part cannot be written: not one record per dart slot, a

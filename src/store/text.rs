@@ -197,8 +197,27 @@ fn syntax(line: usize, message: String) -> StoreError {
     StoreError::Syntax { at: Where::Line(line), message }
 }
 
+/// An unsigned decimal integer in its one written form: ASCII digits only, no sign, no leading
+/// zero (`0`, `7`, `12`; not `+1`, `01`), below 2^64. `None` otherwise. O(len).
+fn unsigned(tok: &str) -> Option<u64> {
+    let digits = !tok.is_empty() && tok.bytes().all(|b| b.is_ascii_digit());
+    let canonical = tok == "0" || !tok.starts_with('0');
+    if digits && canonical {
+        tok.parse::<u64>().ok()
+    } else {
+        None
+    }
+}
+
 fn int(tok: &str, line: usize, what: &str) -> Result<u64, StoreError> {
-    tok.parse::<u64>().map_err(|_| syntax(line, format!("{what}: {tok:?} is not a non-negative integer")))
+    unsigned(tok).ok_or_else(|| {
+        let why = if tok.bytes().all(|b| b.is_ascii_digit()) && !tok.is_empty() && tok.len() < 20 {
+            "has a leading zero"
+        } else {
+            "is not an unsigned decimal integer (digits only, no sign, no leading zero, below 2^64)"
+        };
+        syntax(line, format!("{what}: {tok:?} {why}"))
+    })
 }
 
 fn int32(tok: &str, line: usize, what: &str) -> Result<u32, StoreError> {
@@ -233,6 +252,10 @@ pub(super) fn decode(bytes: &[u8]) -> Result<Document, StoreError> {
     let (version, map) = decode_map(&mut lines)?;
     let (no, head) = lines.next("", "\"mechanics\", \"levels\" or \"end\"")?;
     let mechanics = match head.first() {
+        Some(&"mechanics") if map.dimension != 3 => {
+            let message = format!("a mechanics section needs a 3-G-map, the header says n = {}", map.dimension);
+            return Err(StoreError::Inconsistent { at: Where::Line(no), message });
+        }
         Some(&"mechanics") => Some(decode_mechanics(&mut lines, no, &head)?),
         _ => {
             lines.back();
@@ -306,7 +329,7 @@ fn decode_map(lines: &mut Lines<'_>) -> Result<(u32, RawMap), StoreError> {
             && ahead.next_line().is_some_and(|(_, line)| {
                 let mut tokens = line.split_whitespace();
                 tokens.next() == Some("free-darts")
-                    && tokens.next().is_some_and(|count| count.parse::<u64>() == Ok(dead))
+                    && tokens.next().is_some_and(|count| unsigned(count) == Some(dead))
                     && tokens.count() as u64 == dead
             })
     };

@@ -22,16 +22,16 @@ use super::{LeveledMap, SubdivideError};
 use crate::gmap::{CellId, DartId};
 use crate::mechanics::geom::{cross, dot, sub};
 
-/// ρ · |V| of the tet with finite corners `p`: plain for ordinary extents, else on the fitted
-/// corners scaled back ([`TetMasses::from_density`]). O(1).
-fn density_mass(density: f64, mut p: [[f64; 3]; 4]) -> f64 {
-    let k = crate::mesh::fit_for_products(&mut p);
-    let volume = crate::mesh::signed_volume(p[0], p[1], p[2], p[3]).abs();
-    if k == 0 {
-        density * volume
-    } else {
-        crate::mechanics::geom::ratio_pow2(density, volume, 1.0, -3 * k)
+/// ρ · |V| of the tet with finite corners `p`: plain for ordinary corners
+/// (`mechanics::geom::plain_corners`), else in wide floats with the same operation order
+/// (`crate::wide`), so that V under- or overflowing f64 on its own does not make a representable
+/// mass 0 or ∞ ([`TetMasses::from_density`]). O(1).
+fn density_mass(density: f64, p: [[f64; 3]; 4]) -> f64 {
+    if crate::mechanics::geom::plain_corners(p) {
+        return density * crate::mesh::signed_volume(p[0], p[1], p[2], p[3]).abs();
     }
+    use crate::wide::{six_volume, Wide};
+    six_volume(p[0], p[1], p[2], p[3]).abs().div(Wide::new(6.0)).mul(Wide::new(density)).to_f64()
 }
 
 /// One mass per volume id of a [`LeveledMap<3>`] (index = volume cell id).

@@ -39,7 +39,7 @@ use std::collections::{BTreeMap, BTreeSet};
 
 use super::{EdgeSplit, LeveledMap, Refinement, SubdivideError, TetMasses};
 use crate::gmap::{AlphaMask, DartId, GMap};
-use crate::mechanics::geom::{is_flat, ratio_pow2, rest_length, Vec3};
+use crate::mechanics::geom::{is_flat, rest_length, Vec3};
 use crate::mechanics::model::tet_stiffnesses;
 use crate::mechanics::{Material, SpringSystem};
 
@@ -773,24 +773,28 @@ fn refuse_past_max(dart: Option<DartId>, bound: f64) -> Result<(), CouplingError
 /// and the diagonal, one of the three segments joining the midpoints of opposite edges: none is
 /// shorter than the shortest of these. The children's volumes are computed from other corners,
 /// so they may exceed V/8 by rounding, by a few ulps of ℓ³ (ℓ the longest parent edge): 2⁻⁴⁵ ℓ³
-/// is added. Measured on the corners fitted by `mesh::fit_for_products` and scaled back, so it
-/// neither overflows nor underflows before the result does. ∞ for a segment of length 0. O(1).
+/// is added. Taken in wide floats (`crate::wide`: an f64 mantissa, an unbounded exponent), so
+/// it neither overflows nor underflows before the result does, needles and slivers included.
+/// ∞ for a segment of length 0 or a NaN corner. O(1).
 fn children_term_bound(young: f64, p: [Vec3; 4]) -> f64 {
+    use crate::wide::{difference, norm, six_volume, Wide};
     if young == 0.0 {
         return 0.0;
     }
-    let mut f = p;
-    let k = crate::mesh::fit_for_products(&mut f);
-    let volume = crate::mesh::signed_volume(f[0], f[1], f[2], f[3]).abs();
-    let edges = PAIRS.map(|(i, j)| crate::mesh::distance(f[i], f[j]));
-    let mid = |(i, j): (usize, usize)| crate::mesh::midpoint(f[i], f[j]);
-    let segments = [(0, 5), (1, 4), (2, 3)].map(|(x, y)| crate::mesh::distance(mid(PAIRS[x]), mid(PAIRS[y])));
-    let longest = edges.iter().fold(0.0f64, |a, &e| a.max(e));
-    let shortest = edges.iter().map(|e| e / 2.0).chain(segments).fold(f64::INFINITY, f64::min);
-    if shortest.is_nan() || shortest <= 0.0 {
-        return f64::INFINITY;
+    let length = |a: Vec3, b: Vec3| norm(difference(b, a));
+    let edges = PAIRS.map(|(i, j)| length(p[i], p[j]));
+    let mid = |(i, j): (usize, usize)| crate::mesh::midpoint(p[i], p[j]);
+    let segments = [(0, 5), (1, 4), (2, 3)].map(|(x, y)| length(mid(PAIRS[x]), mid(PAIRS[y])));
+    let halves = edges.map(|e| e.mul(Wide::new(0.5)));
+    let all = halves.iter().chain(&segments);
+    if !all.clone().all(|l| l.is_positive()) {
+        return f64::INFINITY; // a zero length, or NaN
     }
-    ratio_pow2(young, volume / 8.0 + 2f64.powi(-45) * longest.powi(3), shortest, -k)
+    let shortest = all.fold(segments[0], |a, &l| if l.less_than(a) { l } else { a });
+    let longest = edges.iter().fold(edges[0], |a, &e| if a.less_than(e) { e } else { a });
+    let cube = longest.mul(longest).mul(longest).mul(Wide::new(2f64.powi(-45)));
+    let volume = six_volume(p[0], p[1], p[2], p[3]).abs().div(Wide::new(48.0));
+    Wide::new(young).mul(volume.add(cube)).div(shortest.mul(shortest)).to_f64()
 }
 
 /// Errors unless `m` is at level 0 and has a rest position for every vertex id. O(1).

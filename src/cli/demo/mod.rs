@@ -275,7 +275,9 @@ fn play(args: &DemoArgs, loaded: &Loaded, log: &mut dyn Write) -> Result<Played,
     let mut scene = Scene::new(&loaded.mesh.points, &loaded.mesh.tets, n)?;
     let mut output = Output::new(&args.out, &scene.config)?;
     write_setup(log, &scene)?;
-    let bar = progress_bar(n + n / 2 + n / 2 + n / 4, args.json);
+    // Saturating: the four stages' steps (N + N/2 + N/2 + N/4) pass u64::MAX for N > 7.3e18.
+    let total = [n / 2, n / 2, n / 4].iter().fold(n, |sum, &k| sum.saturating_add(k));
+    let bar = progress_bar(total, args.json);
     let mut rows = Vec::new();
     let rest = StageRun { name: "rest", ..StageRun::default() };
     scene.checker.check(&scene.body, rest.name, 0)?;
@@ -321,7 +323,7 @@ fn play(args: &DemoArgs, loaded: &Loaded, log: &mut dyn Write) -> Result<Played,
 
     let mut refinement = StageRun { name: "refinement", ..StageRun::default() };
     bar.set_message("refinement");
-    bar.inc_length(scene.incision_tets.len() as u64);
+    bar.set_length(total.saturating_add(scene.incision_tets.len() as u64));
     let mut refined = refine::refine(&scene.body, &scene.incision_tets, &mut refinement, &bar)?;
     scene.checker.passed += refined.checks;
     let sim = refine::simulate_refined(&mut refined, &scene.body, &scene.config, n / 4)?;
@@ -428,9 +430,10 @@ fn write_refinement(
     )?;
     writeln!(
         out,
-        "        then {} on the refined network ({} slots, {} springs, {} pinned): {:.1} µs per step, \
+        "        then {} of {:.3e} s on the refined network ({} slots, {} springs, {} pinned): {:.1} µs per step, \
          max displacement {:.4}; Σ slot mass = Σ tet mass, no blow-up, pins held",
         plural(sim.steps, "step"),
+        sim.dt,
         sim.slots,
         sim.springs,
         sim.pinned,

@@ -14,8 +14,8 @@
 //! μt ≤ μf ≤ μa, every level extracted and valid). Then the simulation goes on on the refined
 //! network ([`simulate_refined`]): the finest level projected as a flat spring system (slots =
 //! vertex ids, one spring per edge cell, vertex masses from the child tets), stepped with the
-//! scene's integrator and pins; checked: Σ slot mass = Σ tet mass, no blow-up, pinned vertices
-//! unmoved.
+//! scene's integrator and pins at its own stable time step (its springs are stiffer); checked:
+//! Σ slot mass = Σ tet mass, no blow-up, pinned vertices unmoved.
 
 use std::time::Instant;
 
@@ -116,6 +116,9 @@ pub const SIM_CHECKS: usize = 3;
 pub struct RefinedSim {
     /// Steps made on the refined network.
     pub steps: u64,
+    /// Its time step: [`super::scene::time_step`] of the refined network (at most the body's when
+    /// the refinement made it stiffer).
+    pub dt: f64,
     /// Slots (vertex ids of the finest level) and springs (edge cells) of the projected system.
     pub slots: usize,
     /// See `slots`.
@@ -132,8 +135,10 @@ pub struct RefinedSim {
     pub checks: usize,
 }
 
-/// Runs `steps` steps of the scene's integrator (symplectic Euler at `config.dt`, gravity
-/// `config.gravity`) on the finest level of `refined`, in place on its positions and velocities.
+/// Runs `steps` steps of the scene's integrator (symplectic Euler, gravity `config.gravity`) on the
+/// finest level of `refined`, in place on its positions and velocities, at the refined network's
+/// own time step ([`super::scene::time_step`]: its springs are stiffer than the body's, so the
+/// body's `config.dt` may be past its stability limit).
 /// Pins: a vertex id the body has keeps the body's pin; a new vertex is pinned when its rest
 /// coordinate along the long axis is ≤ `config.pin_limit` (the scene's rule). O(steps · (slots +
 /// springs)) plus O(darts + E) to project.
@@ -168,7 +173,10 @@ pub fn simulate_refined(
     }
     let held: Vec<(usize, Vec3)> = (0..sys.slots()).filter(|&v| fixed[v]).map(|v| (v, mech.position[v])).collect();
     let step_error = |step| move |source| DemoError::RefinedStep { step, source };
-    let config_step = StepConfig::new(Integrator::Symplectic, config.dt);
+    // The refined network is stiffer than the body (children are half the size, springs follow
+    // law 2 and the series rule): its own stable step, by the scene's rule, not the body's.
+    let dt = super::scene::time_step(&sys);
+    let config_step = StepConfig::new(Integrator::Symplectic, dt);
     let mut stepper = Stepper::new(config_step, &sys, &mech.position, &mech.velocity).map_err(step_error(0))?;
     let mut times = StepTimes::new(steps);
     for step in 1..=steps {
@@ -188,6 +196,7 @@ pub fn simulate_refined(
         .fold(0.0, topomech::mesh::nan_max);
     Ok(RefinedSim {
         steps,
+        dt,
         slots: sys.slots(),
         springs: sys.springs(),
         pinned: fixed.iter().filter(|&&f| f).count(),

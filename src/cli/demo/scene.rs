@@ -18,7 +18,9 @@ use std::time::Instant;
 
 use indicatif::ProgressBar;
 use topomech::cut::{self, CutError, Plane};
-use topomech::mechanics::{Body, Integrator, Material, PinSpec, Simulation, StepConfig, TouchedCells, Vec3};
+use topomech::mechanics::{
+    Body, Integrator, Material, PinSpec, Simulation, SpringSystem, StepConfig, TouchedCells, Vec3,
+};
 use topomech::mesh::centroid_of;
 use topomech::{AlphaMask, CellId, DartId};
 
@@ -49,7 +51,7 @@ pub const YOUNG_PER_WEIGHT: f64 = 16.0;
 pub const GRAVITY: f64 = 9.81;
 /// Ambient viscosity ν (1/s): damps the sag to rest within about two seconds of simulated time.
 pub const VISCOSITY: f64 = 5.0;
-/// Largest time step; smaller when the mesh's highest frequency needs it (dt ≤ 1/ω_max).
+/// Largest time step; smaller when the mesh's stiffness or damping needs it ([`time_step`]).
 pub const MAX_DT: f64 = 1e-3;
 
 /// The fixed parameters of a scene, derived from the rest shape.
@@ -67,7 +69,7 @@ pub struct SceneConfig {
     pub gravity: Vec3,
     /// The material.
     pub material: Material,
-    /// Rest bounding box.
+    /// Rest bounding box of the points the tets use.
     pub lo: Vec3,
     /// See `lo`.
     pub hi: Vec3,
@@ -119,10 +121,12 @@ pub struct Scene {
     pub plane: Option<Plane>,
 }
 
-fn bounds(points: &[Vec3]) -> (Vec3, Vec3) {
+/// The bounding box of the points the tets use (a point no tet uses is not part of the body: it
+/// must not stretch the box that places the pins, the incision and the removal). O(T).
+fn bounds(points: &[Vec3], tets: &[[u32; 4]]) -> (Vec3, Vec3) {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
-    for p in points {
+    for p in tets.iter().flatten().filter_map(|&v| points.get(v as usize)) {
         for k in 0..3 {
             lo[k] = lo[k].min(p[k]);
             hi[k] = hi[k].max(p[k]);
@@ -131,14 +135,24 @@ fn bounds(points: &[Vec3]) -> (Vec3, Vec3) {
     (lo, hi)
 }
 
+/// The demo's time step for a spring system stepped by symplectic Euler: half the stability limit
+/// of [`Integrator::stable_dt`] (h²ω_max² + 2h c_max ≤ 4, damping included), at most
+/// [`MAX_DT`]: dt = min(MAX_DT, 2 / (c_max + √(c_max² + 4 ω_max²))), which is 1/ω_max undamped.
+/// O(springs + slots).
+pub fn time_step(sys: &SpringSystem) -> f64 {
+    let limit = Integrator::Symplectic.stable_dt(&sys.mode_bounds()).unwrap_or(f64::INFINITY);
+    MAX_DT.min(0.5 * limit)
+}
+
 impl Scene {
-    /// Builds the body of `points`/`tets`, pins its low end along the longest axis and prepares a
-    /// symplectic Euler simulation with dt = min([`MAX_DT`], 1/ω_max). O(T log T).
+    /// Builds the body of `points`/`tets`, pins its low end along the longest axis (the box of the
+    /// points the tets use) and prepares a symplectic Euler simulation with dt = [`time_step`]
+    /// (half the stability limit with the damping). O(T log T).
     ///
     /// # Errors
     /// [`DemoError::Model`] (a degenerate tet, a bad point), [`DemoError::Sim`].
     pub fn new(points: &[Vec3], tets: &[[u32; 4]], steps: u64) -> Result<Self, DemoError> {
-        let (lo, hi) = bounds(points);
+        let (lo, hi) = bounds(points, tets);
         let ext = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
         let long_axis = (0..3).fold(0, |a, k| if ext[k] > ext[a] { k } else { a });
         let up_axis = if long_axis == 2 { 0 } else { 2 };
@@ -155,8 +169,7 @@ impl Scene {
         let pinned = body.attrs().pinned().as_slice().iter().zip(&live).filter(|(&p, &l)| p && l).count();
         let probe = Simulation::new(&mut body, gravity, StepConfig::new(Integrator::Symplectic, MAX_DT))
             .map_err(|source| DemoError::Sim { stage: "setup", source })?;
-        let omega = probe.projection.system().omega_max();
-        let dt = if omega > 0.0 { MAX_DT.min(1.0 / omega) } else { MAX_DT };
+        let dt = time_step(probe.projection.system());
         let sim = Simulation::new(&mut body, gravity, StepConfig::new(Integrator::Symplectic, dt))
             .map_err(|source| DemoError::Sim { stage: "setup", source })?;
         let config = SceneConfig { steps, dt, long_axis, up_axis, gravity, material, lo, hi, pin_limit, pinned };

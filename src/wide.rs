@@ -206,6 +206,10 @@ mod tests {
         assert!(Wide::new(-1.0).sqrt().to_f64().is_nan());
         assert!(Wide::new(f64::NAN).add(Wide::new(1.0)).to_f64().is_nan());
         assert_eq!(Wide::new(f64::INFINITY).mul(Wide::new(2.0)).to_f64(), f64::INFINITY);
+        // Non-finite sums as in f64 (a survivor of the 37th mutation sample read `+` as `−`).
+        assert_eq!(Wide::new(1.0).add(Wide::new(f64::INFINITY)).to_f64(), f64::INFINITY);
+        assert_eq!(Wide::new(f64::NEG_INFINITY).add(Wide::new(2.0)).to_f64(), f64::NEG_INFINITY);
+        assert!(Wide::new(f64::INFINITY).add(Wide::new(f64::NEG_INFINITY)).to_f64().is_nan());
     }
 
     /// A sliver 1e200 wide and 1e-200 thick has the volume 1e200 · 1e200 · 1e-200 / 6; a needle

@@ -115,9 +115,10 @@ pub enum ModelError {
         /// Its coordinates.
         coords: Vec3,
     },
-    /// A tetrahedron of zero volume would make a massless, infinitely stiff element. Decided
-    /// exactly on its corners fitted to a common scale (`mesh::fit_for_products`), so a regular
-    /// tet whose volume merely underflows f64 is not one ([`ModelError::VolumeUnderflow`]).
+    /// A tetrahedron of zero volume would make a massless, infinitely stiff element. Decided on
+    /// its determinant taken in wide floats (an f64 mantissa with an unbounded exponent), so a tet
+    /// whose volume merely underflows f64 (tiny, or a needle) is not one
+    /// ([`ModelError::VolumeUnderflow`]).
     #[error("tetrahedron {tet} has zero volume")]
     DegenerateTet {
         /// Tet index (= volume id).
@@ -1313,8 +1314,8 @@ impl ModelTotals {
     /// Adds tet `t` (its corners and volume) to the totals.
     ///
     /// # Errors
-    /// [`ModelError::DegenerateTet`] for a zero volume (decided on the corners fitted by
-    /// `mesh::fit_for_products`, exactly), [`ModelError::VolumeUnderflow`] for a tet that is not
+    /// [`ModelError::DegenerateTet`] for a zero volume (its determinant decided in wide floats,
+    /// `geom::is_flat`), [`ModelError::VolumeUnderflow`] for a tet that is not
     /// flat but whose volume is below the normal range of f64 (the model stores rest volumes),
     /// [`ModelError::MassTooSmall`] when a quarter of the tet's mass has no finite inverse (every
     /// vertex mass is at least the quarter of one of its tets' masses, so this keeps every 1/m_v

@@ -86,11 +86,10 @@ pub struct Refinement {
 impl TetMasses {
     /// Masses ρ · |V_t| from the positions of the map's vertices. O(darts).
     ///
-    /// The product is formed scale-safely: for ordinary extents as ρ · |V| (the same bits as
-    /// ever), otherwise from the volume of the corners fitted by `mesh::fit_for_products` (V times
-    /// 2^3k) scaled back by 2^−3k on the mantissas, so that V under- or overflowing f64 on its own
-    /// does not make a representable mass 0 or ∞ (ρ = 1e300 at edge 1e-110, ρ = 1e-100 at edge
-    /// 1e110).
+    /// The product is formed scale-safely: for ordinary corners as ρ · |V| (the same bits as
+    /// ever), otherwise in wide floats (an f64 mantissa with an unbounded exponent), so that V
+    /// under- or overflowing f64 on its own does not make a representable mass 0 or ∞ (ρ = 1e300
+    /// at edge 1e-110, ρ = 1e-100 at edge 1e110, ρ = 1e300 for a needle 1e-170 thin).
     ///
     /// Errors: [`SubdivideError::BadDensity`] unless the density is finite and > 0;
     /// [`SubdivideError::NotATetrahedron`] if a volume does not have 4 vertices;

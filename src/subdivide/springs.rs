@@ -239,8 +239,8 @@ pub enum CouplingError {
     #[error(transparent)]
     Material(crate::mechanics::ModelError),
     /// A level-0 tet has zero volume: it would get no mass and no stiffness (a
-    /// [`crate::mechanics::Body`] refuses it too). Decided exactly on its corners fitted to a
-    /// common scale, so a tiny regular tet whose volume underflows f64 is not one.
+    /// [`crate::mechanics::Body`] refuses it too). Decided on its determinant taken in wide
+    /// floats, so a tet whose volume underflows f64 (tiny, or a needle) is not one.
     #[error("volume {volume} (dart {dart}) has zero volume")]
     DegenerateTet {
         /// The volume cell id.
@@ -351,9 +351,9 @@ impl LeveledMechanics {
     /// The coupling of a level-0 map: masses ρ·V_t, springs from law 2 (k_e = Σ_{t ∋ e} E V_t / L_e²
     /// over the tets whose volume holds the edge cell e, c_e = β k_e, L_e the rest distance), at rest
     /// with zero velocity. Two edge cells joining the same vertices get a spring each, from their own
-    /// tets. L_e and E V_t / L_e² are measured scale-safely (on corners fitted to a common scale
-    /// when a tet's extent is outside 2^±250; the plain formulas, same bits, inside), so a spring is
-    /// ∞ only when its value is. O(darts + E log E).
+    /// tets. L_e and E V_t / L_e² are measured scale-safely (in wide floats, an f64 mantissa with
+    /// an unbounded exponent, unless every edge-vector component is 0 or within 2^±250, where the
+    /// plain formulas give the same bits), so a spring is ∞ only when its value is. O(darts + E log E).
     ///
     /// Errors: [`CouplingError::NotLevelZero`], [`CouplingError::NoGeometry`],
     /// [`CouplingError::Material`] (a material a [`crate::mechanics::Body`] refuses too),

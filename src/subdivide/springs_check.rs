@@ -14,8 +14,8 @@
 //!    springs has Σ 1/k_i = 1/k_root, Σ 1/c_i = 1/c_root and Σ L_i = L_root;
 //! 5. every spring that is not a half of a split: k = Σ_{t ∋ e} E V_t / L_e² over the level-0 tets
 //!    and the finest tets of level μt ≥ 1 whose volume holds the edge cell e between two of its
-//!    corners, and c = β k (each term measured on corners fitted to a common scale when the tet's
-//!    extent is outside the ordinary range, so a tet of edge 1e-110 has its finite terms);
+//!    corners, and c = β k (each term measured in wide floats when the tet's corners are outside
+//!    the ordinary range, so a tet of edge 1e-110 or a needle has its finite terms);
 //! 6. Σ_t m_t equals its value when the coupling was built, and every vertex mass gathered from the
 //!    volumes around the vertex (m_v = Σ m_t / n_t) equals the scatter of
 //!    [`LeveledMechanics::vertex_masses`], so Σ_v m_v = Σ_t m_t.

@@ -3,42 +3,17 @@
 //! box from the points the tets use, and step counts that must not overflow.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Stdio};
 
 use serde_json::Value;
 use topomech::mechanics::{Integrator, SpringSystem, StepConfig, StepError, Stepper};
 
-const BIN: &str = env!("CARGO_BIN_EXE_topomech");
+mod cli_common;
+use cli_common::{run_in, text, write_msh, BIN};
 
-/// A fresh empty directory under Cargo's per-test temporary directory.
+/// A fresh scratch directory of this suite.
 fn fresh_dir(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("topomech-round18-demo").join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn run_in(dir: &Path, args: &[&str]) -> Output {
-    Command::new(BIN).current_dir(dir).args(args).output().expect("the topomech binary runs")
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
-
-/// Writes a Gmsh MSH 2.2 file of `points` and 0-based `tets`.
-fn write_msh(path: &Path, points: &[[f64; 3]], tets: &[[u32; 4]]) {
-    let mut s = String::from("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n");
-    s += &format!("{}\n", points.len());
-    for (k, p) in points.iter().enumerate() {
-        s += &format!("{} {:e} {:e} {:e}\n", k + 1, p[0], p[1], p[2]);
-    }
-    s += &format!("$EndNodes\n$Elements\n{}\n", tets.len());
-    for (k, t) in tets.iter().enumerate() {
-        s += &format!("{} 4 2 0 0 {} {} {} {}\n", k + 1, t[0] + 1, t[1] + 1, t[2] + 1, t[3] + 1);
-    }
-    s += "$EndElements\n";
-    std::fs::write(path, s).unwrap();
+    cli_common::fresh_dir("topomech-round18-demo", name)
 }
 
 /// The Kuhn cube of side `k` with every coordinate times `scale`, written to `dir/name`.

@@ -3,28 +3,18 @@
 //! files it names exist and are what they claim to be (ParaView series, OBJ, PNG).
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use serde_json::Value;
 
-const BIN: &str = env!("CARGO_BIN_EXE_topomech");
-const STAGES: [&str; 6] = ["rest", "sag", "incision", "tear", "removal", "refinement"];
+mod cli_common;
+use cli_common::{run_in, text};
 
-/// A fresh empty directory under Cargo's per-test temporary directory.
+/// A fresh scratch directory of this suite.
 fn fresh_dir(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("topomech-demo").join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    cli_common::fresh_dir("topomech-demo", name)
 }
 
-fn run_in(dir: &Path, args: &[&str]) -> Output {
-    Command::new(BIN).current_dir(dir).args(args).output().expect("the topomech binary runs")
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
+const STAGES: [&str; 6] = ["rest", "sag", "incision", "tear", "removal", "refinement"];
 
 /// Runs `demo --json --steps STEPS --out out` in a fresh directory; returns it and the summary.
 fn demo_json(name: &str, steps: u64) -> (PathBuf, Value) {

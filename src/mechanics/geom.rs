@@ -65,28 +65,27 @@ pub(crate) fn plain_corners(c: [Vec3; 4]) -> bool {
     edges.iter().flatten().all(|x| *x == 0.0 || crate::mesh::PLAIN_EXTENT.contains(&x.abs()))
 }
 
+/// |volume| of each tet of `tets`, up to one common positive factor (for ratios of volumes):
+/// the plain |[`crate::mesh::signed_volume`]| (the same bits as ever) when every tet has
+/// [`plain_corners`], else each |6V| in wide floats (`crate::wide`) divided by the largest, so
+/// that for any finite corners no ratio is lost to an over- or underflow of the volumes
+/// themselves (the children of a needle whose volume is below the smallest subnormal, or of a
+/// sliver whose volume is past `f64::MAX`). All 0 when every volume is exactly 0. O(K).
+pub(crate) fn volume_ratios<const K: usize>(tets: [[Vec3; 4]; K]) -> [f64; K] {
+    if tets.iter().all(|&t| plain_corners(t)) {
+        return tets.map(|t| crate::mesh::signed_volume(t[0], t[1], t[2], t[3]).abs());
+    }
+    let six = tets.map(|t| crate::wide::six_volume(t[0], t[1], t[2], t[3]).abs());
+    let largest = six.iter().fold(crate::wide::Wide::new(0.0), |m, &v| if m.less_than(v) { v } else { m });
+    if largest.is_zero() {
+        return [0.0; K];
+    }
+    six.map(|v| v.div(largest).to_f64())
+}
+
 /// Whether `a` and `b` agree to a relative tolerance `rel` (absolute below `f64::MIN_POSITIVE`).
 pub(crate) fn close(a: f64, b: f64, rel: f64) -> bool {
     (a - b).abs() <= rel * a.abs().max(b.abs()).max(f64::MIN_POSITIVE)
-}
-
-/// (m, e) with x = m · 2^e and 1 ≤ |m| < 2 for a finite non-zero x (subnormals included), read
-/// from the bits (exact); (x, 0) for 0, ∞ and NaN. O(1).
-pub(crate) fn split_exponent(x: f64) -> (f64, i64) {
-    if x == 0.0 || !x.is_finite() {
-        return (x, 0);
-    }
-    let e = crate::mesh::binary_exponent(x.abs());
-    (crate::mesh::times_pow2(x, -e), e)
-}
-
-/// a · b / l² · 2^e with no intermediate overflow or underflow: the product and quotient are
-/// taken on the mantissas (in (1/4, 4)), the exponents are added, and the result is scaled once
-/// ([`crate::mesh::times_pow2`]), so it is ∞ or 0 only when the value itself is past `f64::MAX`
-/// or below the smallest subnormal. For finite a, b and a finite l ≠ 0. O(1).
-pub(crate) fn ratio_pow2(a: f64, b: f64, l: f64, e: i64) -> f64 {
-    let [(ma, ea), (mb, eb), (ml, el)] = [a, b, l].map(split_exponent);
-    crate::mesh::times_pow2(ma * mb / (ml * ml), ea + eb - 2 * el + e)
 }
 
 /// The rest length |b − a|: √(Σ dₖ²) as it is (the same bits as before) when the largest
@@ -115,21 +114,22 @@ pub(crate) fn is_flat(c: [Vec3; 4]) -> bool {
 mod tests {
     use super::*;
 
+    /// Ratios of volumes: the plain bits for ordinary tets; for a needle whose volumes underflow
+    /// f64 (and a sliver whose volumes overflow it), the true ratios, not 0/0.
     #[test]
-    fn split_exponent_is_exact_for_normals_and_subnormals() {
-        assert_eq!(split_exponent(12.0), (1.5, 3));
-        assert_eq!(split_exponent(-0.75), (-1.5, -1));
-        assert_eq!(split_exponent(5e-324), (1.0, -1074));
-        assert_eq!(split_exponent(f64::MAX).1, 1023);
-        assert_eq!(split_exponent(0.0), (0.0, 0));
-    }
-
-    #[test]
-    fn ratio_pow2_has_no_intermediate_overflow() {
-        assert!((ratio_pow2(1e300, 1e100, 1e100, 0) / 1e200 - 1.0).abs() < 1e-15); // E·V = ∞ on its own
-        assert_eq!(ratio_pow2(3.0, 4.0, 2.0, 1), 6.0);
-        assert!((ratio_pow2(1e-300, 1e-300, 1e-300, 0) / 1.0 - 1.0).abs() < 1e-15);
-        assert_eq!(ratio_pow2(f64::MAX, 4.0, 1.0, 0), f64::INFINITY);
+    fn volume_ratios_survive_volumes_outside_f64() {
+        let unit = [[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        let double = unit.map(|c| c.map(|x| 2.0 * x));
+        assert_eq!(volume_ratios([unit, double]), [1.0 / 6.0, 8.0 / 6.0]);
+        for (w, l) in [(1e-200, 1.0), (1e-170, 1e-10), (1e-200, 1e200), (1e150, 1e150)] {
+            let needle = [[0.0; 3], [l, 0.0, 0.0], [0.0, w, 0.0], [0.0, 0.0, w]];
+            let thicker = [[0.0; 3], [l, 0.0, 0.0], [0.0, 2.0 * w, 0.0], [0.0, 0.0, 3.0 * w]];
+            let r = volume_ratios([needle, thicker]);
+            assert!(r.iter().all(|v| v.is_finite()), "{w} {l}: {r:?}");
+            assert!((r[1] / r[0] - 6.0).abs() < 1e-14, "{w} {l}: {r:?}");
+        }
+        let flat = [[0.0; 3], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 1e-300, 0.0]];
+        assert_eq!(volume_ratios([flat, flat]), [0.0, 0.0]);
     }
 
     #[test]

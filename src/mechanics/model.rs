@@ -1050,8 +1050,8 @@ impl Mechanics {
 /// Law 2's per-tet term: k_{t,e} = E·|V|/L², zero for a zero-length edge (or E = 0, V = 0). O(1).
 ///
 /// Computed as (E·|V|)/(L·L) when both products are normal numbers (every ordinary input: the
-/// same bits as ever); otherwise, for finite inputs, on the mantissas with the exponents added
-/// (`geom::ratio_pow2`, crate-private), so that E·|V| overflowing or L² under- or overflowing does not
+/// same bits as ever); otherwise, for finite inputs, in wide floats (`crate::wide`: an `f64`
+/// mantissa with an unbounded exponent, the same rounding), so that E·|V| overflowing or L² under- or overflowing does not
 /// make a finite k infinite or zero: k is ∞ or 0 only when it is itself past `f64::MAX` or below
 /// the smallest subnormal.
 ///
@@ -1075,7 +1075,9 @@ pub fn stiffness_contribution(young: f64, volume: f64, rest_length: f64) -> f64 
     if !finite || (ev.is_normal() && ll.is_normal()) {
         return ev / ll;
     }
-    super::geom::ratio_pow2(young, volume.abs(), rest_length, 0)
+    use crate::wide::Wide;
+    let l = Wide::new(rest_length);
+    Wide::new(young).mul(Wide::new(volume.abs())).div(l.mul(l)).to_f64()
 }
 
 /// The corner pairs of a tet, in the order of [`tet_stiffnesses`].
@@ -1588,6 +1590,16 @@ impl Mechanics {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Law 2's term has no intermediate over- or underflow: ∞ or 0 only when k itself is.
+    #[test]
+    fn stiffness_contribution_has_no_intermediate_overflow() {
+        assert!((stiffness_contribution(1e300, 1e100, 1e100) / 1e200 - 1.0).abs() < 1e-15); // E·V = ∞ alone
+        assert_eq!(stiffness_contribution(1e-300, 1e-300, 1e-300), 1.0); // E·V and L² underflow alone
+        assert_eq!(stiffness_contribution(3.0, 4.0, 2.0), 3.0);
+        assert_eq!(stiffness_contribution(f64::MAX, 4.0, 1.0), f64::INFINITY);
+        assert_eq!(stiffness_contribution(1e-300, 1e-300, 1e300), 0.0); // k below the smallest subnormal
+    }
 
     /// `Body::check` reports a broken law: one moved rest position (possible only inside the
     /// crate since finding 33) no longer matches the rest lengths. Found missing by the

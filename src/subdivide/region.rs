@@ -293,7 +293,9 @@ pub(super) fn share(m: f64, v: f64, total: f64) -> f64 {
 /// difference is outside [2⁻²⁵⁰, 2²⁵⁰] (squares of products of differences would over- or
 /// underflow), the corners are translated to `p` and scaled by one power of two, and the distance
 /// is scaled back (∞ only for a distance past `f64::MAX`); inside that range nothing is
-/// translated or scaled (the same bits as the plain computation). O(1).
+/// translated or scaled (the same bits as the plain computation). The inside test reads the
+/// signs of the volumes in wide floats where a plain product could underflow, so a point inside
+/// a needle 1e-200 thin beside a unit edge is at distance 0. O(1).
 ///
 /// # Examples
 ///
@@ -321,18 +323,29 @@ pub fn tet_distance(p: [f64; 3], t: [[f64; 3]; 4]) -> f64 {
     crate::mesh::times_pow2(plain_tet_distance(p, t), -k)
 }
 
+/// The sign of the signed volume of the tet `c` (1, −1 or 0): plain for
+/// [`crate::mechanics::geom::plain_corners`] (no product underflows there), else in wide floats,
+/// so a needle whose volume underflows f64 still has the sign of its determinant. O(1).
+fn volume_sign(c: [[f64; 3]; 4]) -> f64 {
+    if crate::mechanics::geom::plain_corners(c) {
+        let s = crate::mesh::signed_volume(c[0], c[1], c[2], c[3]);
+        return if s == 0.0 { 0.0 } else { s.signum() };
+    }
+    crate::wide::six_volume(c[0], c[1], c[2], c[3]).signum()
+}
+
 /// [`tet_distance`] without scaling: finite results for coordinate differences in
 /// [2⁻²⁵⁰, 2²⁵⁰]. O(1).
 fn plain_tet_distance(p: [f64; 3], t: [[f64; 3]; 4]) -> f64 {
     let faces = [[t[1], t[2], t[3]], [t[0], t[3], t[2]], [t[0], t[1], t[3]], [t[0], t[2], t[1]]];
-    let vol = crate::mesh::signed_volume(t[0], t[1], t[2], t[3]);
+    let vol = volume_sign(t);
     // Each face is listed so that the opposite corner gives the sign of −vol: p is inside when it
     // is on that side (or on the plane) of all four faces.
     // Signs compared, not multiplied: a product of two volumes (a sixth power of the lengths)
     // underflows to 0 for tets of edge 1e-54 already, and 0 ≤ 0 put every point inside.
     let same_side = |f: &[[f64; 3]; 3]| {
-        let s = crate::mesh::signed_volume(f[0], f[1], f[2], p);
-        s == 0.0 || (s < 0.0) != (vol < 0.0)
+        let s = volume_sign([f[0], f[1], f[2], p]);
+        s == 0.0 || s != vol
     };
     if vol != 0.0 && faces.iter().all(same_side) {
         return 0.0;
@@ -499,20 +512,18 @@ impl LeveledMap<3> {
     }
 
     /// |volume| of each of the eight `children` of a subdivided tet, up to one common factor
-    /// (`mesh::fit_for_products`: 1 unless a volume would under- or overflow), so that their
-    /// ratios are finite for any finite corners. O(1).
+    /// (`geom::volume_ratios`: 1 for ordinary corners), so that their ratios are finite for any
+    /// finite corners. O(1).
     ///
     /// Errors: those of [`Self::tet_vertices`] and of the corner positions (not met for the
     /// children of a tet whose corners have finite positions: their corners are those and the
     /// finite midpoints of its edges).
     fn volumes_of_children(&self, children: &[DartId; 8]) -> Result<[f64; 8], SubdivideError> {
-        let mut pos = [[0.0; 3]; 32];
-        for (k, &c) in children.iter().enumerate() {
-            pos[4 * k..4 * k + 4].copy_from_slice(&self.corner_positions(self.tet_vertices(c)?)?);
+        let mut tets = [[[0.0; 3]; 4]; 8];
+        for (t, &c) in tets.iter_mut().zip(children) {
+            *t = self.corner_positions(self.tet_vertices(c)?)?;
         }
-        crate::mesh::fit_for_products(&mut pos);
-        Ok([0, 1, 2, 3, 4, 5, 6, 7]
-            .map(|k| crate::mesh::signed_volume(pos[4 * k], pos[4 * k + 1], pos[4 * k + 2], pos[4 * k + 3]).abs()))
+        Ok(crate::mechanics::geom::volume_ratios(tets))
     }
 
     /// Refines the zone of the ball B(center, radius) up to level `levels` (module docs): for
@@ -884,6 +895,21 @@ mod tests {
     use super::*;
 
     const UNIT: [[f64; 3]; 4] = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+
+    /// The sign of a volume that underflows f64 is still its determinant's: a needle of width
+    /// 1e-170 beside a unit edge, in either orientation; a flat tet has sign 0.
+    #[test]
+    fn volume_sign_reads_needles_in_wide_floats() {
+        let needle = [[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1e-170, 0.0], [0.0, 0.0, 1e-170]];
+        assert_eq!(crate::mesh::signed_volume(needle[0], needle[1], needle[2], needle[3]), 0.0);
+        assert_eq!(volume_sign(needle), 1.0);
+        assert_eq!(volume_sign([needle[1], needle[0], needle[2], needle[3]]), -1.0);
+        assert_eq!(volume_sign(UNIT), 1.0);
+        assert_eq!(volume_sign([UNIT[0], UNIT[1], UNIT[2], [0.5, 0.5, 0.0]]), 0.0);
+        let inside = [0.1, 1e-173, 1e-173];
+        assert_eq!(tet_distance(inside, needle), 0.0);
+        assert!(tet_distance([0.1, -1e-100, 0.0], needle) > 0.0);
+    }
 
     #[test]
     fn tet_distance_is_zero_inside_and_euclidean_outside() {

@@ -829,8 +829,7 @@ impl LeveledMap<3> {
     }
 
     /// |volume| of each child of a refined parent, from the corner positions and the midpoints,
-    /// up to one common factor (`mesh::fit_for_products`: 1 unless a volume would under- or
-    /// overflow).
+    /// up to one common factor (`geom::volume_ratios`: 1 for ordinary corners).
     fn child_volumes(&self, tp: &Template, darts: &[u32]) -> [f64; 8] {
         let mut pos = [[0.0; 3]; 10];
         for x in 0..4 {
@@ -840,13 +839,7 @@ impl LeveledMap<3> {
             pos[4 + k] = crate::mesh::midpoint(pos[x as usize], pos[y as usize]);
         }
         // Only the ratios are used: one common scale keeps them finite for any finite corners.
-        crate::mesh::fit_for_products(&mut pos);
-        let mut out = [0.0; 8];
-        for (c, set) in tp.children.iter().enumerate() {
-            let p = set.map(|l| pos[l as usize]);
-            out[c] = crate::mesh::signed_volume(p[0], p[1], p[2], p[3]).abs();
-        }
-        out
+        crate::mechanics::geom::volume_ratios(std::array::from_fn(|c| tp.children[c].map(|l| pos[l as usize])))
     }
 }
 

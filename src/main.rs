@@ -83,8 +83,13 @@ impl Command {
 /// `cmd` with every single-valued option that takes negative numbers (`allow_negative_numbers`)
 /// also taking values that start with a hyphen, in every subcommand: clap's test for a negative
 /// number misses `-1e-4` and `-.5`, which then read as unknown flags (`unexpected argument '-1'`)
-/// instead of reaching the option's own value check. A flag written where the value belongs
-/// (`--dt --json`) is then that value, refused by the check. O(arguments).
+/// instead of reaching the option's own value check. A comma list (`--cuts 1,5`, `--pin`,
+/// `--tets`, declared with `value_delimiter` and `allow_negative_numbers`) is one value per
+/// occurrence, so it is single-valued here too: `--cuts -1` reaches the count check and
+/// `--cuts 5 --json` still reads `--json` as a flag. A flag written where the value belongs
+/// (`--dt --json`, `--cuts --json`) is then that value, refused by the check. An option taking
+/// several values per occurrence is left alone (it would swallow the flags after it).
+/// O(arguments).
 fn hyphen_numbers(cmd: clap::Command) -> clap::Command {
     cmd.mut_args(|arg| {
         let single = arg.get_num_args().is_none_or(|n| n.max_values() <= 1);

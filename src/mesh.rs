@@ -14,6 +14,7 @@
 //! | NaN or infinite coordinate | error [`MeshError::NonFiniteCoordinate`] | error [`MeshError::NonFiniteCoordinate`] |
 //! | `node_tags` neither empty nor one per point | error [`MeshError::TagCountMismatch`] | — |
 //! | more than `u32::MAX - 1` points | error [`MeshError::TooManyPoints`] | error [`MeshError::TooManyPoints`] |
+//! | two cells with the same corners, in any order | error [`MeshError::DuplicateTet`] | error [`MeshError::DuplicateTriangle`] |
 //! | zero volume / zero area (see [`DEGENERACY_TOLERANCE`]) | warning | warning |
 //! | negative signed volume (inverted tet) | warning | — |
 //! | signed volume not a finite number (coordinates so large that it overflows f64) | warning | — |
@@ -165,8 +166,11 @@ pub enum MeshError {
         tag: Option<u64>,
     },
     /// Two tets have the same four corners: a volume listed twice overlaps itself (its copies
-    /// would sew into a closed two-tet component and double its mass).
-    #[error("duplicate tet: tets {first} and {second} have the same corners {corners:?}")]
+    /// would sew into a closed two-tet component and double its mass). The readers report it
+    /// with the file's element numbers and node tags instead (`io::ReadError::DuplicateElement`).
+    #[error(
+        "duplicate tet: tets {first} and {second} have the same corners {corners:?} (0-based tet and point indices)"
+    )]
     DuplicateTet {
         /// The lower tet id.
         first: usize,
@@ -174,6 +178,20 @@ pub enum MeshError {
         second: usize,
         /// Their corners as listed by `first`.
         corners: [u32; 4],
+    },
+    /// Two triangles of a [`TriMesh`] have the same three corners: a surface listed twice (its
+    /// copies would sew into a closed two-triangle "pillow").
+    #[error(
+        "duplicate triangle: triangles {first} and {second} have the same corners {corners:?} \
+         (0-based triangle and point indices)"
+    )]
+    DuplicateTriangle {
+        /// The lower triangle id.
+        first: usize,
+        /// The other triangle id.
+        second: usize,
+        /// Their corners as listed by `first`.
+        corners: [u32; 3],
     },
     /// A coordinate is NaN or infinite.
     #[error("non-finite coordinate: point {point}{} is {coords:?}", tag_suffix(.tag))]
@@ -565,20 +583,28 @@ enum TetShape {
     Positive,
 }
 
+/// The corner pairs of a tet's six edges.
+const EDGES: [(usize, usize); 6] = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
+
 /// The class of the tet with corners `c`: unmeasurable when its volume is not a finite f64
 /// (past `f64::MAX`, or NaN), zero-volume when |6V| ≤ [`DEGENERACY_TOLERANCE`] · l³ (l its
 /// longest edge), else inverted for V < 0. Plain for ordinary corners
-/// (`mechanics::geom::plain_corners`: the same bits as ever), else in wide floats (an f64
-/// mantissa with an unbounded exponent), so the test stays scale-invariant where 6V or l³ under-
-/// or overflows f64: a regular tet of edge 1e-150 is not zero-volume. O(1).
+/// (`mechanics::geom::plain_corners`), else in wide floats (an f64 mantissa with an unbounded
+/// exponent), so the test stays scale-invariant where 6V or l³ under- or overflows f64: a
+/// regular tet of edge 1e-150 is not zero-volume. Both branches make the same operations in the
+/// same order — 6V the raw determinant det[c₁ − c₀, c₂ − c₀, c₃ − c₀], l the largest
+/// `√(x² + y² + z²)` of the six edges, the bound `((TOL · l) · l) · l` — so they give the same
+/// bits, and the class does not change when the tet is scaled by a power of two across the gate
+/// (no plain intermediate over- or underflows for ordinary corners). O(1).
 fn tet_shape(c: [[f64; 3]; 4]) -> TetShape {
-    use crate::wide::{difference, norm, six_volume, Wide};
+    use crate::wide::{self, Wide};
     let (six, small) = if crate::mechanics::geom::plain_corners(c) {
-        let six = 6.0 * signed_volume(c[0], c[1], c[2], c[3]);
-        (Wide::new(six), six.abs() <= DEGENERACY_TOLERANCE * longest_edge(&c).powi(3))
+        let six = dot(cross(sub(c[1], c[0]), sub(c[2], c[0])), sub(c[3], c[0]));
+        let l = EDGES.iter().fold(0.0_f64, |m, &(i, j)| m.max(norm(sub(c[j], c[i]))));
+        (Wide::new(six), six.abs() <= DEGENERACY_TOLERANCE * l * l * l)
     } else {
-        let six = six_volume(c[0], c[1], c[2], c[3]);
-        let lengths = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)].map(|(i, j)| norm(difference(c[j], c[i])));
+        let six = wide::six_volume(c[0], c[1], c[2], c[3]);
+        let lengths = EDGES.map(|(i, j)| wide::norm(wide::difference(c[j], c[i])));
         let l = lengths.iter().fold(lengths[0], |a, &x| if a.less_than(x) { x } else { a });
         let bound = Wide::new(DEGENERACY_TOLERANCE).mul(l).mul(l).mul(l);
         (six, !bound.less_than(six.abs()))
@@ -663,29 +689,29 @@ fn check_cells<const N: usize>(
     Ok(())
 }
 
-/// [`MeshError::DuplicateTet`] for the first pair of tets with the same corner set (the lowest
-/// second id, paired with the first tet of its corners). The sorted corners are packed into one
-/// `u128` key and the keys sorted (16 bytes per tet); only when two keys are equal are the tets
-/// looked for, in one pass. O(T log T).
-fn check_duplicate_tets(tets: &[[u32; 4]]) -> Result<(), MeshError> {
-    let key = |c: &[u32; 4]| {
+/// The first pair of cells (N ≤ 4 corners) with the same corner set, as (first, second): the
+/// lowest second id, paired with the first cell of its corners. The sorted corners are packed
+/// into one `u128` key and the keys sorted (16 bytes per cell); only when two keys are equal are
+/// the cells looked for, in one pass. O(C log C).
+pub(crate) fn duplicate_cells<const N: usize>(cells: &[[u32; N]]) -> Option<(usize, usize)> {
+    let key = |c: &[u32; N]| {
         let mut k = *c;
         k.sort_unstable();
         k.iter().fold(0u128, |acc, &v| acc << 32 | u128::from(v))
     };
-    let mut keys: Vec<u128> = tets.iter().map(key).collect();
+    let mut keys: Vec<u128> = cells.iter().map(key).collect();
     keys.sort_unstable();
     if keys.windows(2).all(|w| w[0] != w[1]) {
-        return Ok(());
+        return None;
     }
     let mut first_of: rustc_hash::FxHashMap<u128, usize> = rustc_hash::FxHashMap::default();
-    for (t, c) in tets.iter().enumerate() {
+    for (t, c) in cells.iter().enumerate() {
         if let Some(&first) = first_of.get(&key(c)) {
-            return Err(MeshError::DuplicateTet { first, second: t, corners: tets[first] });
+            return Some((first, t));
         }
         first_of.insert(key(c), t);
     }
-    Ok(())
+    None
 }
 
 fn check_points(points: &[[f64; 3]], tags: &[u64]) -> Result<(), MeshError> {
@@ -871,13 +897,15 @@ impl TetMesh {
     /// Checks the mesh: `Err` for a defect that makes it unusable, otherwise the list of
     /// warnings. See the table in the [module docs](self) for what is which.
     ///
-    /// Cost: O(P + T) plus O((T + B) log(T + B)) for the boundary cross-check when
-    /// `boundary_triangles` is not empty (P points, T tets, B file triangles).
+    /// Cost: O(P + T log T) (the duplicate test sorts one key per tet) plus
+    /// O((T + B) log(T + B)) for the boundary cross-check when `boundary_triangles` is not empty
+    /// (P points, T tets, B file triangles).
     ///
     /// # Errors
     /// [`MeshError::Empty`], [`MeshError::TooManyPoints`], [`MeshError::TagCountMismatch`],
     /// [`MeshError::NonFiniteCoordinate`], [`MeshError::IndexOutOfRange`],
-    /// [`MeshError::RepeatedVertex`] (for tets and for `boundary_triangles`).
+    /// [`MeshError::RepeatedVertex`] (for tets and for `boundary_triangles`),
+    /// [`MeshError::DuplicateTet`] (a tet listed twice, in any corner order).
     ///
     /// # Examples
     ///
@@ -902,7 +930,9 @@ impl TetMesh {
         let n = self.points.len();
         check_cells(CellKind::Tet, &self.tets, n, &self.node_tags)?;
         check_cells(CellKind::BoundaryTriangle, &self.boundary_triangles, n, &self.node_tags)?;
-        check_duplicate_tets(&self.tets)?;
+        if let Some((first, second)) = duplicate_cells(&self.tets) {
+            return Err(MeshError::DuplicateTet { first, second, corners: self.tets[first] });
+        }
         let mut report = MeshReport::default();
         for (i, t) in self.tets.iter().enumerate() {
             let c = t.map(|v| self.points[v as usize]);
@@ -1153,11 +1183,12 @@ impl TriMesh {
     /// warnings (zero-area triangles, unreferenced points). See the table in the
     /// [module docs](self). The zero-area test is scale-invariant at every scale: a well-shaped
     /// triangle with legs of 1e-90 or 1e155, or corners ±`f64::MAX` apart, is not zero-area.
-    /// O(P + T).
+    /// O(P + T log T).
     ///
     /// # Errors
     /// [`MeshError::Empty`], [`MeshError::TooManyPoints`], [`MeshError::NonFiniteCoordinate`],
-    /// [`MeshError::IndexOutOfRange`], [`MeshError::RepeatedVertex`] (a degenerate triangle).
+    /// [`MeshError::IndexOutOfRange`], [`MeshError::RepeatedVertex`] (a degenerate triangle),
+    /// [`MeshError::DuplicateTriangle`] (a triangle listed twice, in any corner order).
     ///
     /// # Examples
     ///
@@ -1179,6 +1210,9 @@ impl TriMesh {
         check_points(&self.points, &[])?;
         let n = self.points.len();
         check_cells(CellKind::Triangle, &self.triangles, n, &[])?;
+        if let Some((first, second)) = duplicate_cells(&self.triangles) {
+            return Err(MeshError::DuplicateTriangle { first, second, corners: self.triangles[first] });
+        }
         let mut report = TriMeshReport::default();
         for (i, t) in self.triangles.iter().enumerate() {
             let mut c = t.map(|v| self.points[v as usize]);

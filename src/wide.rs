@@ -150,8 +150,10 @@ pub(crate) fn norm(u: WideVec) -> Wide {
 
 /// 6 × the signed volume of the tet (a, b, c, d), det[b − a, c − a, d − a], in the operation
 /// order of `mesh::signed_volume` (so its bits where that one neither over- nor underflows).
-/// Exactly 0 only for corners whose determinant cancels or underflows even with an unbounded
-/// exponent, i.e. a flat tet (up to the rounding of the differences). O(1).
+/// It is 0 exactly when the plain formula's rounded operations give 0 with an unbounded exponent
+/// (no underflow can make it 0). That is the rounded determinant, not the exact one: the
+/// differences, the products and the sums each round, so an exactly flat tet may get a nonzero
+/// value and a tet of tiny nonzero volume 0, even when every difference is exact. O(1).
 pub(crate) fn six_volume(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> Wide {
     dot(cross(difference(b, a), difference(c, a)), difference(d, a))
 }

@@ -36,7 +36,7 @@ fn f119_below_zero_is_zero() {
 }
 
 /// Finding 120: a 0-unsew of any sewn dart of a body is refused before anything changes (map,
-/// attributes, version), naming the dart and its edge; 1-, 2- and 3-unsews keep the laws.
+/// attributes, version), naming the dart and its edge; so is a 1-unsew (finding 150).
 #[test]
 fn f120_body_refuses_a_zero_unsew_unchanged() {
     let (points, tets) = kuhn_cube(1);
@@ -56,9 +56,12 @@ fn f120_body_refuses_a_zero_unsew_unchanged() {
         assert_eq!((body.version(), body.map().alpha::<0>(d)), (version, alpha0), "dart {d} changed");
     }
     body.check().unwrap();
+    // Since finding 150 a 1-unsew (it opens a tet) is refused unchanged too; 3-unsews cut.
     let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
     let d = darts[0];
-    body.unsew(1, d).unwrap();
+    let err = body.unsew(1, d).unwrap_err();
+    assert!(matches!(err, EmbedError::Refused { op: "unsew", dart, .. } if dart == d), "{err}");
+    assert_eq!(body.version(), 0);
     body.check().unwrap();
     body.map().validate().unwrap();
 }

@@ -5,7 +5,8 @@
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
-use std::time::{Duration, Instant};
+
+mod cli_common;
 
 const BIN: &str = env!("CARGO_BIN_EXE_topomech");
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
@@ -63,7 +64,7 @@ fn into_a_full_device(args: &[&str]) -> Option<(Option<i32>, String)> {
 /// Runs `args`; if the process is still running after a minute (blocked on a FIFO, say) it is
 /// killed and the test fails. The exit code and stdout + stderr.
 fn run_guarded(args: &[&str], cwd: &Path) -> (Option<i32>, String) {
-    let mut child = Command::new(BIN)
+    let child = Command::new(BIN)
         .args(args)
         .current_dir(cwd)
         .stdin(Stdio::null())
@@ -71,16 +72,8 @@ fn run_guarded(args: &[&str], cwd: &Path) -> (Option<i32>, String) {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    let start = Instant::now();
-    while child.try_wait().unwrap().is_none() {
-        if start.elapsed() > Duration::from_secs(60) {
-            child.kill().unwrap();
-            child.wait().unwrap();
-            panic!("{args:?} still ran after a minute: it blocks on its input");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    let out = child.wait_with_output().unwrap();
+    let out = cli_common::wait_at_most_a_minute(child)
+        .unwrap_or_else(|| panic!("{args:?} still ran after a minute: it blocks on its input"));
     (out.status.code(), text(&out.stdout) + &text(&out.stderr))
 }
 

@@ -252,9 +252,10 @@ pub fn campaign_k(
     sequences: usize,
     rng: &mut SplitMix64,
 ) -> Result<(KStats, Vec<Run>), CampaignError> {
-    let (fresh, _) = GMap::<3>::from_tets(points, tets)?;
-    // A mesh the indexed model refuses (a duplicated tet) is refused before any sequence.
+    // A mesh the indexed model refuses (a duplicated tet) is refused before any sequence, by the
+    // indexed model's own error (the g-map builder refuses it too, as `DuplicateElement`).
     IndexedModel::new(points, tets)?;
+    let (fresh, _) = GMap::<3>::from_tets(points, tets)?;
     let faces = glued_faces(&fresh);
     if faces.len() < k {
         return Err(CampaignError::TooFewFaces { asked: k, faces: faces.len() });

@@ -31,7 +31,8 @@ use crate::BuildError;
 pub struct Gluing {
     /// Number of sides of each polygon (1-gons and 2-gons are allowed in a G-map).
     pub sides: Vec<u8>,
-    /// Glued sides `[a, b, same_direction]` (global side indices, same_direction as 0/1).
+    /// Glued sides `[a, b, same_direction]` (global side indices, same_direction 0 or 1; any other
+    /// value is refused by [`Gluing::build`] with [`ConstructError::BadWay`]).
     pub pairs: Vec<[u16; 3]>,
 }
 
@@ -48,8 +49,11 @@ pub struct Gluing {
 /// ```
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ConstructError {
-    /// A side index past the last side, a side glued twice or to itself.
-    #[error("side {side} cannot be glued (there are {sides} sides; each side is glued at most once)")]
+    /// A side (a polygon's side for [`Gluing`], a tet's face for [`FaceGluing`]) index past the
+    /// last one, a side glued twice or to itself. Refused before any sew.
+    #[error(
+        "side {side} cannot be glued (there are {sides} sides; each side is glued at most once, and not to itself)"
+    )]
     BadSide {
         /// The side.
         side: u16,
@@ -68,6 +72,17 @@ pub enum ConstructError {
     /// A polygon with no side, or too many darts.
     #[error("polygon {0} has no side")]
     EmptyPolygon(usize),
+    /// A glued pair whose last entry is not one of its ways: a [`Gluing`] direction flag other
+    /// than 0 or 1, a [`FaceGluing`] way k ≥ 6. Refused before any sew.
+    #[error("glued pair {pair} has way {way}, not one of 0..{ways} (a side pair's direction is 0 or 1, a face pair's k is in 0..6)")]
+    BadWay {
+        /// The index of the pair in `pairs`.
+        pair: usize,
+        /// The value given.
+        way: u16,
+        /// The number of ways (2 for sides, 6 for faces).
+        ways: u16,
+    },
 }
 
 impl Gluing {
@@ -86,8 +101,9 @@ impl Gluing {
         self.sides.iter().map(|&s| s as usize).sum()
     }
 
-    /// The 2-G-map (4 darts per side). Errors name the first bad side or refused sew.
-    /// O(sides).
+    /// The 2-G-map (2 darts per side, one α0 pair). Errors name the first bad side (past the
+    /// last, glued twice or to itself), the first pair whose direction is not 0 or 1, or the
+    /// refused sew. O(sides).
     ///
     /// # Examples
     ///
@@ -100,6 +116,8 @@ impl Gluing {
     /// assert!(map.is_orientable() && map.boundary_darts().count() == 0);
     /// let twice = Gluing { sides: vec![3], pairs: vec![[0, 1, 0], [1, 2, 0]] };
     /// assert!(matches!(twice.build(), Err(ConstructError::BadSide { side: 1, .. })));
+    /// let seven = Gluing { sides: vec![4], pairs: vec![[0, 2, 7]] };
+    /// assert_eq!(seven.build().unwrap_err(), ConstructError::BadWay { pair: 0, way: 7, ways: 2 });
     /// ```
     pub fn build(&self) -> Result<GMap<2>, ConstructError> {
         let total = self.side_count();
@@ -121,16 +139,9 @@ impl Gluing {
             }
             offset += s;
         }
-        let mut used = vec![false; total];
+        check_pairs(&self.pairs, total, 2)?;
         for &[a, b, same] in &self.pairs {
-            for side in [a, b] {
-                let slot = used.get_mut(side as usize).ok_or(ConstructError::BadSide { side, sides: total })?;
-                if *slot {
-                    return Err(ConstructError::BadSide { side, sides: total });
-                }
-                *slot = true;
-            }
-            let target = if same != 0 { 2 * b as u32 } else { 2 * b as u32 + 1 };
+            let target = if same == 1 { 2 * b as u32 } else { 2 * b as u32 + 1 };
             map.sew::<2>(DartId(2 * a as u32), DartId(target))?;
         }
         Ok(map)
@@ -441,7 +452,9 @@ pub struct FaceGluing {
 }
 
 impl FaceGluing {
-    /// The 3-G-map (24 darts per tet). Errors: a bad face index or a refused sew. O(tets).
+    /// The 3-G-map (24 darts per tet). Errors, found before any sew: a face index past the last
+    /// face, a face glued twice or to itself ([`ConstructError::BadSide`], as for [`Gluing`]), a
+    /// way k ≥ 6 ([`ConstructError::BadWay`]); then a sew the kernel refuses. O(tets + pairs).
     ///
     /// # Examples
     ///
@@ -454,20 +467,39 @@ impl FaceGluing {
     /// assert_eq!(map.boundary_darts().count(), 48 - 12);
     /// let bad = FaceGluing { tets: 2, pairs: vec![[0, 8, 0]] };
     /// assert!(matches!(bad.build(), Err(ConstructError::BadSide { side: 8, sides: 8 })));
+    /// let itself = FaceGluing { tets: 1, pairs: vec![[0, 0, 1]] };
+    /// assert!(matches!(itself.build(), Err(ConstructError::BadSide { side: 0, sides: 4 })));
     /// ```
     pub fn build(&self) -> Result<GMap<3>, ConstructError> {
         let n = self.tets as u32;
         let tets: Vec<[u32; 4]> = (0..n).map(|t| [4 * t, 4 * t + 1, 4 * t + 2, 4 * t + 3]).collect();
         let (mut map, _) = GMap::<3>::from_tets(4 * n as usize, &tets)?;
-        let faces = 4 * self.tets as usize;
+        check_pairs(&self.pairs, 4 * self.tets as usize, 6)?;
         for &[a, b, k] in &self.pairs {
-            if a as usize >= faces || b as usize >= faces || k >= 6 {
-                return Err(ConstructError::BadSide { side: a.max(b), sides: faces });
-            }
             map.sew::<3>(DartId(6 * a as u32), DartId(6 * b as u32 + k as u32))?;
         }
         Ok(map)
     }
+}
+
+/// Checks glued pairs `[a, b, way]` over `sides` sides before anything is sewn: each side index
+/// below `sides` and used at most once over all pairs (so never glued to itself), each way below
+/// `ways`. The first fault in pair order, a before b, is named. O(sides + pairs).
+fn check_pairs(pairs: &[[u16; 3]], sides: usize, ways: u16) -> Result<(), ConstructError> {
+    let mut used = vec![false; sides];
+    for (pair, &[a, b, way]) in pairs.iter().enumerate() {
+        for side in [a, b] {
+            let slot = used.get_mut(side as usize).ok_or(ConstructError::BadSide { side, sides })?;
+            if *slot {
+                return Err(ConstructError::BadSide { side, sides });
+            }
+            *slot = true;
+        }
+        if way >= ways {
+            return Err(ConstructError::BadWay { pair, way, ways });
+        }
+    }
+    Ok(())
 }
 
 /// Every gluing of the faces of 1..=`max_tets` tets with at most `max_pairs` glued pairs, in
@@ -557,7 +589,7 @@ mod tests {
     fn a_face_gluing_way_out_of_range_is_refused() {
         assert!(FaceGluing { tets: 2, pairs: vec![[0, 4, 5]] }.build().is_ok());
         let bad = FaceGluing { tets: 2, pairs: vec![[0, 4, 6]] };
-        assert!(matches!(bad.build(), Err(ConstructError::BadSide { .. })));
+        assert_eq!(bad.build().unwrap_err(), ConstructError::BadWay { pair: 0, way: 6, ways: 6 });
     }
 
     #[test]

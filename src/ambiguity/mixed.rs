@@ -307,6 +307,11 @@ impl MixedRun {
 /// assert!(!run.ambiguous()); // all refined: nothing hangs, both models agree
 /// ```
 pub fn run_ops(points: &[[f64; 3]], tets: &[[u32; 4]], ops: &[Op]) -> Result<MixedRun, MixedError> {
+    // A duplicated tet is named by the indexed model's own error, as the campaigns name it (the
+    // g-map builder refuses it too, as `BuildError::DuplicateElement`).
+    if let Some((first, second)) = crate::mesh::duplicate_cells(tets) {
+        return Err(MixedError::Indexed(IndexedError::CoincidentTets { first, second, points: tets[second] }));
+    }
     let (map, report) = GMap::<3>::from_tets(points.len(), tets)?;
     if !report.pinched_vertices.is_empty() {
         return Err(MixedError::Pinched(report.pinched_vertices.len()));

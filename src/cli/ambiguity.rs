@@ -23,7 +23,7 @@ pub struct AmbiguityArgs {
     /// (547 points, 1852 tets); `kuhn:K` builds a Kuhn cube with 6K³ tets instead.
     pub mesh: Option<PathBuf>,
     /// Cuts per sequence (each at least 1); several values separated by commas.
-    #[arg(long, value_delimiter = ',', default_values_t = vec![1usize, 5, 10, 50], value_parser = cut_count)]
+    #[arg(long, value_delimiter = ',', default_values_t = vec![1usize, 5, 10, 50], value_parser = cut_count, allow_negative_numbers = true)]
     pub cuts: Vec<usize>,
     /// Seed of the random cut sequences.
     #[arg(long, default_value_t = 1, allow_negative_numbers = true)]

@@ -59,7 +59,7 @@ pub struct RemoveArgs {
     pub common: CommonArgs,
     /// Tet ids to remove (0-based positions in the file), comma-separated; an id listed twice is
     /// removed once. Exactly one of --tets and --sphere is required.
-    #[arg(long, value_delimiter = ',', conflicts_with = "sphere")]
+    #[arg(long, value_delimiter = ',', conflicts_with = "sphere", allow_negative_numbers = true)]
     pub tets: Vec<u32>,
     /// Remove the tets whose centroid lies in the ball `X,Y,Z,R`.
     #[arg(long, value_parser = parse_numbers::<4>, allow_hyphen_values = true)]

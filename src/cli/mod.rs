@@ -253,20 +253,20 @@ pub(crate) fn print_report(
 }
 
 /// Writes each `(path, bytes)` through [`topomech::store::write_atomically`] (a temporary file
-/// beside it and a rename), so a failed write (a full disk) leaves the earlier file at that path
-/// whole, never truncated. Every path is checked before the first write: one that exists and is
-/// not a regular file (a directory, a device) is refused then, so such a run replaces nothing.
-/// A later write failing (the disk filling up) leaves the files before it new and the rest as
-/// they were. O(total bytes).
+/// beside the target and a rename; a symbolic link is followed and keeps being a link, the old
+/// file's permissions are kept), so a failed write (a full disk) leaves the earlier file at that
+/// path whole, never truncated — unless its directory takes no new file and it is written in
+/// place (see `write_atomically`). Every path is checked before the first write: one that exists
+/// and is not a regular file (a directory, a device), or a file that cannot be opened for writing
+/// (read-only for this user), is refused then, so such a run replaces nothing. A later write
+/// failing (the disk filling up) leaves the files before it new and the rest as they were.
+/// O(total bytes).
 ///
 /// # Errors
 /// The path and the cause of the first refusal or failed write.
 pub(crate) fn write_files(files: &[(PathBuf, Vec<u8>)]) -> Result<(), (PathBuf, std::io::Error)> {
     for (path, _) in files {
-        if std::fs::metadata(path).is_ok_and(|m| !m.is_file()) {
-            let why = std::io::Error::other("it exists and is not a regular file (nothing was written)");
-            return Err((path.clone(), why));
-        }
+        refuse_unwritable(path).map_err(|why| (path.clone(), why))?;
     }
     for (path, bytes) in files {
         topomech::store::write_atomically(path, bytes).map_err(|e| match e {
@@ -275,6 +275,24 @@ pub(crate) fn write_files(files: &[(PathBuf, Vec<u8>)]) -> Result<(), (PathBuf, 
         })?;
     }
     Ok(())
+}
+
+/// `Err` when `path` exists and is not a regular file, or is a regular file that does not open
+/// for writing (opened without truncation; nothing is written). O(1).
+fn refuse_unwritable(path: &Path) -> std::io::Result<()> {
+    match std::fs::metadata(path) {
+        Ok(m) if !m.is_file() => {
+            Err(std::io::Error::other("it exists and is not a regular file (nothing was written)"))
+        }
+        Ok(_) => match std::fs::OpenOptions::new().write(true).open(path) {
+            Ok(_) => Ok(()),
+            Err(e) => Err(std::io::Error::new(
+                e.kind(),
+                format!("it exists and cannot be opened for writing ({e}); nothing was written"),
+            )),
+        },
+        Err(_) => Ok(()),
+    }
 }
 
 /// Refuses the first of `ids` that is not below `n`, naming the flag, the id and the range

@@ -32,7 +32,7 @@ pub struct SimulateArgs {
     #[arg(long, value_name = "AXIS=VALUE", value_parser = parse_pin_below)]
     pub pin_below: Option<(usize, f64)>,
     /// Fix these vertex ids (comma-separated; 0-based points of the file, each must exist).
-    #[arg(long, value_delimiter = ',')]
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
     pub pin: Vec<u32>,
     /// Gravity acceleration `X,Y,Z`.
     #[arg(long, value_parser = parse_vec3, default_value = "0,0,-9.81", allow_hyphen_values = true)]
@@ -222,19 +222,30 @@ fn print_summary(
 /// The warning for a `dt` past the stability limit of an explicit `integrator` on `sys`
 /// ([`Integrator::stable_dt`] of [`SpringSystem::mode_bounds`]: the stiffness and the damping
 /// terms, docs/MECHANICS.md "Time step"); `None` when dt is within it or the scheme is implicit.
-/// O(springs + slots).
+/// The text says which limit it is: an ordinary one, forward Euler's 0 on a system without the
+/// damping its bound needs (c_max = 0: undamped; else β_min = ν_min = 0), or one below the normal
+/// range of f64 (a system too stiff or too damped for any f64 step). O(springs + slots).
 pub fn stability_warning(integrator: Integrator, dt: f64, sys: &SpringSystem) -> Option<String> {
     let b = sys.mode_bounds();
     let limit = integrator.stable_dt(&b).filter(|&limit| dt > limit)?;
     let modes = format!("ω_max = {:.3e} /s, damping rate c_max = {:.3e} /s", b.omega_max, b.damping_max);
-    Some(if limit > 0.0 {
+    let name = integrator.name();
+    let euler_zero = limit == 0.0 && integrator == Integrator::Euler && b.beta_min == 0.0 && b.nu_min == 0.0;
+    Some(if limit.is_normal() {
+        format!("dt = {dt:.3e} exceeds the stability limit {limit:.3e} of {name} on this system ({modes}): the run may blow up")
+    } else if euler_zero && b.damping_max == 0.0 {
+        format!("forward Euler is unstable at every dt on this system ({modes}, undamped modes): the run may blow up")
+    } else if euler_zero {
         format!(
-            "dt = {dt:.3e} exceeds the stability limit {limit:.3e} of {} on this system ({modes}): \
-             the run may blow up",
-            integrator.name()
+            "forward Euler has no stable dt its bound can vouch for on this system ({modes}; a spring without \
+             damping and a slot without viscosity: β_min = ν_min = 0): the run may blow up"
         )
     } else {
-        format!("forward Euler is unstable at every dt on this system ({modes}, undamped modes): the run may blow up")
+        format!(
+            "dt = {dt:.3e} exceeds the stability limit {limit:.3e} of {name} on this system ({modes}), a limit \
+             below the normal range of f64 (the system is too stiff or too damped for any f64 time step): the run \
+             may blow up"
+        )
     })
 }
 

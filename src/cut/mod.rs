@@ -66,11 +66,11 @@ pub enum CutError {
     #[error("{0} does not exist in this body")]
     NoSuchDart(DartId),
     /// A face id that no live dart carries.
-    #[error("face {0} does not exist in this body")]
+    #[error("face {} does not exist in this body", .0.0)]
     NoSuchFace(CellId),
     /// A dissociation given back (to [`crate::subdivide::measure_cut`]) whose dart is live but not
     /// α3-free on the face it reported: the incision was made on another body.
-    #[error("dart {dart} is not an α3-free dart of face {face} in this body: the incision was not made on it")]
+    #[error("{dart} is not an α3-free dart of face {} in this body: the incision was not made on it", .face.0)]
     NotDissociated {
         /// A dart of the dissociation.
         dart: DartId,
@@ -78,7 +78,7 @@ pub enum CutError {
         face: CellId,
     },
     /// The face is α3-free: it is on the boundary already, there is nothing to dissociate.
-    #[error("face {face} (dart {dart}) is a boundary face: nothing to dissociate")]
+    #[error("face {} ({dart}) is a boundary face: nothing to dissociate", .face.0)]
     BoundaryFace {
         /// The face id.
         face: CellId,
@@ -86,10 +86,10 @@ pub enum CutError {
         dart: DartId,
     },
     /// A volume id that no live dart carries (never created, or already removed).
-    #[error("volume {0} does not exist (never created or already removed)")]
+    #[error("volume {} does not exist (never created or already removed)", .0.0)]
     NoSuchVolume(CellId),
     /// The volume is not a tetrahedron (24 darts).
-    #[error("volume {volume} (dart {dart}) has {darts} darts, not the 24 of a tetrahedron")]
+    #[error("volume {} ({dart}) has {darts} darts, not the 24 of a tetrahedron", .volume.0)]
     NotATet {
         /// The volume id.
         volume: CellId,
@@ -99,11 +99,11 @@ pub enum CutError {
         darts: usize,
     },
     /// A vertex id that no live dart carries.
-    #[error("vertex {0} does not exist in this body")]
+    #[error("vertex {} does not exist in this body", .0.0)]
     NoSuchVertex(CellId),
     /// A live vertex whose current position is NaN or infinite, where the operation needs it
     /// (the sides of an incision, the face normals of a tear): nothing is cut.
-    #[error("vertex {vertex} has the non-finite position {position:?}: its tets have no side to be cut on")]
+    #[error("vertex {} has the non-finite position {position:?}: its tets have no side to be cut on", .vertex.0)]
     NonFinitePosition {
         /// The smallest such vertex id (for a tear: one on the face that needed it).
         vertex: CellId,

@@ -7,7 +7,7 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use super::{Location, ReadError};
-use crate::mesh::{TetMesh, TriMesh};
+use crate::mesh::{CellKind, MeshError, TetMesh, TriMesh};
 
 /// What a reader does with an element of a given type.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -174,6 +174,32 @@ impl TagIndex {
     }
 }
 
+/// The file's element numbers of the cells of one list, in order, kept as runs of consecutive
+/// numbers: (cell where a run starts, its number). Files number their elements consecutively
+/// (a Gmsh block, a TetGen `.ele`), so a few runs stand for millions of cells; any numbering is
+/// kept exactly. `push` O(1), `get` O(log runs).
+#[derive(Debug, Default)]
+struct ElementNumbers {
+    runs: Vec<(usize, u64)>,
+    cells: usize,
+}
+
+impl ElementNumbers {
+    fn push(&mut self, number: u64) {
+        let next = self.runs.last().map(|&(cell, first)| first.wrapping_add((self.cells - cell) as u64));
+        if next != Some(number) {
+            self.runs.push((self.cells, number));
+        }
+        self.cells += 1;
+    }
+
+    /// The number of cell `cell` (< the cells pushed).
+    fn get(&self, cell: usize) -> u64 {
+        let (start, first) = self.runs[self.runs.partition_point(|&(c, _)| c <= cell) - 1];
+        first.wrapping_add((cell - start) as u64)
+    }
+}
+
 /// Collects points (by file tag) and cells, checking each record as it comes.
 #[derive(Debug, Default)]
 pub(crate) struct MeshBuilder {
@@ -181,7 +207,9 @@ pub(crate) struct MeshBuilder {
     tags: Vec<u64>,
     index: TagIndex,
     tets: Vec<[u32; 4]>,
+    tet_numbers: ElementNumbers,
     triangles: Vec<[u32; 3]>,
+    triangle_numbers: ElementNumbers,
     target: Target,
 }
 
@@ -298,10 +326,12 @@ impl MeshBuilder {
             ElementUse::Tet => {
                 let t = self.resolve::<4>(path, at, element, nodes)?;
                 self.tets.push(t);
+                self.tet_numbers.push(element);
             }
             ElementUse::Triangle => {
                 let t = self.resolve::<3>(path, at, element, nodes)?;
                 self.triangles.push(t);
+                self.triangle_numbers.push(element);
             }
             ElementUse::Skip => {
                 if let Some(&tag) = nodes.iter().find(|&&tag| self.index.get(tag).is_none()) {
@@ -315,22 +345,42 @@ impl MeshBuilder {
     /// The tet mesh, after [`TetMesh::check`] found no error.
     ///
     /// # Errors
-    /// `InvalidMesh` (e.g. no tetrahedra).
+    /// `DuplicateElement` (named by the file's element numbers and node tags), `InvalidMesh`
+    /// for the check's other errors (e.g. no tetrahedra).
     pub fn into_tet_mesh(self, path: &Path) -> Result<TetMesh, ReadError> {
         let mesh =
             TetMesh { points: self.points, tets: self.tets, boundary_triangles: self.triangles, node_tags: self.tags };
-        mesh.check().map_err(|source| ReadError::InvalidMesh { path: path.to_path_buf(), source })?;
+        mesh.check().map_err(|source| in_file_terms(path, source, &self.tet_numbers, &mesh.node_tags))?;
         Ok(mesh)
     }
 
     /// The triangle mesh (tets are dropped), after [`TriMesh::check`] found no error.
     ///
     /// # Errors
-    /// `InvalidMesh` (e.g. no triangles).
+    /// `DuplicateElement` (named by the file's element numbers and node tags), `InvalidMesh`
+    /// for the check's other errors (e.g. no triangles).
     pub fn into_tri_mesh(self, path: &Path) -> Result<TriMesh, ReadError> {
         let mesh = TriMesh { points: self.points, triangles: self.triangles };
-        mesh.check().map_err(|source| ReadError::InvalidMesh { path: path.to_path_buf(), source })?;
+        mesh.check().map_err(|source| in_file_terms(path, source, &self.triangle_numbers, &self.tags))?;
         Ok(mesh)
+    }
+}
+
+/// The read error for a mesh check's error: a duplicate cell as `DuplicateElement`, with the
+/// file's element numbers (`numbers`) and node tags (`tags`, one per point) for the check's
+/// 0-based indices; anything else as `InvalidMesh`. O(corners + log runs).
+fn in_file_terms(path: &Path, source: MeshError, numbers: &ElementNumbers, tags: &[u64]) -> ReadError {
+    let (kind, first, second, corners) = match &source {
+        MeshError::DuplicateTet { first, second, corners } => (CellKind::Tet, *first, *second, &corners[..]),
+        MeshError::DuplicateTriangle { first, second, corners } => (CellKind::Triangle, *first, *second, &corners[..]),
+        _ => return ReadError::InvalidMesh { path: path.to_path_buf(), source },
+    };
+    ReadError::DuplicateElement {
+        path: path.to_path_buf(),
+        kind,
+        first: numbers.get(first),
+        second: numbers.get(second),
+        nodes: corners.iter().map(|&p| tags[p as usize]).collect(),
     }
 }
 
@@ -415,6 +465,18 @@ mod tests {
             (index.get(7), index.get(0), index.get(1030), index.get(u64::MAX), index.get(5)),
             (Some(0), Some(1), Some(2), Some(3), None)
         );
+    }
+
+    /// Element numbers are kept exactly, whatever the numbering, in one run per break.
+    #[test]
+    fn element_numbers_are_runs() {
+        let numbers = [5u64, 6, 7, 10, 11, 3, u64::MAX, 0, 1, 1];
+        let mut kept = ElementNumbers::default();
+        for n in numbers {
+            kept.push(n);
+        }
+        assert_eq!(kept.runs.len(), 5);
+        assert!(numbers.iter().enumerate().all(|(cell, &n)| kept.get(cell) == n));
     }
 
     #[test]

@@ -278,6 +278,26 @@ pub enum ReadError {
         /// Where the node that does not fit is.
         at: Location,
     },
+    /// Two elements have the same nodes, in any order: a tetrahedron (triangle, in a surface
+    /// read) listed twice. The mesh check's [`MeshError::DuplicateTet`] /
+    /// [`MeshError::DuplicateTriangle`], named with the file's element numbers and node tags.
+    #[error(
+        "{}: duplicate element: elements {first} and {second} have the same nodes {nodes:?} \
+         (a {kind} listed twice)",
+        .path.display()
+    )]
+    DuplicateElement {
+        /// The file.
+        path: PathBuf,
+        /// Tet or triangle.
+        kind: crate::mesh::CellKind,
+        /// The element number (tag) in the file of the earliest copy.
+        first: u64,
+        /// The element number of the element that repeats it.
+        second: u64,
+        /// The node tags, as `first` lists them.
+        nodes: Vec<u64>,
+    },
     /// The records parse but the mesh fails [`TetMesh::check`] / [`TriMesh::check`] (e.g. it
     /// has no tetrahedra).
     #[error("{}: invalid mesh: {source}", .path.display())]
@@ -303,23 +323,42 @@ fn read_file(path: &Path) -> Result<Vec<u8>, ReadError> {
     read_whole(path).map_err(|source| ReadError::Io { path: path.to_path_buf(), source })
 }
 
-/// The bytes of the file at `path`: a regular file or an anonymous pipe (`<(zcat mesh.msh.gz)`,
-/// `zcat mesh.msh.gz | topomech info /dev/stdin`). Refused with [`std::io::ErrorKind::InvalidInput`]
-/// before the file is opened ([`refuse_special`]): a character or block device or a socket
+/// The bytes of the file at `path`: a regular file, an anonymous pipe (`<(zcat mesh.msh.gz)`,
+/// `zcat mesh.msh.gz | topomech info /dev/stdin`), or standard input named as `/dev/stdin`,
+/// `/dev/fd/0` or `/proc/self/fd/0` when it is a named pipe (`topomech info /dev/stdin < FIFO`):
+/// that one is read from the open descriptor, never reopened (opening a FIFO waits for a writer,
+/// for ever once the writer has left). Refused with [`std::io::ErrorKind::InvalidInput`] before
+/// the file is opened ([`refuse_special`]): a character or block device or a socket
 /// (`/dev/zero` or `/dev/urandom` never end, and reading one would fill the memory before
-/// failing) and a named pipe (FIFO) in the file system (opening it waits for a writer that may
-/// never come). O(file).
+/// failing) and any other named pipe. O(file).
 pub(crate) fn read_whole(path: &Path) -> std::io::Result<Vec<u8>> {
-    refuse_special(path)?;
-    std::fs::read(path)
+    match refuse_special(path)? {
+        Source::Path => std::fs::read(path),
+        Source::Stdin => {
+            let mut bytes = Vec::new();
+            std::io::Read::read_to_end(&mut std::io::stdin().lock(), &mut bytes)?;
+            Ok(bytes)
+        }
+    }
+}
+
+/// Where [`read_whole`] takes the bytes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Source {
+    /// Open the path.
+    Path,
+    /// Read the process's standard input, which the path names.
+    Stdin,
 }
 
 /// `Err(InvalidInput)` when `path` (followed through symbolic links) is a device, a socket or a
-/// named pipe: nothing that [`read_whole`] could read to an end without waiting for someone. An
-/// anonymous pipe (`/dev/fd/N`, `/dev/stdin` fed by `|`) is a FIFO too, but it has no name in
-/// the file system (its path does not canonicalize) and its writer exists: it is read. Nothing
-/// is opened. O(path length) file-system queries.
-fn refuse_special(path: &Path) -> std::io::Result<()> {
+/// named pipe that [`read_whole`] would have to open: nothing it could read to an end without
+/// waiting for someone. A named pipe already open as standard input (`/dev/stdin`, `/dev/fd/0`,
+/// `/proc/self/fd/0`) is [`Source::Stdin`]: its writer was there when the shell opened it, and
+/// it is read where it is. An anonymous pipe (`/dev/fd/N`, `/dev/stdin` fed by `|`) is a FIFO
+/// too, but it has no name in the file system (its path does not canonicalize) and reopening it
+/// does not wait: it is read by its path. Nothing is opened. O(path length) file-system queries.
+fn refuse_special(path: &Path) -> std::io::Result<Source> {
     #[cfg(unix)]
     {
         use std::os::unix::fs::FileTypeExt;
@@ -329,15 +368,25 @@ fn refuse_special(path: &Path) -> std::io::Result<()> {
             return refuse("a device or socket, not a file (reading it might never end)");
         }
         if kind.is_fifo() && std::fs::canonicalize(path).is_ok() {
+            if names_stdin(path) {
+                return Ok(Source::Stdin);
+            }
             return refuse(
                 "a named pipe (FIFO), not a file (opening it waits for a writer that may never come; \
-                 pipe it in instead: `cat FIFO | topomech … /dev/stdin`)",
+                 give it as standard input instead: `topomech … /dev/stdin < FIFO` or `cat FIFO | topomech … /dev/stdin`)",
             );
         }
     }
     #[cfg(not(unix))]
     let _ = path;
-    Ok(())
+    Ok(Source::Path)
+}
+
+/// Whether `path` is written as a name of this process's standard input: `/dev/stdin`,
+/// `/dev/fd/0` or `/proc/self/fd/0`. O(path length).
+#[cfg(unix)]
+fn names_stdin(path: &Path) -> bool {
+    ["/dev/stdin", "/dev/fd/0", "/proc/self/fd/0"].iter().any(|name| path == Path::new(name))
 }
 
 fn extension(path: &Path) -> String {

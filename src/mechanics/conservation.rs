@@ -42,7 +42,7 @@ pub const TOLERANCE: f64 = 1e-12;
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ConservationError {
     /// m_v ≠ Σ_{t ∋ v} m_t / 4.
-    #[error("vertex {vertex} (e.g. {dart}): stored mass {stored} but its tets give {expected}")]
+    #[error("vertex {} (e.g. {dart}): stored mass {stored} but its tets give {expected}", .vertex.0)]
     VertexMass {
         /// The vertex id.
         vertex: CellId,
@@ -54,7 +54,7 @@ pub enum ConservationError {
         expected: f64,
     },
     /// γ_v ≠ ν · m_v.
-    #[error("vertex {vertex}: stored viscosity {stored} but ν·m gives {expected}")]
+    #[error("vertex {}: stored viscosity {stored} but ν·m gives {expected}", .vertex.0)]
     VertexViscosity {
         /// The vertex id.
         vertex: CellId,
@@ -64,7 +64,7 @@ pub enum ConservationError {
         expected: f64,
     },
     /// L_e differs from the distance between the rest positions of its vertices.
-    #[error("edge {edge} (e.g. {dart}): stored rest length {stored} but its vertices are {expected} apart")]
+    #[error("edge {} (e.g. {dart}): stored rest length {stored} but its vertices are {expected} apart", .edge.0)]
     RestLength {
         /// The edge id.
         edge: CellId,
@@ -76,7 +76,7 @@ pub enum ConservationError {
         expected: f64,
     },
     /// k_e ≠ Σ_{t ∋ e} E_t V_t / L_e².
-    #[error("edge {edge} (e.g. {dart}): stored stiffness {stored} but its tets give {expected}")]
+    #[error("edge {} (e.g. {dart}): stored stiffness {stored} but its tets give {expected}", .edge.0)]
     EdgeStiffness {
         /// The edge id.
         edge: CellId,
@@ -88,7 +88,7 @@ pub enum ConservationError {
         expected: f64,
     },
     /// c_e ≠ β · k_e.
-    #[error("edge {edge}: stored damping {stored} but β·k gives {expected}")]
+    #[error("edge {}: stored damping {stored} but β·k gives {expected}", .edge.0)]
     EdgeDamping {
         /// The edge id.
         edge: CellId,
@@ -98,7 +98,7 @@ pub enum ConservationError {
         expected: f64,
     },
     /// m_t ≠ ρ · V_t.
-    #[error("volume {tet}: stored mass {stored} but ρ·V gives {expected}")]
+    #[error("volume {}: stored mass {stored} but ρ·V gives {expected}", .tet.0)]
     TetMass {
         /// The volume id.
         tet: CellId,
@@ -132,7 +132,7 @@ pub enum ConservationError {
     /// A sew would merge two vertices that are apart at rest: the merged vertex has one rest
     /// position, so the rest lengths (law 3) of the edges of one side would be wrong. Raised
     /// before the sew ([`crate::embedding::CellRules::check_sew`]), which is then refused.
-    #[error("sewing {dart} to {other} would merge vertex {vertex} with vertex {other_vertex}, {distance} apart at rest (only faces that coincide at rest can be sewn)")]
+    #[error("sewing {dart} to {other} would merge vertex {} with vertex {}, {distance} apart at rest (only faces that coincide at rest can be sewn)", .vertex.0, .other_vertex.0)]
     SewApart {
         /// A dart of the sew.
         dart: DartId,
@@ -149,12 +149,45 @@ pub enum ConservationError {
     /// lose an end, so no rest length or stiffness could follow it. Raised before the unsew
     /// ([`crate::embedding::CellRules::check_unsew`]), which is then refused; bodies are cut by
     /// dissociating faces (3-unsews), which split springs into parallel ones instead.
-    #[error("0-unsewing {dart} would cut the spring of its edge {edge} into ends with no length (a body's edges cannot lose a vertex; cut by 3-unsews)")]
+    #[error("0-unsewing {dart} would cut the spring of its edge {} into ends with no length (a body's edges cannot lose a vertex; cut by 3-unsews)", .edge.0)]
     UnsewEdge {
         /// The dart the unsew was called with.
         dart: DartId,
         /// Its edge.
         edge: CellId,
+    },
+    /// A 1- or 2-unsew would open a tetrahedron: it unlinks two darts of one volume, so it splits
+    /// a vertex or an edge *inside* that volume (a tet with five vertices, each given m_t/4, breaks
+    /// law 1; an edge split inside one tet gives both halves the tet's whole term of law 2, so the
+    /// unsew creates stiffness). The model has laws for closed tetrahedra only. Raised before the
+    /// unsew ([`crate::embedding::CellRules::check_unsew`]), which is then refused; bodies are cut
+    /// by dissociating faces (3-unsews).
+    #[error("{i}-unsewing {dart} would open the tetrahedron of volume {} (the mass/spring laws hold for closed tetrahedra only; cut by 3-unsews)", .volume.0)]
+    UnsewOpensTet {
+        /// The dart the unsew was called with.
+        dart: DartId,
+        /// The dimension of the unsew (1 or 2).
+        i: usize,
+        /// Its volume.
+        volume: CellId,
+    },
+    /// An i-sew with i ≤ 2 would link darts by α0, α1 or α2, which stay inside one volume: it
+    /// would join two volumes into one (a 1-sew of two tets makes a 7-vertex volume whose vertex
+    /// masses no law covers) or change a tet's own cells. A body's volumes are closed tetrahedra,
+    /// glued face to face by 3-sews only. Raised before the sew
+    /// ([`crate::embedding::CellRules::check_sew`]), which is then refused.
+    #[error("{i}-sewing {dart} to {other} would α{i}-link volume {} to volume {}: a body's tetrahedra are closed (their α0, α1, α2 links are fixed) and glued face to face by 3-sews only", .volume.0, .other_volume.0)]
+    SewInsideVolume {
+        /// A dart of the sew.
+        dart: DartId,
+        /// The dart it would be linked with.
+        other: DartId,
+        /// The dimension of the sew (0, 1 or 2).
+        i: usize,
+        /// The volume of `dart`.
+        volume: CellId,
+        /// The volume of `other`.
+        other_volume: CellId,
     },
 }
 

@@ -136,5 +136,9 @@ fn check(points: &[Vec3], tets: &[[u32; 4]]) -> Result<(), ModelError> {
             }
         }
     }
+    // A tet listed twice, refused as `Body::from_tets` refuses it (its copies would double the mass).
+    if let Some((first, second)) = crate::mesh::duplicate_cells(tets) {
+        return Err(BuildError::DuplicateElement { what: "tet", first, second, points: tets[first].to_vec() }.into());
+    }
     Ok(())
 }

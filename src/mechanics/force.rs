@@ -47,6 +47,7 @@ use rayon::prelude::*;
 
 use super::geom::{dot, norm, sub, Vec3};
 use super::simd::{multiversion, Kernel};
+use crate::wide::Wide;
 
 /// Spring and vertex count above which the parallel passes are worth their overhead.
 pub const PARALLEL_CHUNK: usize = 4096;
@@ -1183,7 +1184,11 @@ impl SpringSystem {
     }
 
     /// A bound on the largest angular frequency, ω_max² ≤ max_v Σ_{s ∋ v} 2 k_s / m_v
-    /// (Gershgorin on M⁻¹K), over free slots. Explicit schemes need dt ≲ 2/ω_max. O(springs).
+    /// (Gershgorin on M⁻¹K), over free slots. Explicit schemes need dt ≲ 2/ω_max. ω_max² is formed
+    /// per slot in wide floats when the plain one leaves the normal range (see `per_mass`), so
+    /// ω_max² may pass `f64::MAX` (a stiff, light vertex: a needle edge of 1e-153 beside a unit
+    /// one) and ω_max is ∞ only when ω_max itself is past it; ordinary systems keep the plain bits
+    /// √(max_v (Σ 2k_s)·(1/m_v)). O(springs).
     ///
     /// # Examples
     ///
@@ -1195,16 +1200,31 @@ impl SpringSystem {
     /// sys.push_slot(0.5, false, 0.0).unwrap();
     /// sys.push_spring([0, 1], 1.0, 4.0, 0.0).unwrap();
     /// assert_eq!(sys.omega_max(), 4.0); // √(2k / m)
+    /// sys.set_slot(1, 1e-300, false, 0.0).unwrap();
+    /// sys.set_spring(0, [0, 1], 1.0, 5e9, 0.0).unwrap();
+    /// let w = sys.omega_max(); // ω² = 1e310 is past f64::MAX, ω is not
+    /// assert!((w / 1e155 - 1.0).abs() < 1e-15, "{w:e}");
     /// ```
     pub fn omega_max(&self) -> f64 {
-        let mut w2: f64 = 0.0;
-        for i in 0..self.slots() {
-            if self.inv_mass[i] > 0.0 {
-                let k: f64 = self.incident(i).map(|(s, _)| 2.0 * self.stiffness[s]).sum();
-                w2 = w2.max(k * self.inv_mass[i]);
-            }
+        let free = (0..self.slots()).filter(|&i| self.inv_mass[i] > 0.0);
+        free.map(|i| self.per_mass(i, 0.0, &self.stiffness).sqrt().to_f64()).fold(0.0, f64::max)
+    }
+
+    /// (own + Σ_{s ∋ i} 2 x_s) · (1/m_i) for slot i (a rate per mass: Σ 2k/m or (γ + Σ 2c)/m),
+    /// summed in incidence order. The plain `f64` value when it is normal (then the wide
+    /// operations would give its bits: the terms are ≥ 0, so an overflow would have left ∞, and
+    /// doubling and adding subnormals are exact), else the same operations in wide floats
+    /// (`crate::wide`: an unbounded exponent), so a value past `f64::MAX` keeps its digits.
+    /// O(degree of i).
+    fn per_mass(&self, i: usize, own: f64, x: &[f64]) -> Wide {
+        let sum: f64 = self.incident(i).map(|(s, _)| 2.0 * x[s]).sum();
+        let plain = (own + sum) * self.inv_mass[i];
+        if plain.is_normal() {
+            return Wide::new(plain);
         }
-        w2.sqrt()
+        let two = Wide::new(2.0);
+        let sum = self.incident(i).fold(Wide::new(0.0), |sum, (s, _)| sum.add(two.mul(Wide::new(x[s]))));
+        Wide::new(own).add(sum).mul(Wide::new(self.inv_mass[i]))
     }
 
     /// Bounds on the modes of the system at rest, for the stable time step of an explicit scheme
@@ -1213,7 +1233,10 @@ impl SpringSystem {
     /// mode's rate c = ν + β ω² is at most this, by the same argument as ω_max: xᵀCx =
     /// Σ c_s ((x_a − x_b)·n)² ≤ Σ_v |x_v|² Σ_{s ∋ v} 2 c_s); the least spring ratio c_s / k_s
     /// (β_min, over springs with k_s > 0 and a free end) and the least γ_v / m_v (ν_min, over free
-    /// slots), ∞ when there is none. O(springs + slots).
+    /// slots), ∞ when there is none. ω_max and c_max are formed without intermediate overflow
+    /// (the plain bits on ordinary systems): each is ∞ only when it is itself past `f64::MAX`,
+    /// and then every stable limit is below the normal range of f64 (each is at most
+    /// 2.6/ω_max and 2.6/c_max < 1.5e-308). O(springs + slots).
     ///
     /// # Examples
     ///
@@ -1234,8 +1257,7 @@ impl SpringSystem {
         for i in 0..self.slots() {
             let w = self.inv_mass[i];
             if w > 0.0 {
-                let c: f64 = self.incident(i).map(|(s, _)| 2.0 * self.damping[s]).sum();
-                damping_max = damping_max.max((self.viscosity[i] + c) * w);
+                damping_max = damping_max.max(self.per_mass(i, self.viscosity[i], &self.damping).to_f64());
                 nu_min = nu_min.min(self.viscosity[i] * w);
             }
         }

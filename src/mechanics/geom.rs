@@ -102,10 +102,14 @@ pub(crate) fn rest_length(a: Vec3, b: Vec3) -> f64 {
     }
 }
 
-/// Whether the tet with corners `c` has exactly zero volume, its determinant taken in wide floats
-/// (`crate::wide`: the plain bits for ordinary corners, no over- or underflow otherwise), so that
-/// a tet whose volume under- or overflows f64 (tiny or huge, a needle 1e-170 thin beside a unit
-/// edge, a sliver 1e-200 thick and 1e200 wide) is not called flat. O(1).
+/// Whether the tet with corners `c` is flat in the sense the model uses: its determinant
+/// det[c₁ − c₀, c₂ − c₀, c₃ − c₀], computed with the plain formula's roundings (those of
+/// `mesh::signed_volume`) but an unbounded exponent (`crate::wide`), is 0. So a tet whose volume
+/// merely under- or overflows f64 (tiny or huge, a needle 1e-170 thin beside a unit edge, a sliver
+/// 1e-200 thick and 1e200 wide) is not called flat. This is the rounded determinant, not the
+/// exact volume: the products of the cross product round, so an exactly coplanar tet can have a
+/// nonzero rounded determinant (it is then not flat here) and a tet of tiny nonzero volume a
+/// zero one, even with exact differences. O(1).
 pub(crate) fn is_flat(c: [Vec3; 4]) -> bool {
     crate::wide::six_volume(c[0], c[1], c[2], c[3]).is_zero()
 }

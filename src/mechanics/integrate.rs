@@ -28,6 +28,7 @@ use rayon::prelude::*;
 use super::force::{ModeBounds, Rec4, SlotState, SpringSystem, SumPlan, PARALLEL_CHUNK};
 use super::geom::{dot, norm, sub, Vec3};
 use super::simd::{multiversion, Kernel};
+use crate::wide::Wide;
 
 /// Radius of a left half-disc {|z| ≤ r, Re z ≤ 0} inside RK4's stability region
 /// |1 + z + z²/2 + z³/6 + z⁴/24| ≤ 1 (the largest such radius is about 2.61).
@@ -95,7 +96,13 @@ impl Integrator {
     ///   (|λ| = ω when it oscillates, ≤ c when overdamped): h ≤ 2.6 / max(ω_max, c_max), a
     ///   sufficient bound.
     ///
-    /// ∞ when nothing bounds the step (no spring, no damping). O(1).
+    /// ∞ when nothing bounds the step (no spring, no damping). Computed without intermediate
+    /// overflow (ω_max² may pass `f64::MAX` while the limit is an ordinary number: a needle's
+    /// 1e309 gives a step near 1e-306), with the plain formula's bits wherever it stays in range.
+    /// So the limit is 0 only for forward Euler with β_min = ν_min = 0 (no damping the bound can
+    /// count on: an undamped system) or when the limit itself is below the smallest subnormal,
+    /// and it leaves the normal range of f64 only when it is below 2.2e-308 (as it is for
+    /// ω_max or c_max = ∞, see [`SpringSystem::mode_bounds`]). O(1).
     ///
     /// # Examples
     ///
@@ -116,17 +123,45 @@ impl Integrator {
     /// ```
     pub fn stable_dt(self, b: &ModeBounds) -> Option<f64> {
         let (w, c) = (b.omega_max, b.damping_max);
-        let limit = |num: f64, den: f64| if den > 0.0 { num / den } else { f64::INFINITY };
         match self {
-            Integrator::Symplectic => Some(limit(4.0, c + c.hypot(2.0 * w))),
-            Integrator::Euler => {
-                let oscillating = if w > 0.0 { b.beta_min + b.nu_min / (w * w) } else { f64::INFINITY };
-                Some(oscillating.min(limit(2.0, c)))
-            }
+            Integrator::Symplectic => Some(symplectic_limit(w, c)),
+            Integrator::Euler => Some(euler_oscillating_limit(b).min(limit(2.0, c))),
             Integrator::Rk4 => Some(limit(RK4_HALF_DISC, w.max(c))),
             Integrator::Implicit => None,
         }
     }
+}
+
+/// num / den, ∞ for den = 0 (nothing bounds the step). O(1).
+fn limit(num: f64, den: f64) -> f64 {
+    if den > 0.0 {
+        num / den
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// Symplectic Euler's limit 4 / (c + √(c² + 4ω²)): the plain formula (`hypot`, no intermediate
+/// overflow) while its denominator is finite, else the same in wide floats (the limit is then
+/// below 4/`f64::MAX` and comes out subnormal or 0). O(1).
+fn symplectic_limit(w: f64, c: f64) -> f64 {
+    let den = c + c.hypot(2.0 * w);
+    if den.is_finite() {
+        return limit(4.0, den);
+    }
+    let (two_w, c) = (Wide::new(2.0).mul(Wide::new(w)), Wide::new(c));
+    Wide::new(4.0).div(c.add(c.mul(c).add(two_w.mul(two_w)).sqrt())).to_f64()
+}
+
+/// Forward Euler's limit on the oscillating modes, β_min + ν_min / ω_max² (∞ for ω_max = 0), in
+/// wide floats: ω_max² may pass `f64::MAX` (the plain bits where nothing over- or underflows).
+/// O(1).
+fn euler_oscillating_limit(b: &ModeBounds) -> f64 {
+    if b.omega_max <= 0.0 {
+        return f64::INFINITY;
+    }
+    let w = Wide::new(b.omega_max);
+    Wide::new(b.beta_min).add(Wide::new(b.nu_min).div(w.mul(w))).to_f64()
 }
 
 /// An integrator name that is not one of the four.

@@ -75,7 +75,9 @@ pub enum SimError {
     },
 }
 
-/// Which vertices to fix, by rest position or id.
+/// Which vertices to fix, by rest position or id. The fields are public, so a spec can hold what
+/// pins nothing by mistake (an axis past 2, a NaN bound, an empty box): [`PinSpec::check`]
+/// refuses those, and [`PinSpec::pins`] never panics on them.
 ///
 /// # Examples
 ///
@@ -100,8 +102,58 @@ pub struct PinSpec {
     pub inside: Option<(Vec3, Vec3)>,
 }
 
+/// Why a [`PinSpec`] would silently pin nothing by its `below` or `inside` part
+/// ([`PinSpec::check`]).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::mechanics::{PinSpec, PinSpecError};
+///
+/// let spec = PinSpec { below: Some((3, 0.0)), ..Default::default() };
+/// assert_eq!(spec.check(), Err(PinSpecError::BadAxis { axis: 3 }));
+/// assert_eq!(spec.check().unwrap_err().to_string(), "pin axis 3 is not 0 (x), 1 (y) or 2 (z)");
+/// ```
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PinSpecError {
+    /// `below` names an axis past 2.
+    #[error("pin axis {axis} is not 0 (x), 1 (y) or 2 (z)")]
+    BadAxis {
+        /// The axis given.
+        axis: usize,
+    },
+    /// `below` has a NaN bound: no coordinate compares ≤ it.
+    #[error("pin bound on axis {axis} is NaN: no vertex would compare below it")]
+    NanBound {
+        /// The axis given.
+        axis: usize,
+    },
+    /// `inside` has a NaN coordinate in a corner: no coordinate compares inside it.
+    #[error("pin box ({min:?}, {max:?}) has a NaN corner coordinate on axis {axis}: no vertex would be inside it")]
+    NanCorner {
+        /// The first axis with a NaN.
+        axis: usize,
+        /// The box's min corner.
+        min: Vec3,
+        /// The box's max corner.
+        max: Vec3,
+    },
+    /// `inside` is empty: its min is above its max on an axis.
+    #[error("pin box is empty on axis {axis}: min {min} > max {max}")]
+    EmptyBox {
+        /// The first such axis.
+        axis: usize,
+        /// The min corner's coordinate on it.
+        min: f64,
+        /// The max corner's coordinate on it.
+        max: f64,
+    },
+}
+
 impl PinSpec {
-    /// Whether vertex `id` at rest position `p` is fixed. O(ids).
+    /// Whether vertex `id` at rest position `p` is fixed. Never panics: a `below` axis past 2
+    /// pins nothing, and so do a NaN bound or a box with a NaN corner or min > max on some axis
+    /// ([`PinSpec::check`] refuses all of them). O(ids).
     ///
     /// # Examples
     ///
@@ -113,11 +165,51 @@ impl PinSpec {
     /// assert!(pins.pins(CellId(3), [1.0, 1.0, 0.0])); // on the floor
     /// assert!(pins.pins(CellId(7), [1.0, 1.0, 5.0])); // named
     /// assert!(!pins.pins(CellId(3), [1.0, 1.0, 0.5]));
+    /// let past = PinSpec { below: Some((3, 0.0)), ..Default::default() };
+    /// assert!(!past.pins(CellId(3), [-1.0; 3])); // axis 3: nothing by `below`
     /// ```
     pub fn pins(&self, id: CellId, p: Vec3) -> bool {
-        let below = self.below.is_some_and(|(axis, value)| p[axis] <= value);
+        let below = self.below.is_some_and(|(axis, value)| p.get(axis).is_some_and(|&c| c <= value));
         let inside = self.inside.is_some_and(|(lo, hi)| (0..3).all(|k| lo[k] <= p[k] && p[k] <= hi[k]));
         below || inside || self.ids.contains(&id.0)
+    }
+
+    /// Refuses a spec whose `below` or `inside` part would silently pin nothing: an axis past 2,
+    /// a NaN bound, a box with a NaN corner coordinate or with min > max on some axis (the first
+    /// such axis is named). Infinite bounds are taken (−∞ pins nothing by that part, +∞
+    /// everything); ids are not checked. O(1).
+    ///
+    /// # Errors
+    /// [`PinSpecError`] naming the axis and values at fault.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::{PinSpec, PinSpecError};
+    ///
+    /// let nan = PinSpec { below: Some((2, f64::NAN)), ..Default::default() };
+    /// assert_eq!(nan.check(), Err(PinSpecError::NanBound { axis: 2 }));
+    /// let inverted = PinSpec { inside: Some(([0.0; 3], [1.0, -1.0, 1.0])), ..Default::default() };
+    /// assert_eq!(inverted.check(), Err(PinSpecError::EmptyBox { axis: 1, min: 0.0, max: -1.0 }));
+    /// assert!(PinSpec { below: Some((0, 0.5)), ..Default::default() }.check().is_ok());
+    /// ```
+    pub fn check(&self) -> Result<(), PinSpecError> {
+        if let Some((axis, value)) = self.below {
+            if axis > 2 {
+                return Err(PinSpecError::BadAxis { axis });
+            }
+            if value.is_nan() {
+                return Err(PinSpecError::NanBound { axis });
+            }
+        }
+        let Some((min, max)) = self.inside else { return Ok(()) };
+        if let Some(axis) = (0..3).find(|&k| min[k].is_nan() || max[k].is_nan()) {
+            return Err(PinSpecError::NanCorner { axis, min, max });
+        }
+        match (0..3).find(|&k| min[k] > max[k]) {
+            Some(axis) => Err(PinSpecError::EmptyBox { axis, min: min[axis], max: max[axis] }),
+            None => Ok(()),
+        }
     }
 }
 

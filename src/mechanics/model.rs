@@ -34,8 +34,9 @@
 //! - face split / merge: boundary flags and normals of the faces touched are recomputed.
 //! - vertex merge: position and velocity become the mass-weighted means (momentum is kept), mass
 //!   is recomputed (= m1 + m2); edge merge: stiffness recomputed (= k1 + k2).
-//! - volume split (an unsew inside a tet) has no mechanical meaning: the new volume gets zero mass
-//!   and the conservation check reports it.
+//! - only 3-unsews and 3-sews (face dissociation and gluing) reach these rules: every i-unsew
+//!   and i-sew with i ≤ 2 would open a tet or join volumes, for which the model has no law, and
+//!   is refused before the map changes ([`CellRules::check_unsew`], [`CellRules::check_sew`]).
 
 use crate::embedding::{CellArray, CellRules, CellSliceMut, Embedded, Split};
 use crate::gmap::CellChanges;
@@ -115,17 +116,20 @@ pub enum ModelError {
         /// Its coordinates.
         coords: Vec3,
     },
-    /// A tetrahedron of zero volume would make a massless, infinitely stiff element. Decided on
-    /// its determinant taken in wide floats (an f64 mantissa with an unbounded exponent), so a tet
-    /// whose volume merely underflows f64 (tiny, or a needle) is not one
-    /// ([`ModelError::VolumeUnderflow`]).
+    /// A flat tetrahedron, which would make a massless, infinitely stiff element: its determinant
+    /// det[b − a, c − a, d − a], computed with the plain formula's roundings and an unbounded
+    /// exponent (wide floats), is 0. That is the rounded determinant, not the exact volume: an
+    /// exactly coplanar tet whose products do not cancel in rounding builds, and a tet of tiny
+    /// nonzero volume whose products do is refused (the mesh check's relative test
+    /// |6V| ≤ 10⁻¹² l³ flags both). A tet whose volume merely underflows f64 (tiny, or a needle)
+    /// is not one ([`ModelError::VolumeUnderflow`]).
     #[error("tetrahedron {tet} has zero volume")]
     DegenerateTet {
         /// Tet index (= volume id).
         tet: usize,
     },
-    /// A tetrahedron that is not flat (its volume is not zero on its corners fitted to a common
-    /// scale) but whose volume, as an f64, is below the normal range (about 2.2e-308: a regular
+    /// A tetrahedron that is not flat (its determinant in wide floats is not 0:
+    /// [`ModelError::DegenerateTet`]) but whose volume, as an f64, is below the normal range (about 2.2e-308: a regular
     /// tet of edge 1e-103 or less). A model stores rest volumes and measures masses and stiffnesses
     /// on them, so such a volume would be 0 or lose its precision: refused, not called flat.
     #[error("tetrahedron {tet} has volume {volume:e}, below the normal range of f64 (coordinates too small for a stored rest volume; it is not flat)")]
@@ -256,13 +260,16 @@ pub struct Mechanics {
     pub(crate) position_epoch: u64,
 }
 
-/// A mechanical body: a 3-G-map whose sew/unsew keep the [`Mechanics`] attributes lawful.
+/// A mechanical body: a 3-G-map whose sew/unsew keep the [`Mechanics`] attributes lawful. Its
+/// volumes are closed tetrahedra: it takes 3-unsews and 3-sews (face dissociation and gluing)
+/// and refuses every i-unsew and i-sew with i ≤ 2, unchanged.
 ///
 /// # Examples
 ///
 /// ```
+/// use topomech::embedding::EmbedError;
 /// use topomech::generate::kuhn_cube;
-/// use topomech::mechanics::{Body, Material};
+/// use topomech::mechanics::{Body, ConservationError, Material};
 ///
 /// let (points, tets) = kuhn_cube(1);
 /// let (mut body, _): (Body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
@@ -270,6 +277,9 @@ pub struct Mechanics {
 /// body.unsew3(d).unwrap();
 /// assert_eq!(body.version(), 1);
 /// assert!(body.check().is_ok()); // the mechanical laws still hold
+/// let err = body.unsew(2, d).unwrap_err(); // would open a tet: refused
+/// assert!(matches!(err, EmbedError::Refused { source: ConservationError::UnsewOpensTet { i: 2, .. }, .. }));
+/// assert_eq!(body.version(), 1);
 /// ```
 pub type Body = Embedded<3, Mechanics>;
 
@@ -1164,12 +1174,17 @@ impl CellRules<3> for Mechanics {
         }
     }
 
-    /// An i-sew (i ≥ 1) merges the vertices of each linked pair; they must have the same rest
-    /// position, exactly (as the two sides of a dissociated face do: a split copies it), or the
-    /// rest lengths of one side's edges would no longer be the distances of their ends.
+    /// Only a 3-sew glues tetrahedra (face to face): an i-sew with i ≤ 2 links darts inside what
+    /// must stay one closed tet, joining two volumes into one that no law covers (a 1-sew of two
+    /// tets makes a 7-vertex volume) or changing a tet's own cells: refused with
+    /// [`ConservationError::SewInsideVolume`]. A 3-sew merges the vertices of each linked pair;
+    /// they must have the same rest position, exactly (as the two sides of a dissociated face do:
+    /// a split copies it), or the rest lengths of one side's edges would no longer be the
+    /// distances of their ends ([`ConservationError::SewApart`]). O(pairs).
     fn check_sew(&self, map: &GMap<3>, i: usize, pairs: &[(DartId, DartId)]) -> Result<(), ConservationError> {
-        if i == 0 {
-            return Ok(()); // an α0 link joins the two ends of an edge: no vertex merges
+        if let (true, Some(&(x, y))) = (i <= 2, pairs.first()) {
+            let (volume, other_volume) = (map.cell_id(3, x), map.cell_id(3, y));
+            return Err(ConservationError::SewInsideVolume { dart: x, other: y, i, volume, other_volume });
         }
         for &(x, y) in pairs {
             let (vx, vy) = (map.vertex_id(x), map.vertex_id(y));
@@ -1182,13 +1197,21 @@ impl CellRules<3> for Mechanics {
         Ok(())
     }
 
-    /// A 0-unsew would give an edge's two ends one vertex (law 3 has no rest length for it):
-    /// refused. 1-, 2- and 3-unsews split vertices, edges and faces with their rules. O(1).
+    /// Only a 3-unsew (a face dissociation) cuts a body: it splits vertices, edges and faces
+    /// *between* tets with the rules above. A 0-unsew would give an edge's two ends one vertex
+    /// (law 3 has no rest length for it): refused with [`ConservationError::UnsewEdge`]. A 1- or
+    /// 2-unsew would open a tet, splitting a vertex or an edge *inside* it (a tet with five
+    /// vertices breaks law 1; both halves of an edge split inside one tet would get its whole
+    /// term of law 2, creating stiffness): refused with [`ConservationError::UnsewOpensTet`].
+    /// A dart that is not live or already i-free is left to the kernel's own error. O(1).
     fn check_unsew(&self, map: &GMap<3>, i: usize, d: DartId) -> Result<(), ConservationError> {
-        if i == 0 && map.contains(d) && !map.is_free(0, d) {
-            return Err(ConservationError::UnsewEdge { dart: d, edge: map.cell_id(1, d) });
+        if i > 2 || !map.contains(d) || map.is_free(i, d) {
+            return Ok(());
         }
-        Ok(())
+        Err(match i {
+            0 => ConservationError::UnsewEdge { dart: d, edge: map.cell_id(1, d) },
+            _ => ConservationError::UnsewOpensTet { dart: d, i, volume: map.cell_id(3, d) },
+        })
     }
 
     fn on_merge(&mut self, _map: &GMap<3>, dim: usize, kept: CellId, absorbed: CellId) {
@@ -1614,8 +1637,8 @@ mod tests {
     }
 
     /// The O(1) outward normal equals the orbit-based one, bit for bit, at every dart of a body
-    /// with dissociated faces (tets as built: the five-load path), then with a tet opened inside
-    /// (where the flag is down and the closure check must step aside).
+    /// with dissociated faces (tets as built: the five-load path), then on its map with a tet
+    /// opened inside (where the flag is down and the closure check must step aside).
     #[test]
     fn fast_outward_normal_is_the_orbit_one() {
         let (points, tets) = crate::cut::ops::jittered_cube(2, 7);
@@ -1625,8 +1648,7 @@ mod tests {
         for d in inner.into_iter().step_by(2) {
             body.unsew3(d).unwrap();
         }
-        let same_everywhere = |body: &Body| {
-            let (map, mech) = (body.map(), body.attrs());
+        let same_everywhere = |map: &GMap<3>, mech: &Mechanics| {
             let mut nonzero = 0;
             for d in map.darts() {
                 let fast = mech.outward_normal(map, d);
@@ -1636,11 +1658,15 @@ mod tests {
             assert!(nonzero > 0);
         };
         assert!(body.map().tets_as_built());
-        same_everywhere(&body);
-        let _ = body.unsew(2, DartId(0)); // may report the opened tet under expensive-checks
-        assert!(!body.map().tets_as_built());
-        assert!(body.map().closed_tet_darts(DartId(0)).is_none());
-        same_everywhere(&body);
+        same_everywhere(body.map(), body.attrs());
+        // A body refuses to open a tet (finding 150); its plain map can, and both normals read
+        // the positions by vertex id only (a 2-unsew splits an edge, no vertex).
+        let (mut map, mut mech) = body.into_parts();
+        map.unsew_dyn(2, DartId(0)).unwrap();
+        mech.grow_to(&map);
+        assert!(!map.tets_as_built());
+        assert!(map.closed_tet_darts(DartId(0)).is_none());
+        same_everywhere(&map, &mech);
     }
 
     /// A vertex split's new-side mass read off the kernel's side list equals law 1 from the map,

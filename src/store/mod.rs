@@ -32,9 +32,12 @@
 //! a file holding it is version 2 ([`save_leveled`] / [`load_leveled`]). Files without it are
 //! still written and read as version 1, byte for byte as before.
 //!
-//! Writes are atomic: [`save_document`] writes a temporary file in the target's directory, flushes
-//! and fsyncs it, then renames it into place, so a crash or an error leaves either the old file or
-//! the new one, never half of one.
+//! Writes are atomic: [`save_document`] (through [`write_atomically`]) writes a temporary file in
+//! the target's directory, flushes and fsyncs it, then renames it into place, so a crash or an
+//! error leaves either the old file or the new one, never half of one. A symbolic link is
+//! followed (the file it points to is replaced, the link kept) and the old file's permissions
+//! are kept. The one exception: an existing writable file in a directory that takes no new file
+//! is written in place, where a failed write can leave it partial.
 
 mod binary;
 mod check;
@@ -42,14 +45,15 @@ mod check_levels;
 mod raw;
 mod structure;
 mod text;
+mod write;
 
 use std::fmt;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 pub use crate::subdivide::{DartLevels, HistoryEntry, LevelParts};
 pub use check::{check_all_laws, CheckReport, Finding};
 pub use raw::{IdAllocRecord, RawMap, RawMechanics, VertexRecord};
+pub use write::write_atomically;
 
 use crate::mechanics::{Body, ConservationError};
 use crate::subdivide::{LevelPartsError, LeveledMap};
@@ -163,10 +167,12 @@ impl fmt::Display for Where {
 /// ```
 #[derive(Debug, thiserror::Error)]
 pub enum StoreError {
-    /// The operating system refused (open, write, fsync, rename).
+    /// The operating system refused (open, write, fsync, rename), or [`write_atomically`]
+    /// refused before writing (a target that cannot be opened for writing; a directory that
+    /// takes no temporary file, named in `source`).
     #[error("{}: {source}", .path.display())]
     Io {
-        /// The file (or the temporary file next to it).
+        /// The file asked for (a temporary file beside it is never named).
         path: PathBuf,
         /// The system error.
         source: std::io::Error,
@@ -805,13 +811,16 @@ pub fn save_body(body: &Body, path: &Path, format: Format) -> Result<(), StoreEr
     save_document(&Document::from_body(body), path, format)
 }
 
-/// Encodes `doc` and writes it atomically: a temporary file in the same directory, written,
-/// flushed and fsynced, renamed onto `path`, then the directory fsynced (best effort). On any
-/// error the temporary file is removed and an existing `path` is left untouched. O(size).
+/// Encodes `doc` and writes it with [`write_atomically`]: a temporary file in the target's
+/// directory, written, flushed and fsynced, renamed onto `path` (onto the file a symbolic link
+/// names, with the old file's permissions), then the directory fsynced (best effort). On any
+/// error the temporary file is removed and an existing `path` is left untouched — except an
+/// existing writable file in a directory that takes no new file, written in place (see
+/// [`write_atomically`]). O(size).
 ///
 /// # Errors
-/// The errors of [`encode`] (nothing is written); [`StoreError::Io`] naming the file the
-/// system refused.
+/// The errors of [`encode`] (nothing is written); [`StoreError::Io`] naming `path` as
+/// [`write_atomically`].
 ///
 /// # Examples
 ///
@@ -832,55 +841,4 @@ pub fn save_body(body: &Body, path: &Path, format: Format) -> Result<(), StoreEr
 pub fn save_document(doc: &Document, path: &Path, format: Format) -> Result<(), StoreError> {
     let bytes = encode(doc, format)?;
     write_atomically(path, &bytes)
-}
-
-/// Writes `bytes` to `path` through a temporary file and a rename (see [`save_document`]).
-///
-/// # Errors
-/// [`StoreError::Io`].
-///
-/// # Examples
-///
-/// ```
-/// let path = std::env::temp_dir().join(format!("topomech-doc-{}-atomic.bin", std::process::id()));
-/// topomech::store::write_atomically(&path, b"first").unwrap();
-/// topomech::store::write_atomically(&path, b"second").unwrap();
-/// assert_eq!(std::fs::read(&path).unwrap(), b"second");
-/// let missing = path.with_extension("d").join("no/such/dir.bin");
-/// let err = topomech::store::write_atomically(&missing, b"x").unwrap_err();
-/// assert!(matches!(&err, topomech::store::StoreError::Io { path, .. } if *path == missing), "{err}");
-/// # std::fs::remove_file(&path).unwrap();
-/// ```
-pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), StoreError> {
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "map".into());
-    static COUNTER: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-    let serial = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let tmp = dir.join(format!(".{name}.tmp-{}-{serial}", std::process::id()));
-    let io = |p: &Path| {
-        let p = p.to_path_buf();
-        move |source| StoreError::Io { path: p, source }
-    };
-    let result = (|| {
-        // Errors name `path`, the file the caller asked for, not the temporary beside it.
-        let mut file = std::fs::OpenOptions::new().write(true).create_new(true).open(&tmp).map_err(io(path))?;
-        file.write_all(bytes).map_err(io(path))?;
-        file.flush().map_err(io(path))?;
-        file.sync_all().map_err(io(path))?;
-        drop(file);
-        std::fs::rename(&tmp, path).map_err(io(path))
-    })();
-    if result.is_err() {
-        // The temporary file may not exist (creation failed); nothing else to undo.
-        let _ = std::fs::remove_file(&tmp);
-        return result;
-    }
-    // Persist the rename itself; not every platform lets a directory be opened and synced.
-    if let Ok(d) = std::fs::File::open(&dir) {
-        let _ = d.sync_all();
-    }
-    Ok(())
 }

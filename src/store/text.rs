@@ -139,18 +139,20 @@ impl<'a> Lines<'a> {
         lines
     }
 
-    /// The next significant line, trimmed, with its number; `None` at the end.
+    /// The next significant line (not blank, not a `#` comment), without its line end (LF or
+    /// CRLF) and its leading and trailing spaces and tabs, with its number; `None` at the end.
     fn next_line(&mut self) -> Option<(usize, &'a str)> {
         while self.offset < self.text.len() {
             let rest = &self.text[self.offset..];
             let (raw, step) = match rest.find('\n') {
-                Some(i) => (&rest[..i], i + 1),
+                // LF or CRLF ends a line; any other CR stays, for `check_characters` to refuse.
+                Some(i) => (rest[..i].strip_suffix('\r').unwrap_or(&rest[..i]), i + 1),
                 None => (rest, rest.len()),
             };
             let no = self.line;
             self.offset += step;
             self.line += 1;
-            let t = raw.trim();
+            let t = raw.trim_matches(SEPARATORS);
             if !t.is_empty() && !t.starts_with('#') {
                 return Some((no, t));
             }
@@ -181,11 +183,36 @@ impl<'a> Lines<'a> {
             return Err(StoreError::Truncated { at: Where::Line(self.end_line), expected: expected.into() });
         };
         self.taken += 1;
-        let tokens: Vec<&str> = line.split_whitespace().collect();
+        check_characters(no, line)?;
+        let tokens: Vec<&str> = tokens(line).collect();
         if !keyword.is_empty() && tokens.first() != Some(&keyword) {
             return Err(syntax(no, format!("expected {expected}, found {:?}", first_chars(line))));
         }
         Ok((no, tokens))
+    }
+}
+
+/// What separates tokens: ASCII spaces and tabs, nothing else (docs/FILE_FORMAT.md).
+const SEPARATORS: [char; 2] = [' ', '\t'];
+
+/// The tokens of a line: the non-empty runs between [`SEPARATORS`]. O(len).
+fn tokens(line: &str) -> impl Iterator<Item = &str> {
+    line.split(SEPARATORS).filter(|t| !t.is_empty())
+}
+
+/// Refuses a significant line holding whitespace other than the [`SEPARATORS`] (a no-break or
+/// em space, a vertical tab, a form feed) or a control character (a CR not ending the line):
+/// a `Syntax` error naming the line and the character. O(len).
+fn check_characters(no: usize, line: &str) -> Result<(), StoreError> {
+    match line.chars().find(|&c| !SEPARATORS.contains(&c) && (c.is_whitespace() || c.is_control())) {
+        Some(c) => Err(syntax(
+            no,
+            format!(
+                "character U+{:04X} is not allowed: tokens are separated by ASCII spaces or tabs, lines end with LF or CRLF",
+                u32::from(c)
+            ),
+        )),
+        None => Ok(()),
     }
 }
 
@@ -327,7 +354,7 @@ fn decode_map(lines: &mut Lines<'_>) -> Result<(u32, RawMap), StoreError> {
         let mut ahead = *lines;
         (0..live_count).all(|_| ahead.next_line().is_some())
             && ahead.next_line().is_some_and(|(_, line)| {
-                let mut tokens = line.split_whitespace();
+                let mut tokens = tokens(line);
                 tokens.next() == Some("free-darts")
                     && tokens.next().is_some_and(|count| unsigned(count) == Some(dead))
                     && tokens.count() as u64 == dead

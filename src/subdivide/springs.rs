@@ -241,7 +241,7 @@ pub enum CouplingError {
     /// A level-0 tet has zero volume: it would get no mass and no stiffness (a
     /// [`crate::mechanics::Body`] refuses it too). Decided on its determinant taken in wide
     /// floats, so a tet whose volume underflows f64 (tiny, or a needle) is not one.
-    #[error("volume {volume} (dart {dart}) has zero volume")]
+    #[error("volume {volume} ({dart}) has zero volume")]
     DegenerateTet {
         /// The volume cell id.
         volume: u32,

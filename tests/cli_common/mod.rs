@@ -3,7 +3,8 @@
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::{Child, Command, Output};
+use std::time::{Duration, Instant};
 
 /// The binary under test (Cargo builds it for integration tests).
 pub const BIN: &str = env!("CARGO_BIN_EXE_topomech");
@@ -40,4 +41,19 @@ pub fn write_msh(path: &Path, points: &[[f64; 3]], tets: &[[u32; 4]]) {
     }
     s += "$EndElements\n";
     std::fs::write(path, s).unwrap();
+}
+
+/// Waits for `child` (spawned with piped stdout and stderr) at most a minute: its output, or
+/// `None` when it still runs then (blocked on its input, say), after killing it.
+pub fn wait_at_most_a_minute(mut child: Child) -> Option<Output> {
+    let start = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > Duration::from_secs(60) {
+            let _ = child.kill();
+            let _ = child.wait();
+            return None;
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    Some(child.wait_with_output().unwrap())
 }

@@ -85,6 +85,23 @@ pub enum DemoError {
         /// The cause.
         source: SimError,
     },
+    /// The stable time step of a spring system is below the normal range of f64
+    /// ([`scene::time_step`]): the mesh is too stiff or too damped for any f64 step.
+    #[error(
+        "stage {stage}: the time step {dt:.3e} s (half the stability limit) is below the normal range of f64 \
+         (ω_max = {omega_max:.3e} /s, damping rate c_max = {damping_max:.3e} /s): the mesh is too stiff or too \
+         damped for an f64 step (an edge far shorter than the body, a tet far lighter than its springs)"
+    )]
+    TimeStep {
+        /// The stage ("setup" for the body, "refinement" for the refined network).
+        stage: &'static str,
+        /// The step: half the symplectic limit, subnormal or 0.
+        dt: f64,
+        /// The bound on the angular frequencies (1/s).
+        omega_max: f64,
+        /// The bound on the damping rates (1/s).
+        damping_max: f64,
+    },
     /// A cutting operation failed.
     #[error("stage {stage}: cutting failed: {source}")]
     Cut {

@@ -144,7 +144,8 @@ pub struct RefinedSim {
 /// springs)) plus O(darts + E) to project.
 ///
 /// # Errors
-/// [`DemoError::Balance`] when Σ slot mass differs from Σ tet mass, [`DemoError::RefinedStep`] on
+/// [`DemoError::Balance`] when Σ slot mass differs from Σ tet mass, [`DemoError::TimeStep`] when
+/// the refined network's step is below the normal range of f64, [`DemoError::RefinedStep`] on
 /// a blow-up (naming the step), [`DemoError::RefinedPin`] when a pinned vertex moved.
 pub fn simulate_refined(
     refined: &mut Refined,
@@ -175,7 +176,7 @@ pub fn simulate_refined(
     let step_error = |step| move |source| DemoError::RefinedStep { step, source };
     // The refined network is stiffer than the body (children are half the size, springs follow
     // law 2 and the series rule): its own stable step, by the scene's rule, not the body's.
-    let dt = super::scene::time_step(&sys);
+    let dt = super::scene::time_step(&sys, "refinement")?;
     let config_step = StepConfig::new(Integrator::Symplectic, dt);
     let mut stepper = Stepper::new(config_step, &sys, &mech.position, &mech.velocity).map_err(step_error(0))?;
     let mut times = StepTimes::new(steps);

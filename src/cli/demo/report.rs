@@ -197,17 +197,30 @@ fn opt(v: Option<f64>, f: impl Fn(f64) -> String) -> String {
     v.map_or_else(|| "-".to_string(), f)
 }
 
-/// The summary table. O(stages).
+/// A total mass for the table, with at least 7 significant digits and at most 13 characters at
+/// any magnitude: six decimals in [1, 10⁵) (the liver's 38.165235; 99999.9999996 rounds to the
+/// 13 characters of 100000.000000), else the exponent form of the Δm/M0 column (1.000000e-9,
+/// 1.000000e15, 2.225074e-308). O(1).
+fn mass_cell(m: f64) -> String {
+    if (1.0..1e5).contains(&m) {
+        format!("{m:.6}")
+    } else {
+        format!("{m:.6e}")
+    }
+}
+
+/// The summary table: one row per stage. The total mass column is 14 wide for cells of at most
+/// 13 characters ([`mass_cell`]), so a mass never runs into the component count. O(stages).
 pub fn write_table(out: &mut dyn Write, rows: &[StageRow]) -> std::io::Result<()> {
     writeln!(
         out,
-        "  {:<11}{:>6}{:>7}{:>7}{:>7}{:>6}{:>5}{:>13}{:>10}{:>10}{:>7}{:>9}",
+        "  {:<11}{:>6}{:>7}{:>7}{:>7}{:>6}{:>5}{:>14}{:>10}{:>10}{:>7}{:>9}",
         "stage", "V", "E", "F", "T", "bnd", "cmp", "total mass", "Δm/M0", "Δk/K0", "steps", "step µs"
     )?;
     for r in rows {
         writeln!(
             out,
-            "  {:<11}{:>6}{:>7}{:>7}{:>7}{:>6}{:>5}{:>13}{:>10}{:>10}{:>7}{:>9}",
+            "  {:<11}{:>6}{:>7}{:>7}{:>7}{:>6}{:>5}{:>14}{:>10}{:>10}{:>7}{:>9}",
             r.stage,
             r.cells.vertices,
             r.cells.edges,
@@ -215,7 +228,7 @@ pub fn write_table(out: &mut dyn Write, rows: &[StageRow]) -> std::io::Result<()
             r.cells.volumes,
             r.cells.boundary_faces,
             r.cells.components,
-            opt(r.total_mass, |m| format!("{m:.6}")),
+            opt(r.total_mass, mass_cell),
             opt(r.mass_residual, |x| format!("{x:.1e}")),
             opt(r.stiffness_residual, |x| format!("{x:.1e}")),
             r.steps,

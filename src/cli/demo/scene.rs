@@ -138,10 +138,21 @@ fn bounds(points: &[Vec3], tets: &[[u32; 4]]) -> (Vec3, Vec3) {
 /// The demo's time step for a spring system stepped by symplectic Euler: half the stability limit
 /// of [`Integrator::stable_dt`] (h²ω_max² + 2h c_max ≤ 4, damping included), at most
 /// [`MAX_DT`]: dt = min(MAX_DT, 2 / (c_max + √(c_max² + 4 ω_max²))), which is 1/ω_max undamped.
+/// ω_max² may pass `f64::MAX` (a needle edge of 1e-153): the limit is formed without it.
 /// O(springs + slots).
-pub fn time_step(sys: &SpringSystem) -> f64 {
-    let limit = Integrator::Symplectic.stable_dt(&sys.mode_bounds()).unwrap_or(f64::INFINITY);
-    MAX_DT.min(0.5 * limit)
+///
+/// # Errors
+/// [`DemoError::TimeStep`] (naming `stage`) when dt is below the normal range of f64: a system
+/// that stiff or that damped (a needle edge below about 1e-154 of the body) has no step that
+/// f64 can take.
+pub fn time_step(sys: &SpringSystem, stage: &'static str) -> Result<f64, DemoError> {
+    let b = sys.mode_bounds();
+    let limit = Integrator::Symplectic.stable_dt(&b).unwrap_or(f64::INFINITY);
+    let dt = MAX_DT.min(0.5 * limit);
+    if !dt.is_normal() {
+        return Err(DemoError::TimeStep { stage, dt, omega_max: b.omega_max, damping_max: b.damping_max });
+    }
+    Ok(dt)
 }
 
 impl Scene {
@@ -150,7 +161,8 @@ impl Scene {
     /// (half the stability limit with the damping). O(T log T).
     ///
     /// # Errors
-    /// [`DemoError::Model`] (a degenerate tet, a bad point), [`DemoError::Sim`].
+    /// [`DemoError::Model`] (a degenerate tet, a bad point), [`DemoError::TimeStep`] (a step
+    /// below the normal range of f64), [`DemoError::Sim`].
     pub fn new(points: &[Vec3], tets: &[[u32; 4]], steps: u64) -> Result<Self, DemoError> {
         let (lo, hi) = bounds(points, tets);
         let ext = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
@@ -169,7 +181,7 @@ impl Scene {
         let pinned = body.attrs().pinned().as_slice().iter().zip(&live).filter(|(&p, &l)| p && l).count();
         let probe = Simulation::new(&mut body, gravity, StepConfig::new(Integrator::Symplectic, MAX_DT))
             .map_err(|source| DemoError::Sim { stage: "setup", source })?;
-        let dt = time_step(probe.projection.system());
+        let dt = time_step(probe.projection.system(), "setup")?;
         let sim = Simulation::new(&mut body, gravity, StepConfig::new(Integrator::Symplectic, dt))
             .map_err(|source| DemoError::Sim { stage: "setup", source })?;
         let config = SceneConfig { steps, dt, long_axis, up_axis, gravity, material, lo, hi, pin_limit, pinned };

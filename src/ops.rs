@@ -104,10 +104,13 @@ pub enum Seed {
     /// polygon of 1..=6 edges.
     Structured,
     /// n = 3: a random subset of the tets of the Kuhn cube k = 2; n = 2: a random triangle soup
-    /// on at most 5 points (may be refused as non-manifold); n = 1: an open chain of 1..=6 edges.
+    /// on at most 5 points (may be refused as non-manifold; a draw that repeats a triangle gives
+    /// the pillow: two triangles glued along their three edges); n = 1: an open chain of 1..=6
+    /// edges.
     Soup,
-    /// n = 3: random tets on at most 6 points (may be refused); n = 2: the boundary of a
-    /// tetrahedron (a sphere); n = 1: a single edge.
+    /// n = 3: random tets on at most 6 points (may be refused; a draw that repeats a tet gives
+    /// the pillow: two tets glued along their four faces, a closed map); n = 2: the boundary of
+    /// a tetrahedron (a sphere); n = 1: a single edge.
     Wild,
 }
 
@@ -708,6 +711,10 @@ fn seeded_table_2(kind: Seed, rng: &mut SplitMix64) -> Result<AlphaTable, OpErro
         }
         Seed::Wild => (4, vec![[0, 1, 2], [0, 3, 1], [1, 3, 2], [2, 3, 0]]),
     };
+    if repeats_a_cell(&triangles) {
+        let (one, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]])?;
+        return Ok(pillow(&alpha_table(&one)));
+    }
     let (map, _) = GMap::<2>::from_triangles(points, &triangles)?;
     Ok(alpha_table(&map))
 }
@@ -732,8 +739,45 @@ fn seeded_table_3(kind: Seed, rng: &mut SplitMix64) -> Result<AlphaTable, OpErro
             (points, (0..count).map(|_| distinct::<4>(rng, points)).collect())
         }
     };
+    if repeats_a_cell(&tets) {
+        let (one, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]])?;
+        return Ok(pillow(&alpha_table(&one)));
+    }
     let (map, _) = GMap::<3>::from_tets(points, &tets)?;
     Ok(alpha_table(&map))
+}
+
+/// Whether two of `cells` have the same vertex set (the builders refuse such a list). O(c log c).
+fn repeats_a_cell<const K: usize>(cells: &[[u32; K]]) -> bool {
+    let mut keys: Vec<[u32; K]> = cells
+        .iter()
+        .map(|c| {
+            let mut k = *c;
+            k.sort_unstable();
+            k
+        })
+        .collect();
+    keys.sort_unstable();
+    keys.windows(2).any(|w| w[0] == w[1])
+}
+
+/// The pillow of one n-simplex's table: two copies of it glued along every facet (dart r of
+/// the copy is r + darts, αn exchanges r and r + darts), a closed map of two n-cells with no
+/// boundary — the 3-sphere of two tets, the 2-sphere of two triangles. A random draw that
+/// repeats a cell yields it, so the seeds keep producing closed two-cell maps although the
+/// builders refuse repeated cells. αn of the simplex must be free (every row r has αn(r) = r).
+/// O(darts · n).
+fn pillow(simplex: &AlphaTable) -> AlphaTable {
+    let darts = simplex.len() as u32;
+    let copy = |offset: u32, across: u32| {
+        simplex.iter().enumerate().map(move |(r, row)| {
+            let n = row.len() - 1;
+            let mut out: Vec<u32> = row.iter().map(|&a| a + offset).collect();
+            out[n] = r as u32 + across;
+            out
+        })
+    };
+    copy(0, darts).chain(copy(darts, 0)).collect()
 }
 
 /// K distinct random numbers below `points` (points ≥ K).
@@ -1254,6 +1298,30 @@ mod tests {
             KernelOp::Grow { kind: Seed::Soup, seed: 42 },
         ];
         assert_eq!(decode(&encode(&ops)), ops);
+    }
+
+    /// Draws that repeat a cell give the pillow (a closed two-cell map), often enough to matter:
+    /// for n = 3 Wild draws on 4 points with 2 or more tets, for n = 2 Soup draws that repeat a
+    /// triangle. The pillow is valid, has no boundary dart, and its cells are those of two
+    /// simplices glued along every facet.
+    #[test]
+    fn draws_that_repeat_a_cell_give_the_closed_pillow() {
+        let pillows = |table_of: &dyn Fn(u32) -> Result<AlphaTable, OpError>, darts: usize| {
+            (0..200).filter(|&s| table_of(s).is_ok_and(|t| t.len() == darts)).count()
+        };
+        let three = pillows(&|s| seeded_table::<3>(Seed::Wild, s), 48);
+        let two = pillows(&|s| seeded_table::<2>(Seed::Soup, s), 12);
+        assert!(three >= 20 && two >= 20, "pillows among 200 draws: {three} (n = 3), {two} (n = 2)");
+        let seed3 = (0..200).find(|&s| seeded_table::<3>(Seed::Wild, s).unwrap().len() == 48).unwrap();
+        let map3 = from_alpha_table::<3>(&seeded_table::<3>(Seed::Wild, seed3).unwrap()).unwrap();
+        assert_eq!(map3.validate(), Ok(()));
+        assert_eq!(map3.count_cells().0, [4, 6, 4, 2]);
+        assert!(map3.darts().all(|d| !map3.is_free(3, d)), "the pillow of two tets is closed");
+        let seed2 = (0..200).find(|&s| seeded_table::<2>(Seed::Soup, s).is_ok_and(|t| t.len() == 12)).unwrap();
+        let map2 = from_alpha_table::<2>(&seeded_table::<2>(Seed::Soup, seed2).unwrap()).unwrap();
+        assert_eq!(map2.validate(), Ok(()));
+        assert_eq!(map2.count_cells().0, [3, 3, 2]);
+        assert!(map2.darts().all(|d| !map2.is_free(2, d)), "the pillow of two triangles is closed");
     }
 
     #[test]

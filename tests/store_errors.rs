@@ -418,3 +418,29 @@ fn check_names_the_quasi_manifold_and_cell_id_laws_with_their_darts() {
     assert!(findings.iter().any(|(law, darts)| law == "cell_id_unique" && darts.contains(&0)), "{findings:?}");
     assert!(findings.iter().all(|(law, _)| law.starts_with("cell_id")), "{findings:?}");
 }
+
+/// The text twin of the test above: a record count is bounded by the significant lines *left
+/// after* the header that states it, not by the lines of the whole file. A vertex count one past
+/// the lines left (but well under the file's line total) is a bad count naming that limit.
+#[test]
+fn a_text_vertex_count_past_the_lines_left_is_a_bad_count() {
+    let doc = Document::from_body(&small_body());
+    let text = String::from_utf8(store::encode(&doc, Format::Text).unwrap()).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    let at = lines.iter().position(|l| l.starts_with("mechanics ")).expect("a body has a mechanics line");
+    let significant = |ls: &[&str]| ls.iter().filter(|l| !l.trim().is_empty() && !l.trim().starts_with('#')).count();
+    let left = significant(&lines[at + 1..]);
+    assert!(significant(&lines[..at]) > 1, "the map's lines precede the mechanics line");
+    let head: Vec<&str> = lines[at].split(' ').collect();
+    let count = left + 1;
+    let changed = format!("mechanics {count} {} {} {}", head[2], head[3], head[4]);
+    let broken: Vec<String> =
+        lines.iter().enumerate().map(|(k, l)| if k == at { changed.clone() } else { l.to_string() }).collect();
+    match store::decode((broken.join("\n") + "\n").as_bytes()).unwrap_err() {
+        StoreError::BadCount { what: "mechanics records", count: c, limit, .. } => {
+            assert_eq!(c, count as u64);
+            assert_eq!(limit, left as u64, "the limit is the significant lines after the mechanics line");
+        }
+        e => panic!("a vertex count past the lines left must be a bad count: {e}"),
+    }
+}

@@ -207,7 +207,7 @@ fn print_summary(
         writeln!(out, "{}", args.mesh.display())?;
         let (springs, slots) = (sys.springs(), sys.slots());
         writeln!(out, "  {:<22}mass/spring ({springs} springs, {slots} vertex slots, {fixed} fixed)", "system")?;
-        writeln!(out, "  {:<22}{} × {} s ({})", "steps", s.steps, s.dt, s.integrator)?;
+        writeln!(out, "  {:<22}{} × {} s ({})", "steps", s.steps, super::number(s.dt), s.integrator)?;
         writeln!(out, "  {:<22}{:.2} µs", "median step", s.step_us_median)?;
         writeln!(out, "  {:<22}{:.6e}", "total mass", s.total_mass)?;
         writeln!(out, "  {:<22}{:.6e}", "kinetic energy", s.kinetic_energy)?;

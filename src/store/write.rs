@@ -150,15 +150,22 @@ fn directory_of(target: &Path) -> PathBuf {
     }
 }
 
+/// The serial of the next temporary name of this process.
+static TEMPORARY_SERIAL: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+/// The temporary name of serial `serial` in `dir`.
+fn temporary_name(dir: &Path, serial: u64) -> PathBuf {
+    dir.join(format!(".topomech.tmp-{}-{serial}", std::process::id()))
+}
+
 /// A new temporary file in `dir`, named `.topomech.tmp-PID-SERIAL` (unique per process and
 /// call; a name left by a crashed process is skipped). Created `private` (0600 on Unix) when it
 /// will replace a file whose permissions it takes later, with the default mode otherwise.
 fn create_temporary(dir: &Path, private: bool) -> io::Result<(PathBuf, File)> {
-    static COUNTER: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
     let mut last = None;
     for _ in 0..MAX_TEMPORARIES {
-        let serial = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        let tmp = dir.join(format!(".topomech.tmp-{}-{serial}", std::process::id()));
+        let serial = TEMPORARY_SERIAL.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let tmp = temporary_name(dir, serial);
         let mut options = OpenOptions::new();
         options.write(true).create_new(true);
         #[cfg(unix)]
@@ -219,4 +226,29 @@ fn write_in_place(target: &Path, bytes: &[u8]) -> io::Result<()> {
     file.write_all(bytes)?;
     file.flush()?;
     file.sync_all()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Names left by another writer (or a crashed run of a process with the same id) are
+    /// skipped: the next free serial is taken, and the files already there are left untouched.
+    #[test]
+    fn temporary_names_already_taken_are_skipped() {
+        let dir = std::env::temp_dir().join(format!("topomech-write-unit-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let next = TEMPORARY_SERIAL.load(std::sync::atomic::Ordering::Relaxed);
+        let taken: Vec<PathBuf> = (next..next + 8).map(|s| temporary_name(&dir, s)).collect();
+        for t in &taken {
+            std::fs::write(t, b"left by someone else").unwrap();
+        }
+        let (tmp, file) = create_temporary(&dir, true).expect("a free name past the taken ones");
+        drop(file);
+        assert!(!taken.contains(&tmp), "{} was already taken", tmp.display());
+        for t in &taken {
+            assert_eq!(std::fs::read(t).unwrap(), b"left by someone else", "{} was overwritten", t.display());
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

@@ -14,7 +14,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use topomech::load;
-use topomech::mechanics::{FlatModel, Integrator, Material, PinSpec, Simulation, StepConfig, Stepper};
+use topomech::mechanics::{FlatModel, Integrator, Material, PinSpec, Simulation, SpringSystem, StepConfig, Stepper};
 use topomech::mesh::TetMesh;
 
 use super::simulate::{median, StepTimes};
@@ -133,14 +133,50 @@ pub fn run(args: BenchArgs) -> Result<(), CliError> {
     }
 }
 
-/// A flat model of `mesh` pinned on its low-x tenth, at rest, with its stepper (dt = 0.5/ω_max).
+/// The benchmark's time step for `integrator` on `sys`: half its stability limit
+/// ([`Integrator::stable_dt`] of [`SpringSystem::mode_bounds`], damping included), the implicit
+/// scheme at the symplectic one's, so that every scheme times a run that stays bounded (a run
+/// past its limit grows until the runaway test stops the benchmark); 1 ms when nothing bounds
+/// the step. O(springs + slots).
+///
+/// # Errors
+/// [`CliError::Other`] naming the scheme when the half limit is not a normal f64 (forward Euler
+/// on an undamped system is unstable at every step; a needle below about 1e-154 of the body
+/// leaves no step f64 can take).
+pub fn bench_dt(integrator: Integrator, sys: &SpringSystem) -> Result<f64, CliError> {
+    let b = sys.mode_bounds();
+    let scheme = match integrator {
+        Integrator::Implicit => Integrator::Symplectic,
+        explicit => explicit,
+    };
+    let dt = match scheme.stable_dt(&b) {
+        Some(limit) if limit.is_finite() => 0.5 * limit,
+        _ => 1e-3,
+    };
+    if dt.is_normal() {
+        return Ok(dt);
+    }
+    let why = match integrator.stable_dt(&b) {
+        Some(0.0) => "unstable at every time step on this system (no damping its bound can count on)",
+        _ => "left with no time step in the normal range of f64 on this system (too stiff or too damped)",
+    };
+    Err(other(format!(
+        "bench: the {} integrator is {why}: stability limit {:e} (ω_max = {:e}, c_max = {:e})",
+        integrator.name(),
+        2.0 * dt,
+        b.omega_max,
+        b.damping_max
+    )))
+}
+
+/// A flat model of `mesh` pinned on its low-x tenth, at rest, with its stepper ([`bench_dt`]).
 fn flat_case(mesh: &TetMesh, integrator: Integrator, parallel: bool) -> Result<(FlatModel, Stepper), CliError> {
     let points = &mesh.points;
     let (lo, hi) = points.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p[0]), hi.max(p[0])));
     let pinned: Vec<bool> = points.iter().map(|p| p[0] <= lo + 0.1 * (hi - lo)).collect();
     let flat =
         FlatModel::from_tets(points, &mesh.tets, Material::default(), [0.0, 0.0, -9.81], &pinned).map_err(other)?;
-    let config = StepConfig { parallel, ..StepConfig::new(integrator, 0.5 / flat.system.omega_max()) };
+    let config = StepConfig { parallel, ..StepConfig::new(integrator, bench_dt(integrator, &flat.system)?) };
     let stepper = Stepper::new(config, &flat.system, &flat.position, &flat.velocity).map_err(other)?;
     Ok((flat, stepper))
 }
@@ -235,7 +271,7 @@ fn run_step(args: StepBenchArgs) -> Result<(), CliError> {
     body.attrs_mut().pin_where(|id, p| pins.pins(id, p));
     let pinned: Vec<bool> = points.iter().enumerate().map(|(i, &p)| pins.pins(topomech::CellId(i as u32), p)).collect();
     let mut flat = FlatModel::from_tets(points, tets, material, gravity, &pinned).map_err(other)?;
-    let dt = 0.5 / flat.system.omega_max();
+    let dt = bench_dt(args.integrator, &flat.system)?;
     let config = StepConfig::new(args.integrator, dt);
     let mut sim = Simulation::new(&mut body, gravity, config).map_err(other)?;
     let mut stepper = Stepper::new(config, &flat.system, &flat.position, &flat.velocity).map_err(other)?;
@@ -281,6 +317,28 @@ fn run_step(args: StepBenchArgs) -> Result<(), CliError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Finding 170: `bench order`'s flat cases step at half each scheme's own limit (they took
+    /// 0.5/ω_max, 15 % past forward Euler's limit on the liver), and a scheme with no step is
+    /// refused by name.
+    #[test]
+    fn flat_cases_step_at_half_their_own_limit() {
+        let mesh = topomech::io::read_mesh(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("data/liver_547_v22.msh"));
+        let mesh = mesh.unwrap();
+        for integrator in [Integrator::Euler, Integrator::Symplectic, Integrator::Rk4, Integrator::Implicit] {
+            let (flat, stepper) = flat_case(&mesh, integrator, false).unwrap();
+            let scheme = if integrator == Integrator::Implicit { Integrator::Symplectic } else { integrator };
+            let limit = scheme.stable_dt(&flat.system.mode_bounds()).unwrap();
+            assert_eq!(stepper.config().dt, 0.5 * limit, "{}", integrator.name());
+        }
+        let mut undamped = SpringSystem::default();
+        undamped.push_slot(1.0, false, 0.0).unwrap();
+        undamped.push_slot(1.0, false, 0.0).unwrap();
+        undamped.push_spring([0, 1], 1.0, 1.0, 0.0).unwrap();
+        let e = bench_dt(Integrator::Euler, &undamped).unwrap_err().to_string();
+        assert!(e.contains("euler") && e.contains("unstable at every time step"), "{e}");
+        assert!((bench_dt(Integrator::Symplectic, &undamped).unwrap() - 1.0 / 2f64.sqrt()).abs() < 1e-15);
+    }
 
     #[test]
     fn bench_order_reports_the_liver_and_positive_times() {

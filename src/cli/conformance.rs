@@ -3,8 +3,9 @@
 //! (`docs/CONFORMANCE.md`).
 //!
 //! `check` exits with 0 when every vector replays, 1 when one mismatches (or breaks a law, or is
-//! refused by [`Vector::check_fields`](topomech::conformance::Vector::check_fields), or its name
-//! is not its file stem), 2 when a file cannot be read or parsed (wrong format or version) or the
+//! refused by [`Vector::check_fields`](topomech::conformance::Vector::check_fields), or is
+//! ambiguous: an `incise` plane within the margin of a tet centroid, reported as "ambiguous
+//! vector", not as "expected …, got …"; or its name is not its file stem), 2 when a file cannot be read or parsed (wrong format or version) or the
 //! directory holds none, and 3 when every vector passed but the report could not be written
 //! (a write to stdout failed: a pipe whose reader has gone, a full device). A stdout that was
 //! closed before the process started (`>&-`) is not seen: Rust's runtime opens /dev/null in its

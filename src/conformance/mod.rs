@@ -24,7 +24,7 @@ mod runner;
 mod schema;
 pub mod standard;
 
-pub use runner::{generate, generate_in, replay, replay_in, Ops, Recipe};
+pub use runner::{generate, generate_in, replay, replay_in, Ops, Recipe, PLANE_MARGIN};
 pub use schema::{Expect, MaterialSpec, MeshSpec, Op, Refusal, Step, Vector};
 
 use std::path::{Path, PathBuf};
@@ -194,17 +194,28 @@ pub enum ConformanceError {
         /// Which law and how.
         message: String,
     },
-    /// Generation only: a cutting plane passes within the safety margin of a tet centroid, so
-    /// engines with different rounding could classify it differently.
-    #[error("vector {vector}, {}: the plane passes {distance:e} from a tet centroid (margin {margin:e})", at(.step))]
+    /// An `incise` step whose plane passes within [`PLANE_MARGIN`] · (bounding-box diagonal) of a
+    /// live tet centroid: the side of that tet would be decided by rounding or by a tie rule
+    /// (topomech's puts a centroid on the plane on the negative side), so the vector does not
+    /// determine the outcome. A defect of the vector, not a failure of the engine replaying it:
+    /// [`generate`] refuses to write such a step and [`replay_in`] refuses to replay one.
+    #[error(
+        "vector {vector}, {}: ambiguous vector: the centroid of tet {tet} is {distance:e} from the incise plane, \
+         within the vectors' margin {margin:e} ({PLANE_MARGIN:e} × the bounding-box diagonal): its side is \
+         left to rounding and tie rules, not fixed by the vector; not replayed",
+        at(.step)
+    )]
     AmbiguousPlane {
         /// The vector.
         vector: String,
         /// The step index.
         step: Option<usize>,
-        /// The smallest centroid distance.
+        /// The live input tet whose centroid is closest to the plane (the smallest id among equals).
+        tet: u32,
+        /// Its centroid's distance from the plane.
         distance: f64,
-        /// The required margin.
+        /// The required margin: [`PLANE_MARGIN`] × the diagonal of the bounding box of the points
+        /// the tets use.
         margin: f64,
     },
 }

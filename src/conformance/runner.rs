@@ -76,8 +76,10 @@ pub struct Recipe {
 /// The largest Kuhn cube a vector may ask for (6·16³ tets).
 const MAX_KUHN: usize = 16;
 
-/// Smallest allowed distance of a tet centroid from an incision plane, relative to the mesh's
-/// bounding-box diagonal (generation refuses planes closer than this).
+/// Smallest allowed distance of a live tet centroid from an incision plane, relative to the
+/// diagonal of the bounding box of the points the tets use: generation and replay refuse a plane
+/// closer than this ([`ConformanceError::AmbiguousPlane`]), as rounding (or a tie rule) would
+/// then decide the side of that tet.
 pub const PLANE_MARGIN: f64 = 1e-6;
 
 /// What one operation did.
@@ -220,16 +222,20 @@ pub fn replay(v: &Vector) -> Result<(), ConformanceError> {
 /// material, finite expectations), then rebuilds the body of `v` (mesh files relative to `root`,
 /// and they must resolve inside it, symbolic links followed; `data/liver_547_v22.msh` falls back
 /// to the copy compiled into topomech), compares the initial state, then applies each step and
-/// compares every field of its [`Expect`] (floats to the vector's relative tolerance). After every
-/// step it also checks `validate()`, the conservation laws and the union-find model's counts.
+/// compares every field of its [`Expect`] (floats to the vector's relative tolerance). Before an
+/// `incise` step it checks the plane margin, as [`generate_in`] does. After every step it also
+/// checks `validate()`, the conservation laws and the union-find model's counts.
 ///
 /// Cost: O(T log T) + Σ steps (operation + O(darts + T)).
 ///
 /// # Errors
 /// The first problem: as [`Vector::check_fields`], [`ConformanceError::Mesh`],
 /// [`ConformanceError::OutsideRoot`],
-/// [`ConformanceError::BadOp`], [`ConformanceError::Mismatch`] (step, field, expected, got) or
-/// [`ConformanceError::Law`].
+/// [`ConformanceError::BadOp`], [`ConformanceError::AmbiguousPlane`] (an `incise` step whose plane
+/// passes within [`PLANE_MARGIN`] · diagonal of a live tet centroid: the vector does not decide
+/// that tet's side, so it is refused before the step is applied, as generation refuses it),
+/// [`ConformanceError::Mismatch`] (step, field, expected, got; a `refused` value is printed as
+/// its JSON, `"boundary_face"`, `"removed_tet"` or `null`) or [`ConformanceError::Law`].
 ///
 /// # Examples
 ///
@@ -260,8 +266,7 @@ pub fn replay_in(v: &Vector, root: &Path) -> Result<(), ConformanceError> {
     let got = r.observe(Outcome { refused: None, dissociated: Vec::new() });
     compare(v, None, &v.initial, &got)?;
     for (k, step) in v.steps.iter().enumerate() {
-        let outcome = r.apply(k, &step.op)?;
-        r.check_laws(Some(k))?;
+        let outcome = r.run(k, &step.op)?;
         let got = r.observe(outcome);
         compare(v, Some(k), &step.expect, &got)?;
     }
@@ -286,7 +291,12 @@ fn compare(v: &Vector, step: Option<usize>, want: &Expect, got: &Expect) -> Resu
             }
         };
     }
-    exact!(refused);
+    // `refused` in the vector's vocabulary: its JSON value, `"boundary_face"`, `"removed_tet"`,
+    // or `null` for an operation that is applied (the field absent).
+    if want.refused != got.refused {
+        let json = |r: &Option<Refusal>| serde_json::to_string(r).expect("a refusal serialises");
+        return Err(fail("refused", json(&want.refused), json(&got.refused)));
+    }
     exact!(dissociated);
     exact!(darts);
     exact!(cells);
@@ -409,14 +419,22 @@ impl Runner {
         self.body.map().cell_id(3, d).0
     }
 
-    /// Runs one step while generating: checks the plane margin, applies, checks the laws.
+    /// Runs one step while generating ([`Runner::run`]) and records the state after it.
     fn run_generating(&mut self, k: usize, op: &Op) -> Result<Step, ConformanceError> {
+        let outcome = self.run(k, op)?;
+        Ok(Step { op: op.clone(), expect: self.observe(outcome) })
+    }
+
+    /// Runs step `k`, the same way for generation and replay: an incision plane must keep the
+    /// margin from every live centroid ([`Runner::check_margin`], before anything is applied),
+    /// then the operation is applied and the laws are checked.
+    fn run(&mut self, k: usize, op: &Op) -> Result<Outcome, ConformanceError> {
         if let Op::Incise { point, normal } = op {
             self.check_margin(k, &Plane { point: *point, normal: *normal })?;
         }
         let outcome = self.apply(k, op)?;
         self.check_laws(Some(k))?;
-        Ok(Step { op: op.clone(), expect: self.observe(outcome) })
+        Ok(outcome)
     }
 
     fn apply(&mut self, step: usize, op: &Op) -> Result<Outcome, ConformanceError> {
@@ -523,16 +541,17 @@ impl Runner {
         Ok(Outcome { refused: None, dissociated: pairs })
     }
 
-    /// Generation only: every live tet centroid keeps [`PLANE_MARGIN`] · diagonal from the plane,
-    /// the diagonal of the bounding box of the points the input tets use (an unused point does
-    /// not widen it). Lengths are taken scale-safe (divided by the largest component first), so
-    /// every nonzero finite normal is accepted, as [`cut::incise_plane`] accepts it.
+    /// Generation and replay: every live tet centroid keeps [`PLANE_MARGIN`] · diagonal from the
+    /// plane, the diagonal of the bounding box of the points the input tets use (an unused point
+    /// does not widen it). Closer, the side of that tet would be decided by rounding (topomech's
+    /// tie rule puts a centroid on the plane on the negative side, another engine may not), so
+    /// the vector does not determine the outcome of the step. Lengths are taken scale-safe
+    /// (divided by the largest component first), so every nonzero finite normal is accepted, as
+    /// [`cut::incise_plane`] accepts it. O(T).
     fn check_margin(&self, step: usize, plane: &Plane) -> Result<(), ConformanceError> {
+        plane.check().map_err(|e| self.bad(step, e.to_string()))?;
         let n = plane.normal;
         let scale = n.iter().fold(0.0_f64, |m, c| m.max(c.abs()));
-        if !(scale > 0.0 && n.iter().all(|c| c.is_finite())) {
-            return Err(self.bad(step, format!("plane normal {n:?} is zero or not finite")));
-        }
         let unit = {
             let m = n.map(|c| c / scale);
             let len = norm(m);
@@ -546,23 +565,29 @@ impl Runner {
             }
         }
         let diagonal = if self.oracle.tets.is_empty() { 0.0 } else { norm([0, 1, 2].map(|k| hi[k] - lo[k])) };
-        let distance = (0..self.oracle.tets.len())
+        let margin = PLANE_MARGIN * diagonal;
+        // The closest live centroid (the smallest tet id among equals).
+        let closest = (0..self.oracle.tets.len())
             .filter(|&t| self.oracle.alive[t])
             .map(|t| {
                 let c = self.oracle.centroid(t);
-                ((0..3).map(|k| (c[k] - plane.point[k]) * unit[k]).sum::<f64>()).abs()
+                (t, ((0..3).map(|k| (c[k] - plane.point[k]) * unit[k]).sum::<f64>()).abs())
             })
-            .fold(f64::INFINITY, f64::min);
-        let margin = PLANE_MARGIN * diagonal;
-        if distance < margin {
-            return Err(ConformanceError::AmbiguousPlane {
+            .filter(|(_, d)| !d.is_nan()) // overflowing coordinates: no distance (as before)
+            .fold(None, |best: Option<(usize, f64)>, (t, d)| match best {
+                Some((_, b)) if b <= d => best,
+                _ => Some((t, d)),
+            });
+        match closest {
+            Some((tet, distance)) if distance < margin => Err(ConformanceError::AmbiguousPlane {
                 vector: self.name.clone(),
                 step: Some(step),
+                tet: tet as u32,
                 distance,
                 margin,
-            });
+            }),
+            _ => Ok(()),
         }
-        Ok(())
     }
 
     /// `validate()`, conservation, and the union-find model's counts.

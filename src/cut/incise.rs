@@ -23,12 +23,21 @@ use super::{dissociate_face, CutError, Dissociation};
 pub struct Plane {
     /// A point of the plane.
     pub point: Vec3,
-    /// Its normal; the positive side is where (x − point)·normal > 0.
+    /// Its normal; the positive side is where (x − point)·normal > 0 (a point on the plane is on
+    /// the negative side, [`Plane::positive`]).
     pub normal: Vec3,
 }
 
 impl Plane {
     /// Whether `x` is strictly on the positive side: (x − point) · normal > 0. O(1).
+    ///
+    /// The tie rule: a point whose dot product is 0 (on the plane, or so close that the product
+    /// rounds to 0) is *not* positive, i.e. it is on the negative side. [`incise_plane`] cuts a
+    /// glued face when exactly one of its two tets' centroids is positive, so a centroid on the
+    /// plane goes with the tets below it. (Conformance vectors never rely on this rule: their
+    /// planes keep every live centroid at least
+    /// [`PLANE_MARGIN`](crate::conformance::PLANE_MARGIN) × the bounding-box diagonal away, and
+    /// a vector that does not is refused as ambiguous; `docs/CONFORMANCE.md`.)
     ///
     /// The answer does not depend on the length of the normal nor on the scale of the
     /// coordinates (for finite ones): x − point and the normal are each scaled by a power of two
@@ -172,8 +181,10 @@ pub(crate) fn tet_centroids(body: &Body) -> Result<Vec<Option<Vec3>>, CutError> 
     Ok(centroid)
 }
 
-/// Dissociates every inner face whose two tets' centroids lie on opposite sides of `plane`
-/// (seed §3.2 face separation; a precise cut through tets needs refinement). The faces are found
+/// Dissociates every inner face whose two tets' centroids lie on opposite sides of `plane`, as
+/// [`Plane::positive`] decides them (a centroid on the plane is on the negative side, so such a
+/// face is cut when the other centroid is on the positive side) (seed §3.2 face separation; a
+/// precise cut through tets needs refinement). The faces are found
 /// first, then dissociated one by one, so the result does not depend on the order.
 ///
 /// Cost: O(darts) to classify, plus one [`dissociate_face`] per cut face.

@@ -37,9 +37,13 @@ use super::{dissociate_face, CutError, Dissociation};
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Stress {
-    /// The largest eigenvalue of σ_v (a force: the "inner force" compared with the threshold).
+    /// The largest eigenvalue of σ_v (a force: the "inner force" compared with the threshold),
+    /// to O(ε ‖σ_v‖); NaN when σ_v is not finite (a NaN or infinite position at v or a
+    /// neighbour), which no threshold passes.
     pub magnitude: f64,
-    /// Its unit eigenvector (zero when the magnitude is zero).
+    /// Its unit eigenvector, sign chosen so that its largest component is positive (zero when
+    /// σ_v is zero). With a repeated largest eigenvalue, a deterministic unit vector of its
+    /// eigenspace.
     pub direction: Vec3,
 }
 
@@ -147,31 +151,87 @@ pub fn principal_stress(body: &Body, sim: &Simulation) -> Result<Vec<Stress>, Si
     Ok(sigma.iter().map(largest_eigenpair).collect())
 }
 
-/// Largest eigenpair of a symmetric positive semi-definite 3×3 matrix by power iteration started
-/// from its largest column (64 iterations at most). O(1).
+/// Largest eigenpair of a symmetric 3×3 matrix (its upper triangle is read) by cyclic Jacobi
+/// rotations to convergence. O(1): a few sweeps of three rotations, at most [`JACOBI_SWEEPS`].
+///
+/// The power iteration used before (finding 172) started from the largest column and never left
+/// it when that column was an eigenvector of a smaller eigenvalue (exact zeros, as on Kuhn cubes).
+/// Jacobi has no start vector: the diagonal it converges to holds every eigenvalue, to
+/// O(ε ‖m‖), and the rotations' product the eigenvectors, orthonormal to O(ε). A diagonal
+/// matrix is returned exactly (no rotation). The largest diagonal entry wins, the lowest index
+/// on exact ties (repeated eigenvalues: any unit vector of the eigenspace is right, this one is
+/// deterministic); its vector is normalised and signed so that its largest component (lowest
+/// index on ties) is positive. No randomness, no 0/0: m = 0 gives magnitude 0 and the zero
+/// direction ([`Stress::direction`]); a NaN or infinite entry gives NaN (never above a
+/// threshold).
 fn largest_eigenpair(m: &[[f64; 3]; 3]) -> Stress {
-    let mut v =
-        (0..3).map(|j| [m[0][j], m[1][j], m[2][j]]).fold([0.0; 3], |a, c| if dot(c, c) > dot(a, a) { c } else { a });
-    if dot(v, v) == 0.0 {
+    let mut a = [[m[0][0], m[0][1], m[0][2]], [m[0][1], m[1][1], m[1][2]], [m[0][2], m[1][2], m[2][2]]];
+    if a.iter().flatten().any(|e| !e.is_finite()) {
+        return Stress { magnitude: f64::NAN, direction: [f64::NAN; 3] };
+    }
+    if a.iter().flatten().all(|&e| e == 0.0) {
         return Stress { magnitude: 0.0, direction: [0.0; 3] };
     }
-    let mut lambda = 0.0;
-    for _ in 0..64 {
-        let w = mul(m, v);
-        let n = dot(w, w).sqrt();
-        if n == 0.0 {
-            break;
+    let mut v = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]; // columns: eigenvectors
+    for _ in 0..JACOBI_SWEEPS {
+        let mut rotated = false;
+        for (p, q) in [(0, 1), (0, 2), (1, 2)] {
+            let apq = a[p][q];
+            if apq == 0.0 {
+                continue;
+            }
+            // Negligible against both diagonal entries: dropping it moves the eigenvalues by
+            // less than 1e-2 ulp of them (Numerical Recipes' `jacobi` test).
+            let g = 100.0 * apq.abs();
+            if a[p][p].abs() + g == a[p][p].abs() && a[q][q].abs() + g == a[q][q].abs() {
+                a[p][q] = 0.0;
+                a[q][p] = 0.0;
+                continue;
+            }
+            rotated = true;
+            // The rotation that zeroes a[p][q] (Golub & Van Loan, sym.schur2), the smaller angle:
+            // t = tan φ = sign(θ) / (|θ| + √(θ² + 1)), θ = (a_qq − a_pp) / (2 a_pq). θ may be
+            // infinite (a tiny a_pq): t = 0, no change; θ² overflowing gives t = 0 too.
+            let theta = (a[q][q] - a[p][p]) / (2.0 * apq);
+            let t = if theta.abs() > 1e150 {
+                0.5 / theta
+            } else {
+                theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt())
+            };
+            let c = 1.0 / (t * t + 1.0).sqrt();
+            let s = t * c;
+            a[p][p] -= t * apq;
+            a[q][q] += t * apq;
+            a[p][q] = 0.0;
+            a[q][p] = 0.0;
+            let r = 3 - p - q;
+            let (arp, arq) = (a[r][p], a[r][q]);
+            a[r][p] = c * arp - s * arq;
+            a[p][r] = a[r][p];
+            a[r][q] = s * arp + c * arq;
+            a[q][r] = a[r][q];
+            for row in &mut v {
+                let (vp, vq) = (row[p], row[q]);
+                row[p] = c * vp - s * vq;
+                row[q] = s * vp + c * vq;
+            }
         }
-        v = [w[0] / n, w[1] / n, w[2] / n];
-        let next = dot(v, mul(m, v));
-        let done = (next - lambda).abs() <= 1e-14 * next.abs();
-        lambda = next;
-        if done {
+        if !rotated {
             break;
         }
     }
-    Stress { magnitude: lambda, direction: v }
+    let k = (1..3).fold(0, |k, i| if a[i][i] > a[k][k] { i } else { k });
+    let mut x = [v[0][k], v[1][k], v[2][k]];
+    let big = (1..3).fold(0, |b, i| if x[i].abs() > x[b].abs() { i } else { b });
+    // |x| = 1 to O(ε) (a product of rotations): the division is safe.
+    let n = dot(x, x).sqrt().copysign(x[big]);
+    x = [x[0] / n, x[1] / n, x[2] / n];
+    Stress { magnitude: a[k][k], direction: x }
 }
+
+/// Sweeps of [`largest_eigenpair`] at most. Jacobi converges quadratically: 3×3 matrices need
+/// 3 to 6 sweeps to reach zero (or negligible) off-diagonal entries.
+const JACOBI_SWEEPS: usize = 32;
 
 /// One dart per face of the fan around the vertex of `d0`, starting with `d0`'s face, in walk
 /// order (module docs). Faces met twice are listed once. Every walk is bounded by the dart count.
@@ -456,15 +516,12 @@ pub fn tear_step(
     Ok(out)
 }
 
-fn mul(m: &[[f64; 3]; 3], v: Vec3) -> Vec3 {
-    [dot(m[0], v), dot(m[1], v), dot(m[2], v)]
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::cut::ops::jittered_cube;
     use crate::mechanics::Material;
+    use proptest::prelude::*;
 
     /// The start face is the one the full scan (every inner dart of the vertex scored, highest
     /// score then smallest dart) picks, also with exact ties (the unjittered cube) and after cuts.
@@ -517,5 +574,142 @@ mod tests {
             let corners = triangle_vertices(map, tear.fan[0]).unwrap().map(|v| position[v]);
             assert!(corners.iter().all(|p| p[axis] == 1.0), "axis {axis}: first fan face {corners:?}");
         }
+    }
+    fn mat_vec(m: &[[f64; 3]; 3], v: Vec3) -> Vec3 {
+        [dot(m[0], v), dot(m[1], v), dot(m[2], v)]
+    }
+
+    /// σ = Σ T n nᵀ over (T, d) with n = d / |d|, formed as `principal_stress` forms it.
+    fn sigma_of(springs: &[(f64, Vec3)]) -> [[f64; 3]; 3] {
+        let mut m = [[0.0; 3]; 3];
+        for &(t, d) in springs {
+            let l2 = dot(d, d);
+            for (i, row) in m.iter_mut().enumerate() {
+                for (j, e) in row.iter_mut().enumerate() {
+                    *e += t * d[i] * d[j] / l2;
+                }
+            }
+        }
+        m
+    }
+
+    /// The independent check of finding 172: |v| = 1, ‖σv − λv‖ ≤ 1e-12 ‖σ‖ (λ is an eigenvalue,
+    /// v its vector) and λ ≥ xᵀσx / xᵀx − 1e-12 ‖σ‖ for every x given (λ is the largest), and
+    /// the same bits on a second call.
+    fn check_largest(m: &[[f64; 3]; 3], probes: &[Vec3]) -> Stress {
+        let s = largest_eigenpair(m);
+        assert_eq!(format!("{s:?}"), format!("{:?}", largest_eigenpair(m)), "deterministic");
+        let norm = m.iter().flatten().map(|e| e * e).sum::<f64>().sqrt();
+        let (l, v) = (s.magnitude, s.direction);
+        assert!((dot(v, v).sqrt() - 1.0).abs() <= 1e-14, "{m:?}: |v| = {}", dot(v, v).sqrt());
+        let r = sub(mat_vec(m, v), [l * v[0], l * v[1], l * v[2]]);
+        assert!(dot(r, r).sqrt() <= 1e-12 * norm, "{m:?}: residual {:e}, λ {l}, v {v:?}", dot(r, r).sqrt());
+        let mut all = vec![[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        all.extend((0..3).map(|j| [m[0][j], m[1][j], m[2][j]]));
+        all.extend_from_slice(probes);
+        for x in all.into_iter().filter(|x| dot(*x, *x) > 0.0) {
+            let q = dot(x, mat_vec(m, x)) / dot(x, x);
+            assert!(l >= q - 1e-12 * norm, "{m:?}: λ {l} < Rayleigh quotient {q} along {x:?}");
+        }
+        s
+    }
+
+    /// Directions with exact zeros, as on Kuhn cubes and boxes: axes, face and body diagonals.
+    fn lattice() -> impl Strategy<Value = Vec3> {
+        (0usize..13, any::<bool>()).prop_map(|(i, flip)| {
+            let d = [
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.0, 0.0, 1.0],
+                [1.0, 1.0, 0.0],
+                [1.0, -1.0, 0.0],
+                [1.0, 0.0, 1.0],
+                [1.0, 0.0, -1.0],
+                [0.0, 1.0, 1.0],
+                [0.0, 1.0, -1.0],
+                [1.0, 1.0, 1.0],
+                [1.0, -1.0, 1.0],
+                [1.0, 1.0, -1.0],
+                [-1.0, 1.0, 1.0],
+            ][i];
+            if flip {
+                d.map(|c| -c)
+            } else {
+                d
+            }
+        })
+    }
+
+    fn direction() -> impl Strategy<Value = Vec3> {
+        prop_oneof![
+            lattice(),
+            [-1.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0].prop_filter("non-zero", |d| dot(*d, *d) > 1e-6),
+        ]
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(2000))]
+        /// Finding 172: for σ = Σ T n nᵀ (1 to 6 springs, tensions over 12 orders of magnitude,
+        /// lattice or random directions) the pair is the largest eigenvalue and a unit vector of
+        /// it. The power iteration failed this on lattice directions (it returned the second
+        /// eigenpair whenever the largest column was an eigenvector of a smaller eigenvalue).
+        #[test]
+        fn largest_eigenpair_is_the_largest_for_every_spring_stress(
+            springs in proptest::collection::vec((1e-6f64..1e6, direction()), 1..7),
+            probes in proptest::collection::vec(direction(), 0..4),
+        ) {
+            let m = sigma_of(&springs);
+            let mut probes = probes;
+            probes.extend(springs.iter().map(|&(_, d)| d));
+            let s = check_largest(&m, &probes);
+            let trace = m[0][0] + m[1][1] + m[2][2];
+            prop_assert!(s.magnitude > 0.0 && s.magnitude <= trace * (1.0 + 1e-12));
+        }
+    }
+
+    /// Exact structured cases: a diagonal matrix gives its largest entry and that axis exactly,
+    /// wherever it is; repeated eigenvalues give the lowest axis (diagonal) or a unit vector of
+    /// the eigenspace; rank 1 gives its direction; zero gives the documented zero pair; a NaN
+    /// entry gives NaN, never a number that could pass a threshold.
+    #[test]
+    fn largest_eigenpair_exact_structured_cases() {
+        for k in 0..3 {
+            for (big, small) in [(3.0, [1.0, 2.0]), (1e-300, [0.0, 5e-301]), (7.5, [7.0, 0.0])] {
+                let mut m = [[0.0; 3]; 3];
+                let mut e = [0.0; 3];
+                e[k] = 1.0;
+                m[k][k] = big;
+                m[(k + 1) % 3][(k + 1) % 3] = small[0];
+                m[(k + 2) % 3][(k + 2) % 3] = small[1];
+                assert_eq!(largest_eigenpair(&m), Stress { magnitude: big, direction: e }, "{m:?}");
+            }
+        }
+        let diag = |a: f64, b: f64, c: f64| [[a, 0.0, 0.0], [0.0, b, 0.0], [0.0, 0.0, c]];
+        assert_eq!(largest_eigenpair(&diag(2.0, 2.0, 1.0)).direction, [1.0, 0.0, 0.0]);
+        assert_eq!(largest_eigenpair(&diag(1.0, 2.0, 2.0)).direction, [0.0, 1.0, 0.0]);
+        assert_eq!(largest_eigenpair(&diag(4.0, 4.0, 4.0)), Stress { magnitude: 4.0, direction: [1.0, 0.0, 0.0] });
+        assert_eq!(largest_eigenpair(&[[0.0; 3]; 3]), Stress { magnitude: 0.0, direction: [0.0; 3] });
+        let nan = largest_eigenpair(&diag(1.0, f64::NAN, 0.0));
+        assert!(nan.magnitude.is_nan() && nan.direction.iter().all(|c| c.is_nan()));
+        assert!(largest_eigenpair(&diag(1.0, f64::INFINITY, 0.0)).magnitude.is_nan());
+
+        let r = std::f64::consts::FRAC_1_SQRT_2;
+        // The finding's σ: 5/3 along (1, 1, 0)/√2 and 1.5 along z (largest column (0, 0, 1.5)).
+        let s = check_largest(&sigma_of(&[(5.0 / 3.0, [1.0, 1.0, 0.0]), (1.5, [0.0, 0.0, 1.0])]), &[]);
+        assert!((s.magnitude - 5.0 / 3.0).abs() <= 1e-15 && (dot(s.direction, [r, r, 0.0]).abs() - 1.0).abs() <= 1e-15);
+        // Rank 1 along a body diagonal and along a face diagonal.
+        for d in [[1.0, 1.0, 1.0], [0.0, 1.0, -1.0]] {
+            let s = check_largest(&sigma_of(&[(2.0, d)]), &[]);
+            let n = dot(d, d).sqrt();
+            assert!((s.magnitude - 2.0).abs() <= 1e-15 && (dot(s.direction, d).abs() / n - 1.0).abs() <= 1e-15);
+        }
+        // A double largest eigenvalue with a non-axis eigenspace: 3 on span{(1,1,0), (1,−1,2)}, 1
+        // on their normal (−1, 1, 1): the vector is in the span (orthogonal to the normal).
+        let m = sigma_of(&[(3.0, [1.0, 1.0, 0.0]), (3.0, [1.0, -1.0, 2.0]), (1.0, [-1.0, 1.0, 1.0])]);
+        let s = check_largest(&m, &[[1.0, 1.0, 0.0], [1.0, -1.0, 2.0]]);
+        assert!((s.magnitude - 3.0).abs() <= 1e-14 && dot(s.direction, [-1.0, 1.0, 1.0]).abs() <= 1e-14);
+        // Off-diagonal entries far below the diagonal's (1e-200 against 1): no underflow, no NaN.
+        let tiny = [[1.0, 1e-200, 0.0], [1e-200, 1.0, 1e-200], [0.0, 1e-200, 0.5]];
+        assert_eq!(check_largest(&tiny, &[]).magnitude, 1.0);
     }
 }

@@ -45,7 +45,7 @@
 
 use rayon::prelude::*;
 
-use super::geom::{dot, norm, sub, Vec3};
+use super::geom::{dot, Vec3};
 use super::simd::{multiversion, Kernel};
 use crate::wide::Wide;
 
@@ -55,7 +55,10 @@ pub const PARALLEL_CHUNK: usize = 4096;
 /// The mass/spring system as flat arrays: what the step loop reads.
 ///
 /// Vertices are *slots* `0..slots()`: positions and velocities are passed in as slices of that
-/// length. A slot with `inv_mass == 0` does not move (pinned, dead or massless). Equality compares
+/// length. A slot with `inv_mass == 0` (fixed: pinned, dead or massless) has no acceleration: it
+/// keeps its velocity, so it stays put at velocity 0 and moves at constant velocity otherwise (a
+/// driven pin, in every scheme of [`crate::mechanics::Stepper`]); its kinetic energy counts
+/// nowhere ([`SpringSystem::kinetic_energy`], the runaway test). Equality compares
 /// the arrays and, per slot, the incident lists in order (not where they sit in memory).
 ///
 /// # Examples
@@ -1153,7 +1156,8 @@ impl SpringSystem {
         (0..self.springs())
             .map(|s| {
                 let [a, b] = self.ends[s];
-                let stretch = norm(sub(x[b as usize], x[a as usize])) - self.rest[s];
+                // l as rest lengths are measured: a needle's l² would be subnormal or 0.
+                let stretch = super::geom::rest_length(x[a as usize], x[b as usize]) - self.rest[s];
                 0.5 * self.stiffness[s] * stretch * stretch
             })
             .fold(0.0, |sum, e| sum + e) // +0 with no spring (`sum` starts at −0)
@@ -1453,16 +1457,39 @@ fn spring_pass_body(springs: Springs<'_>, x: &[Vec3], v: &[Vec3], out: &mut [Vec
         }
         let (rest, k, damp) =
             (&springs.rest[first..first + n], &springs.stiffness[first..first + n], &springs.damping[first..first + n]);
-        let (dx, dy, dz) = (&d[0][..n], &d[1][..n], &d[2][..n]);
         let (dvx, dvy, dvz) = (&dv[0][..n], &dv[1][..n], &dv[2][..n]);
         let s = &mut s[..n];
-        for j in 0..n {
-            s[j] = spring_scale(dx[j], dy[j], dz[j], dvx[j], dvy[j], dvz[j], rest[j], k[j], damp[j]);
+        let mut rare = 0u64;
+        {
+            let (dx, dy, dz) = (&d[0][..n], &d[1][..n], &d[2][..n]);
+            for j in 0..n {
+                let (q, l2) = spring_scale(dx[j], dy[j], dz[j], dvx[j], dvy[j], dvz[j], rest[j], k[j], damp[j]);
+                s[j] = q;
+                rare |= outside_plain(l2);
+            }
         }
+        if rare != 0 {
+            redo_rare(&mut d, &dv, rest, k, damp, s);
+        }
+        let (dx, dy, dz) = (&d[0][..n], &d[1][..n], &d[2][..n]);
         for (j, f) in out[first..first + n].iter_mut().enumerate() {
             *f = [s[j] * dx[j], s[j] * dy[j], s[j] * dz[j]];
         }
         first += n;
+    }
+}
+
+/// The cold pass of a block of [`spring_pass`] with a rare lane: as [`redo_rare4`] on
+/// per-coordinate arrays.
+#[cold]
+#[inline(never)]
+fn redo_rare(d: &mut [[f64; BLOCK]; 3], dv: &[[f64; BLOCK]; 3], rest: &[f64], k: &[f64], damp: &[f64], s: &mut [f64]) {
+    for j in 0..s.len() {
+        let mut e = [d[0][j], d[1][j], d[2][j]];
+        if !PLAIN_L2.contains(&(e[0] * e[0] + e[1] * e[1] + e[2] * e[2])) {
+            s[j] = spring_scale_rare(&mut e, [dv[0][j], dv[1][j], dv[2][j]], rest[j], k[j], damp[j], s[j]);
+            (d[0][j], d[1][j], d[2][j]) = (e[0], e[1], e[2]);
+        }
     }
 }
 
@@ -1572,15 +1599,35 @@ fn spring_blocks4(springs: Springs<'_>, y: &[SlotState], sink: &mut impl BlockSi
         let (rest, k, damp) =
             (&springs.rest[first..first + n], &springs.stiffness[first..first + n], &springs.damping[first..first + n]);
         let s = &mut s[..n];
+        let mut rare = 0u64;
         for j in 0..n {
             let (e, w) = (dd[j], ddv[j]);
             // The pads are +0, so l2 + (pad² + pad²) = l2 exactly; reading them keeps the
             // interleaved loads gap-free, which spares the vectoriser a scalar epilogue.
             let pads = e[3] * e[3] + w[3] * w[3];
-            s[j] = spring_scale_padded(e[0], e[1], e[2], w[0], w[1], w[2], pads, rest[j], k[j], damp[j]);
+            let (q, l2) = spring_scale_padded(e[0], e[1], e[2], w[0], w[1], w[2], pads, rest[j], k[j], damp[j]);
+            s[j] = q;
+            rare |= outside_plain(l2);
+        }
+        if rare != 0 {
+            redo_rare4(dd, ddv, rest, k, damp, s);
         }
         sink.emit(first, ends, &d[..n], s);
         first += n;
+    }
+}
+
+/// The cold pass of a block of [`spring_blocks4`] with a rare lane: redoes each spring whose l²
+/// is outside [`PLAIN_L2`] with [`spring_scale_rare`] (its d rescaled in place).
+#[cold]
+#[inline(never)]
+fn redo_rare4(d: &mut [Rec4], dv: &[Rec4], rest: &[f64], k: &[f64], damp: &[f64], s: &mut [f64]) {
+    for j in 0..s.len() {
+        let (e, w) = (&mut d[j], dv[j]);
+        let l2 = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) + (e[3] * e[3] + w[3] * w[3]);
+        if !PLAIN_L2.contains(&l2) {
+            s[j] = spring_scale_rare(&mut e[..3], [w[0], w[1], w[2]], rest[j], k[j], damp[j], s[j]);
+        }
     }
 }
 
@@ -1602,10 +1649,10 @@ fn scatter_pass4_body(springs: Springs<'_>, y: &[SlotState], first_slot: usize, 
 fn spring_force4(springs: &Springs<'_>, s: usize, y: &[SlotState]) -> Vec3 {
     let [a, b] = springs.ends[s];
     let (ya, yb) = (&y[a as usize], &y[b as usize]);
-    let d: Rec4 = std::array::from_fn(|c| yb.x[c] - ya.x[c]);
+    let mut d: Rec4 = std::array::from_fn(|c| yb.x[c] - ya.x[c]);
     let w: Rec4 = std::array::from_fn(|c| yb.v[c] - ya.v[c]);
     let pads = d[3] * d[3] + w[3] * w[3];
-    let q = spring_scale_padded(
+    let (mut q, l2) = spring_scale_padded(
         d[0],
         d[1],
         d[2],
@@ -1617,6 +1664,9 @@ fn spring_force4(springs: &Springs<'_>, s: usize, y: &[SlotState]) -> Vec3 {
         springs.stiffness[s],
         springs.damping[s],
     );
+    if !PLAIN_L2.contains(&l2) {
+        q = spring_scale_rare(&mut d, [w[0], w[1], w[2]], springs.rest[s], springs.stiffness[s], springs.damping[s], q);
+    }
     [q * d[0], q * d[1], q * d[2]]
 }
 
@@ -1760,23 +1810,36 @@ fn acceleration_pass_body(sys: &SpringSystem, first: usize, v: &[Vec3], sf: &[Ve
 /// ```
 #[inline(always)]
 pub fn spring_force(xa: Vec3, xb: Vec3, va: Vec3, vb: Vec3, rest: f64, k: f64, c: f64) -> Vec3 {
-    let d = [xb[0] - xa[0], xb[1] - xa[1], xb[2] - xa[2]];
+    let mut d = [xb[0] - xa[0], xb[1] - xa[1], xb[2] - xa[2]];
     let dv = [vb[0] - va[0], vb[1] - va[1], vb[2] - va[2]];
-    let s = spring_scale(d[0], d[1], d[2], dv[0], dv[1], dv[2], rest, k, c);
+    let s = spring_scale_full(&mut d, dv, rest, k, c);
     [s * d[0], s * d[1], s * d[2]]
 }
 
 /// The scalar s with F_s = s·d: s = [k (l − L) l + c (dv·d)] / l², one sqrt and one division;
 /// zero when l = 0. This is [`spring_scale_padded`] with pads −0: x + (−0) = x for every x, so
-/// the compiler drops the addition (the same machine code as a copy without it).
+/// the compiler drops the addition (the same machine code as a copy without it). Also returns l²:
+/// outside [`PLAIN_L2`], s must be redone by [`spring_scale_rare`].
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn spring_scale(dx: f64, dy: f64, dz: f64, dvx: f64, dvy: f64, dvz: f64, rest: f64, k: f64, c: f64) -> f64 {
+fn spring_scale(dx: f64, dy: f64, dz: f64, dvx: f64, dvy: f64, dvz: f64, rest: f64, k: f64, c: f64) -> (f64, f64) {
     spring_scale_padded(dx, dy, dz, dvx, dvy, dvz, -0.0, rest, k, c)
 }
 
-/// [`spring_scale`] with `pads` (±0) added to l²: the same bits. Division by max(l², tiny) keeps
-/// the loop branch-free; the select zeroes l = 0.
+/// The squared spring lengths the branch-free scale takes as they are: 2⁻⁴⁹⁸ ≤ l² ≤ 2⁵⁰⁰. Inside,
+/// the largest component of d is at most 2²⁵⁰ and, since l² ≤ 3 max dₖ², at least 2⁻²⁵⁰ (well,
+/// past (2⁻⁴⁹⁸ / 3)^½ > 2⁻²⁵⁰), so d is a plain difference of [`crate::mesh::PLAIN_EXTENT`]
+/// (the one [`super::geom::rest_length`] measures with √(Σ dₖ²)): l² neither under- nor
+/// overflows, and l has the bits of the rest length of the same shape. Every spring of an
+/// ordinary mesh; the rest (needles shorter than 2⁻²⁴⁹, lengths past 2²⁵⁰, l = 0, non-finite
+/// states) go to [`spring_scale_rare`].
+const PLAIN_L2: std::ops::RangeInclusive<f64> = 1.221974545399842e-150..=3.273390607896142e150; // 2⁻⁴⁹⁸ ..= 2⁵⁰⁰
+
+/// [`spring_scale`] with `pads` (±0) added to l²: the same bits. Branch-free, and l² with it: the
+/// callers flag the blocks with an l² outside [`PLAIN_L2`] ([`outside_plain`]) and redo the springs whose l² is outside [`PLAIN_L2`] with [`spring_scale_rare`],
+/// which is where the plain quotient is wrong (a subnormal l², finding 168) or undefined (l² = 0,
+/// coincident ends: 0/0; l² = ∞). Inside, the quotient has the bits it had with the former guard
+/// max(l², MIN_POSITIVE) and select, which only ever mattered outside.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn spring_scale_padded(
@@ -1790,15 +1853,58 @@ fn spring_scale_padded(
     rest: f64,
     k: f64,
     c: f64,
-) -> f64 {
+) -> (f64, f64) {
     let l2 = (dx * dx + dy * dy + dz * dz) + pads;
     let l = l2.sqrt();
     let num = k * (l - rest) * l + c * (dvx * dx + dvy * dy + dvz * dz);
-    let q = num / l2.max(f64::MIN_POSITIVE);
-    if l2 > 0.0 {
-        q
+    (num / l2, l2)
+}
+
+/// 1 when l² is below or above [`PLAIN_L2`], else 0: an integer the block loops OR together
+/// (two vector compares and an OR per lane group; a float min/max reduction would not
+/// vectorise). A NaN l², from a NaN state, gives 0: its force is NaN either way. O(1).
+#[inline(always)]
+fn outside_plain(l2: f64) -> u64 {
+    ((l2 < *PLAIN_L2.start()) | (l2 > *PLAIN_L2.end())) as u64
+}
+
+/// The cold path of a spring whose l² is outside [`PLAIN_L2`] (see [`spring_scale_padded`],
+/// whose result `q` it is given): returns s' and rescales `d` in place to d' = 2^p d so that
+/// F_s = s'·d' is k (l − L) n + c (dv·n) n, n = d / l, for any finite d ≠ 0 whose force is
+/// representable. The largest |d'ₖ| is in [1, 2) (a power-of-two scaling, exact but for
+/// components 2⁻¹⁰²² below the largest), l is measured as [`super::geom::rest_length`] measures
+/// a rest length (so a spring in its rest shape feels exactly k·0), and
+/// s' = [k (l − L) l' + c (dv·d')] / l'² with l' = 2^p l in [1, 2√3]: no intermediate over- or
+/// underflows unless the force does. Returns 0 when d is 0 (coincident ends: no force), and keeps
+/// `q` (and d) when d is not finite (NaN, as before) or of plain extent after all (the
+/// branch-free bits). O(1).
+#[cold]
+#[inline(never)]
+fn spring_scale_rare(d: &mut [f64], dv: [f64; 3], rest: f64, k: f64, c: f64, q: f64) -> f64 {
+    let largest = d[..3].iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    if largest == 0.0 {
+        return 0.0;
+    }
+    if !largest.is_finite() || crate::mesh::PLAIN_EXTENT.contains(&largest) {
+        return q;
+    }
+    let l = crate::mesh::distance([d[0], d[1], d[2]], [0.0; 3]);
+    let p = -crate::mesh::binary_exponent(largest);
+    for x in &mut d[..3] {
+        *x = crate::mesh::times_pow2(*x, p);
+    }
+    let l1 = crate::mesh::times_pow2(l, p);
+    (k * (l - rest) * l1 + c * (dv[0] * d[0] + dv[1] * d[1] + dv[2] * d[2])) / (l1 * l1)
+}
+
+/// [`spring_scale`] with its cold path: s and d (rescaled when rare) with F_s = s·d. O(1).
+#[inline(always)]
+fn spring_scale_full(d: &mut [f64; 3], dv: [f64; 3], rest: f64, k: f64, c: f64) -> f64 {
+    let (q, l2) = spring_scale(d[0], d[1], d[2], dv[0], dv[1], dv[2], rest, k, c);
+    if !PLAIN_L2.contains(&l2) {
+        spring_scale_rare(d, dv, rest, k, c, q)
     } else {
-        0.0
+        q
     }
 }
 

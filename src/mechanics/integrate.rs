@@ -16,7 +16,12 @@
 //! [`StepConfig::runaway_factor`] times the energy scale of the start (kinetic plus elastic energy
 //! plus M |g| D, with D the diagonal of the bounding box; when that is 0 — at rest in the rest
 //! shape without gravity — Σ ½ k L² over the springs, the material's own energy scale), is
-//! returned as [`StepError::BlowUp`] naming the step and the slot. A start state whose energy
+//! returned as [`StepError::BlowUp`] naming the step and the slot. The kinetic energy is that of
+//! the free slots, as everywhere in this crate: a fixed slot (inverse mass 0) has no
+//! acceleration but keeps its velocity, so a fixed slot given a velocity moves at that constant
+//! velocity in all four schemes (x₁ = x₀ + h ẋ₀: a kinematically driven pin, a grasped vertex),
+//! and being prescribed it is neither part of the runaway test nor named by it (finding 169).
+//! A non-finite coordinate of any slot is a blow-up. A start state whose energy
 //! scale is not finite is refused. State written between steps is new energy put in by hand:
 //! [`Stepper::reset_energy_scale`] takes it as the new start ([`crate::mechanics::Simulation`]
 //! does so itself when positions or velocities were handed out for writing).
@@ -335,6 +340,9 @@ impl StepConfig {
 
 /// The integrator's scratch buffers and step counter; reused every step (no allocation).
 ///
+/// A fixed slot with a velocity is a driven pin: it moves at that constant velocity, and its
+/// kinetic energy is not part of the runaway test (module docs).
+///
 /// # Examples
 ///
 /// ```
@@ -348,6 +356,14 @@ impl StepConfig {
 /// (0..10).for_each(|_| stepper.step(&sys, &mut x, &mut v).unwrap());
 /// assert_eq!(stepper.steps_done(), 10);
 /// assert!((v[0][2] + 10.0).abs() < 1e-12); // free fall for 1 s: v = g t
+///
+/// // A driven pin: fixed slot 1 moves at 1 km/s (½ m v² = 5e5, far above the limit 1e3 × 20);
+/// // the runaway test counts the free slot only.
+/// sys.push_slot(1.0, true, 0.0).unwrap();
+/// let (mut x, mut v) = (vec![[0.0; 3], [1.0, 0.0, 0.0]], vec![[0.0; 3], [1000.0, 0.0, 0.0]]);
+/// let mut stepper = Stepper::new(StepConfig::new(Integrator::Symplectic, 0.01), &sys, &x, &v).unwrap();
+/// stepper.step(&sys, &mut x, &mut v).unwrap();
+/// assert_eq!((x[1][0], v[1][0]), (11.0, 1000.0));
 /// ```
 #[derive(Clone, Debug)]
 pub struct Stepper {
@@ -691,7 +707,8 @@ impl Stepper {
         if self.config.integrator != Integrator::Rk4 {
             let par = self.config.parallel;
             chunked(par, x.len(), &mut self.partials, |first, n| {
-                probe_state(&sys.mass[first..first + n], &x[first..first + n], &v[first..first + n])
+                let r = first..first + n;
+                probe_state(&sys.mass[r.clone()], &sys.inv_mass[r.clone()], &x[r.clone()], &v[r])
             });
         }
         self.check_state(sys, x, v)?;
@@ -765,10 +782,11 @@ impl Stepper {
         }
         let limit = self.config.runaway_factor * self.energy_scale;
         if self.energy_scale > 0.0 && kinetic > limit {
+            // The culprit is the free slot of largest ½ m |v|², as the probe counts free slots only.
             let (mut worst, mut worst_slot) = (-1.0, 0);
-            for (i, (&m, vi)) in sys.mass.iter().zip(v).enumerate() {
+            for (i, ((&m, &w), vi)) in sys.mass.iter().zip(&sys.inv_mass).zip(v).enumerate() {
                 let e = 0.5 * m * dot(*vi, *vi);
-                if e > worst {
+                if w > 0.0 && e > worst {
                     (worst, worst_slot) = (e, i);
                 }
             }
@@ -778,8 +796,11 @@ impl Stepper {
     }
 }
 
-/// Blow-up probes of a chunk of slots: its kinetic energy Σ ½ m |v|², and Σ 0·c over every
-/// coordinate c of x and v, which is NaN exactly when some c is NaN or infinite.
+/// Blow-up probes of a chunk of slots: its kinetic energy Σ ½ m |v|² over the **free** slots
+/// (inverse mass > 0, as [`SpringSystem::kinetic_energy`] and the energy scale count it: a fixed
+/// slot with a velocity is a driven pin, its motion prescribed, and cannot run away), and
+/// Σ 0·c over every coordinate c of x and v of every slot, which is NaN exactly when some c is
+/// NaN or infinite.
 #[derive(Clone, Copy, Debug, Default)]
 struct Probe {
     kinetic: f64,
@@ -788,17 +809,20 @@ struct Probe {
 
 impl Probe {
     #[inline(always)]
-    fn add(&mut self, m: f64, x: Vec3, v: Vec3) {
+    fn add(&mut self, m: f64, inv_mass: f64, x: Vec3, v: Vec3) {
+        // A select, not a branch: m of a free slot, +0 of a fixed one (adding 0.5 · 0 · |v|² = +0
+        // leaves the sum's bits, so the sum is the free slots' one).
+        let m = if inv_mass > 0.0 { m } else { 0.0 };
         self.kinetic += 0.5 * m * dot(v, v);
         self.probe += (x[0] * 0.0 + x[1] * 0.0 + x[2] * 0.0) + (v[0] * 0.0 + v[1] * 0.0 + v[2] * 0.0);
     }
 }
 
-/// Probes of slots with masses `m`, positions `x`, velocities `v`.
-fn probe_state(m: &[f64], x: &[Vec3], v: &[Vec3]) -> Probe {
+/// Probes of slots with masses `m`, inverse masses `w`, positions `x`, velocities `v`.
+fn probe_state(m: &[f64], w: &[f64], x: &[Vec3], v: &[Vec3]) -> Probe {
     let mut p = Probe::default();
-    for ((&m, &x), &v) in m.iter().zip(x).zip(v) {
-        p.add(m, x, v);
+    for (((&m, &w), &x), &v) in m.iter().zip(w).zip(x).zip(v) {
+        p.add(m, w, x, v);
     }
     p
 }
@@ -928,7 +952,7 @@ fn stage_slots(
                 // store-to-load forwarding failed (a stall per slot).
                 let (xk, vk) = (madd(x[k], c, add(ax[k], vi)), madd(v[k], c, add(av[k], a)));
                 (x[k], v[k]) = (xk, vk);
-                probe.add(sys.mass[first + k], xk, vk);
+                probe.add(sys.mass[first + k], sys.inv_mass[first + k], xk, vk);
             }
         }
     }
@@ -1104,7 +1128,9 @@ fn linearise(sys: &SpringSystem, x: &[Vec3], dir: &mut [Vec3], coef: &mut [[f64;
     for s in 0..sys.springs() {
         let [a, b] = sys.ends[s];
         let d = sub(x[b as usize], x[a as usize]);
-        let l = norm(d);
+        // Measured as rest lengths are (plain √(Σ dₖ²) at ordinary extents, scale-safe beyond),
+        // so a needle's direction is a unit vector and a spring at rest has rest / l = 1.
+        let l = super::geom::rest_length(x[a as usize], x[b as usize]);
         let (k, rest) = (sys.stiffness[s], sys.rest[s]);
         if l > 0.0 {
             dir[s] = [d[0] / l, d[1] / l, d[2] / l];

@@ -29,10 +29,28 @@
 //! every pattern the adaptive refinement produces — faces refined several times, any number of
 //! inserted vertices on a side — because it relies only on convexity.
 //!
+//! # Cut faces: the closure expresses the map's topology or refuses
+//! The output is a tet list keyed by vertex ids, and [`crate::GMap::from_tets`] glues two tets
+//! exactly where they share three vertex ids; it labels vertices and edges as the fans of that
+//! face gluing. So the list means the finest map (subdivided) exactly when its face gluing is the
+//! map's: every output triangle (sorted vertex ids) is met at most twice, and twice only inside
+//! one closed volume (a side of two cone tets) or on both sides of one α3-sewn face. Then the
+//! vertex and edge fans are the map's too (a split edge or a non-manifold vertex of a cut map is
+//! kept as it is). A cut (α3-free) face side breaks this when one of its triangles has the vertex
+//! ids of another output triangle — the other side of the cut when the cut split none of these
+//! vertices (a slit inside the body, or its rim): `from_tets` would glue the cut again. The
+//! closure checks the matching as it builds (a hash of the triangles) and refuses such a map
+//! with [`SubdivideError::CutNotExpressible`] (the cut side, the other side, the triangle). A cut
+//! that separates its vertices (through the whole body, or out to the boundary on all sides of a
+//! vertex) gives distinct ids on its two sides and is expressed exactly. The documented flow
+//! closes before cutting (`cut_error`, `topomech refine --cut`); cutting inside a leveled map
+//! ([`LeveledMap::unsew_face`]) and closing it works only for such separating cuts.
+//!
 //! # Costs
 //! O(darts) to walk the volumes and faces, plus O(k³) per face polygon of k vertices for the ear
-//! clipping (k is 3 for a plain face and small otherwise). Output: Σ_{closed tets} Σ_faces (k − 2)
-//! cone tets, one Steiner point per closed tet.
+//! clipping (k is 3 for a plain face and small otherwise), plus one hash entry per distinct
+//! output triangle for the gluing check (O(output) expected). Output: Σ_{closed tets} Σ_faces
+//! (k − 2) cone tets, one Steiner point per closed tet.
 
 use crate::mechanics::geom::{cross, dot, norm, sub};
 use std::collections::hash_map::Entry;
@@ -168,14 +186,82 @@ fn canonical_cycle(mut cycle: Vec<u32>) -> Vec<u32> {
     cycle
 }
 
+/// How the finest map glues the face of an output tet: what [`GMap::from_tets`] must find on
+/// the other tet that shares its three vertex ids.
+///
+/// [`GMap::from_tets`]: crate::GMap::from_tets
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Glue {
+    /// A triangle of an α3-sewn face side, keyed by its face cell id: shared by the two sides.
+    Sewn(u32),
+    /// A triangle of an α3-free face side (a cut or the boundary): shared with nothing.
+    Free,
+    /// A side of a cone tet, inside the closed volume of this Steiner point: shared by the two
+    /// cone tets over the two triangles of the volume's boundary that meet at its base edge.
+    Inside(u32),
+}
+
+/// The face matching the tet list will have ([`GMap::from_tets`] glues two tets exactly where
+/// they share three vertex ids), checked as the closure is built: every triangle (by its sorted
+/// vertex ids) is met at most twice, and twice only with equal [`Glue`] other than
+/// [`Glue::Free`] — then the tet list glues exactly what the finest map glues. One hash entry per
+/// distinct triangle: O(1) expected per tet face, O(output) in all.
+///
+/// [`GMap::from_tets`]: crate::GMap::from_tets
+struct Gluing {
+    /// Sorted triangle → its glue, the dart of the face side (or volume) it came from, and
+    /// whether it was met twice.
+    seen: FxHashMap<[u32; 3], (Glue, DartId, bool)>,
+}
+
+impl Gluing {
+    /// An empty matching with room for `n` triangles.
+    fn with_capacity(n: usize) -> Self {
+        Gluing { seen: FxHashMap::with_capacity_and_hasher(n, Default::default()) }
+    }
+
+    /// Records a face of an output tet, or refuses the closure when the tet list would glue it
+    /// where the map does not ([`SubdivideError::CutNotExpressible`], naming an α3-free side
+    /// when there is one).
+    fn add(&mut self, mut triangle: [u32; 3], glue: Glue, dart: DartId) -> Result<(), SubdivideError> {
+        triangle.sort_unstable();
+        match self.seen.entry(triangle) {
+            Entry::Vacant(e) => {
+                e.insert((glue, dart, false));
+                Ok(())
+            }
+            Entry::Occupied(mut e) => {
+                let (first, other, twice) = *e.get();
+                if first == glue && glue != Glue::Free && !twice {
+                    e.get_mut().2 = true;
+                    return Ok(());
+                }
+                let (dart, other) =
+                    if glue == Glue::Free || first != Glue::Free { (dart, other) } else { (other, dart) };
+                Err(SubdivideError::CutNotExpressible { dart, other, triangle })
+            }
+        }
+    }
+}
+
 impl LeveledMap<3> {
     /// A conforming tetrahedral mesh of the finest level (module docs of `conform`): tets without
     /// inserted vertices as they are, every other volume coned from a Steiner point at its
     /// centroid over the triangulations of its face polygons (one triangulation per face, shared
     /// by both sides). Every output tet has a positive signed volume; the volumes sum to the
-    /// input's. O(darts + Σ_faces k³).
+    /// input's.
     ///
-    /// Errors: [`SubdivideError::OpenEdge`] if a face is not closed, the errors of
+    /// Invariant (module docs, "Cut faces"): [`crate::GMap::from_tets`] on the output glues
+    /// exactly the faces the finest map glues, so it has the finest map's χ, components and
+    /// orientability, its vertices plus one per Steiner point, and Σ (k − 2) boundary triangles
+    /// over [`Self::boundary_polygons`] (the same cell counts when nothing is closed). A map with a
+    /// cut face that a tet list cannot express (its triangle has the vertex ids of another output
+    /// triangle, typically the other side of a cut that split none of its vertices) is refused
+    /// with [`SubdivideError::CutNotExpressible`]; nothing is changed (`&self`).
+    /// O(darts + Σ_faces k³ + output) (a hash entry per output triangle).
+    ///
+    /// Errors (the first met, volume by volume): [`SubdivideError::OpenEdge`] if a face is not
+    /// closed, [`SubdivideError::CutNotExpressible`] above, the errors of
     /// [`Self::tet_vertices`] for a closed volume that is not a tet at its level,
     /// [`SubdivideError::DegenerateFace`] if a face polygon cannot be triangulated (zero area,
     /// reflex corner) or a cone tet would have a non-positive volume;
@@ -207,16 +293,40 @@ impl LeveledMap<3> {
     /// nan[3][1] = f64::NAN;
     /// let nan = LeveledMap::new(m.map().clone(), nan);
     /// assert!(matches!(nan.conforming_tets(), Err(topomech::subdivide::SubdivideError::NonFinitePosition { vertex: 3, .. })));
+    /// // A face cut inside the cube keeps its three vertices joined: a tet list would glue it again.
+    /// let (points, tets) = kuhn_cube(2);
+    /// let (map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+    /// let mut cut = LeveledMap::new(map, points);
+    /// let f = cut.map().darts().find(|&d| !cut.map().is_free(3, d)).unwrap();
+    /// cut.unsew_face(f, 0).unwrap();
+    /// let e = cut.conforming_tets().unwrap_err();
+    /// assert!(matches!(e, topomech::subdivide::SubdivideError::CutNotExpressible { .. }), "{e}");
     /// ```
     pub fn conforming_tets(&self) -> Result<ConformingMesh, SubdivideError> {
         self.check_positions_given()?;
         self.check_positions_finite()?;
         let mut out = ConformingMesh { points: self.points.clone(), ..ConformingMesh::default() };
         let mut face_tris: FxHashMap<u32, Vec<[u32; 3]>> = FxHashMap::default();
+        let mut gluing = Gluing::with_capacity(self.map.dart_count() / 6);
         for d in self.map.one_dart_per_cell(3) {
-            if self.map.orbit(d, AlphaMask::of(&[0, 1, 2])).len() == 24 {
+            let volume = self.map.orbit(d, AlphaMask::of(&[0, 1, 2]));
+            if volume.len() == 24 {
                 let t = self.tet_vertices(d)?;
                 out.tets.push(self.oriented(t, &out.points, d)?);
+                // Its four vertex ids are distinct (positive volume): one triangle per face side,
+                // read from any of its darts x as the vertices of x, α0(x) and α0(α1(x)).
+                let (mut sides, mut n) = ([[0u32; 3]; 4], 0);
+                for &x in &volume {
+                    let v = |y: DartId| self.map.vertex_id(y).0;
+                    let mut tri =
+                        [v(x), v(self.map.alpha_dyn(0, x)), v(self.map.alpha_dyn(0, self.map.alpha_dyn(1, x)))];
+                    tri.sort_unstable();
+                    if !sides[..n].contains(&tri) {
+                        *sides.get_mut(n).ok_or(SubdivideError::DegenerateFace(x))? = tri;
+                        n += 1;
+                        gluing.add(tri, self.side_glue(x), x)?;
+                    }
+                }
                 out.kept += 1;
                 continue;
             }
@@ -233,13 +343,28 @@ impl LeveledMap<3> {
                         e.insert(triangulate_polygon(&cycle, &out.points).ok_or(SubdivideError::DegenerateFace(f))?)
                     }
                 };
+                let glue = self.side_glue(f);
                 for &[a, b, c] in tris.iter() {
                     out.tets.push(self.oriented([a, b, c, apex], &out.points, f)?);
+                    gluing.add([a, b, c], glue, f)?;
+                    for side in [[a, b, apex], [b, c, apex], [c, a, apex]] {
+                        gluing.add(side, Glue::Inside(apex), d)?;
+                    }
                 }
             }
             out.closed += 1;
         }
         Ok(out)
+    }
+
+    /// How the face side of `f` is glued in the finest map: α3-sewn (to the other side of its
+    /// face cell) or cut / on the boundary (α3-free, glued to nothing). O(1).
+    fn side_glue(&self, f: DartId) -> Glue {
+        if self.map.is_free(3, f) {
+            Glue::Free
+        } else {
+            Glue::Sewn(self.map.cell_id(2, f).0)
+        }
     }
 
     /// [`SubdivideError::NonFinitePosition`] for the smallest live vertex id whose position is NaN

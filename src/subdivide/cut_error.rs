@@ -5,7 +5,11 @@
 //! opposite sides of the plane, so the cut surface is made of mesh faces and deviates from the
 //! plane by up to the size of the tets it crosses. Refining the zone first (and closing it with
 //! [`super::LeveledMap::conforming_tets`] so that the mechanics runs on tets) makes the faces
-//! smaller there, and the cut surface closer to the plane.
+//! smaller there, which bounds the error more tightly: a vertex x of a cut face shared by tets A
+//! and B lies within max(|x − c_A|, |x − c_B|) of the plane, since the segment between the two
+//! centroids crosses it. The error itself is not monotone in the level: the centroid rule may
+//! pick other faces among the children (a Kuhn cube cut at z = 2.1 follows the layer z = 2 when
+//! coarse, error 0.1, and a staircase with error 0.15 two levels finer; docs/SUBDIVISION.md).
 //!
 //! # The measure
 //! For each dissociated face: the distances |(x − p) · n| / |n| of its three vertices x (current

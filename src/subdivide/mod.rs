@@ -228,6 +228,25 @@ pub enum SubdivideError {
     /// corner) or a cone tet of zero volume, at the face or volume of this dart.
     #[error("the face or volume of {0} is degenerate: no conforming triangulation")]
     DegenerateFace(DartId),
+    /// The conforming closure ([`LeveledMap::conforming_tets`]) is a tet list, and a tet list
+    /// glues two tets exactly where they share three vertex ids: a triangle of the cut
+    /// (α3-free) face of `dart` has the vertex ids `triangle` of a triangle of the face of `other`
+    /// (the other side of the same cut when the cut split none of these vertices, or another face
+    /// on the same vertices), so [`crate::GMap::from_tets`] would glue the cut again. Refused
+    /// rather than output with another topology; nothing is changed.
+    #[error(
+        "the conforming closure cannot express the cut face of {dart}: its triangle {triangle:?} (vertex ids) \
+         is also a triangle of the face of {other}, and a tet list glues two tets sharing three vertices \
+         (the cut did not split them: close the map before cutting)"
+    )]
+    CutNotExpressible {
+        /// A dart of the cut (α3-free) face side.
+        dart: DartId,
+        /// A dart of the other face side with the same triangle.
+        other: DartId,
+        /// The shared triangle's vertex ids, increasing.
+        triangle: [u32; 3],
+    },
     /// The ball of a refinement by region has a non-finite centre or a radius that is not a
     /// finite number ≥ 0 (with NaN no tet would compare inside it: nothing would be refined).
     #[error("refinement ball centre {center:?} / radius {radius} is not finite (or the radius is negative)")]

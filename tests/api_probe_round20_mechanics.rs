@@ -227,3 +227,23 @@ fn grasped_liver_is_no_runaway() {
         }
     }
 }
+
+/// The slot a runaway names is the smallest of the free slots of largest ½ m|v|² (docs/MECHANICS.md
+/// §8): two free slots flying apart symmetrically have bitwise equal energies at every step
+/// (equal and opposite forces), and the report names slot 0 (a thirty-ninth-sample survivor
+/// named the last one on ties).
+#[test]
+fn a_runaway_tie_names_the_smallest_slot() {
+    let mut sys = SpringSystem::default();
+    sys.push_slot(1.0, false, 0.0).unwrap();
+    sys.push_slot(1.0, false, 0.0).unwrap();
+    sys.push_spring([0, 1], 1.0, 1e6, 0.0).unwrap();
+    let (mut x, mut v) = (vec![[0.0; 3], [1.0, 0.0, 0.0]], vec![[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]]);
+    let mut st = Stepper::new(StepConfig::new(Integrator::Euler, 1.0), &sys, &x, &v).unwrap();
+    let err = (0..10).find_map(|_| st.step(&sys, &mut x, &mut v).err()).expect("Euler at ω h ≈ 1400 runs away");
+    assert_eq!(v[0][0], -v[1][0], "the two energies are equal");
+    match err {
+        StepError::BlowUp { slot: 0, reason, .. } => assert!(reason.contains("runaway"), "{reason}"),
+        other => panic!("{other:?}"),
+    }
+}

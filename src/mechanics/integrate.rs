@@ -782,7 +782,8 @@ impl Stepper {
         }
         let limit = self.config.runaway_factor * self.energy_scale;
         if self.energy_scale > 0.0 && kinetic > limit {
-            // The culprit is the free slot of largest ½ m |v|², as the probe counts free slots only.
+            // The culprit is the free slot of largest ½ m |v|², as the probe counts free slots only
+            // (the smallest such slot on a tie: `>`, not `>=`).
             let (mut worst, mut worst_slot) = (-1.0, 0);
             for (i, ((&m, &w), vi)) in sys.mass.iter().zip(&sys.inv_mass).zip(v).enumerate() {
                 let e = 0.5 * m * dot(*vi, *vi);

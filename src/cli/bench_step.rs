@@ -133,9 +133,9 @@ pub fn run(args: BenchArgs) -> Result<(), CliError> {
     }
 }
 
-/// The benchmark's time step for `integrator` on `sys`: half its stability limit
-/// ([`Integrator::stable_dt`] of [`SpringSystem::mode_bounds`], damping included), the implicit
-/// scheme at the symplectic one's, so that every scheme times a run that stays bounded (a run
+/// The benchmark's time step for `integrator` on `sys`: [`Integrator::half_stable_dt`] of
+/// [`SpringSystem::mode_bounds`] (half the stability limit, damping included; the implicit
+/// scheme at the symplectic one's), so that every scheme times a run that stays bounded (a run
 /// past its limit grows until the runaway test stops the benchmark); 1 ms when nothing bounds
 /// the step. O(springs + slots).
 ///
@@ -145,12 +145,8 @@ pub fn run(args: BenchArgs) -> Result<(), CliError> {
 /// leaves no step f64 can take).
 pub fn bench_dt(integrator: Integrator, sys: &SpringSystem) -> Result<f64, CliError> {
     let b = sys.mode_bounds();
-    let scheme = match integrator {
-        Integrator::Implicit => Integrator::Symplectic,
-        explicit => explicit,
-    };
-    let dt = match scheme.stable_dt(&b) {
-        Some(limit) if limit.is_finite() => 0.5 * limit,
+    let dt = match integrator.half_stable_dt(&b) {
+        h if h.is_finite() => h,
         _ => 1e-3,
     };
     if dt.is_normal() {

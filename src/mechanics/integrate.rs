@@ -135,6 +135,34 @@ impl Integrator {
             Integrator::Implicit => None,
         }
     }
+
+    /// Half this scheme's stability limit, the working step that the demo and the benchmarks
+    /// take: h = ½ [`Integrator::stable_dt`], the implicit scheme at symplectic Euler's (it is
+    /// stable at every step, but a step that resolves the stiffest mode keeps it comparable with
+    /// the explicit ones). ∞ when nothing bounds the step; 0 or subnormal when the system leaves
+    /// no step f64 can take (forward Euler undamped, a needle near 1e-154): callers cap the
+    /// first and refuse the second. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::mechanics::force::ModeBounds;
+    /// use topomech::mechanics::Integrator;
+    ///
+    /// let b = ModeBounds { omega_max: 100.0, damping_max: 0.0, beta_min: 0.0, nu_min: 0.0 };
+    /// assert_eq!(Integrator::Symplectic.half_stable_dt(&b), 0.01);
+    /// assert_eq!(Integrator::Implicit.half_stable_dt(&b), 0.01);
+    /// assert_eq!(Integrator::Euler.half_stable_dt(&b), 0.0);
+    /// let free = ModeBounds { omega_max: 0.0, ..b };
+    /// assert_eq!(Integrator::Rk4.half_stable_dt(&free), f64::INFINITY);
+    /// ```
+    pub fn half_stable_dt(self, b: &ModeBounds) -> f64 {
+        let scheme = match self {
+            Integrator::Implicit => Integrator::Symplectic,
+            explicit => explicit,
+        };
+        0.5 * scheme.stable_dt(b).unwrap_or(f64::INFINITY)
+    }
 }
 
 /// num / den, ∞ for den = 0 (nothing bounds the step). O(1).

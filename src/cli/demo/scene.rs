@@ -135,9 +135,9 @@ fn bounds(points: &[Vec3], tets: &[[u32; 4]]) -> (Vec3, Vec3) {
     (lo, hi)
 }
 
-/// The demo's time step for a spring system stepped by symplectic Euler: half the stability limit
-/// of [`Integrator::stable_dt`] (h²ω_max² + 2h c_max ≤ 4, damping included), at most
-/// [`MAX_DT`]: dt = min(MAX_DT, 2 / (c_max + √(c_max² + 4 ω_max²))), which is 1/ω_max undamped.
+/// The demo's time step for a spring system stepped by symplectic Euler:
+/// [`Integrator::half_stable_dt`], half the stability limit (h²ω_max² + 2h c_max ≤ 4, damping
+/// included), at most [`MAX_DT`]: dt = min(MAX_DT, 2 / (c_max + √(c_max² + 4 ω_max²))), which is 1/ω_max undamped.
 /// ω_max² may pass `f64::MAX` (a needle edge of 1e-153): the limit is formed without it.
 /// O(springs + slots).
 ///
@@ -147,8 +147,7 @@ fn bounds(points: &[Vec3], tets: &[[u32; 4]]) -> (Vec3, Vec3) {
 /// f64 can take.
 pub fn time_step(sys: &SpringSystem, stage: &'static str) -> Result<f64, DemoError> {
     let b = sys.mode_bounds();
-    let limit = Integrator::Symplectic.stable_dt(&b).unwrap_or(f64::INFINITY);
-    let dt = MAX_DT.min(0.5 * limit);
+    let dt = MAX_DT.min(Integrator::Symplectic.half_stable_dt(&b));
     if !dt.is_normal() {
         return Err(DemoError::TimeStep { stage, dt, omega_max: b.omega_max, damping_max: b.damping_max });
     }

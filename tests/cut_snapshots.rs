@@ -23,5 +23,13 @@ fn plane_cut_of_liver_547_json() {
     let (b, a) = (&json["before"], &json["after"]);
     assert_eq!(a["boundary_faces"].as_u64().unwrap(), b["boundary_faces"].as_u64().unwrap() + 2 * cut);
     assert_eq!(a["faces"].as_u64().unwrap(), b["faces"].as_u64().unwrap() + cut);
+    // One mass per component, summing to the total mass (finding 186).
+    for side in [b, a] {
+        let masses: Vec<f64> =
+            side["component_masses"].as_array().unwrap().iter().map(|m| m.as_f64().unwrap()).collect();
+        assert_eq!(masses.len() as u64, side["components"].as_u64().unwrap());
+        let total = side["total_mass"].as_f64().unwrap();
+        assert!((masses.iter().sum::<f64>() - total).abs() <= 1e-12 * total);
+    }
     insta::assert_json_snapshot!("cut_liver_547_plane", json);
 }

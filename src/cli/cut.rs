@@ -11,9 +11,11 @@ use std::time::Instant;
 use topomech::cut::{self, Plane, PolylineSweep};
 use topomech::load;
 use topomech::mechanics::{check_conservation, Body, Integrator, Material, Simulation, StepConfig, Vec3};
+use topomech::mesh::TetMesh;
 use topomech::vtk::{body_tets, Frame};
 use topomech::CellId;
 
+use super::simulate::{check_pin_region, file_vertex, step_error};
 use super::{at_least_one, build_body, check_ids, other, parse_finite, print_warnings, CellCensus, CliError};
 
 /// Options shared by the three subcommands.
@@ -32,20 +34,30 @@ pub struct CommonArgs {
     pub json: bool,
 }
 
-/// Arguments of `topomech cut`.
+/// Arguments of `topomech cut`: exactly one of `--plane` and `--polyline` (a required group, so
+/// that a missing or doubled surface is named as such), and `--sweep` with `--polyline` only.
 #[derive(Debug, Clone, clap::Args)]
+#[command(group(clap::ArgGroup::new("surface").required(true).multiple(false).args(["plane", "polyline"])))]
 pub struct CutArgs {
     /// Mesh, density, output.
     #[command(flatten)]
     pub common: CommonArgs,
-    /// The plane: a point and a normal, `PX,PY,PZ,NX,NY,NZ`.
-    #[arg(long, value_parser = parse_numbers::<6>, allow_hyphen_values = true, required_unless_present = "polyline")]
+    /// The plane: a point and a normal, `PX,PY,PZ,NX,NY,NZ`. Exactly one of --plane and
+    /// --polyline is required.
+    #[arg(long, value_parser = parse_numbers::<6>, allow_hyphen_values = true)]
     pub plane: Option<[f64; 6]>,
     /// Instead of a plane, a scalpel path `X,Y,Z;X,Y,Z;…` swept along `--sweep` (a bounded cut).
-    #[arg(long, value_parser = parse_polyline, allow_hyphen_values = true, conflicts_with = "plane", requires = "sweep")]
+    #[arg(long, value_parser = parse_polyline, allow_hyphen_values = true, requires = "sweep")]
     pub polyline: Option<Polyline>,
-    /// The depth vector `WX,WY,WZ` the polyline is swept along (its length is the cut depth).
-    #[arg(long, value_parser = parse_numbers::<3>, allow_hyphen_values = true, requires = "polyline")]
+    /// The depth vector `WX,WY,WZ` the polyline is swept along (its length is the cut depth);
+    /// only with --polyline.
+    #[arg(
+        long,
+        value_parser = parse_numbers::<3>,
+        allow_hyphen_values = true,
+        requires = "polyline",
+        conflicts_with = "plane"
+    )]
     pub sweep: Option<[f64; 3]>,
 }
 
@@ -81,7 +93,8 @@ pub struct TearArgs {
     /// Time step (seconds).
     #[arg(long, default_value_t = 1e-4, allow_negative_numbers = true)]
     pub dt: f64,
-    /// Fix the vertices whose rest z is at most this value (default: the lowest 10% of the body).
+    /// Fix the vertices whose rest z is at most this value (default: the lowest 10% of the body);
+    /// a value below the whole body (pinning no vertex) is refused.
     #[arg(long, allow_hyphen_values = true, value_parser = parse_finite)]
     pub pin_z: Option<f64>,
     /// Gravity along z (negative pulls down); large values stretch the body.
@@ -100,6 +113,11 @@ pub struct BodyStats {
     pub cells: CellCensus,
     /// Σ_v m_v.
     pub total_mass: f64,
+    /// The mass of each connected component (`cut::components`), ascending (the order of the
+    /// conformance suite's `component_masses`): one entry per component, summing to
+    /// `total_mass` up to rounding. The parts are stepped in one spring
+    /// system with no spring between them, the same dynamics as separate bodies.
+    pub component_masses: Vec<f64>,
     /// Mass removed so far.
     pub removed_mass: f64,
     /// Σ_e k_e.
@@ -130,6 +148,7 @@ pub fn stats(body: &Body, removed_mass: f64) -> BodyStats {
     BodyStats {
         cells: CellCensus::of(map),
         total_mass: body.total_vertex_mass(),
+        component_masses: component_masses(body),
         removed_mass,
         stiffness_sum: map
             .one_dart_per_cell(1)
@@ -141,19 +160,28 @@ pub fn stats(body: &Body, removed_mass: f64) -> BodyStats {
     }
 }
 
+/// The masses of the connected components of `body` ([`cut::components`]), ascending, as the
+/// conformance suite orders its `component_masses`. O(darts).
+pub fn component_masses(body: &Body) -> Vec<f64> {
+    let mut masses: Vec<f64> = cut::components(body).into_iter().map(|c| c.mass).collect();
+    masses.sort_by(f64::total_cmp);
+    masses
+}
+
 /// `topomech cut`.
 ///
 /// # Errors
 /// [`CliError`] when the mesh cannot be loaded, the plane is bad, or the output cannot be written.
 pub fn run(args: CutArgs) -> Result<(), CliError> {
-    let (mut body, load_us) = load_body(&args.common)?;
+    let (mut body, _, load_us) = load_body(&args.common)?;
     let before = stats(&body, 0.0);
     let t = Instant::now();
     let inc = match (args.plane, args.polyline) {
         (Some([px, py, pz, nx, ny, nz]), _) => {
             cut::incise_plane(&mut body, &Plane { point: [px, py, pz], normal: [nx, ny, nz] })
         }
-        // A missing --sweep is a zero sweep, which the library refuses with a clear error.
+        // clap requires exactly one of --plane and --polyline, and --sweep with --polyline; a
+        // missing --sweep would be a zero sweep, which the library refuses with a clear error.
         (None, points) => {
             let surface = PolylineSweep {
                 points: points.map(|p| p.0).unwrap_or_default(),
@@ -173,7 +201,7 @@ pub fn run(args: CutArgs) -> Result<(), CliError> {
 /// # Errors
 /// As [`run`]; also a tet id that does not exist.
 pub fn run_remove(args: RemoveArgs) -> Result<(), CliError> {
-    let (mut body, load_us) = load_body(&args.common)?;
+    let (mut body, _, load_us) = load_body(&args.common)?;
     let before = stats(&body, 0.0);
     // A fresh body's volume ids are the tets' positions in the file: check them all before the
     // first removal, so that a bad id is named as such (not as "already removed" after an
@@ -206,36 +234,55 @@ pub fn run_remove(args: RemoveArgs) -> Result<(), CliError> {
 /// # Errors
 /// As [`run`]; also a bad time step or a blow-up.
 pub fn run_tear(args: TearArgs) -> Result<(), CliError> {
-    let (mut body, load_us) = load_body(&args.common)?;
+    let (mut body, mesh, load_us) = load_body(&args.common)?;
     let before = stats(&body, 0.0);
     let rest = body.attrs().rest_position().as_slice().to_vec();
     let (lo, hi) = rest.iter().fold((f64::MAX, f64::MIN), |(lo, hi), p| (lo.min(p[2]), hi.max(p[2])));
+    // An explicit --pin-z under the whole body would let it fall unpinned: refuse it.
+    if let Some(z) = args.pin_z {
+        check_pin_region("--pin-z", 2, z, &rest)?;
+    }
     let pin_z = args.pin_z.unwrap_or(lo + 0.1 * (hi - lo));
     body.attrs_mut().pin_where(|_, p| p[2] <= pin_z);
     let config = StepConfig::new(Integrator::Symplectic, args.dt);
     let mut sim = Simulation::new(&mut body, [0.0, 0.0, args.gravity_z], config).map_err(other)?;
     let (mut faces, mut step_us, mut tear_us) = (0, 0u64, 0u64);
-    for _ in 0..args.steps {
+    // file_point[slot]: the point of the file a vertex slot stands for (a fresh body's slots are
+    // the file's points; a torn-off copy stands for the point it was split from).
+    let (tags, points) = (&mesh.node_tags, mesh.points.len());
+    let mut file_point: Vec<u32> = (0..points as u32).collect();
+    for step in 1..=args.steps {
         let t = Instant::now();
-        sim.step(&mut body).map_err(other)?;
+        sim.step(&mut body)
+            .map_err(|e| step_error(e, step, args.steps, |slot| file_vertex(tags, &file_point, points, slot)))?;
         step_us += t.elapsed().as_micros() as u64;
         let t = Instant::now();
         let torn = cut::tear_step(&mut body, &mut sim, args.threshold, args.per_step).map_err(other)?;
         tear_us += t.elapsed().as_micros() as u64;
         faces += torn.tears.iter().map(|t| t.dissociations.len()).sum::<usize>();
+        for split in torn.tears.iter().flat_map(|t| &t.dissociations).flat_map(|d| &d.vertices) {
+            let (kept, new) = (split.kept.0 as usize, split.new.0 as usize);
+            let from = file_point.get(kept).copied().unwrap_or(u32::MAX);
+            if file_point.len() <= new {
+                file_point.resize(new + 1, u32::MAX);
+            }
+            file_point[new] = from;
+        }
     }
     let timings =
         BTreeMap::from([("load".to_string(), load_us), ("steps".to_string(), step_us), ("tear".to_string(), tear_us)]);
     finish(&args.common, &body, before, 0.0, faces, timings)
 }
 
-fn load_body(common: &CommonArgs) -> Result<(Body, u64), CliError> {
+/// The body of `common.mesh`, the mesh it was built on (its points are the body's first vertex
+/// slots) and the load time in µs.
+fn load_body(common: &CommonArgs) -> Result<(Body, TetMesh, u64), CliError> {
     let t = Instant::now();
     let loaded = load::load_tet_map(&common.mesh)?;
     print_warnings(&loaded);
     let material = Material { density: common.density, ..Material::default() };
     let body = build_body(&common.mesh, &loaded.mesh, material)?;
-    Ok((body, t.elapsed().as_micros() as u64))
+    Ok((body, loaded.mesh, t.elapsed().as_micros() as u64))
 }
 
 /// Tet (volume) ids whose centroid at rest is within distance r of c.
@@ -286,6 +333,13 @@ fn finish(
         )?;
         writeln!(out, "boundary faces {} -> {}", bc.boundary_faces, ac.boundary_faces)?;
         writeln!(out, "components     {} -> {}", bc.components, ac.components)?;
+        let masses: Vec<String> = a.component_masses.iter().map(|&m| super::number(m)).collect();
+        match masses.as_slice() {
+            [first, .., last] if masses.len() > 8 => {
+                writeln!(out, "part masses    {first} … {last} ({} parts, ascending; all in --json)", masses.len())?
+            }
+            _ => writeln!(out, "part masses    {} (ascending)", masses.join(", "))?,
+        }
         let mass = [b.total_mass, a.total_mass, a.removed_mass].map(super::number);
         writeln!(out, "total mass     {} -> {} (removed {})", mass[0], mass[1], mass[2])?;
         writeln!(out, "valid {}  conservation {}", a.valid, a.conservation_ok)?;
@@ -293,14 +347,53 @@ fn finish(
     Ok(())
 }
 
+/// The live part of `body` as a VTU: one point per live vertex (the vertex cells of the map, in
+/// increasing id; a removal or a merge leaves dead slots in the attribute arrays, which are not
+/// written), the tets renumbered onto them, and the velocity of each written point, so that
+/// `NumberOfPoints` is the report's `after.vertices` and every point belongs to a tet.
+/// O(darts + slots).
 fn write_vtu(body: &Body, path: &Path) -> Result<(), CliError> {
-    let tets = body_tets(body);
-    let frame = Frame {
-        points: body.attrs().position().as_slice(),
-        tets: &tets,
-        vectors: vec![("velocity", body.attrs().velocity().as_slice())],
-    };
+    let live = live_mesh(body)?;
+    let frame = Frame { points: &live.points, tets: &live.tets, vectors: vec![("velocity", &live.velocity)] };
     frame.write(path).map_err(other)
+}
+
+/// The live vertices of a body renumbered compactly ([`live_mesh`]): positions, tets in the
+/// new numbering, velocities.
+struct LiveMesh {
+    points: Vec<Vec3>,
+    tets: Vec<[u32; 4]>,
+    velocity: Vec<Vec3>,
+}
+
+/// Positions, tets (in the written numbering) and velocities of the live vertices of `body`, in
+/// increasing vertex id ([`write_vtu`]). O(darts + slots).
+fn live_mesh(body: &Body) -> Result<LiveMesh, CliError> {
+    let map = body.map();
+    let mut live: Vec<u32> = map.one_dart_per_cell(0).into_iter().map(|d| map.vertex_id(d).0).collect();
+    live.sort_unstable();
+    live.dedup();
+    let (position, velocity) = (body.attrs().position().as_slice(), body.attrs().velocity().as_slice());
+    let bound = live.last().map_or(0, |&v| v as usize + 1);
+    if bound > position.len().min(velocity.len()) {
+        return Err(other(format!("vertex {} has no attribute slot (a topomech bug)", bound - 1)));
+    }
+    let mut written = vec![u32::MAX; bound];
+    for (new, &old) in live.iter().enumerate() {
+        written[old as usize] = new as u32;
+    }
+    let tets = body_tets(body)
+        .into_iter()
+        .map(|t| {
+            let mapped = t.map(|v| written.get(v as usize).copied().unwrap_or(u32::MAX));
+            match mapped.contains(&u32::MAX) {
+                true => Err(other(format!("tet {t:?} uses a vertex that is not live (a topomech bug)"))),
+                false => Ok(mapped),
+            }
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let pick = |a: &[Vec3]| live.iter().map(|&v| a[v as usize]).collect::<Vec<Vec3>>();
+    Ok(LiveMesh { points: pick(position), tets, velocity: pick(velocity) })
 }
 
 fn parse_numbers<const K: usize>(s: &str) -> Result<[f64; K], String> {

@@ -73,7 +73,9 @@ pub struct RefineJson {
     pub volumes: usize,
     /// Darts of the finest map.
     pub darts: usize,
-    /// Volumes of the extracted level i, i = 0..=k.
+    /// Volumes of the extracted level i, i = 0..=L (L = `--levels`; always L + 1 entries, as
+    /// `subdivided_per_level`): a level at which nothing was refined (an empty zone) repeats the
+    /// count of the level before it, since G_i = G_{i−1} then.
     pub tets_per_level: Vec<usize>,
     /// Tets subdivided at each level (index 0 is 0).
     pub subdivided_per_level: Vec<usize>,
@@ -174,6 +176,15 @@ pub fn run(args: RefineArgs) -> Result<(), CliError> {
     let (refinement, masses, mech, refine_ms) = refine(&args, &mut m, material)?;
     let laws = Laws::check(&m);
     let mut report = report(&m, &masses, &refinement, refine_ms, &laws)?;
+    pad_levels(&mut report.tets_per_level, usize::from(args.levels) + 1);
+    if args.levels > 0 && refinement.subdivided_per_level.iter().all(|&n| n == 0) {
+        eprintln!(
+            "topomech: warning: the zone (ball at {:?}, radius {}) meets no tet: nothing was refined, every level \
+             is the input mesh",
+            args.around,
+            super::number(args.radius)
+        );
+    }
     let spring_laws = mech.as_ref().map(|(before, x)| fill_springs(&mut report, *before, x, &m));
     let closure = if args.conforming || args.cut.is_some() {
         let c = m.conforming_tets().map_err(|e| other(format!("{}: conforming closure: {e}", args.mesh.display())))?;
@@ -199,6 +210,14 @@ pub fn run(args: RefineArgs) -> Result<(), CliError> {
     match laws.first_error() {
         None => Ok(()),
         Some(e) => Err(other(format!("{}: the refined map breaks a law (a topomech bug): {e}", args.mesh.display()))),
+    }
+}
+
+/// Pads `tets_per_level` to `levels` entries (levels 0..levels−1) with its last count: a level the
+/// refinement did not reach (nothing left to refine) is the level before it. O(levels).
+fn pad_levels(tets_per_level: &mut Vec<usize>, levels: usize) {
+    if let Some(&last) = tets_per_level.last() {
+        tets_per_level.resize(tets_per_level.len().max(levels), last);
     }
 }
 

@@ -28,7 +28,8 @@ pub struct SimulateArgs {
     /// euler, symplectic, rk4 or implicit.
     #[arg(long, default_value = "rk4")]
     pub integrator: Integrator,
-    /// Fix the vertices whose rest coordinate is at most VALUE, e.g. `x=0.5` or `z=-1`.
+    /// Fix the vertices whose rest coordinate is at most VALUE, e.g. `x=0.5` or `z=-1`; a VALUE
+    /// below the whole body (pinning no vertex) is refused, naming the body's range.
     #[arg(long, value_name = "AXIS=VALUE", value_parser = parse_pin_below)]
     pub pin_below: Option<(usize, f64)>,
     /// Fix these vertex ids (comma-separated; 0-based points of the file, each must exist).
@@ -136,7 +137,8 @@ fn parse_threads(s: &str) -> Result<usize, String> {
 ///
 /// # Errors
 /// [`CliError::Load`] for a bad mesh; [`CliError::Other`] for a `--pin` id past the last point, a
-/// bad material, a blow-up (naming the step and vertex), a thread pool the system refuses or an unwritable
+/// `--pin-below` that pins no vertex, a bad material, a blow-up (naming the 1-based step of the
+/// run and the file's node tag of the vertex), a thread pool the system refuses or an unwritable
 /// output directory.
 pub fn run(args: SimulateArgs) -> Result<(), CliError> {
     let threads = args.threads;
@@ -155,11 +157,26 @@ fn simulate(args: &SimulateArgs, parallel: bool) -> Result<(), CliError> {
     let (mut mesh, mut pin_ids) = (loaded.mesh, args.pin.clone());
     // A pinned id that names no point would pin nothing, silently: refuse it.
     check_ids("--pin", ("vertex", "points"), &pin_ids, mesh.points.len())?;
+    // So would a --pin-below bound under the whole body (it fell unpinned: finding 182).
+    if let Some((axis, value)) = args.pin_below {
+        check_pin_region("--pin-below", axis, value, &mesh.points)?;
+    }
+    // file_point[slot]: the point of the file that vertex slot `slot` stands for, through the
+    // reorderings (a blow-up names the file's point, not the slot, which each order moves).
+    let mut file_point: Vec<u32> = (0..mesh.points.len() as u32).collect();
+    let (file_tags, file_points) = (mesh.node_tags.clone(), mesh.points.len());
     let reorders: [(bool, Renumbering); 2] =
         [(args.spatial_order, TetMesh::spatially_ordered), (args.rcm_order, TetMesh::bandwidth_ordered)];
     for (_, reorder) in reorders.into_iter().filter(|(wanted, _)| *wanted) {
         let (ordered, new_of_old) = reorder(&mesh);
         pin_ids = pin_ids.iter().map(|&v| new_of_old.get(v as usize).copied().unwrap_or(v)).collect();
+        let mut moved = file_point.clone();
+        for (old, &new) in new_of_old.iter().enumerate() {
+            if let (Some(slot), Some(&point)) = (moved.get_mut(new as usize), file_point.get(old)) {
+                *slot = point;
+            }
+        }
+        file_point = moved;
         mesh = ordered;
     }
     let mut body = build_body(&args.mesh, &mesh, material)?;
@@ -177,7 +194,9 @@ fn simulate(args: &SimulateArgs, parallel: bool) -> Result<(), CliError> {
     let mut times = StepTimes::new(args.steps);
     for step in 1..=args.steps {
         let start = Instant::now();
-        sim.step(&mut body).map_err(other)?;
+        sim.step(&mut body).map_err(|e| {
+            step_error(e, step, args.steps, |slot| file_vertex(&file_tags, &file_point, file_points, slot))
+        })?;
         times.push(start.elapsed().as_secs_f64() * 1e6);
         frames.maybe_write(step, &body)?;
         bar.inc(1);
@@ -217,6 +236,61 @@ fn print_summary(
         }
         Ok(())
     })
+}
+
+/// Refuses a pin region of the command line (`flag` with `axis` ≤ `value`) that pins no point of
+/// `points`: the body would fall unpinned while the run reported success. The message names the
+/// flag, the value and the body's range on that axis. O(points).
+pub(crate) fn check_pin_region(flag: &str, axis: usize, value: f64, points: &[Vec3]) -> Result<(), CliError> {
+    let coord = |p: &Vec3| p.get(axis).copied().unwrap_or(f64::NAN);
+    if points.iter().any(|p| coord(p) <= value) {
+        return Ok(());
+    }
+    let (lo, hi) =
+        points.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(coord(p)), hi.max(coord(p))));
+    let name = ["x", "y", "z"].get(axis).copied().unwrap_or("?");
+    Err(other(format!(
+        "{flag}: {name} ≤ {} pins no vertex: the body's {name} runs from {} to {} (give a value ≥ {})",
+        super::number(value),
+        super::number(lo),
+        super::number(hi),
+        super::number(lo)
+    )))
+}
+
+/// How a blow-up names its vertex: the file's node tag (`tags`, indexed by the file's points) of
+/// the point that vertex slot `slot` stands for (`file_point` maps slots to the file's points
+/// through any renumbering or tear; `u32::MAX` for none), or the file's 0-based point when the
+/// file has no tags; a slot past the file's `points` is a copy a tear split off that point. Only
+/// a slot that stands for no point is named as a slot. O(1).
+pub(crate) fn file_vertex(tags: &[u64], file_point: &[u32], points: usize, slot: usize) -> String {
+    let Some(&point) = file_point.get(slot).filter(|&&p| (p as usize) < points) else {
+        return format!("vertex slot {slot} (not a point of the file)");
+    };
+    let copy = if slot >= points { ", a copy of it split off by tearing" } else { "" };
+    match tags.get(point as usize) {
+        Some(tag) => format!("file node tag {tag} (point {point} of the file, 0-based{copy})"),
+        None => format!("point {point} of the file (0-based{copy})"),
+    }
+}
+
+/// The CLI's message for a failed step: a blow-up is stated in the steps the user counts (step
+/// `step` of `steps`, 1-based as the progress bar and the frames count them) and at the vertex
+/// `name_vertex` gives for its slot; other errors go through as they are. O(1).
+pub(crate) fn step_error(
+    e: topomech::mechanics::SimError,
+    step: u64,
+    steps: u64,
+    name_vertex: impl FnOnce(usize) -> String,
+) -> CliError {
+    use topomech::mechanics::{SimError, StepError};
+    match e {
+        SimError::Step(StepError::BlowUp { slot, reason, .. }) => other(format!(
+            "simulation blew up in step {step} of {steps} (counted from 1, as the progress bar does), at {}: {reason}",
+            name_vertex(slot)
+        )),
+        e => other(e),
+    }
 }
 
 /// The warning for a `dt` past the stability limit of an explicit `integrator` on `sys`

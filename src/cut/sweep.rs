@@ -33,7 +33,8 @@
 //! vector is about 2^1000 times smaller than its largest one; any other factor changes them only
 //! through the rounding of the scaled coordinates themselves.
 
-use crate::mechanics::{geom, Body, Vec3};
+use crate::mechanics::geom::{self, exponent, pow2};
+use crate::mechanics::{Body, Vec3};
 use crate::DartId;
 
 use super::incise::{dissociate_all, tet_centroids};
@@ -220,28 +221,6 @@ impl Scaled {
             return Scaled::new(v, 0, target);
         }
         Scaled::new(geom::sub(geom::scale(x, 0.5), geom::scale(y, 0.5)), 1, target)
-    }
-}
-
-/// The exponent k with 2^k ≤ m < 2^(k+1), for finite m > 0 (subnormals included). O(1).
-fn exponent(m: f64) -> i32 {
-    let bits = m.to_bits();
-    let biased = ((bits >> 52) & 0x7ff) as i32;
-    if biased == 0 {
-        // Subnormal: m = bits · 2^-1074.
-        63 - bits.leading_zeros() as i32 - 1074
-    } else {
-        biased - 1023
-    }
-}
-
-/// 2^e, exact for e in [−1074, 1023] (subnormals included), 0 below and +∞ above. O(1).
-fn pow2(e: i32) -> f64 {
-    match e {
-        1024.. => f64::INFINITY,
-        -1022..=1023 => f64::from_bits(((e + 1023) as u64) << 52),
-        -1074..=-1023 => f64::from_bits(1u64 << (e + 1074)),
-        _ => 0.0,
     }
 }
 

@@ -8,7 +8,7 @@
 //! comes back to d0, or before an α3 that is free (the surface); in that case it starts again from
 //! α1(d0) to collect the other half of the fan.
 
-use crate::mechanics::geom::{cross, dot, sub};
+use crate::mechanics::geom::{self, cross, dot, sub};
 use crate::mechanics::model::{closed_triangle_vertices, triangle_vertices};
 use crate::mechanics::{Body, SimError, Simulation, TouchedCells, Vec3};
 use crate::{AlphaMask, CellId, DartId, GMap};
@@ -134,16 +134,20 @@ pub fn principal_stress(body: &Body, sim: &Simulation) -> Result<Vec<Stress>, Si
     let mut sigma = vec![[[0.0f64; 3]; 3]; sys.slots()];
     for s in 0..sys.springs() {
         let [a, b] = sys.ends[s];
-        let d = sub(x[b as usize], x[a as usize]);
-        let l = dot(d, d).sqrt();
+        let (xa, xb) = (x[a as usize], x[b as usize]);
+        // The length measured as rest lengths are (scale-safe beyond ordinary extents) and the
+        // unit direction first: T nᵢ nⱼ over- or underflows only when the stress does (finding
+        // 178: T dᵢ dⱼ / l² overflowed for a body of edges near 1e80, underflowed near 1e-90).
+        let l = geom::rest_length(xa, xb);
         let tension = sys.stiffness[s] * (l - sys.rest[s]);
         if l == 0.0 || tension <= 0.0 {
             continue;
         }
+        let n = sub(xb, xa).map(|c| c / l);
         for v in [a, b] {
             for (i, row) in sigma[v as usize].iter_mut().enumerate() {
                 for (j, e) in row.iter_mut().enumerate() {
-                    *e += tension * d[i] * d[j] / (l * l);
+                    *e += tension * n[i] * n[j];
                 }
             }
         }

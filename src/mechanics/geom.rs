@@ -83,6 +83,28 @@ pub(crate) fn volume_ratios<const K: usize>(tets: [[Vec3; 4]; K]) -> [f64; K] {
     six.map(|v| v.div(largest).to_f64())
 }
 
+/// The exponent k with 2^k ≤ m < 2^(k+1), for finite m > 0 (subnormals included). O(1).
+pub(crate) fn exponent(m: f64) -> i32 {
+    let bits = m.to_bits();
+    let biased = ((bits >> 52) & 0x7ff) as i32;
+    if biased == 0 {
+        // Subnormal: m = bits · 2^-1074.
+        63 - bits.leading_zeros() as i32 - 1074
+    } else {
+        biased - 1023
+    }
+}
+
+/// 2^e, exact for e in [−1074, 1023] (subnormals included), 0 below and +∞ above. O(1).
+pub(crate) fn pow2(e: i32) -> f64 {
+    match e {
+        1024.. => f64::INFINITY,
+        -1022..=1023 => f64::from_bits(((e + 1023) as u64) << 52),
+        -1074..=-1023 => f64::from_bits(1u64 << (e + 1074)),
+        _ => 0.0,
+    }
+}
+
 /// Whether `a` and `b` agree to a relative tolerance `rel` (absolute below `f64::MIN_POSITIVE`).
 pub(crate) fn close(a: f64, b: f64, rel: f64) -> bool {
     (a - b).abs() <= rel * a.abs().max(b.abs()).max(f64::MIN_POSITIVE)

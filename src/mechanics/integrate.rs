@@ -31,7 +31,7 @@ use std::str::FromStr;
 use rayon::prelude::*;
 
 use super::force::{ModeBounds, Rec4, SlotState, SpringSystem, SumPlan, PARALLEL_CHUNK};
-use super::geom::{dot, norm, sub, Vec3};
+use super::geom::{dot, exponent, norm, pow2, sub, Vec3};
 use super::simd::{multiversion, Kernel};
 use crate::wide::Wide;
 
@@ -575,9 +575,37 @@ impl Stepper {
         Ok(())
     }
 
+    /// Fits the buffers to `sys`, the system this stepper steps after a topological change
+    /// (slots and springs added, springs moved), keeping the configuration, the step count and
+    /// the runaway test's energy scale. The system is checked as [`Stepper::new`] does in debug
+    /// builds and under `expensive-checks` only (the crate's projection maintains it). O(growth)
+    /// amortised.
+    ///
+    /// # Errors
+    /// [`StepError::BadInput`]: a system the stepper cannot take (checked builds only; the
+    /// buffers are unchanged then).
+    pub(crate) fn follow_system(&mut self, sys: &SpringSystem) -> Result<(), StepError> {
+        #[cfg(any(debug_assertions, feature = "expensive-checks"))]
+        check_system(sys).map_err(StepError::BadInput)?;
+        let (n, s) = (sys.slots(), sys.springs());
+        self.sf.resize(s, [0.0; 3]);
+        self.ys.resize(n, SlotState::default());
+        for buf in [&mut self.acc, &mut self.ax, &mut self.av] {
+            buf.resize(n, [0.0; 3]);
+        }
+        self.sums.resize(n, [0.0; 4]);
+        Ok(())
+    }
+
+    /// Drops the runaway test's energy scale: the next step must take one
+    /// ([`Stepper::reset_energy_scale`]), as after [`Stepper::with_buffers`]. O(1).
+    pub(crate) fn forget_energy_scale(&mut self) {
+        self.energy_scale = f64::NAN;
+    }
+
     /// Whether the runaway test has its energy scale (every public constructor takes it; only a
-    /// crate-internal [`Stepper::with_buffers`] stepper waits for
-    /// [`Stepper::reset_energy_scale`]). O(1).
+    /// crate-internal [`Stepper::with_buffers`] stepper, or one told to
+    /// [`Stepper::forget_energy_scale`], waits for [`Stepper::reset_energy_scale`]). O(1).
     pub(crate) fn has_energy_scale(&self) -> bool {
         !self.energy_scale.is_nan()
     }
@@ -723,7 +751,7 @@ impl Stepper {
         check_len(sys, x)?;
         check_len(sys, v)?;
         if !self.has_energy_scale() {
-            // Only a crate-internal `with_buffers` stepper lacks it; never step without the test.
+            // Only a crate-internal `with_buffers` or forgetful stepper lacks it; never step without it.
             return Err(StepError::BadInput("the runaway test has no energy scale yet (reset_energy_scale)".into()));
         }
         match self.config.integrator {
@@ -1113,25 +1141,48 @@ impl Stepper {
     }
 
     /// Solves A Δv = r (r holds b on entry) by CG on the free slots; Δv in `cg.dv`.
+    ///
+    /// Scale-safe: CG runs on 2^-β b and 2^-α A, with 2^β the binade of max |bᵢ| and 2^α that
+    /// of the largest diagonal mass term mᵢ + h νᵢ of a free slot, so that ‖b‖², pᵀAp and the
+    /// step lengths stay near 1 for a body of any size (finding 179: ‖b‖² under- or
+    /// overflowed for edges beyond about 1e±33, and an underflowed ‖b‖ ended the solve with
+    /// Δv = 0, every force dropped). Powers of two scale exactly, so in the normal range the
+    /// iterates are the unscaled ones' bits, times powers of two; Δv = 2^(β−α) y at the end.
+    /// Only an exactly zero b has nothing to solve.
     fn conjugate_gradient(&mut self, sys: &SpringSystem, h: f64) -> Result<usize, StepError> {
         let par = self.config.parallel;
         let cg = &mut self.cg;
         cg.dv.iter_mut().for_each(|d| *d = [0.0; 3]);
-        cg.p.copy_from_slice(&cg.r);
-        let b_norm = dot_all(&cg.r, &cg.r).sqrt();
-        if !b_norm.is_finite() {
-            // ‖b‖² overflowed (or b holds NaN): ∞ ≤ tol · ∞ would "converge" at once with Δv = 0.
-            return Err(StepError::SolverFailed { step: self.step, iterations: 0, residual: b_norm });
-        }
-        if b_norm == 0.0 {
+        let b_max = cg.r.iter().flatten().fold(0.0f64, |m, c| m.max(c.abs()));
+        if b_max == 0.0 {
             return Ok(0);
         }
+        if !b_max.is_finite() || cg.r.iter().flatten().any(|c| c.is_nan()) {
+            // b overflowed or holds NaN: there is no finite right-hand side to solve for.
+            let residual = dot_all(&cg.r, &cg.r).sqrt();
+            return Err(StepError::SolverFailed { step: self.step, iterations: 0, residual });
+        }
+        let beta = exponent(b_max);
+        let alpha = (0..sys.slots())
+            .filter(|&i| sys.inv_mass[i] > 0.0)
+            .map(|i| sys.mass[i] + h * sys.viscosity[i])
+            .fold(0.0f64, f64::max);
+        let alpha = if alpha > 0.0 && alpha.is_finite() { exponent(alpha) } else { 0 };
+        scale_all(&mut cg.r, -beta);
+        let a_scale = (pow2(-alpha / 2), pow2(-alpha - (-alpha / 2)));
+        cg.p.copy_from_slice(&cg.r);
+        let b_norm = dot_all(&cg.r, &cg.r).sqrt();
         let mut rr = dot_all(&cg.r, &cg.r);
+        let solved = |cg: &mut CgBuffers, it: usize| {
+            scale_all(&mut cg.dv, beta - alpha);
+            Ok(it)
+        };
         for it in 0..self.config.cg_max_iterations {
             if rr.sqrt() <= self.config.cg_tolerance * b_norm {
-                return Ok(it);
+                return solved(cg, it);
             }
             apply_system(sys, &cg.dir, &cg.coef, h, &cg.p, &mut self.sf, &mut cg.q, par);
+            cg.q.iter_mut().flatten().for_each(|c| *c = *c * a_scale.0 * a_scale.1);
             let alpha = rr / dot_all(&cg.p, &cg.q);
             for i in 0..cg.p.len() {
                 cg.dv[i] = madd(cg.dv[i], alpha, cg.p[i]);
@@ -1146,7 +1197,7 @@ impl Stepper {
         }
         let residual = rr.sqrt() / b_norm;
         if residual <= self.config.cg_tolerance {
-            return Ok(self.config.cg_max_iterations);
+            return solved(cg, self.config.cg_max_iterations);
         }
         Err(StepError::SolverFailed { step: self.step, iterations: self.config.cg_max_iterations, residual })
     }
@@ -1229,6 +1280,13 @@ fn apply_system(
     } else {
         q.iter_mut().enumerate().for_each(|(i, o)| *o = value(i));
     }
+}
+
+/// Every coordinate of `a` times 2^e, in two exact steps (e in [−2046, 2046]; a product
+/// leaving f64's range gives 0 or ±∞ as it would in one step). O(len).
+fn scale_all(a: &mut [Vec3], e: i32) {
+    let (f1, f2) = (pow2(e / 2), pow2(e - e / 2));
+    a.iter_mut().flatten().for_each(|c| *c = *c * f1 * f2);
 }
 
 fn dot_all(a: &[Vec3], b: &[Vec3]) -> f64 {

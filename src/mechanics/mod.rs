@@ -299,6 +299,16 @@ impl Simulation {
         }
     }
 
+    /// [`Simulation::hold_fixed`] for the vertex ids `ids` only. O(|ids|).
+    fn hold_fixed_among(&self, body: &mut Body, ids: impl Iterator<Item = CellId>) {
+        let velocity = body.attrs_mut().velocity.as_mut_slice();
+        for v in ids {
+            if self.projection.system.inv_mass[v.index()] == 0.0 {
+                velocity[v.index()] = [0.0; 3];
+            }
+        }
+    }
+
     /// Records the body's velocity and position epochs: what was written so far is taken up.
     fn record_epochs(&mut self, body: &Body) {
         self.velocity_epoch = body.attrs().velocity_epoch;
@@ -396,12 +406,18 @@ impl Simulation {
         Ok(())
     }
 
-    /// Rebuilds the projection and the stepper's buffers after topological changes, keeping the
-    /// step count's configuration. O(darts + E log E).
+    /// Rebuilds the projection from the body after topological changes and fits the stepper's
+    /// buffers to it, keeping the configuration, the step count and the runaway test's energy
+    /// scale as [`Simulation::update`] does (pins, positions or velocities written since the
+    /// last step make the next step take the scale again). Fixed slots get zero velocity.
+    /// A simulation built for another body adopts `body` instead: it becomes
+    /// [`Simulation::new`] of `body` with this gravity and configuration (the step count
+    /// starts again, the scale is `body`'s). O(darts + E log E).
     ///
     /// # Errors
-    /// [`SimError::OtherBody`] if the simulation was built for another body (nothing changes);
-    /// otherwise as [`Simulation::new`].
+    /// For another body, as [`Simulation::new`]; for its own body, in checked builds (debug,
+    /// `expensive-checks`) [`StepError::BadInput`] for a projection the stepper cannot take (a
+    /// bug). Nothing changes on an error.
     ///
     /// # Examples
     ///
@@ -420,18 +436,35 @@ impl Simulation {
     /// sim.step(&mut body).unwrap();
     /// ```
     pub fn rebuild(&mut self, body: &mut Body) -> Result<(), SimError> {
-        let config = *self.stepper.config();
-        *self = Simulation::new(body, self.projection.system.gravity, config)?;
+        if self.check_body(body).is_err() {
+            let config = *self.stepper.config();
+            *self = Simulation::new(body, self.projection.system.gravity, config)?;
+            return Ok(());
+        }
+        let pins_written = !self.projection.pins_current(body);
+        let projection = Projection::build_raw(body, self.projection.system.gravity);
+        self.stepper.follow_system(&projection.system)?;
+        self.projection = projection;
+        self.hold_fixed(body);
+        if pins_written {
+            self.stepper.forget_energy_scale();
+        }
         Ok(())
     }
 
-    /// Follows topological changes incrementally ([`Projection::update`] with `touched`), then
-    /// re-sizes the stepper's buffers (a new [`Stepper`]: the step counter restarts, and the
-    /// energy scale of the runaway test is taken from the state at the next step, which refuses
-    /// a NaN or infinite state or energy scale with nothing changed). It reads the topology,
-    /// masses and pins, never the positions or velocities, so no state can make it fail halfway.
-    /// The projection part is O(touched cells · degree); the new stepper costs O(slots + springs)
-    /// (its buffers) until `Stepper` can grow its buffers in place.
+    /// Follows topological changes incrementally ([`Projection::update`] with `touched`) and fits
+    /// the stepper's buffers to the new system in place. The step count goes on, and the runaway
+    /// test keeps its energy scale: a cut, a tear or a removal puts no energy in (a split vertex's
+    /// two sides share its velocity and its mass, m = m₁ + m₂, so the kinetic energy is
+    /// unchanged; a removal only takes energy out), so a blow-up that runs on while the body is
+    /// cut is still caught and named by its step since the start (finding 177). Pins handed out
+    /// for writing since the last step are new energy put in by hand, as in
+    /// [`Simulation::step`]: the scale is taken again at the next step then. Fixed slots (pinned,
+    /// dead) get zero velocity, among the touched vertices and the new ids. It reads the
+    /// topology, masses and pins, never the positions or velocities, so no state can make it
+    /// fail halfway. O(touched cells · degree + new ids) amortised; O(slots) more when the pins
+    /// were handed out for writing, O(darts + E log E) when `touched` cannot be trusted and the
+    /// projection is rebuilt ([`Projection::update`]).
     ///
     /// # Errors
     /// [`SimError::OtherBody`] if the simulation was built for another body (nothing changes);
@@ -456,10 +489,19 @@ impl Simulation {
     /// ```
     pub fn update(&mut self, body: &mut Body, touched: &TouchedCells) -> Result<(), SimError> {
         self.check_body(body)?;
-        self.projection.update(body, touched);
-        self.hold_fixed(body);
-        // Follows the topology only: the new stepper has no energy scale, the next step takes it.
-        self.stepper = Stepper::with_buffers(*self.stepper.config(), &self.projection.system)?;
+        let (slots_before, pins_written) = (self.projection.system.slots(), !self.projection.pins_current(body));
+        let incremental = self.projection.update(body, touched);
+        self.stepper.follow_system(&self.projection.system)?;
+        if !incremental || pins_written {
+            self.hold_fixed(body);
+            if pins_written {
+                self.stepper.forget_energy_scale();
+            }
+            return Ok(());
+        }
+        let new_ids = (slots_before..self.projection.system.slots()).map(|v| CellId(v as u32));
+        let touched_ids = touched.vertices.iter().map(|&(v, _)| v);
+        self.hold_fixed_among(body, touched_ids.chain(new_ids));
         Ok(())
     }
 

@@ -80,6 +80,16 @@ pub enum SurfaceError {
         /// The number of vertices (`positions.len()`).
         vertices: usize,
     },
+    /// A triangle names one vertex at two of its corners (the fields of [`Surface`] are
+    /// public): a degenerate triangle, which the OBJ reader refuses (`RepeatedVertex`), so
+    /// [`Surface::to_obj`] does not write it.
+    #[error("triangle {triangle} uses vertex {vertex} at two corners")]
+    RepeatedCorner {
+        /// The triangle's index in `triangles`.
+        triangle: usize,
+        /// The repeated vertex index.
+        vertex: u32,
+    },
     /// A vertex position is NaN or infinite (the fields of [`Surface`] are public): no measure
     /// or OBJ file of it would be meaningful, and the OBJ reader refuses such a file.
     #[error("surface vertex {vertex} (vertex id {id}) has a non-finite position {position:?}")]
@@ -104,8 +114,9 @@ pub enum SurfaceError {
 /// An indexed triangle mesh: the boundary of a solid.
 ///
 /// Invariants (kept by the constructors of this module for finite input; the fields are public,
-/// so [`Surface::check`] checks the first two, and the measures and OBJ writers call it): every
-/// index of `triangles` is `< positions.len()`; every position is finite; every surface vertex
+/// so [`Surface::check`] checks the first three, and the measures and OBJ writers call it): every
+/// index of `triangles` is `< positions.len()`; no triangle names a vertex twice; every position
+/// is finite; every surface vertex
 /// is used by some triangle (the vertex array is compacted); `vertex_ids.len() ==
 /// positions.len()` and `face_volumes.len() == triangles.len()`;
 /// each triangle is oriented outward, i.e. its normal (b − a) × (c − a) points away from the
@@ -289,15 +300,17 @@ impl Builder {
 }
 
 impl Surface {
-    /// Checks that every triangle corner is an index into `positions` and that every position is
-    /// finite, the invariants the measures ([`Surface::area`], [`Surface::enclosed_volume`]) and
+    /// Checks that every triangle corner is an index into `positions`, that no triangle names a
+    /// vertex at two corners, and that every position is finite, the invariants the measures ([`Surface::area`], [`Surface::enclosed_volume`]) and
     /// the OBJ writers ([`Surface::to_obj`], [`Surface::write_obj`]) rely on; they call it first.
     /// O(triangles + vertices).
     ///
     /// # Errors
     /// [`SurfaceError::VertexOutOfRange`] naming the first triangle, corner and index past the
-    /// vertices; then [`SurfaceError::NonFinitePosition`] naming the first vertex with a NaN or
-    /// infinite coordinate.
+    /// vertices, or [`SurfaceError::RepeatedCorner`] naming the first triangle with a repeated
+    /// corner (whichever triangle comes first; range first within a triangle); then
+    /// [`SurfaceError::NonFinitePosition`] naming the first vertex with a NaN or infinite
+    /// coordinate.
     ///
     /// # Examples
     ///
@@ -312,6 +325,9 @@ impl Surface {
     ///     s.check(),
     ///     Err(SurfaceError::VertexOutOfRange { triangle: 1, corner: 0, index: 4, vertices: 4 })
     /// ));
+    /// s.triangles[1][0] = s.triangles[1][1]; // a degenerate triangle
+    /// let Err(SurfaceError::RepeatedCorner { triangle: 1, vertex }) = s.check() else { panic!() };
+    /// assert_eq!(vertex, s.triangles[1][1]);
     /// s.triangles[1][0] = 0;
     /// s.positions[2][1] = f64::NAN; // surface vertex 2 is point s.vertex_ids[2] of the mesh
     /// let Err(SurfaceError::NonFinitePosition { vertex: 2, id, .. }) = s.check() else { panic!() };
@@ -322,6 +338,11 @@ impl Surface {
         for (triangle, tri) in self.triangles.iter().enumerate() {
             if let Some((corner, &index)) = tri.iter().enumerate().find(|(_, &i)| i as usize >= vertices) {
                 return Err(SurfaceError::VertexOutOfRange { triangle, corner, index, vertices });
+            }
+            let [a, b, c] = *tri;
+            if a == b || a == c || b == c {
+                let vertex = if a == b || a == c { a } else { b };
+                return Err(SurfaceError::RepeatedCorner { triangle, vertex });
             }
         }
         if let Some((vertex, &position)) =
@@ -364,7 +385,8 @@ impl Surface {
     ///
     /// # Errors
     /// As [`Surface::check`]: [`SurfaceError::VertexOutOfRange`] naming the first triangle corner
-    /// past the vertices, [`SurfaceError::NonFinitePosition`] naming a non-finite vertex.
+    /// past the vertices, [`SurfaceError::RepeatedCorner`] naming a degenerate triangle,
+    /// [`SurfaceError::NonFinitePosition`] naming a non-finite vertex.
     ///
     /// # Examples
     ///
@@ -397,7 +419,8 @@ impl Surface {
     ///
     /// # Errors
     /// As [`Surface::check`]: [`SurfaceError::VertexOutOfRange`] naming the first triangle corner
-    /// past the vertices, [`SurfaceError::NonFinitePosition`] naming a non-finite vertex.
+    /// past the vertices, [`SurfaceError::RepeatedCorner`] naming a degenerate triangle,
+    /// [`SurfaceError::NonFinitePosition`] naming a non-finite vertex.
     ///
     /// # Examples
     ///
@@ -422,13 +445,25 @@ impl Surface {
 
     /// The surface as Wavefront OBJ text: a comment header, one `v x y z` line per vertex
     /// (shortest round-trip decimal form), one `f i j k` line per triangle (1-based indices, in
-    /// the triangle's outward orientation), which [`crate::io::parse_obj`] reads back bit for bit.
-    /// O(vertices + triangles), including the check.
+    /// the triangle's outward orientation). O(vertices + triangles), including the check.
+    ///
+    /// [`crate::io::parse_obj`] reads it back bit for bit (same positions, same triangles) when
+    /// the surface is one the mesh reader accepts: non-empty, and without two triangles on the
+    /// same three vertices. Two surfaces that pass the check are written but not read back:
+    /// - a body with a dissociated face whose corners did not split (an inner face cut alone:
+    ///   its vertices and edges stay whole) has both sides of the cut on its boundary, two
+    ///   coincident triangles of opposite orientation (a slit), which `parse_obj` refuses as a
+    ///   duplicate (`ReadError::DuplicateElement`);
+    /// - an empty surface (no tets, or every volume removed) writes a header-only file, which
+    ///   `parse_obj` refuses as an empty mesh.
+    ///
+    /// Both are legitimate boundaries of cut bodies (the demo writes them), so they are written.
     ///
     /// # Errors
     /// As [`Surface::check`]: [`SurfaceError::VertexOutOfRange`] naming the first triangle corner
-    /// past the vertices (a face with no vertex is not written), [`SurfaceError::NonFinitePosition`]
-    /// naming a NaN or infinite vertex (which the OBJ reader would refuse).
+    /// past the vertices (a face with no vertex is not written), [`SurfaceError::RepeatedCorner`]
+    /// naming a degenerate triangle and [`SurfaceError::NonFinitePosition`] naming a NaN or
+    /// infinite vertex (both of which the OBJ reader would refuse).
     ///
     /// # Examples
     ///
@@ -465,8 +500,8 @@ impl Surface {
     /// then a rename: see [`crate::store::write_atomically`]). O(vertices + triangles).
     ///
     /// # Errors
-    /// [`SurfaceError::VertexOutOfRange`] and [`SurfaceError::NonFinitePosition`] as
-    /// [`Surface::to_obj`], checked before anything is written (no file is created or replaced);
+    /// [`SurfaceError::VertexOutOfRange`], [`SurfaceError::RepeatedCorner`] and
+    /// [`SurfaceError::NonFinitePosition`] as [`Surface::to_obj`], checked before anything is written (no file is created or replaced);
     /// [`SurfaceError::Write`] naming `path`.
     ///
     /// # Examples

@@ -107,9 +107,9 @@ fn after_updates_every_fixed_slot_is_still() {
         sim.update(&mut body, &touched).unwrap();
         let sys = sim.projection.system();
         let v = body.attrs().velocity().as_slice();
-        for slot in 0..sys.slots() {
-            if sys.inv_mass()[slot] == 0.0 {
-                assert_eq!(v[slot], [0.0; 3], "fixed slot {slot} moves after update {round}");
+        for (slot, (&w, vel)) in sys.inv_mass().iter().zip(v).enumerate() {
+            if w == 0.0 {
+                assert_eq!(*vel, [0.0; 3], "fixed slot {slot} moves after update {round}");
             }
         }
         let free_moving = (0..sys.slots()).any(|s| sys.inv_mass()[s] > 0.0 && v[s] != [0.0; 3]);
@@ -164,8 +164,8 @@ fn the_implicit_scheme_steps_a_body_of_any_size() {
     assert!(unit[2] < 1.2 - 1e-5, "the pulled corner springs back: {unit:?}");
     for s in [1e-100, 1e-60, 1e-35, 1e35, 1e60, 1e90] {
         let x = run(s);
-        for k in 0..3 {
-            assert!((x[k] - unit[k]).abs() <= 1e-9, "scale {s:e}: x7/s = {x:?}, at scale 1 {unit:?}");
+        for (a, b) in x.iter().zip(&unit) {
+            assert!((a - b).abs() <= 1e-9, "scale {s:e}: x7/s = {x:?}, at scale 1 {unit:?}");
         }
     }
 }

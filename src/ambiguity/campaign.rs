@@ -11,7 +11,7 @@
 //! is an isomorphism) while the maps are not isomorphic (they differ in their number of faces).
 
 use crate::ambiguity::construct::{glued_faces, shared_face_dart, ConstructError, CutComplex};
-use crate::ambiguity::indexed::{Audit, CutOutcome, IndexedError, IndexedModel};
+use crate::ambiguity::indexed::{Audit, AuditError, CutOutcome, IndexedError, IndexedModel};
 use crate::generate::SplitMix64;
 use crate::gmap::GMap;
 use crate::BuildError;
@@ -48,6 +48,17 @@ pub enum CampaignError {
         /// Interior faces.
         faces: usize,
     },
+}
+
+impl From<AuditError> for CampaignError {
+    /// [`AuditError::Build`] as [`CampaignError::Build`], [`AuditError::Cut`] as
+    /// [`CampaignError::Indexed`] (its [`IndexedError::NoSuchTet`]).
+    fn from(e: AuditError) -> Self {
+        match e {
+            AuditError::Build(b) => CampaignError::Build(b),
+            AuditError::Cut { source, .. } => CampaignError::Indexed(source),
+        }
+    }
 }
 
 /// A symptom found after a cut sequence.
@@ -326,7 +337,9 @@ pub fn ddmin<T: Clone>(items: &[T], budget: usize, test: &mut dyn FnMut(&[T]) ->
 }
 
 /// The complex restricted to the tets `keep` (indices into `c.tets`), points renumbered densely in
-/// order of first use, cuts renumbered; `None` if a cut names a dropped tet. O(tets + cuts).
+/// order of first use, cuts renumbered; `None` if a cut names a dropped tet, and likewise (never
+/// a panic) if an index is out of range: a tet of `keep` past `c.tets`, a point of a kept tet
+/// past `c.points`, or a cut naming a tet past `c.tets`. O(tets + cuts).
 ///
 /// # Examples
 ///
@@ -338,6 +351,7 @@ pub fn ddmin<T: Clone>(items: &[T], budget: usize, test: &mut dyn FnMut(&[T]) ->
 /// assert_eq!(sub_complex(&c, &[1]), None); // the cut names the dropped tet 0
 /// let alone = sub_complex(&second, &[1]).unwrap();
 /// assert_eq!((alone.points, alone.tets), (4, vec![[0, 1, 2, 3]]));
+/// assert_eq!(sub_complex(&second, &[5]), None); // no tet 5
 /// ```
 pub fn sub_complex(c: &CutComplex, keep: &[usize]) -> Option<CutComplex> {
     let mut tet_map = vec![u32::MAX; c.tets.len()];
@@ -345,21 +359,23 @@ pub fn sub_complex(c: &CutComplex, keep: &[usize]) -> Option<CutComplex> {
     let mut points = 0u32;
     let mut tets = Vec::with_capacity(keep.len());
     for (new, &t) in keep.iter().enumerate() {
-        tet_map[t] = new as u32;
-        let tet = c.tets[t].map(|p| {
-            if point_map[p as usize] == u32::MAX {
-                point_map[p as usize] = points;
+        *tet_map.get_mut(t)? = new as u32;
+        let mut tet = *c.tets.get(t)?;
+        for p in &mut tet {
+            let slot = point_map.get_mut(*p as usize)?;
+            if *slot == u32::MAX {
+                *slot = points;
                 points += 1;
             }
-            point_map[p as usize]
-        });
+            *p = *slot;
+        }
         tets.push(tet);
     }
     let cuts = c
         .cuts
         .iter()
         .map(|&[a, b]| {
-            let (ma, mb) = (tet_map[a as usize], tet_map[b as usize]);
+            let (ma, mb) = (*tet_map.get(a as usize)?, *tet_map.get(b as usize)?);
             (ma != u32::MAX && mb != u32::MAX).then_some([ma, mb])
         })
         .collect::<Option<Vec<_>>>()?;

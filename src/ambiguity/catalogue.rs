@@ -187,7 +187,8 @@ fn describe<const N: usize>(a: &Candidate<N>, b: &Candidate<N>) -> String {
     format!("{} vs {}", origin_text(&a.origin), origin_text(&b.origin))
 }
 
-/// A construction in one line: a gluing word, or tets and cuts.
+/// A construction in one line: a gluing word ([`crate::ambiguity::construct::Gluing::word`]:
+/// `?` for a gluing that names a side past the last one, never a panic), or tets and cuts.
 ///
 /// # Examples
 ///
@@ -198,6 +199,8 @@ fn describe<const N: usize>(a: &Candidate<N>, b: &Candidate<N>) -> String {
 ///
 /// let torus = Gluing { sides: vec![4], pairs: vec![[0, 2, 0], [1, 3, 0]] };
 /// assert_eq!(origin_text(&Origin::Gluing(torus)), "(a b a' b')");
+/// let bad = Gluing { sides: vec![2], pairs: vec![[0, 5, 0]] }; // `build` refuses side 5 of 2
+/// assert_eq!(origin_text(&Origin::Gluing(bad)), "?");
 /// let tet = CutComplex { points: 4, tets: vec![[0, 1, 2, 3]], cuts: vec![] };
 /// assert_eq!(origin_text(&Origin::Complex(tet)), "tets [[0, 1, 2, 3]] cut []");
 /// ```

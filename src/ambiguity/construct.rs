@@ -150,6 +150,12 @@ impl Gluing {
     /// The gluing as a word per polygon: letters for glued sides (`x'` = x⁻¹), `·` for boundary
     /// sides, e.g. `(a b a' b')` for the torus. O(sides).
     ///
+    /// Pair k is named by the letter `a` + k mod 26, followed from the 27th pair on by the round
+    /// k / 26 (`a` … `z`, then `a1` … `z1`, `a2` …), so that distinct pairs always get distinct
+    /// names. The fields are public, so a gluing may name a side past the last one (which
+    /// [`Gluing::build`] refuses with [`ConstructError::BadSide`]): its word is then `?`, and
+    /// never a panic.
+    ///
     /// # Examples
     ///
     /// ```
@@ -159,12 +165,22 @@ impl Gluing {
     /// assert_eq!(klein.word(), "(a b a' b)");
     /// let open = Gluing { sides: vec![3, 1], pairs: vec![] };
     /// assert_eq!(open.word(), "(· · ·) (·)");
+    /// let bad = Gluing { sides: vec![2], pairs: vec![[0, 5, 0]] }; // side 5 of 2
+    /// assert_eq!(bad.word(), "?");
+    /// let squares = Gluing { sides: vec![4; 14], pairs: (0..28u16).map(|k| [2 * k, 2 * k + 1, 0]).collect() };
+    /// assert!(squares.word().ends_with("(y y' z z') (a1 a1' b1 b1')"));
     /// ```
     pub fn word(&self) -> String {
         let total = self.side_count();
+        if self.pairs.iter().any(|&[a, b, _]| a as usize >= total || b as usize >= total) {
+            return "?".to_string();
+        }
         let mut label = vec!["·".to_string(); total];
         for (n, &[a, b, same]) in self.pairs.iter().enumerate() {
-            let letter = char::from(b'a' + (n % 26) as u8).to_string();
+            let mut letter = char::from(b'a' + (n % 26) as u8).to_string();
+            if n >= 26 {
+                letter.push_str(&(n / 26).to_string());
+            }
             label[a as usize] = letter.clone();
             label[b as usize] = if same != 0 { letter } else { format!("{letter}'") };
         }

@@ -63,7 +63,8 @@ pub enum DartsError {
         /// The involution.
         i: usize,
     },
-    /// The kernel refused a sew: the links break the quasi-manifold law.
+    /// The kernel refused a sew: the links break the quasi-manifold law (the kernel refuses only
+    /// some such links; the others are [`DartsError::NotQuasiManifold`]).
     #[error("rebuilding alpha{i} at dart {dart}: {source}")]
     Sew {
         /// The dart.
@@ -72,6 +73,23 @@ pub enum DartsError {
         i: usize,
         /// The kernel's reason.
         source: SewError,
+    },
+    /// The links break the quasi-manifold law (some αi∘αj with j ≥ i + 2 is no involution) in a
+    /// way the kernel's orbit sews do not refuse: sewing the stored pairs also linked darts that
+    /// the data stores otherwise. `dart` and `i` name the first difference (smallest dart, then
+    /// smallest i) between the rebuilt links and the stored ones.
+    #[error(
+        "the links break the quasi-manifold law: the rebuilt alpha{i} of dart {dart} is {rebuilt}, the stored one {stored}"
+    )]
+    NotQuasiManifold {
+        /// The dart.
+        dart: usize,
+        /// The involution.
+        i: usize,
+        /// αi(dart) as stored.
+        stored: u32,
+        /// αi(dart) in the map the sews built.
+        rebuilt: u32,
     },
     /// The kernel could not create the darts.
     #[error("cannot create dart {0}")]
@@ -103,8 +121,16 @@ impl DartsJson {
 
     /// Rebuilds the map through the public kernel API only: creates the darts, then sews α0,
     /// α1, …, αn in that order (when αi is sewn, the involutions αj with j ≤ i − 2 it must commute
-    /// with are already in place and those with j ≥ i + 2 are still free, so every orbit sew
-    /// links exactly the stored pairs). O(darts · n²).
+    /// with are already in place and those with j ≥ i + 2 are still free, so for links that obey
+    /// the quasi-manifold law every orbit sew links exactly the stored pairs). Links that break
+    /// the law are refused: either a sew fails, or an orbit sew links darts the data stores
+    /// otherwise, and the rebuilt links are compared with the stored ones at the end (the map is
+    /// returned only if [`DartsJson::of`] of it is `self`). O(darts · n²).
+    ///
+    /// # Errors
+    /// [`DartsError::Dimension`], [`DartsError::BadRow`], [`DartsError::NotInvolution`] for
+    /// malformed rows; [`DartsError::Sew`] or [`DartsError::NotQuasiManifold`] for links that are
+    /// no n-G-map.
     ///
     /// # Examples
     ///
@@ -117,6 +143,12 @@ impl DartsJson {
     /// let back: GMap<3> = json.to_map().unwrap();
     /// assert!(back.is_isomorphic(&map));
     /// assert!(matches!(json.to_map::<2>(), Err(DartsError::Dimension { expected: 2, found: 3 })));
+    /// // Edges 0–1 and 2–3, α2 linking 0 and 2 only: α0α2(0) = 3 but α0α2(3) = 2.
+    /// let bad = DartsJson { dim: 2, alpha: vec![vec![1, 0, 2], vec![0, 1, 1], vec![3, 2, 0], vec![2, 3, 3]] };
+    /// assert!(matches!(
+    ///     bad.to_map::<2>(),
+    ///     Err(DartsError::NotQuasiManifold { dart: 1, i: 2, stored: 1, rebuilt: 3 })
+    /// ));
     /// ```
     pub fn to_map<const N: usize>(&self) -> Result<GMap<N>, DartsError> {
         if self.dim != N {
@@ -140,6 +172,16 @@ impl DartsJson {
                 })?;
             }
         }
+        // The darts were created as 0..len: compare the rebuilt links with the stored ones.
+        for (d, row) in self.alpha.iter().enumerate() {
+            for (i, &stored) in row.iter().enumerate() {
+                let rebuilt = map.alpha_dyn(i, DartId(d as u32)).0;
+                if rebuilt != stored {
+                    return Err(DartsError::NotQuasiManifold { dart: d, i, stored, rebuilt });
+                }
+            }
+        }
+        debug_assert!(DartsJson::of(&map) == *self);
         Ok(map)
     }
 

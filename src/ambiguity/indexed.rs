@@ -121,6 +121,38 @@ pub enum IndexedError {
     },
 }
 
+/// Why [`IndexedModel::audit`] could not compare the models.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ambiguity::construct::CutComplex;
+/// use topomech::ambiguity::indexed::{AuditError, IndexedError, IndexedModel};
+///
+/// let tets = [[0, 1, 2, 3], [1, 2, 3, 4]];
+/// let model = IndexedModel::new(5, &tets).unwrap();
+/// let gmap = CutComplex { points: 5, tets: tets.to_vec(), cuts: vec![] }.build().unwrap();
+/// assert_eq!(
+///     model.audit(&gmap, &[[0, 9]], &[]).unwrap_err(),
+///     AuditError::Cut { cut: 0, source: IndexedError::NoSuchTet { tet: 9, tets: 2 } }
+/// );
+/// ```
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum AuditError {
+    /// A cut names a tet past the end of the model's tet list
+    /// ([`IndexedError::NoSuchTet`]).
+    #[error("cut {cut}: {source}")]
+    Cut {
+        /// The cut's index in `cuts`.
+        cut: usize,
+        /// Why it is refused.
+        source: IndexedError,
+    },
+    /// The model's tet list no longer builds as a g-map.
+    #[error(transparent)]
+    Build(#[from] BuildError),
+}
+
 /// [`IndexedError::NoSuchPoint`] for the first point of `tet` (tet number `t`) past `points`.
 fn check_points(t: usize, tet: &[u32; 4], points: usize) -> Result<(), IndexedError> {
     match tet.iter().find(|&&p| p as usize >= points) {
@@ -433,8 +465,13 @@ impl IndexedModel {
 
     /// Compares the model with `gmap`, the g-map built from the same input by `GMap::from_tets`
     /// and cut by `unsew::<3>` on the same `cuts` (with `outcomes` the model's results of them).
-    /// Errors: the tet list no longer builds (cannot happen with this cut rule: it never makes a
-    /// face shared by three tets). O(tets + darts · n).
+    /// O(tets + cuts + darts · n).
+    ///
+    /// # Errors
+    /// [`AuditError::Cut`] for the first cut that names a tet past the end of the tet list (as
+    /// [`IndexedModel::cut`] refuses it: [`IndexedError::NoSuchTet`]), checked first, never a
+    /// panic; [`AuditError::Build`] if the tet list no longer builds (cannot happen with this cut
+    /// rule: it never makes a face shared by three tets).
     ///
     /// # Examples
     ///
@@ -450,7 +487,12 @@ impl IndexedModel {
     /// assert!(!audit.ambiguous() && !audit.wrong() && audit.gmap_valid);
     /// assert_eq!((audit.gmap_vertices, audit.indexed_vertices), (8, 8));
     /// ```
-    pub fn audit(&self, gmap: &GMap<3>, cuts: &[[u32; 2]], outcomes: &[CutOutcome]) -> Result<Audit, BuildError> {
+    pub fn audit(&self, gmap: &GMap<3>, cuts: &[[u32; 2]], outcomes: &[CutOutcome]) -> Result<Audit, AuditError> {
+        for (cut, &[a, b]) in cuts.iter().enumerate() {
+            for t in [a, b] {
+                self.tet(t).map_err(|source| AuditError::Cut { cut, source })?;
+            }
+        }
         let (rebuilt, report) = GMap::<3>::from_tets(self.points, &self.tets)?;
         let gluing_differs = gmap.capacity() != rebuilt.capacity()
             || gmap.darts().any(|d| !rebuilt.contains(d) || rebuilt.alpha::<3>(d) != gmap.alpha::<3>(d));

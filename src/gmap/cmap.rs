@@ -32,7 +32,9 @@ pub struct CombinatorialMap {
 
 impl CombinatorialMap {
     /// Checks that β1 is a permutation and every βi (i ≥ 2) an involution without fixed points
-    /// where defined. O(darts · n).
+    /// where defined. `false` (never a panic) when `beta1` or a row of `beta` does not have
+    /// exactly `origin.len()` entries, so no β may name a dart that does not exist.
+    /// O(darts · n).
     ///
     /// # Examples
     ///
@@ -51,6 +53,9 @@ impl CombinatorialMap {
     /// ```
     pub fn is_valid(&self) -> bool {
         let n = self.origin.len();
+        if self.beta1.len() != n || self.beta.iter().any(|bi| bi.len() != n) {
+            return false;
+        }
         let mut hit = vec![false; n];
         for &b in &self.beta1 {
             if b as usize >= n || std::mem::replace(&mut hit[b as usize], true) {

@@ -6,8 +6,8 @@
 //!
 //! | [`GraphKind`] | nodes | an edge {a, b} with weight m when |
 //! |---|---|---|
-//! | `VertexEdge` (1-skeleton) | 0-cells | m 1-cells have endpoints a and b (a = b: m loops) |
-//! | `Dual` | n-cells | m (n−1)-cells lie between n-cells a and b (a = b: glued to itself) |
+//! | `VertexEdge` (1-skeleton) | 0-cells | m 1-cells have endpoints a and b (a = b: m loops, each with two distinct end incidences at a; a folded edge is no loop, see below) |
+//! | `Dual` | n-cells | m (n−1)-cells lie between n-cells a and b (a = b: m (n−1)-cells each with two distinct incidences at a, i.e. a glued to itself across two different faces; a folded (n−1)-cell is no loop, see below) |
 //! | `Incidence` | every cell | a is a k-cell, b a (k+1)-cell, and a occurs m times in ∂b |
 //!
 //! # Incidences and their multiplicity
@@ -21,9 +21,23 @@
 //! "incidence graph with multiplicities", which is still ambiguous (torus and Klein bottle share
 //! it: see `docs/ambiguity.md`).
 //!
-//! An edge with a single endpoint incidence (an α0-free dart: a dangling half-edge) adds no edge
-//! to the 1-skeleton; an (n−1)-cell on the boundary (αn-free) adds none to the dual graph. Both
-//! still appear in the incidence graph.
+//! # Cells with a single end incidence
+//! The 1-skeleton and the dual graph join the two *end incidences* of an edge (its two vertex
+//! incidences, orbits ⟨α2, …, αn⟩) or of an (n−1)-cell (its two n-cell incidences, orbits
+//! ⟨α0, …, αn−2⟩). A cell with a single end incidence adds nothing to these two graphs. That is
+//! the case of
+//! - a dangling half-edge (an α0-free dart) and a boundary (n−1)-cell (αn-free);
+//! - a *folded* cell, sewn but onto itself: an edge with α0(d) in the ⟨α2, …, αn⟩ orbit of d (the
+//!   edge is identified with its own reverse; the quotient of a segment by its reflection is a
+//!   half-edge with one vertex end and the fold as its other end), and an (n−1)-cell glued to
+//!   itself by its own reflection, αn(d) in its ⟨α0, …, αn−2⟩ orbit (for n = 3: α3(d) in the
+//!   ⟨α0, α1⟩ orbit of d; the quotient has one n-cell side).
+//!
+//! A *loop* is different: an edge whose two ends are two distinct incidences at the same vertex
+//! (a = b in the table) counts one unit of weight on {a, a}, and likewise an (n−1)-cell whose two
+//! sides are two distinct incidences with the same n-cell. All these cells still appear in the
+//! incidence graph, with their true multiplicity (a folded edge has multiplicity 1 at its vertex,
+//! a loop 2).
 //!
 //! Cost: every export is O(darts · n) plus the graph size.
 
@@ -220,7 +234,8 @@ impl Builder {
 }
 
 /// Joins, for each c-cell, the cells of dimension `end_dim` it has incidences with, pairwise: a
-/// c-cell with exactly two end incidences (counting multiplicity) adds one to that edge.
+/// c-cell with exactly two end incidences (counting multiplicity) adds one to that edge. A cell
+/// with one end incidence (free, or folded onto itself: see the module docs) adds nothing.
 fn join_through(b: &mut Builder, inc: &BTreeMap<(u32, u32), u32>, end_dim: usize, ends_are_low: bool) {
     let mut ends: BTreeMap<u32, Vec<u32>> = BTreeMap::new();
     for (&(low, high), &m) in inc {
@@ -236,8 +251,9 @@ fn join_through(b: &mut Builder, inc: &BTreeMap<(u32, u32), u32>, end_dim: usize
     }
 }
 
-/// The 1-skeleton: vertices, and one unit of weight per edge joining its two endpoints.
-/// O(darts · n). Panics for N = 0 (not a valid map dimension anyway).
+/// The 1-skeleton: vertices, and one unit of weight per edge joining its two endpoints (two
+/// distinct end incidences; a dangling or folded edge has one and adds nothing: see the
+/// [module docs](self)). O(darts · n). Panics for N = 0 (not a valid map dimension anyway).
 ///
 /// # Examples
 ///
@@ -256,8 +272,9 @@ pub fn vertex_edge_graph<const N: usize>(map: &GMap<N>) -> CellGraph {
     b.finish()
 }
 
-/// The dual graph: n-cells, and one unit of weight per (n−1)-cell lying between two of them.
-/// O(darts · n).
+/// The dual graph: n-cells, and one unit of weight per (n−1)-cell lying between two of them (two
+/// distinct n-cell incidences; a boundary or folded (n−1)-cell has one and adds nothing: see the
+/// [module docs](self)). O(darts · n).
 ///
 /// # Examples
 ///

@@ -1463,9 +1463,9 @@ fn spring_pass_body(springs: Springs<'_>, x: &[Vec3], v: &[Vec3], out: &mut [Vec
         {
             let (dx, dy, dz) = (&d[0][..n], &d[1][..n], &d[2][..n]);
             for j in 0..n {
-                let (q, l2) = spring_scale(dx[j], dy[j], dz[j], dvx[j], dvy[j], dvz[j], rest[j], k[j], damp[j]);
+                let (q, untrusted) = spring_scale(dx[j], dy[j], dz[j], dvx[j], dvy[j], dvz[j], rest[j], k[j], damp[j]);
                 s[j] = q;
-                rare |= outside_plain(l2);
+                rare |= untrusted;
             }
         }
         if rare != 0 {
@@ -1486,8 +1486,10 @@ fn spring_pass_body(springs: Springs<'_>, x: &[Vec3], v: &[Vec3], out: &mut [Vec
 fn redo_rare(d: &mut [[f64; BLOCK]; 3], dv: &[[f64; BLOCK]; 3], rest: &[f64], k: &[f64], damp: &[f64], s: &mut [f64]) {
     for j in 0..s.len() {
         let mut e = [d[0][j], d[1][j], d[2][j]];
-        if !PLAIN_L2.contains(&(e[0] * e[0] + e[1] * e[1] + e[2] * e[2])) {
-            s[j] = spring_scale_rare(&mut e, [dv[0][j], dv[1][j], dv[2][j]], rest[j], k[j], damp[j], s[j]);
+        let w = [dv[0][j], dv[1][j], dv[2][j]];
+        let (q, untrusted) = spring_scale(e[0], e[1], e[2], w[0], w[1], w[2], rest[j], k[j], damp[j]);
+        if untrusted != 0 {
+            s[j] = spring_scale_rare(&mut e, w, rest[j], k[j], damp[j], q);
             (d[0][j], d[1][j], d[2][j]) = (e[0], e[1], e[2]);
         }
     }
@@ -1605,9 +1607,9 @@ fn spring_blocks4(springs: Springs<'_>, y: &[SlotState], sink: &mut impl BlockSi
             // The pads are +0, so l2 + (pad² + pad²) = l2 exactly; reading them keeps the
             // interleaved loads gap-free, which spares the vectoriser a scalar epilogue.
             let pads = e[3] * e[3] + w[3] * w[3];
-            let (q, l2) = spring_scale_padded(e[0], e[1], e[2], w[0], w[1], w[2], pads, rest[j], k[j], damp[j]);
+            let (q, untrusted) = spring_scale_padded(e[0], e[1], e[2], w[0], w[1], w[2], pads, rest[j], k[j], damp[j]);
             s[j] = q;
-            rare |= outside_plain(l2);
+            rare |= untrusted;
         }
         if rare != 0 {
             redo_rare4(dd, ddv, rest, k, damp, s);
@@ -1617,16 +1619,18 @@ fn spring_blocks4(springs: Springs<'_>, y: &[SlotState], sink: &mut impl BlockSi
     }
 }
 
-/// The cold pass of a block of [`spring_blocks4`] with a rare lane: redoes each spring whose l²
-/// is outside [`PLAIN_L2`] with [`spring_scale_rare`] (its d rescaled in place).
+/// The cold pass of a block of [`spring_blocks4`] with a rare lane: redoes each spring whose
+/// branch-free scale is untrusted ([`spring_scale_padded`], the same bits recomputed on one lane)
+/// with [`spring_scale_rare`] (its s and d replaced).
 #[cold]
 #[inline(never)]
 fn redo_rare4(d: &mut [Rec4], dv: &[Rec4], rest: &[f64], k: &[f64], damp: &[f64], s: &mut [f64]) {
     for j in 0..s.len() {
         let (e, w) = (&mut d[j], dv[j]);
-        let l2 = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) + (e[3] * e[3] + w[3] * w[3]);
-        if !PLAIN_L2.contains(&l2) {
-            s[j] = spring_scale_rare(&mut e[..3], [w[0], w[1], w[2]], rest[j], k[j], damp[j], s[j]);
+        let pads = e[3] * e[3] + w[3] * w[3];
+        let (q, untrusted) = spring_scale_padded(e[0], e[1], e[2], w[0], w[1], w[2], pads, rest[j], k[j], damp[j]);
+        if untrusted != 0 {
+            s[j] = spring_scale_rare(&mut e[..3], [w[0], w[1], w[2]], rest[j], k[j], damp[j], q);
         }
     }
 }
@@ -1652,7 +1656,7 @@ fn spring_force4(springs: &Springs<'_>, s: usize, y: &[SlotState]) -> Vec3 {
     let mut d: Rec4 = std::array::from_fn(|c| yb.x[c] - ya.x[c]);
     let w: Rec4 = std::array::from_fn(|c| yb.v[c] - ya.v[c]);
     let pads = d[3] * d[3] + w[3] * w[3];
-    let (mut q, l2) = spring_scale_padded(
+    let (mut q, untrusted) = spring_scale_padded(
         d[0],
         d[1],
         d[2],
@@ -1664,8 +1668,15 @@ fn spring_force4(springs: &Springs<'_>, s: usize, y: &[SlotState]) -> Vec3 {
         springs.stiffness[s],
         springs.damping[s],
     );
-    if !PLAIN_L2.contains(&l2) {
-        q = spring_scale_rare(&mut d, [w[0], w[1], w[2]], springs.rest[s], springs.stiffness[s], springs.damping[s], q);
+    if untrusted != 0 {
+        q = spring_scale_rare(
+            &mut d[..3],
+            [w[0], w[1], w[2]],
+            springs.rest[s],
+            springs.stiffness[s],
+            springs.damping[s],
+            q,
+        );
     }
     [q * d[0], q * d[1], q * d[2]]
 }
@@ -1818,11 +1829,11 @@ pub fn spring_force(xa: Vec3, xb: Vec3, va: Vec3, vb: Vec3, rest: f64, k: f64, c
 
 /// The scalar s with F_s = s·d: s = [k (l − L) l + c (dv·d)] / l², one sqrt and one division;
 /// zero when l = 0. This is [`spring_scale_padded`] with pads −0: x + (−0) = x for every x, so
-/// the compiler drops the addition (the same machine code as a copy without it). Also returns l²:
-/// outside [`PLAIN_L2`], s must be redone by [`spring_scale_rare`].
+/// the compiler drops the addition (the same machine code as a copy without it). Also returns
+/// whether s is untrusted (1) and must be redone by [`spring_scale_rare`].
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn spring_scale(dx: f64, dy: f64, dz: f64, dvx: f64, dvy: f64, dvz: f64, rest: f64, k: f64, c: f64) -> (f64, f64) {
+fn spring_scale(dx: f64, dy: f64, dz: f64, dvx: f64, dvy: f64, dvz: f64, rest: f64, k: f64, c: f64) -> (f64, u64) {
     spring_scale_padded(dx, dy, dz, dvx, dvy, dvz, -0.0, rest, k, c)
 }
 
@@ -1835,11 +1846,42 @@ fn spring_scale(dx: f64, dy: f64, dz: f64, dvx: f64, dvy: f64, dvz: f64, rest: f
 /// states) go to [`spring_scale_rare`].
 const PLAIN_L2: std::ops::RangeInclusive<f64> = 1.221974545399842e-150..=3.273390607896142e150; // 2⁻⁴⁹⁸ ..= 2⁵⁰⁰
 
-/// [`spring_scale`] with `pads` (±0) added to l²: the same bits. Branch-free, and l² with it: the
-/// callers flag the blocks with an l² outside [`PLAIN_L2`] ([`outside_plain`]) and redo the springs whose l² is outside [`PLAIN_L2`] with [`spring_scale_rare`],
-/// which is where the plain quotient is wrong (a subnormal l², finding 168) or undefined (l² = 0,
-/// coincident ends: 0/0; l² = ∞). Inside, the quotient has the bits it had with the former guard
-/// max(l², MIN_POSITIVE) and select, which only ever mattered outside.
+/// 2²⁵⁰: the largest damping c the branch-free scale keeps (see [`spring_scale_padded`]).
+const PLAIN_DAMPING: f64 = 1.8092513943330656e75; // 2²⁵⁰
+
+/// 2⁵²⁵: the largest |n| + |k (l − L)| the branch-free scale keeps (see [`spring_scale_padded`]).
+const PLAIN_TERMS_MAX: f64 = 1.0983676256208976e158; // 2⁵²⁵
+
+/// The bits of 2⁻⁵²¹: the smallest nonzero |n| + |k (l − L)| the branch-free scale keeps (see
+/// [`spring_scale_padded`]).
+const PLAIN_TERMS_MIN_BITS: i64 = 2260807012939988992; // (2⁻⁵²¹).to_bits()
+
+/// [`spring_scale`] with `pads` (±0) added to l²: the same bits. Branch-free, and with it a flag
+/// (1 = untrusted) that the callers OR over a block and, when set, redo the flagged springs
+/// with [`spring_scale_rare`], which evaluates the same formula with an unbounded exponent. With
+/// n = k (l − L) l + c (dv·d) the numerator and t = |n| + |k (l − L)|, the flag is set exactly
+/// when
+///
+/// 1. l² is outside [`PLAIN_L2`] (a subnormal l², finding 168; l² = 0, coincident ends: 0/0;
+///    l² = ∞; so below l ∈ [2⁻²⁴⁹, 2²⁵⁰], l² and l without under- or overflow), or
+/// 2. t is above 2⁵²⁵ or NaN (an overflow anywhere, which reaches n as ±∞ or NaN; below, |s| =
+///    |n| / l² ≤ 2⁵²⁵⁺⁴⁹⁸ is finite), or
+/// 3. 0 < t < 2⁻⁵²¹ (a numerator or an elastic force near or below the subnormals), or
+/// 4. c > 2²⁵⁰ (damping so large that the products dvₖ dₖ rounded among the subnormals matter).
+///
+/// Unflagged, nothing overflowed, and underflow moved F = s·d by at most 2⁻¹⁰⁷⁵ (k (l − L), the
+/// elastic force itself, rounded among the subnormals) plus (3c + 2)·2⁻¹⁰⁷⁵ / l (the products
+/// dvₖ dₖ, c (dv·d) and k (l − L)·l rounded among the subnormals, divided by l on the way to F)
+/// plus 2⁻¹⁰⁷⁵ l (s rounded among the subnormals): either |n| ≥ 2⁻⁵²² and then s is normal and
+/// all this is below 2⁻⁵² |F| (|F| = |n| / l), or |k (l − L)| ≥ 2⁻⁵²² and |n| is a cancellation
+/// of two terms of at least 2⁻⁷⁷¹ and it is below 2⁻⁵² of their size, the accuracy the plain
+/// formula has anyway. Where nothing underflowed the plain result has exactly the bits of the
+/// cold path. Left as 0: t = 0, that is k (l − L) = 0 and n = 0 (a spring at its rest length
+/// with no relative velocity along it: the common case that needs no work), which is exact
+/// unless c (dv·d) underflowed to 0 with dv ≠ 0, c ≠ 0: then the true force is below
+/// 3c·2⁻¹⁰⁷⁵ / l ≤ 2⁻⁵⁷⁴ (every product dvₖ dₖ below 2⁻¹⁰⁷⁵, or c (dv·d) below it).
+///
+/// Cost: three `and`s, an addition, four compares next to the sqrt and the division.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn spring_scale_padded(
@@ -1853,55 +1895,74 @@ fn spring_scale_padded(
     rest: f64,
     k: f64,
     c: f64,
-) -> (f64, f64) {
+) -> (f64, u64) {
     let l2 = (dx * dx + dy * dy + dz * dz) + pads;
     let l = l2.sqrt();
-    let num = k * (l - rest) * l + c * (dvx * dx + dvy * dy + dvz * dz);
-    (num / l2, l2)
+    let elastic = k * (l - rest);
+    let num = elastic * l + c * (dvx * dx + dvy * dy + dvz * dz);
+    let terms = num.abs() + elastic.abs();
+    // 0 < terms < 2⁻⁵²¹ on the bits: terms ≥ +0 (or NaN), so bits − 1 as an unsigned number is
+    // below bits(2⁻⁵²¹) − 1 exactly then; the unsigned order is the signed one shifted by 2⁶³.
+    let tiny = ((terms.to_bits() as i64).wrapping_add(i64::MAX)) < (PLAIN_TERMS_MIN_BITS - 1).wrapping_add(i64::MIN);
+    let outside = (l2 < *PLAIN_L2.start()) | (l2 > *PLAIN_L2.end());
+    // !(t ≤ max), not t > max: a NaN t (an overflow met a 0 or an opposite ∞) is untrusted too,
+    // in one compare.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
+    let untrusted = outside | !(terms <= PLAIN_TERMS_MAX) | tiny | (c > PLAIN_DAMPING);
+    (num / l2, untrusted as u64)
 }
 
-/// 1 when l² is below or above [`PLAIN_L2`], else 0: an integer the block loops OR together
-/// (two vector compares and an OR per lane group; a float min/max reduction would not
-/// vectorise). A NaN l², from a NaN state, gives 0: its force is NaN either way. O(1).
-#[inline(always)]
-fn outside_plain(l2: f64) -> u64 {
-    ((l2 < *PLAIN_L2.start()) | (l2 > *PLAIN_L2.end())) as u64
-}
-
-/// The cold path of a spring whose l² is outside [`PLAIN_L2`] (see [`spring_scale_padded`],
-/// whose result `q` it is given): returns s' and rescales `d` in place to d' = 2^p d so that
-/// F_s = s'·d' is k (l − L) n + c (dv·n) n, n = d / l, for any finite d ≠ 0 whose force is
-/// representable. The largest |d'ₖ| is in [1, 2) (a power-of-two scaling, exact but for
-/// components 2⁻¹⁰²² below the largest), l is measured as [`super::geom::rest_length`] measures
-/// a rest length (so a spring in its rest shape feels exactly k·0), and
-/// s' = [k (l − L) l' + c (dv·d')] / l'² with l' = 2^p l in [1, 2√3]: no intermediate over- or
-/// underflows unless the force does. Returns 0 when d is 0 (coincident ends: no force), and keeps
-/// `q` (and d) when d is not finite (NaN, as before) or of plain extent after all (the
-/// branch-free bits). O(1).
+/// The cold path of a spring whose branch-free scale `q` is untrusted (see
+/// [`spring_scale_padded`]): returns s' and replaces `d` (its first three entries) by d' so that
+/// F_s = s'·d' is [k (l − L) l + c (dv·d)] / l² · d evaluated with an unbounded exponent
+/// (`crate::wide`: each operation rounded as in `f64`, in the plain operation order), that is,
+/// k (l − L) n + c (dv·n) n, n = d / l, for any finite d ≠ 0, to within an ulp wherever the force
+/// is a normal `f64`; a component is ±∞ or 0 only when it is past `f64::MAX` or below half the
+/// smallest subnormal. l is measured as [`super::geom::rest_length`] measures a rest length, so a
+/// spring in its rest shape feels exactly k·0 (the plain √l² of the hot path inside
+/// [`crate::mesh::PLAIN_EXTENT`], [`crate::mesh::distance`] outside). Where no plain
+/// intermediate over- or underflows, s' = q and d' = d, the hot path's bits; where s is a normal
+/// `f64`, s' = s and d' = d (F_s = s·d rounded once per component); else s' = 1 and d' = F_s,
+/// each component rounded from the wide product (twice only among the subnormals). Returns 0
+/// when d is 0 (coincident ends: no force), and keeps `q` (and d) when a state or parameter is
+/// not finite (NaN or ∞, as before). O(1).
 #[cold]
 #[inline(never)]
 fn spring_scale_rare(d: &mut [f64], dv: [f64; 3], rest: f64, k: f64, c: f64, q: f64) -> f64 {
-    let largest = d[..3].iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let e = [d[0], d[1], d[2]];
+    let largest = e.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     if largest == 0.0 {
         return 0.0;
     }
-    if !largest.is_finite() || crate::mesh::PLAIN_EXTENT.contains(&largest) {
+    if !e.iter().chain(&dv).chain(&[rest, k, c]).all(|x| x.is_finite()) {
         return q;
     }
-    let l = crate::mesh::distance([d[0], d[1], d[2]], [0.0; 3]);
-    let p = -crate::mesh::binary_exponent(largest);
-    for x in &mut d[..3] {
-        *x = crate::mesh::times_pow2(*x, p);
+    let l = super::geom::rest_length([0.0; 3], e);
+    let l = if l.is_finite() {
+        Wide::new(l)
+    } else {
+        // |d| past f64::MAX (components near it): measured at half the scale, exactly doubled.
+        Wide::new(crate::mesh::distance(e.map(|x| 0.5 * x), [0.0; 3])).mul(Wide::new(2.0))
+    };
+    let dw = e.map(Wide::new);
+    let elastic = Wide::new(k).mul(l.sub(Wide::new(rest)));
+    let damping = Wide::new(c).mul(crate::wide::dot(dv.map(Wide::new), dw));
+    let s = elastic.mul(l).add(damping).div(crate::wide::dot(dw, dw));
+    let plain = s.to_f64();
+    if plain.is_normal() || s.is_zero() {
+        return plain;
     }
-    let l1 = crate::mesh::times_pow2(l, p);
-    (k * (l - rest) * l1 + c * (dv[0] * d[0] + dv[1] * d[1] + dv[2] * d[2])) / (l1 * l1)
+    for (x, w) in d.iter_mut().zip(dw) {
+        *x = s.mul(w).to_f64();
+    }
+    1.0
 }
 
-/// [`spring_scale`] with its cold path: s and d (rescaled when rare) with F_s = s·d. O(1).
+/// [`spring_scale`] with its cold path: s and d (replaced when rare) with F_s = s·d. O(1).
 #[inline(always)]
 fn spring_scale_full(d: &mut [f64; 3], dv: [f64; 3], rest: f64, k: f64, c: f64) -> f64 {
-    let (q, l2) = spring_scale(d[0], d[1], d[2], dv[0], dv[1], dv[2], rest, k, c);
-    if !PLAIN_L2.contains(&l2) {
+    let (q, untrusted) = spring_scale(d[0], d[1], d[2], dv[0], dv[1], dv[2], rest, k, c);
+    if untrusted != 0 {
         spring_scale_rare(d, dv, rest, k, c, q)
     } else {
         q

@@ -305,6 +305,21 @@ fn tets_in_ball(body: &Body, c: Vec3, r: f64) -> Vec<u32> {
     out
 }
 
+/// The text summary's part masses: all of them up to [`PARTS_LISTED`], else the smallest and
+/// the largest with the count (the JSON always lists every part). O(parts).
+fn part_masses_text(masses: &[f64]) -> String {
+    let masses: Vec<String> = masses.iter().map(|&m| super::number(m)).collect();
+    match masses.as_slice() {
+        [first, .., last] if masses.len() > PARTS_LISTED => {
+            format!("{first} … {last} ({} parts, ascending; all in --json)", masses.len())
+        }
+        _ => format!("{} (ascending)", masses.join(", ")),
+    }
+}
+
+/// How many part masses the text summary lists one by one.
+const PARTS_LISTED: usize = 8;
+
 fn finish(
     common: &CommonArgs,
     body: &Body,
@@ -333,13 +348,7 @@ fn finish(
         )?;
         writeln!(out, "boundary faces {} -> {}", bc.boundary_faces, ac.boundary_faces)?;
         writeln!(out, "components     {} -> {}", bc.components, ac.components)?;
-        let masses: Vec<String> = a.component_masses.iter().map(|&m| super::number(m)).collect();
-        match masses.as_slice() {
-            [first, .., last] if masses.len() > 8 => {
-                writeln!(out, "part masses    {first} … {last} ({} parts, ascending; all in --json)", masses.len())?
-            }
-            _ => writeln!(out, "part masses    {} (ascending)", masses.join(", "))?,
-        }
+        writeln!(out, "part masses    {}", part_masses_text(&a.component_masses))?;
         let mass = [b.total_mass, a.total_mass, a.removed_mass].map(super::number);
         writeln!(out, "total mass     {} -> {} (removed {})", mass[0], mass[1], mass[2])?;
         writeln!(out, "valid {}  conservation {}", a.valid, a.conservation_ok)?;
@@ -408,4 +417,21 @@ pub struct Polyline(pub Vec<Vec3>);
 /// `X,Y,Z;X,Y,Z;…` → points (the cut checks their number and shape).
 fn parse_polyline(s: &str) -> Result<Polyline, String> {
     s.split(';').filter(|t| !t.trim().is_empty()).map(parse_numbers::<3>).collect::<Result<_, _>>().map(Polyline)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Up to eight parts are listed one by one; from nine on, the smallest, the largest and the
+    /// count.
+    #[test]
+    fn part_masses_are_listed_up_to_eight() {
+        let masses: Vec<f64> = (1..=9).map(f64::from).collect();
+        assert_eq!(part_masses_text(&masses[..1]), "1 (ascending)");
+        let eight = part_masses_text(&masses[..PARTS_LISTED]);
+        assert_eq!(eight, "1, 2, 3, 4, 5, 6, 7, 8 (ascending)");
+        let nine = part_masses_text(&masses);
+        assert_eq!(nine, "1 … 9 (9 parts, ascending; all in --json)");
+    }
 }

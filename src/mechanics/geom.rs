@@ -83,16 +83,10 @@ pub(crate) fn volume_ratios<const K: usize>(tets: [[Vec3; 4]; K]) -> [f64; K] {
     six.map(|v| v.div(largest).to_f64())
 }
 
-/// The exponent k with 2^k ≤ m < 2^(k+1), for finite m > 0 (subnormals included). O(1).
+/// The exponent k with 2^k ≤ m < 2^(k+1), for finite m > 0 (subnormals included):
+/// [`crate::mesh::binary_exponent`] as an `i32`. O(1).
 pub(crate) fn exponent(m: f64) -> i32 {
-    let bits = m.to_bits();
-    let biased = ((bits >> 52) & 0x7ff) as i32;
-    if biased == 0 {
-        // Subnormal: m = bits · 2^-1074.
-        63 - bits.leading_zeros() as i32 - 1074
-    } else {
-        biased - 1023
-    }
+    crate::mesh::binary_exponent(m) as i32
 }
 
 /// 2^e, exact for e in [−1074, 1023] (subnormals included), 0 below and +∞ above. O(1).

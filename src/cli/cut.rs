@@ -376,33 +376,18 @@ struct LiveMesh {
 }
 
 /// Positions, tets (in the written numbering) and velocities of the live vertices of `body`, in
-/// increasing vertex id ([`write_vtu`]). O(darts + slots).
+/// increasing vertex id ([`write_vtu`]): the attribute slots that no live tet uses are dropped by
+/// [`TetMesh::compact`], and the velocities follow its renumbering. O(darts + slots).
 fn live_mesh(body: &Body) -> Result<LiveMesh, CliError> {
-    let map = body.map();
-    let mut live: Vec<u32> = map.one_dart_per_cell(0).into_iter().map(|d| map.vertex_id(d).0).collect();
-    live.sort_unstable();
-    live.dedup();
     let (position, velocity) = (body.attrs().position().as_slice(), body.attrs().velocity().as_slice());
-    let bound = live.last().map_or(0, |&v| v as usize + 1);
-    if bound > position.len().min(velocity.len()) {
-        return Err(other(format!("vertex {} has no attribute slot (a topomech bug)", bound - 1)));
+    let slots = TetMesh { points: position.to_vec(), tets: body_tets(body), ..Default::default() };
+    let (live, old_to_new) = slots.compact().map_err(|e| other(format!("{e} (a topomech bug)")))?;
+    let mut live_velocity = vec![[0.0; 3]; live.points.len()];
+    for (old, &new) in old_to_new.iter().enumerate().filter(|&(_, &new)| new != u32::MAX) {
+        live_velocity[new as usize] =
+            *velocity.get(old).ok_or_else(|| other(format!("vertex {old} has no velocity slot (a topomech bug)")))?;
     }
-    let mut written = vec![u32::MAX; bound];
-    for (new, &old) in live.iter().enumerate() {
-        written[old as usize] = new as u32;
-    }
-    let tets = body_tets(body)
-        .into_iter()
-        .map(|t| {
-            let mapped = t.map(|v| written.get(v as usize).copied().unwrap_or(u32::MAX));
-            match mapped.contains(&u32::MAX) {
-                true => Err(other(format!("tet {t:?} uses a vertex that is not live (a topomech bug)"))),
-                false => Ok(mapped),
-            }
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    let pick = |a: &[Vec3]| live.iter().map(|&v| a[v as usize]).collect::<Vec<Vec3>>();
-    Ok(LiveMesh { points: pick(position), tets, velocity: pick(velocity) })
+    Ok(LiveMesh { points: live.points, tets: live.tets, velocity: live_velocity })
 }
 
 fn parse_numbers<const K: usize>(s: &str) -> Result<[f64; K], String> {

@@ -116,6 +116,7 @@ pub enum BuildError {
 /// // Two tets that touch only at point 0: the map gets two vertices there.
 /// let (map, report) = GMap::<3>::from_tets(7, &[[0, 1, 2, 3], [0, 4, 5, 6]]).unwrap();
 /// assert_eq!(report.pinched_vertices, vec![(0, 2)]);
+/// assert_eq!(report.extra_vertices, vec![(7, 0)]); // vertex 7 is the other one at point 0
 /// assert_eq!(map.count_cells().0[0], 8);
 /// assert!(report.split_edges.is_empty() && report.unreferenced_points.is_empty());
 /// ```
@@ -127,6 +128,10 @@ pub struct BuildReport {
     pub split_edges: Vec<([u32; 2], usize)>,
     /// Points no element uses; their vertex ids are left free.
     pub unreferenced_points: Vec<u32>,
+    /// The g-map vertices past the first at each pinched point, as (vertex id, point), by
+    /// increasing vertex id (the first keeps the point's index as its id): with the identity on
+    /// the other ids, which point each vertex id stands for.
+    pub extra_vertices: Vec<(u32, u32)>,
 }
 
 /// The combinatorial template of one tetrahedron's 24 darts.
@@ -263,6 +268,7 @@ impl GMap<3> {
         map.set_id_alloc_raw(2, face_count, Vec::new());
         map.set_id_alloc_raw(3, tets.len() as u32, Vec::new());
         let mut report = vertex_report(&orbits_of);
+        report.extra_vertices = extra_corners(points, tets, &corner_of, vertex_ids);
         map.set_id_alloc_raw(0, vertex_ids, report.unreferenced_points.clone());
         report.split_edges = split_edges(edge_keys);
         map.mark_tets_as_built();
@@ -815,6 +821,23 @@ fn split_edges(keys: Vec<u64>) -> Vec<([u32; 2], usize)> {
     out
 }
 
+/// (vertex id, point) of the corners whose vertex id is not their point (`corner_of`, 4 per tet
+/// in input order, as [`label_tet_corners`] returns them), by increasing id, each id once; empty
+/// at once when no id reaches past the points (`id_bound` = `points`). O(tets) when there are
+/// such corners, O(1) otherwise.
+fn extra_corners(points: usize, tets: &[[u32; 4]], corner_of: &[u32], id_bound: u32) -> Vec<(u32, u32)> {
+    if id_bound as usize <= points {
+        return Vec::new();
+    }
+    let mut point_of = vec![u32::MAX; id_bound as usize - points];
+    for (&id, &p) in corner_of.iter().zip(tets.iter().flatten()) {
+        if let Some(slot) = (id as usize).checked_sub(points).and_then(|k| point_of.get_mut(k)) {
+            *slot = p;
+        }
+    }
+    point_of.iter().enumerate().map(|(k, &p)| ((points + k) as u32, p)).collect()
+}
+
 /// The vertex part of a build report, from the number of vertex orbits of each point.
 fn vertex_report(orbits_of: &[usize]) -> BuildReport {
     BuildReport {
@@ -824,6 +847,7 @@ fn vertex_report(orbits_of: &[usize]) -> BuildReport {
             .collect(),
         split_edges: Vec::new(),
         unreferenced_points: (0..orbits_of.len() as u32).filter(|&p| orbits_of[p as usize] == 0).collect(),
+        extra_vertices: Vec::new(),
     }
 }
 
@@ -957,17 +981,24 @@ impl<const N: usize> GMap<N> {
         let mut orbits_of = vec![0usize; points];
         let mut next = points as u32;
         let mut stack = Vec::new();
+        let mut extra = Vec::new();
         for d in 0..self.capacity() as u32 {
             let d = DartId(d);
             if self.cell_id(0, d).0 != u32::MAX {
                 continue;
             }
             let p = corner(d);
-            let id = if orbits_of[p as usize] == 0 { p } else { (next, next += 1).0 };
+            let id = if orbits_of[p as usize] == 0 {
+                p
+            } else {
+                extra.push((next, p));
+                (next, next += 1).0
+            };
             orbits_of[p as usize] += 1;
             self.flood_label(0, d, &gens, id, &mut stack);
         }
-        let report = vertex_report(&orbits_of);
+        let mut report = vertex_report(&orbits_of);
+        report.extra_vertices = extra;
         self.set_id_alloc_raw(0, next, report.unreferenced_points.clone());
         report
     }

@@ -119,6 +119,35 @@ fn stage_counts_follow_from_the_operations() {
     assert!(refined > 0, "the incision zone is refined");
     assert_eq!(get("refinement", "volumes"), get("removal", "volumes") + 7 * refined);
     assert_eq!(get("refinement", "components"), get("removal", "components"), "refinement keeps the parts");
+    scene_and_refinement_row_are_as_documented(&s);
+}
+
+/// DEMO.md, "JSON": the scene's keys (the material in full, β included: finding 194) and the
+/// refinement row's masses (numbers; only the stiffness residual, stress and displacement null).
+fn scene_and_refinement_row_are_as_documented(s: &Value) {
+    let scene: Vec<&str> = s["scene"].as_object().unwrap().keys().map(String::as_str).collect();
+    let documented = [
+        "sag_steps",
+        "dt",
+        "integrator",
+        "gravity",
+        "young",
+        "density",
+        "viscosity",
+        "damping",
+        "pinned",
+        "tear_threshold",
+    ];
+    assert_eq!(scene.len(), documented.len(), "scene keys {scene:?}");
+    assert!(documented.iter().all(|k| scene.contains(k)), "scene keys {scene:?}");
+    assert!(num(&s["scene"], "damping") > 0.0, "the demo's springs are damped");
+    let row = stage(s, "refinement");
+    for key in ["total_mass", "removed_mass", "mass_residual"] {
+        assert!(row[key].is_number(), "refinement {key} = {}", row[key]);
+    }
+    for key in ["stiffness_residual", "max_stress", "max_displacement"] {
+        assert!(row[key].is_null(), "refinement {key} = {}", row[key]);
+    }
 }
 
 /// The `file="…"` attributes of a `.pvd` file.

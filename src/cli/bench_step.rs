@@ -263,7 +263,7 @@ fn run_step(args: StepBenchArgs) -> Result<(), CliError> {
     let gravity = [0.0, 0.0, -9.81];
     let (lo, hi) = points.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p[0]), hi.max(p[0])));
     let pins = PinSpec { below: Some((0, lo + 0.1 * (hi - lo))), ..PinSpec::default() };
-    let mut body = build_body(&args.mesh, &loaded.mesh, material)?;
+    let (mut body, _) = build_body(&args.mesh, &loaded.mesh, material)?;
     body.attrs_mut().pin_where(|id, p| pins.pins(id, p));
     let pinned: Vec<bool> = points.iter().enumerate().map(|(i, &p)| pins.pins(topomech::CellId(i as u32), p)).collect();
     let mut flat = FlatModel::from_tets(points, tets, material, gravity, &pinned).map_err(other)?;

@@ -13,10 +13,12 @@ use topomech::load;
 use topomech::mechanics::{check_conservation, Body, Integrator, Material, Simulation, StepConfig, Vec3};
 use topomech::mesh::TetMesh;
 use topomech::vtk::{body_tets, Frame};
-use topomech::CellId;
+use topomech::{BuildReport, CellId};
 
 use super::simulate::{check_pin_region, file_vertex, step_error};
-use super::{at_least_one, build_body, check_ids, other, parse_finite, print_warnings, CellCensus, CliError};
+use super::{
+    at_least_one, build_body, check_ids, other, parse_finite, print_warnings, with_extra_vertices, CellCensus, CliError,
+};
 
 /// Options shared by the three subcommands.
 #[derive(Debug, Clone, clap::Args)]
@@ -173,7 +175,7 @@ pub fn component_masses(body: &Body) -> Vec<f64> {
 /// # Errors
 /// [`CliError`] when the mesh cannot be loaded, the plane is bad, or the output cannot be written.
 pub fn run(args: CutArgs) -> Result<(), CliError> {
-    let (mut body, _, load_us) = load_body(&args.common)?;
+    let (mut body, _, _, load_us) = load_body(&args.common)?;
     let before = stats(&body, 0.0);
     let t = Instant::now();
     let inc = match (args.plane, args.polyline) {
@@ -201,7 +203,7 @@ pub fn run(args: CutArgs) -> Result<(), CliError> {
 /// # Errors
 /// As [`run`]; also a tet id that does not exist.
 pub fn run_remove(args: RemoveArgs) -> Result<(), CliError> {
-    let (mut body, _, load_us) = load_body(&args.common)?;
+    let (mut body, _, _, load_us) = load_body(&args.common)?;
     let before = stats(&body, 0.0);
     // A fresh body's volume ids are the tets' positions in the file: check them all before the
     // first removal, so that a bad id is named as such (not as "already removed" after an
@@ -234,7 +236,7 @@ pub fn run_remove(args: RemoveArgs) -> Result<(), CliError> {
 /// # Errors
 /// As [`run`]; also a bad time step or a blow-up.
 pub fn run_tear(args: TearArgs) -> Result<(), CliError> {
-    let (mut body, mesh, load_us) = load_body(&args.common)?;
+    let (mut body, mesh, built, load_us) = load_body(&args.common)?;
     let before = stats(&body, 0.0);
     let rest = body.attrs().rest_position().as_slice().to_vec();
     let (lo, hi) = rest.iter().fold((f64::MAX, f64::MIN), |(lo, hi), p| (lo.min(p[2]), hi.max(p[2])));
@@ -248,9 +250,10 @@ pub fn run_tear(args: TearArgs) -> Result<(), CliError> {
     let mut sim = Simulation::new(&mut body, [0.0, 0.0, args.gravity_z], config).map_err(other)?;
     let (mut faces, mut step_us, mut tear_us) = (0, 0u64, 0u64);
     // file_point[slot]: the point of the file a vertex slot stands for (a fresh body's slots are
-    // the file's points; a torn-off copy stands for the point it was split from).
+    // the file's points and the extra vertices of its pinched points; a torn-off copy stands for
+    // the point it was split from).
     let (tags, points) = (&mesh.node_tags, mesh.points.len());
-    let mut file_point: Vec<u32> = (0..points as u32).collect();
+    let mut file_point = with_extra_vertices((0..points as u32).collect(), &built);
     for step in 1..=args.steps {
         let t = Instant::now();
         sim.step(&mut body)
@@ -275,14 +278,14 @@ pub fn run_tear(args: TearArgs) -> Result<(), CliError> {
 }
 
 /// The body of `common.mesh`, the mesh it was built on (its points are the body's first vertex
-/// slots) and the load time in µs.
-fn load_body(common: &CommonArgs) -> Result<(Body, TetMesh, u64), CliError> {
+/// slots), the build's report and the load time in µs.
+fn load_body(common: &CommonArgs) -> Result<(Body, TetMesh, BuildReport, u64), CliError> {
     let t = Instant::now();
     let loaded = load::load_tet_map(&common.mesh)?;
     print_warnings(&loaded);
     let material = Material { density: common.density, ..Material::default() };
-    let body = build_body(&common.mesh, &loaded.mesh, material)?;
-    Ok((body, loaded.mesh, t.elapsed().as_micros() as u64))
+    let (body, built) = build_body(&common.mesh, &loaded.mesh, material)?;
+    Ok((body, loaded.mesh, built, t.elapsed().as_micros() as u64))
 }
 
 /// Tet (volume) ids whose centroid at rest is within distance r of c.

@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 use topomech::load::{self, LoadError, Loaded};
 use topomech::mechanics::{Body, Material, ModelError};
 use topomech::mesh::TetMesh;
-use topomech::{GMap, InvariantViolation};
+use topomech::{BuildReport, GMap, InvariantViolation};
 
 /// Why a subcommand failed. `main` prints it as `topomech: error: {self}`.
 #[derive(Debug, thiserror::Error)]
@@ -81,10 +81,26 @@ pub(crate) fn other(e: impl Into<Box<dyn std::error::Error + Send + Sync>>) -> C
     CliError::Other(e.into())
 }
 
-/// The mass/spring body of `mesh`, read from `path`; a model error names the file and the file's
+/// The mass/spring body of `mesh`, read from `path`, and the build's report (which vertex ids
+/// past the points stand for which pinched point); a model error names the file and the file's
 /// node tags of the points at fault ([`model_error`]). O(tets).
-pub(crate) fn build_body(path: &Path, mesh: &TetMesh, material: Material) -> Result<Body, CliError> {
-    Body::from_tets(&mesh.points, &mesh.tets, material).map(|(body, _)| body).map_err(|e| model_error(path, mesh, e))
+pub(crate) fn build_body(path: &Path, mesh: &TetMesh, material: Material) -> Result<(Body, BuildReport), CliError> {
+    Body::from_tets(&mesh.points, &mesh.tets, material).map_err(|e| model_error(path, mesh, e))
+}
+
+/// `point_of[id]` for every vertex id of a body built on `points` points with `report`: the
+/// point each id stands for (`point_of` given for the points themselves, e.g. the identity or
+/// the file's point through a renumbering), extended to the extra vertices of pinched points.
+/// O(points + extra vertices).
+pub(crate) fn with_extra_vertices(mut point_of: Vec<u32>, report: &BuildReport) -> Vec<u32> {
+    for &(id, p) in &report.extra_vertices {
+        let point = point_of.get(p as usize).copied().unwrap_or(u32::MAX);
+        if point_of.len() <= id as usize {
+            point_of.resize(id as usize + 1, u32::MAX);
+        }
+        point_of[id as usize] = point;
+    }
+    point_of
 }
 
 /// [`CliError::Model`] for a model built on `mesh`, read from `path`: names the file's node tags

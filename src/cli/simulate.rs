@@ -11,7 +11,9 @@ use topomech::mechanics::{Body, Integrator, Material, PinSpec, Simulation, Sprin
 use topomech::mesh::TetMesh;
 use topomech::vtk::{body_tets, Frame, Series};
 
-use super::{build_body, check_ids, other, parse_finite, parse_vec3, print_report, print_warnings, CliError};
+use super::{
+    build_body, check_ids, other, parse_finite, parse_vec3, print_report, print_warnings, with_extra_vertices, CliError,
+};
 
 /// Arguments of `topomech simulate`.
 #[derive(Debug, Clone, clap::Args)]
@@ -155,11 +157,14 @@ fn simulate(args: &SimulateArgs, parallel: bool) -> Result<(), CliError> {
     let material =
         Material { density: args.density, young: args.young, damping: args.damping, viscosity: args.viscosity };
     let (mut mesh, mut pin_ids) = (loaded.mesh, args.pin.clone());
-    // A pinned id that names no point would pin nothing, silently: refuse it.
+    // A pinned id that names no point, or a point no tet uses, would pin nothing, silently:
+    // refuse it.
     check_ids("--pin", ("vertex", "points"), &pin_ids, mesh.points.len())?;
-    // So would a --pin-below bound under the whole body (it fell unpinned: finding 182).
+    check_pins_used("--pin", &pin_ids, &loaded.build.unreferenced_points)?;
+    // So would a --pin-below bound under the whole body (it fell unpinned: finding 182), the
+    // body being the points its tets use (finding 201).
     if let Some((axis, value)) = args.pin_below {
-        check_pin_region("--pin-below", axis, value, &mesh.points)?;
+        check_pin_region("--pin-below", axis, value, &used_points(&mesh.points, &loaded.build.unreferenced_points))?;
     }
     // file_point[slot]: the point of the file that vertex slot `slot` stands for, through the
     // reorderings (a blow-up names the file's point, not the slot, which each order moves).
@@ -179,7 +184,13 @@ fn simulate(args: &SimulateArgs, parallel: bool) -> Result<(), CliError> {
         file_point = moved;
         mesh = ordered;
     }
-    let mut body = build_body(&args.mesh, &mesh, material)?;
+    let (mut body, built) = build_body(&args.mesh, &mesh, material)?;
+    // A pinched point became several vertices: a blow-up at any of them names the point, and
+    // pinning the point holds each of them (finding 202).
+    let file_point = with_extra_vertices(file_point, &built);
+    pin_ids.extend(
+        built.extra_vertices.iter().filter(|(_, p)| pin_ids.contains(p)).map(|&(id, _)| id).collect::<Vec<_>>(),
+    );
     let pins = PinSpec { ids: pin_ids, below: args.pin_below, inside: None };
     body.attrs_mut().pin_where(|id, p| pins.pins(id, p));
     let mut config = StepConfig::new(args.integrator, args.dt);
@@ -238,6 +249,31 @@ fn print_summary(
     })
 }
 
+/// The points of `points` that are not listed in `unreferenced` (sorted, as
+/// [`topomech::BuildReport`] lists them): the body's rest positions. O(points).
+pub(crate) fn used_points(points: &[Vec3], unreferenced: &[u32]) -> Vec<Vec3> {
+    let mut unused = unreferenced.iter().peekable();
+    let mut used = Vec::with_capacity(points.len());
+    for (i, &p) in points.iter().enumerate() {
+        if unused.next_if(|&&u| u as usize == i).is_none() {
+            used.push(p);
+        }
+    }
+    used
+}
+
+/// Refuses a pinned point (`flag`) that no tet uses (in `unreferenced`, sorted): it is no vertex
+/// of the body, so pinning it would pin nothing. O(ids · log unreferenced).
+pub(crate) fn check_pins_used(flag: &str, ids: &[u32], unreferenced: &[u32]) -> Result<(), CliError> {
+    match ids.iter().find(|id| unreferenced.binary_search(id).is_ok()) {
+        Some(id) => Err(other(format!(
+            "{flag}: point {id} is used by no tet (an unreferenced point of the file), so it is no vertex of the \
+             body and pinning it would pin nothing"
+        ))),
+        None => Ok(()),
+    }
+}
+
 /// Refuses a pin region of the command line (`flag` with `axis` ≤ `value`) that pins no point of
 /// `points`: the body would fall unpinned while the run reported success. The message names the
 /// flag, the value and the body's range on that axis. O(points).
@@ -261,13 +297,18 @@ pub(crate) fn check_pin_region(flag: &str, axis: usize, value: f64, points: &[Ve
 /// How a blow-up names its vertex: the file's node tag (`tags`, indexed by the file's points) of
 /// the point that vertex slot `slot` stands for (`file_point` maps slots to the file's points
 /// through any renumbering or tear; `u32::MAX` for none), or the file's 0-based point when the
-/// file has no tags; a slot past the file's `points` is a copy a tear split off that point. Only
-/// a slot that stands for no point is named as a slot. O(1).
+/// file has no tags; a slot past the file's `points` is one of several vertices at that point
+/// (the extra vertex of a point pinched in the file, or a copy a tear split off). Only a slot
+/// that stands for no point is named as a slot. O(1).
 pub(crate) fn file_vertex(tags: &[u64], file_point: &[u32], points: usize, slot: usize) -> String {
     let Some(&point) = file_point.get(slot).filter(|&&p| (p as usize) < points) else {
         return format!("vertex slot {slot} (not a point of the file)");
     };
-    let copy = if slot >= points { ", a copy of it split off by tearing" } else { "" };
+    let copy = if slot >= points {
+        ", one of several vertices there: a point pinched in the file or split by tearing"
+    } else {
+        ""
+    };
     match tags.get(point as usize) {
         Some(tag) => format!("file node tag {tag} (point {point} of the file, 0-based{copy})"),
         None => format!("point {point} of the file (0-based{copy})"),

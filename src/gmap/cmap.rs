@@ -3,10 +3,19 @@
 //! Keep the darts of one colour of an orientation (every αi link joins two colours). On them,
 //! β1 = α0∘α1 (first α1, then α0) is a permutation and βi = α0∘αi (i ≥ 2) is an involution or
 //! undefined (the dart is i-free in the G-map). Each kept dart stands for itself and α0 of it.
+//!
+//! The G-map's law that αi∘αj is an involution for |i − j| ≥ 2 carries over as the law of an
+//! n-map that βi∘βj (first βj, then βi) is a partial involution for 1 ≤ i, i + 2 ≤ j ≤ n:
+//! β1∘βj = α0α1α0αj and, for i ≥ 2, βi∘βj = α0αiα0αj = αiαj, both involutions because αj
+//! commutes with α0, α1 and αi (and α0 with αi). "Partial": where βi(βj(d)) is defined, so is
+//! βi(βj) of it, and it is d; so a face (a β1 orbit) is j-sewn whole or not at all. In 3D this is
+//! β1∘β3: the two volumes on either side of a face pair its darts in opposite turning order.
 
 use super::{DartId, GMap};
 
-/// An n-map: darts 0..len, β1 a permutation, βi for i ≥ 2 partial involutions.
+/// An n-map: darts 0..len, β1 a permutation, βi for i ≥ 2 partial involutions without fixed
+/// points, and βi∘βj (first βj, then βi) a partial involution for 1 ≤ i, i + 2 ≤ j ≤ n (β1∘β3 in
+/// 3D; see the module docs): wherever βi(βj(d)) is defined, βi(βj(βi(βj(d)))) is defined and is d.
 ///
 /// # Examples
 ///
@@ -31,10 +40,13 @@ pub struct CombinatorialMap {
 }
 
 impl CombinatorialMap {
-    /// Checks that β1 is a permutation and every βi (i ≥ 2) an involution without fixed points
-    /// where defined. `false` (never a panic) when `beta1` or a row of `beta` does not have
-    /// exactly `origin.len()` entries, so no β may name a dart that does not exist.
-    /// O(darts · n).
+    /// Checks that β1 is a permutation, every βi (i ≥ 2) an involution without fixed points
+    /// where defined, and every βi∘βj with 1 ≤ i, i + 2 ≤ j ≤ n (β1∘β3 in 3D) a partial
+    /// involution: wherever βi(βj(d)) is defined, βi(βj) of it is defined and is d (finding 199:
+    /// a β3 re-paired inside a face stayed an involution and passed). Every map
+    /// [`GMap::to_combinatorial_map`] returns passes. `false` (never a panic) when `beta1` or a
+    /// row of `beta` does not have exactly `origin.len()` entries, so no β may name a dart that
+    /// does not exist. O(darts · n²).
     ///
     /// # Examples
     ///
@@ -62,11 +74,30 @@ impl CombinatorialMap {
                 return false;
             }
         }
-        self.beta.iter().all(|bi| {
+        let involutions = self.beta.iter().all(|bi| {
             (0..n).all(|d| match bi[d] {
                 None => true,
                 Some(e) => e as usize != d && bi.get(e as usize) == Some(&Some(d as u32)),
             })
+        });
+        involutions && self.compositions_are_involutions()
+    }
+
+    /// βi(d) for i ≥ 1 (`None` where d is i-free, or i or d out of range). O(1).
+    fn beta_of(&self, i: usize, d: u32) -> Option<u32> {
+        match i {
+            1 => self.beta1.get(d as usize).copied(),
+            _ => self.beta.get(i.checked_sub(2)?)?.get(d as usize).copied().flatten(),
+        }
+    }
+
+    /// Whether βi∘βj is a partial involution for every 1 ≤ i, i + 2 ≤ j ≤ n. O(darts · n²).
+    fn compositions_are_involutions(&self) -> bool {
+        let n = self.beta.len() + 1;
+        let step = |i: usize, j: usize, d: u32| self.beta_of(j, d).and_then(|e| self.beta_of(i, e));
+        (1..=n).all(|i| {
+            (i + 2..=n)
+                .all(|j| (0..self.origin.len() as u32).all(|d| step(i, j, d).is_none_or(|y| step(i, j, y) == Some(d))))
         })
     }
 }

@@ -443,7 +443,9 @@ pub fn read_mesh(path: &Path) -> Result<TetMesh, ReadError> {
         "ele" => read_tetgen(&tetgen_sibling(path, "node"), path),
         "obj" => Err(ReadError::UnknownFormat {
             path: path.to_path_buf(),
-            reason: "OBJ holds a surface, not a volume; use read_tri_mesh".into(),
+            reason: "OBJ holds a surface, not a tetrahedral volume: give an MSH or TetGen .node/.ele mesh \
+                     (a library caller reads surfaces with io::read_tri_mesh)"
+                .into(),
         }),
         _ => parse_msh(&read_file(path)?, path),
     }

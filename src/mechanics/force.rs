@@ -1916,11 +1916,16 @@ fn spring_scale_padded(
 /// [`spring_scale_padded`]): returns s' and replaces `d` (its first three entries) by d' so that
 /// F_s = s'·d' is [k (l − L) l + c (dv·d)] / l² · d evaluated with an unbounded exponent
 /// (`crate::wide`: each operation rounded as in `f64`, in the plain operation order), that is,
-/// k (l − L) n + c (dv·n) n, n = d / l, for any finite d ≠ 0, to within an ulp wherever the force
-/// is a normal `f64`; a component is ±∞ or 0 only when it is past `f64::MAX` or below half the
-/// smallest subnormal. l is measured as [`super::geom::rest_length`] measures a rest length, so a
-/// spring in its rest shape feels exactly k·0 (the plain √l² of the hot path inside
-/// [`crate::mesh::PLAIN_EXTENT`], [`crate::mesh::distance`] outside). Where no plain
+/// k (l − L) n + c (dv·n) n, n = d / l, for any finite d ≠ 0 whose length l = |d| is a normal
+/// `f64` (l ≥ 2⁻¹⁰²²), to within an ulp wherever the force is a normal `f64`; a component is ±∞
+/// or 0 only when it is past `f64::MAX` or below half the smallest subnormal. l is measured as
+/// [`super::geom::rest_length`] measures a rest length, so a spring in its rest shape feels
+/// exactly k·0 (the plain √l² of the hot path inside [`crate::mesh::PLAIN_EXTENT`],
+/// [`crate::mesh::distance`] outside). That l is an `f64`: a subnormal l (0 < l < 2⁻¹⁰²²) is
+/// rounded to a multiple of 2⁻¹⁰⁷⁴, an error ε of up to about 2⁻¹⁰⁷⁵, and the elastic term
+/// k (l − L) n is then off by about k·ε·|2 − L/l| — up to 2⁻¹⁰⁷⁴/l relative when L ≪ l (1.2 % at
+/// l = 20·2⁻¹⁰⁷⁴), more where l − L cancels (findings 168 and 200); the damping term, formed from
+/// d·d and not from l, keeps the ulp bound. Where no plain
 /// intermediate over- or underflows, s' = q and d' = d, the hot path's bits; where s is a normal
 /// `f64`, s' = s and d' = d (F_s = s·d rounded once per component); else s' = 1 and d' = F_s,
 /// each component rounded from the wide product (twice only among the subnormals). Returns 0

@@ -422,7 +422,11 @@ pub struct Stepper {
 #[derive(Clone, Debug, Default)]
 struct CgBuffers {
     dir: Vec<Vec3>,
+    /// Per spring (k, k_transverse, c) from `linearise`; during the solve 2^-α (h² (k − kt),
+    /// h² kt, h c) (`scale_operator`).
     coef: Vec<[f64; 3]>,
+    /// Per slot 2^-α (mᵢ + h νᵢ) during the solve (0 on fixed slots).
+    diag: Vec<f64>,
     r: Vec<Vec3>,
     p: Vec<Vec3>,
     q: Vec<Vec3>,
@@ -1116,6 +1120,7 @@ impl Stepper {
         }
         cg.dir.resize(sys.springs(), [0.0; 3]);
         cg.coef.resize(sys.springs(), [0.0; 3]);
+        cg.diag.resize(n, 0.0);
         linearise(sys, x, &mut cg.dir, &mut cg.coef);
         // b = h f0 + h² K-gather(v0)  (K v0 enters with a minus: −h² K v0, K = −∂f/∂x ⇒ + gather).
         sys.forces_raw(x, v, &mut self.sf, &mut self.acc, par);
@@ -1130,7 +1135,17 @@ impl Stepper {
                 [0.0; 3]
             }
         });
-        let iterations = self.conjugate_gradient(sys, h)?;
+        // A b that is not finite in f64 while the forces are: an intermediate overflowed (K ẋ₀
+        // for a stiffness near f64::MAX, h² for a huge h, h f₀ for h > 1). Formed again in wide
+        // floats and handed to CG already scaled, unless b itself is past f64::MAX (refused, as
+        // a b that is not finite always was). Cold: the plain b stands wherever it is finite.
+        let plain = cg.r.iter().flatten().all(|c| c.is_finite());
+        let forces_finite = (0..n).all(|i| sys.inv_mass[i] == 0.0 || f0[i].iter().all(|c| c.is_finite()));
+        let pre_scaled = match plain || !forces_finite {
+            true => None,
+            false => wide_rhs(sys, &cg.dir, &cg.coef, v, f0, h, &mut cg.r),
+        };
+        let iterations = self.conjugate_gradient(sys, h, pre_scaled)?;
         self.last_cg_iterations = iterations;
         let dv = &self.cg.dv;
         for i in 0..n {
@@ -1140,16 +1155,27 @@ impl Stepper {
         Ok(())
     }
 
-    /// Solves A Δv = r (r holds b on entry) by CG on the free slots; Δv in `cg.dv`.
+    /// Solves A Δv = r (r holds b on entry, or 2^-β b when `pre_scaled` is `Some(β)`, from
+    /// `wide_rhs`) by CG on the free slots; Δv in `cg.dv`.
     ///
-    /// Scale-safe: CG runs on 2^-β b and 2^-α A, with 2^β the binade of max |bᵢ| and 2^α that
-    /// of the largest diagonal mass term mᵢ + h νᵢ of a free slot, so that ‖b‖², pᵀAp and the
-    /// step lengths stay near 1 for a body of any size (finding 179: ‖b‖² under- or
-    /// overflowed for edges beyond about 1e±33, and an underflowed ‖b‖ ended the solve with
-    /// Δv = 0, every force dropped). Powers of two scale exactly, so in the normal range the
-    /// iterates are the unscaled ones' bits, times powers of two; Δv = 2^(β−α) y at the end.
-    /// Only an exactly zero b has nothing to solve.
-    fn conjugate_gradient(&mut self, sys: &SpringSystem, h: f64) -> Result<usize, StepError> {
+    /// Scale-safe: CG runs on 2^-β b and 2^-α A, with 2^β the binade of max |bᵢ| and 2^α
+    /// (`operator_exponent`) midway, in binades, between the smallest diagonal mass term
+    /// mᵢ + h νᵢ of a free slot and the largest term of the operator (mᵢ + h νᵢ, h c_s, h² k_s
+    /// over the free slots and their springs), so that ‖b‖², pᵀAp and the step lengths stay near 1
+    /// for a body of any size (finding 179: ‖b‖² under- or overflowed for edges beyond about
+    /// 1e±33, and an underflowed ‖b‖ ended the solve with Δv = 0, every force dropped). The
+    /// factor 2^-α goes into the operator's coefficients — 2^-α (mᵢ + h νᵢ), 2^-α h² (k − kt),
+    /// 2^-α h² kt and 2^-α h c, each formed in wide floats and rounded once — before any of them
+    /// meets a vector, so no product of the unscaled operator is formed (finding 198: A p was
+    /// formed first and scaled after, and mᵢ pᵢ overflowed for a free slot of mass ≈ 1e308;
+    /// h² k, m + h ν overflowed for a stiffness or viscosity near `f64::MAX`). Powers of two
+    /// scale exactly, so wherever the unscaled solve would neither over- nor underflow the
+    /// iterates are its bits times powers of two, and Δv = 2^(β−α) y at the end is its Δv bit
+    /// for bit; elsewhere the scaled solve keeps the operator's terms inside f64's range as long
+    /// as they span less than about 2^1900 (a term below 2^-1074 of the largest is lost as an
+    /// underflow, a Δv past `f64::MAX` is ±∞ and ends the step as a blow-up). Only an exactly
+    /// zero b has nothing to solve.
+    fn conjugate_gradient(&mut self, sys: &SpringSystem, h: f64, pre_scaled: Option<i32>) -> Result<usize, StepError> {
         let par = self.config.parallel;
         let cg = &mut self.cg;
         cg.dv.iter_mut().for_each(|d| *d = [0.0; 3]);
@@ -1162,14 +1188,16 @@ impl Stepper {
             let residual = dot_all(&cg.r, &cg.r).sqrt();
             return Err(StepError::SolverFailed { step: self.step, iterations: 0, residual });
         }
-        let beta = exponent(b_max);
-        let alpha = (0..sys.slots())
-            .filter(|&i| sys.inv_mass[i] > 0.0)
-            .map(|i| sys.mass[i] + h * sys.viscosity[i])
-            .fold(0.0f64, f64::max);
-        let alpha = if alpha > 0.0 && alpha.is_finite() { exponent(alpha) } else { 0 };
-        scale_all(&mut cg.r, -beta);
-        let a_scale = (pow2(-alpha / 2), pow2(-alpha - (-alpha / 2)));
+        let alpha = operator_exponent(sys, &cg.coef, h);
+        scale_operator(sys, h, alpha, &mut cg.coef, &mut cg.diag);
+        let beta = match pre_scaled {
+            Some(beta) => beta,
+            None => {
+                let beta = exponent(b_max);
+                scale_all(&mut cg.r, -beta);
+                beta
+            }
+        };
         cg.p.copy_from_slice(&cg.r);
         let b_norm = dot_all(&cg.r, &cg.r).sqrt();
         let mut rr = dot_all(&cg.r, &cg.r);
@@ -1181,8 +1209,7 @@ impl Stepper {
             if rr.sqrt() <= self.config.cg_tolerance * b_norm {
                 return solved(cg, it);
             }
-            apply_system(sys, &cg.dir, &cg.coef, h, &cg.p, &mut self.sf, &mut cg.q, par);
-            cg.q.iter_mut().flatten().for_each(|c| *c = *c * a_scale.0 * a_scale.1);
+            apply_system(sys, &cg.dir, &cg.coef, &cg.diag, &cg.p, &mut self.sf, &mut cg.q, par);
             let alpha = rr / dot_all(&cg.p, &cg.q);
             for i in 0..cg.p.len() {
                 cg.dv[i] = madd(cg.dv[i], alpha, cg.p[i]);
@@ -1253,26 +1280,205 @@ fn gather(sys: &SpringSystem, i: usize, y: &[Vec3]) -> Vec3 {
     f
 }
 
-/// q = S (M + h(Γ + C) + h² K) p, S zeroing fixed slots.
+/// The exponent α of the implicit solve's operator scale 2^α: ⌊(e_lo + e_hi) / 2⌋, with e_lo
+/// the binade of the smallest mᵢ + h νᵢ over the free slots and e_hi that of the largest term
+/// of the operator over the free slots and the springs with a free end (mᵢ + h νᵢ, h c_s,
+/// h² k_s), each estimated from its factors' exponents (within 2 of the true one, and no
+/// product formed, so nothing over- or underflows). Scaled by 2^-α the terms lie within
+/// 2^±((e_hi − e_lo) / 2 + 3) of 1. 0 with no free slot. Any α gives the same bits where
+/// nothing over- or underflows; this one keeps the most room on both sides. O(slots + springs).
+fn operator_exponent(sys: &SpringSystem, coef: &[[f64; 3]], h: f64) -> i32 {
+    // exponent(a b) is exponent(a) + exponent(b) or one more, for a, b > 0.
+    let eh = exponent(h);
+    let free = |i: u32| sys.inv_mass[i as usize] > 0.0;
+    let (mut lo, mut hi) = (i32::MAX, i32::MIN);
+    for i in 0..sys.slots() {
+        if sys.inv_mass[i] > 0.0 {
+            let (m, nu) = (sys.mass[i], sys.viscosity[i]);
+            // A free slot's mass is > 0 (inverse mass > 0).
+            let mut e = exponent(m);
+            if nu > 0.0 {
+                e = e.max(eh + exponent(nu));
+            }
+            lo = lo.min(e);
+            hi = hi.max(e);
+        }
+    }
+    if lo == i32::MAX {
+        return 0;
+    }
+    for (s, &[a, b]) in sys.ends.iter().enumerate() {
+        if free(a) || free(b) {
+            let [k, _, c] = coef[s];
+            if k > 0.0 {
+                hi = hi.max(2 * eh + exponent(k));
+            }
+            if c > 0.0 {
+                hi = hi.max(eh + exponent(c));
+            }
+        }
+    }
+    (lo + hi).div_euclid(2)
+}
+
+/// The implicit right-hand side b = h f₀ + h² K ẋ₀ (0 on fixed slots) evaluated in wide floats
+/// in the plain evaluation's order (K ẋ₀ spring by spring as `spring_products` forms it,
+/// gathered, then h f₀ + (h h) g): when max |bᵢ| is at most `f64::MAX`, writes 2^-β b to `r`,
+/// with 2^β the binade of max |bᵢ|, and returns β; else (b itself past `f64::MAX`, refused as
+/// before) leaves `r` alone and returns `None`. For the rare b whose plain evaluation is not
+/// finite while f₀ is: an intermediate (K ẋ₀, h², h f₀) overflowed. The plain bits wherever the
+/// plain evaluation is finite and normal. O(slots + springs).
+fn wide_rhs(
+    sys: &SpringSystem,
+    dir: &[Vec3],
+    coef: &[[f64; 3]],
+    v: &[Vec3],
+    f0: &[Vec3],
+    h: f64,
+    r: &mut [Vec3],
+) -> Option<i32> {
+    let zero = Wide::new(0.0);
+    let y: Vec<[Wide; 3]> = (0..sys.springs())
+        .map(|s| {
+            let [a, b] = sys.ends[s];
+            let w = crate::wide::difference(v[b as usize], v[a as usize]);
+            let n = dir[s].map(Wide::new);
+            let [k, kt, _] = coef[s];
+            let axial = Wide::new(k - kt).mul(crate::wide::dot(n, w));
+            let kt = Wide::new(kt);
+            [0, 1, 2].map(|j| kt.mul(w[j]).add(axial.mul(n[j])))
+        })
+        .collect();
+    let (wh, wh2) = (Wide::new(h), Wide::new(h).mul(Wide::new(h)));
+    let b: Vec<[Wide; 3]> = (0..sys.slots())
+        .map(|i| {
+            if sys.inv_mass[i] == 0.0 {
+                return [zero; 3];
+            }
+            let mut g = [zero; 3];
+            for (s, sign) in sys.incident(i) {
+                g = [0, 1, 2].map(|j| g[j].add(if sign < 0.0 { y[s][j].neg() } else { y[s][j] }));
+            }
+            [0, 1, 2].map(|j| wh.mul(Wide::new(f0[i][j])).add(wh2.mul(g[j])))
+        })
+        .collect();
+    let b_max = b.iter().flatten().fold(zero, |m, c| if m.less_than(c.abs()) { c.abs() } else { m });
+    if !b_max.to_f64().is_finite() {
+        return None;
+    }
+    let beta = if b_max.is_zero() { 0 } else { wide_exponent(b_max) };
+    let scale = wide_pow2(-beta);
+    for (ri, bi) in r.iter_mut().zip(&b) {
+        *ri = bi.map(|c| c.mul(scale).to_f64());
+    }
+    Some(beta)
+}
+
+/// The exponent k with 2^k ≤ w < 2^(k+1) of a finite w > 0 of any size. O(|k| / 1000).
+fn wide_exponent(w: Wide) -> i32 {
+    let (mut x, mut shift) = (w, 0);
+    loop {
+        let t = x.to_f64();
+        if t.is_infinite() {
+            (x, shift) = (x.mul(wide_pow2(-1000)), shift + 1000);
+        } else if t < f64::MIN_POSITIVE {
+            (x, shift) = (x.mul(wide_pow2(1000)), shift - 1000);
+        } else {
+            return shift + exponent(t);
+        }
+    }
+}
+
+/// 2^e as a wide float, exactly, for any e. O(|e| / 1000).
+fn wide_pow2(mut e: i32) -> Wide {
+    let mut w = Wide::new(1.0);
+    while e != 0 {
+        let step = e.clamp(-1000, 1000);
+        w = w.mul(Wide::new(pow2(step)));
+        e -= step;
+    }
+    w
+}
+
+/// Scales the operator by 2^-α before CG: `diag`ᵢ = 2^-α (mᵢ + h νᵢ) on the free slots (0 on
+/// fixed ones), and `coef` (k, kt, c) of each spring with a free end becomes 2^-α (h² (k − kt),
+/// h² kt, h c) (0 for a spring between fixed slots, which no free slot gathers). Each is the
+/// plain formula (h² rounded as h·h, m + h ν as in f64) evaluated with an unbounded exponent and
+/// rounded once to f64: 2^-α times the plain value, bit for bit, wherever the plain value neither
+/// over- nor underflows, and otherwise the scaled value the plain one would have with an
+/// unbounded exponent. The plain value times 2^-α where it and the result are normal (exact
+/// there, and so the same bits), wide floats elsewhere. O(slots + springs).
+fn scale_operator(sys: &SpringSystem, h: f64, alpha: i32, coef: &mut [[f64; 3]], diag: &mut [f64]) {
+    let scale = wide_pow2(-alpha);
+    let (f1, f2) = (pow2(-alpha / 2), pow2(-alpha - (-alpha / 2)));
+    let (wh, hh) = (Wide::new(h), h * h);
+    let wh2 = wh.mul(wh);
+    // 2^-α x for x = `plain` when the plain evaluation kept every bit (`exact`), else from `wide`.
+    let scaled = |plain: f64, exact: bool, wide: &dyn Fn() -> Wide| {
+        let y = plain * f1 * f2;
+        match exact && plain.is_normal() && y.is_normal() {
+            true => y,
+            false => wide().mul(scale).to_f64(),
+        }
+    };
+    // h² x and h x, scaled; exactly 0 for x = 0.
+    let h2_times = |x: f64| match x == 0.0 {
+        true => 0.0,
+        false => scaled(hh * x, hh.is_normal(), &|| wh2.mul(Wide::new(x))),
+    };
+    let h_times = |x: f64| match x == 0.0 {
+        true => 0.0,
+        false => scaled(h * x, true, &|| wh.mul(Wide::new(x))),
+    };
+    let free = |i: u32| sys.inv_mass[i as usize] > 0.0;
+    for (i, d) in diag.iter_mut().enumerate() {
+        let (m, nu) = (sys.mass[i], sys.viscosity[i]);
+        *d = match sys.inv_mass[i] > 0.0 {
+            true => scaled(m + h * nu, nu == 0.0 || (h * nu).is_normal(), &|| Wide::new(m).add(wh.mul(Wide::new(nu)))),
+            false => 0.0,
+        };
+    }
+    for (s, &[a, b]) in sys.ends.iter().enumerate() {
+        let [k, kt, c] = coef[s];
+        coef[s] = match free(a) || free(b) {
+            true => [h2_times(k - kt), h2_times(kt), h_times(c)],
+            false => [0.0; 3],
+        };
+    }
+}
+
+/// q = S 2^-α (M + h(Γ + C) + h² K) p, S zeroing fixed slots, from the scaled coefficients of
+/// [`scale_operator`] (`diag`, and `coef` = 2^-α (h² (k − kt), h² kt, h c) per spring): every
+/// product is one of the scaled operator, in the order of the plain one's evaluation
+/// (h² (k − kt) · (n·w) + h c · (n·w) along n, h² kt · w across), so each is 2^-α times the
+/// plain product, bit for bit, where neither over- nor underflows.
 #[allow(clippy::too_many_arguments)]
 fn apply_system(
     sys: &SpringSystem,
     dir: &[Vec3],
     coef: &[[f64; 3]],
-    h: f64,
+    diag: &[f64],
     p: &[Vec3],
     y: &mut [Vec3],
     q: &mut [Vec3],
     par: bool,
 ) {
-    spring_products(sys, dir, coef, p, h, h * h, y);
+    for s in 0..sys.springs() {
+        let [a, b] = sys.ends[s];
+        let w = sub(p[b as usize], p[a as usize]);
+        let n = dir[s];
+        let [ka, kt, c] = coef[s];
+        let along = dot(n, w);
+        let axial = ka * along + c * along;
+        y[s] = [kt * w[0] + axial * n[0], kt * w[1] + axial * n[1], kt * w[2] + axial * n[2]];
+    }
     let y: &[Vec3] = y;
     let value = |i: usize| {
         if sys.inv_mass[i] == 0.0 {
             return [0.0; 3];
         }
         let g = gather(sys, i, y);
-        let d = sys.mass[i] + h * sys.viscosity[i];
+        let d = diag[i];
         [d * p[i][0] - g[0], d * p[i][1] - g[1], d * p[i][2] - g[2]]
     };
     if par && q.len() > PARALLEL_CHUNK {
@@ -1282,11 +1488,16 @@ fn apply_system(
     }
 }
 
-/// Every coordinate of `a` times 2^e, in two exact steps (e in [−2046, 2046]; a product
-/// leaving f64's range gives 0 or ±∞ as it would in one step). O(len).
+/// Every coordinate of `a` times 2^e: in two steps for e in [−2046, 2046] (exact; a product
+/// leaving f64's range gives 0 or ±∞ as it would in one step), beyond in steps of at most
+/// 2^±1022 (`crate::mesh::times_pow2`, exact wherever the result is normal). O(len).
 fn scale_all(a: &mut [Vec3], e: i32) {
-    let (f1, f2) = (pow2(e / 2), pow2(e - e / 2));
-    a.iter_mut().flatten().for_each(|c| *c = *c * f1 * f2);
+    if (-2046..=2046).contains(&e) {
+        let (f1, f2) = (pow2(e / 2), pow2(e - e / 2));
+        a.iter_mut().flatten().for_each(|c| *c = *c * f1 * f2);
+    } else {
+        a.iter_mut().flatten().for_each(|c| *c = crate::mesh::times_pow2(*c, e as i64));
+    }
 }
 
 fn dot_all(a: &[Vec3], b: &[Vec3]) -> f64 {

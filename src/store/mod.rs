@@ -620,7 +620,9 @@ fn check_levels_representable(map: &RawMap, l: &LevelParts) -> Result<(), String
 }
 
 /// Decodes either form (told apart by the magic) into a raw document, checking its structure but
-/// not the laws. O(size).
+/// not the laws. The binary magic must open the data; the text header is its first significant
+/// line (blank and `#` comment lines before it, and blanks around it, are ignored as anywhere
+/// else in the text form). O(size).
 ///
 /// # Errors
 /// Every structural [`StoreError`] variant, with the line or byte offset; never panics and never
@@ -643,7 +645,7 @@ fn check_levels_representable(map: &RawMap, l: &LevelParts) -> Result<(), String
 pub fn decode(bytes: &[u8]) -> Result<Document, StoreError> {
     if bytes.starts_with(&BINARY_MAGIC) {
         binary::decode(bytes)
-    } else if bytes.starts_with(TEXT_MAGIC.as_bytes()) {
+    } else if text::header_comes_first(bytes) {
         text::decode(bytes)
     } else {
         let head = &bytes[..bytes.len().min(16)];

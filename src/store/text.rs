@@ -270,6 +270,22 @@ fn arity(tokens: &[&str], n: usize, line: usize, what: &str) -> Result<(), Store
 }
 
 /// Parses the text form into a raw document with its structure checked.
+/// Whether the first significant line of `bytes` (as [`Lines`] reads lines: blank and `#`
+/// comment lines skipped, spaces and tabs trimmed, LF or CRLF ends) starts with [`TEXT_MAGIC`],
+/// so that [`decode`] is the decoder to try. Needs no valid UTF-8. O(bytes up to that line).
+pub(super) fn header_comes_first(bytes: &[u8]) -> bool {
+    let blank = |b: &u8| SEPARATORS.contains(&char::from(*b));
+    bytes
+        .split(|&b| b == b'\n')
+        .map(|line| {
+            let line = line.strip_suffix(b"\r").unwrap_or(line);
+            let start = line.iter().position(|b| !blank(b)).unwrap_or(line.len());
+            &line[start..]
+        })
+        .find(|t| !t.iter().all(blank) && !t.starts_with(b"#"))
+        .is_some_and(|t| t.starts_with(TEXT_MAGIC.as_bytes()))
+}
+
 pub(super) fn decode(bytes: &[u8]) -> Result<Document, StoreError> {
     let text = std::str::from_utf8(bytes).map_err(|e| {
         let line = bytes[..e.valid_up_to()].iter().filter(|&&b| b == b'\n').count() + 1;

@@ -649,11 +649,18 @@ impl LeveledMap<3> {
         per_level[self.max_level as usize] = caught_up.map_or(0, |(count, _)| count);
         for level in self.max_level.max(1)..=levels {
             if bulk && self.bulk_applies(center, radius, level) {
-                if let Ok(r) = self.refine_uniform(level, masses) {
-                    per_level[level as usize] += r.subdivided_per_level[level as usize];
-                    before.get_or_insert(r.total_mass_before);
-                    after = Some(r.total_mass_after);
-                    continue;
+                match self.refine_uniform(level, masses) {
+                    Ok(r) => {
+                        per_level[level as usize] += r.subdivided_per_level[level as usize];
+                        before.get_or_insert(r.total_mass_before);
+                        after = Some(r.total_mass_after);
+                        continue;
+                    }
+                    // Its estimate is exact (2ⁿ × the darts); the op-by-op level would make as
+                    // many darts and refuse too, with its coarser per-tet bound.
+                    Err(e @ SubdivideError::DartLimit { .. }) => return Err(e),
+                    // Any other precondition: the op-by-op path decides.
+                    Err(_) => {}
                 }
             }
             if before.is_none() {

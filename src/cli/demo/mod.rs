@@ -474,6 +474,7 @@ impl Played {
                 young: c.material.young,
                 density: c.material.density,
                 viscosity: c.material.viscosity,
+                damping: c.material.damping,
                 pinned: c.pinned,
                 tear_threshold: self.threshold,
             },

@@ -137,6 +137,8 @@ pub struct SceneJson {
     pub density: f64,
     /// Ambient viscosity.
     pub viscosity: f64,
+    /// The damping ratio β of the springs (c = β·k), in seconds.
+    pub damping: f64,
     /// Pinned vertices.
     pub pinned: usize,
     /// Tear threshold (a force).

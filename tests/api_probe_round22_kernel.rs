@@ -110,6 +110,28 @@ fn f198_a_right_hand_side_whose_k_v0_overflows_is_solved() {
     assert!(v[1].abs() < 1e-12, "the transverse motion is damped: {v:?}");
 }
 
+/// The same stiffness with the slot moving along its spring: K ẋ₀ = k vₓ (the axial part
+/// k − kt and the transverse kt together) is past f64::MAX, h² k vₓ is not. Backward Euler's
+/// Δvₓ = (h f − h² k vₓ) / (m + h² k) with f = −k (l − L): the wide right-hand side must add
+/// both parts of K (mutation sample 41: an axial part k / kt instead of k − kt went unseen by
+/// the transverse test above).
+#[test]
+fn f198_a_right_hand_side_along_the_spring_is_solved() {
+    let (m, k, h, vx) = (1.0, 1e308, 1e-3, 10.0);
+    let mut sys = SpringSystem::default();
+    sys.push_slot(1.0, true, 0.0).unwrap();
+    sys.push_slot(m, false, 0.0).unwrap();
+    sys.push_spring([0, 1], 1.0, k, 0.0).unwrap();
+    let (mut x, mut v) = (vec![[0.0; 3], [1.5, 0.0, 0.0]], vec![[0.0; 3], [vx, 0.0, 0.0]]);
+    let mut st = Stepper::new(StepConfig::new(Integrator::Implicit, h), &sys, &x, &v).unwrap();
+    st.step(&sys, &mut x, &mut v).unwrap();
+    let f = -k * 0.5;
+    let expected = (h * f - h * (h * k) * vx) / (m + h * h * k);
+    let dv = v[1][0] - vx;
+    assert!((dv - expected).abs() <= 1e-9 * expected.abs(), "Δvₓ {dv:e} vs {expected:e}");
+    assert_eq!([v[1][1], v[1][2]], [0.0, 0.0], "no motion across the spring");
+}
+
 /// A deterministic xorshift.
 struct Rng(u64);
 

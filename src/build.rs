@@ -259,7 +259,7 @@ impl GMap<3> {
         let local = sweep.as_ref().map_or(&faces, |s| &s.faces);
         let tet_at = |s: usize| sweep.as_ref().map_or(s, |w| w.tet_at[s] as usize);
         let (edge_of, edges, edge_keys) = label_tet_edges(tets, local, tet_at);
-        let (corner_of, vertex_ids, orbits_of) = label_tet_corners(points, tets, local, tet_at);
+        let (corner_of, vertex_ids, orbits_of, extra) = label_tet_corners(points, tets, local, tet_at);
         drop(sweep);
         let (face_of, face_count) = number_tet_faces(&faces.link);
         let (alpha, cell) = tet_rows(&faces, &face_of, &edge_of, &corner_of, darts);
@@ -268,7 +268,7 @@ impl GMap<3> {
         map.set_id_alloc_raw(2, face_count, Vec::new());
         map.set_id_alloc_raw(3, tets.len() as u32, Vec::new());
         let mut report = vertex_report(&orbits_of);
-        report.extra_vertices = extra_corners(points, tets, &corner_of, vertex_ids);
+        report.extra_vertices = extra;
         map.set_id_alloc_raw(0, vertex_ids, report.unreferenced_points.clone());
         report.split_edges = split_edges(edge_keys);
         map.mark_tets_as_built();
@@ -756,14 +756,16 @@ fn label_tet_edges(tets: &[[u32; 4]], faces: &FaceMatch, tet_at: impl Fn(usize) 
 /// Vertex ids of every (tet, corner) pair: the vertex orbits ⟨α1, α2, α3⟩ (tet corners
 /// joined across shared faces); the first orbit of point p gets id p, any further one a fresh
 /// id, in the order of a flood over darts in increasing order. `faces` and `tet_at` as for
-/// [`label_tet_edges`]. Returns the ids (4 per tet, input order), the id bound, and the number of
-/// orbits of each point. O(tets · α + points).
+/// [`label_tet_edges`]. Returns the ids (4 per tet, input order), the id bound, the number of
+/// orbits of each point, and each fresh id with its point, by increasing id
+/// ([`BuildReport::extra_vertices`]). O(tets · α + points).
+#[allow(clippy::type_complexity)]
 fn label_tet_corners(
     points: usize,
     tets: &[[u32; 4]],
     faces: &FaceMatch,
     tet_at: impl Fn(usize) -> usize,
-) -> (Vec<u32>, u32, Vec<usize>) {
+) -> (Vec<u32>, u32, Vec<usize>, Vec<(u32, u32)>) {
     let order = items_by_first_dart(4, |k| TET.vertex[k] as usize);
     let mut orbits_of = vec![0usize; points];
     let mut next = points as u32;
@@ -779,17 +781,19 @@ fn label_tet_corners(
         }
         out
     };
+    let mut extra = Vec::new();
     let new_id = |t: usize, v: usize| {
         let p = tets[t][v];
         orbits_of[p as usize] += 1;
         if orbits_of[p as usize] == 1 {
             p
         } else {
+            extra.push((next, p));
             (next, next += 1).0
         }
     };
     let label = label_orbits(tets.len(), 4, &order, tet_at, neighbours, new_id);
-    (label, next, orbits_of)
+    (label, next, orbits_of, extra)
 }
 
 /// Point pairs carried by more than one edge, in increasing order, from the packed pair
@@ -819,23 +823,6 @@ fn split_edges(keys: Vec<u64>) -> Vec<([u32; 2], usize)> {
         out.extend(repeated.map(|run| ([a as u32, run[0]], run.len())));
     }
     out
-}
-
-/// (vertex id, point) of the corners whose vertex id is not their point (`corner_of`, 4 per tet
-/// in input order, as [`label_tet_corners`] returns them), by increasing id, each id once; empty
-/// at once when no id reaches past the points (`id_bound` = `points`). O(tets) when there are
-/// such corners, O(1) otherwise.
-fn extra_corners(points: usize, tets: &[[u32; 4]], corner_of: &[u32], id_bound: u32) -> Vec<(u32, u32)> {
-    if id_bound as usize <= points {
-        return Vec::new();
-    }
-    let mut point_of = vec![u32::MAX; id_bound as usize - points];
-    for (&id, &p) in corner_of.iter().zip(tets.iter().flatten()) {
-        if let Some(slot) = (id as usize).checked_sub(points).and_then(|k| point_of.get_mut(k)) {
-            *slot = p;
-        }
-    }
-    point_of.iter().enumerate().map(|(k, &p)| ((points + k) as u32, p)).collect()
 }
 
 /// The vertex part of a build report, from the number of vertex orbits of each point.

@@ -347,7 +347,9 @@ impl Series {
     ///
     /// # Errors
     /// [`VtkError::BadTime`] for a time that is not finite (nothing is written), and the errors
-    /// of [`Frame::write`].
+    /// of [`Frame::write`] for the frame or the `.pvd`. On any error the series is as it was: a
+    /// frame whose `.pvd` could not be rewritten is dropped and its file removed, so a retry
+    /// takes the same number.
     ///
     /// # Examples
     ///
@@ -373,7 +375,13 @@ impl Series {
         let path = self.dir.join(&name);
         frame.write(&path)?;
         self.frames.push((time, name));
-        self.write_pvd()?;
+        if let Err(e) = self.write_pvd() {
+            // Refused as a whole (finding 204): the frame is not in the series, its file is
+            // taken away again (best effort) and a retry writes the same name.
+            self.frames.pop();
+            let _ = std::fs::remove_file(&path);
+            return Err(e);
+        }
         Ok(path)
     }
 

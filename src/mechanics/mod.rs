@@ -321,10 +321,13 @@ impl Simulation {
     /// nothing was handed out, else O(vertex ids).
     ///
     /// # Errors
-    /// As [`Simulation::check_current`] (another body: nothing is taken up).
+    /// As [`Simulation::check_current`] (another body: nothing is taken up), and the energy
+    /// scale's refusal of the start state (a NaN or overflowing position or velocity): the
+    /// projection's pins are put back, so the simulation is as it was.
     fn follow_writes(&mut self, body: &mut Body) -> Result<(), SimError> {
         self.check_current(body)?;
         let pins_changed = !self.projection.pins_current(body);
+        let before = pins_changed.then(|| self.projection.pin_snapshot());
         if pins_changed {
             self.projection.follow_pins(body);
         }
@@ -334,10 +337,17 @@ impl Simulation {
             // Energy put in by hand is a new start, not a blow-up (and a body started at rest
             // would otherwise keep a stale scale). Taken before the pinned velocities are
             // zeroed (it counts free slots only), so that on an error the body is unchanged and
-            // the epochs stay unrecorded: the next call checks again.
+            // the epochs stay unrecorded: the next call checks again. The pins just followed
+            // are put back then too, so a refused call leaves the simulation as it was
+            // (finding 203).
             let slots = self.projection.system.slots();
             let (x, v) = (&mech.position.as_slice()[..slots], &mech.velocity.as_slice()[..slots]);
-            self.stepper.reset_energy_scale(&self.projection.system, x, v)?;
+            if let Err(e) = self.stepper.reset_energy_scale(&self.projection.system, x, v) {
+                if let Some(before) = before {
+                    self.projection.restore_pins(before);
+                }
+                return Err(e.into());
+            }
             self.hold_fixed(body);
             self.record_epochs(body);
         }

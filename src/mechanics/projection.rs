@@ -232,6 +232,21 @@ impl Projection {
         self.pins_epoch == body.attrs().pins_epoch
     }
 
+    /// The slots' inverse masses and the pin epoch as they are, for
+    /// [`Projection::restore_pins`] when what follows [`Projection::follow_pins`] is refused
+    /// (finding 203). O(slots).
+    pub(crate) fn pin_snapshot(&self) -> (Vec<f64>, u64) {
+        (self.system.inv_mass.clone(), self.pins_epoch)
+    }
+
+    /// Puts back what [`Projection::pin_snapshot`] took: [`Projection::follow_pins`] changes
+    /// only the inverse masses (the masses and viscosities it writes are the ones there, the
+    /// projection being current) and the epoch. O(slots).
+    pub(crate) fn restore_pins(&mut self, (inv_mass, epoch): (Vec<f64>, u64)) {
+        self.system.inv_mass = inv_mass;
+        self.pins_epoch = epoch;
+    }
+
     /// Re-reads every live vertex's pin into its slot (fixed or not; mass and viscosity as
     /// they are), after the pins were handed out for writing. O(slots).
     pub(crate) fn follow_pins(&mut self, body: &Body) {

@@ -235,7 +235,8 @@ pub enum CouplingError {
         version: u64,
     },
     /// A material constant is refused ([`crate::mechanics::ModelError::BadMaterial`], as for a
-    /// [`crate::mechanics::Body`]).
+    /// [`crate::mechanics::Body`]): by the constructors, and by every operation before the map
+    /// changes, since [`LeveledMechanics::material`] is a public field.
     #[error(transparent)]
     Material(crate::mechanics::ModelError),
     /// A level-0 tet has zero volume: it would get no mass and no stiffness (a
@@ -268,7 +269,9 @@ pub enum CouplingError {
     /// spring take 2k and 2c, and the children of a 1→8 add law 2's terms to their new edges.
     /// `bound` bounds every value the operation (or, for [`LeveledMechanics::refine_around`], the
     /// whole level) would store ([`LeveledMechanics::subdivide_tet`] states it); refused when it
-    /// comes within a factor 1 + 2⁻⁴⁰ of `f64::MAX`, before the map changes.
+    /// comes within a factor 1 + 2⁻⁴⁰ of `f64::MAX`, before the map changes. `bound` is NaN
+    /// when a spring on the edges concerned holds a NaN value (written through
+    /// [`LeveledMechanics::spring_mut`]).
     #[error("splitting at {dart} could make a spring stiffness or damping of {bound:e}, past the range of f64")]
     SplitOverflow {
         /// A dart of the tet (or edge, or face) whose split makes the bound largest.
@@ -685,13 +688,14 @@ impl LeveledMechanics {
         Ok(())
     }
 
-    /// The largest stiffness or damping of the springs on the edges of the live `darts`.
-    /// O(darts · log E).
+    /// The largest stiffness or damping of the springs on the edges of the live `darts`; NaN
+    /// if one of them is NaN (written through [`Self::spring_mut`]), so that the headroom
+    /// checks refuse it rather than drop it (finding 205). O(darts · log E).
     fn largest_spring(&self, m: &LeveledMap<3>, darts: &[DartId]) -> f64 {
         let map = m.map();
         let springs =
             darts.iter().filter(|&&x| map.contains(x)).filter_map(|&x| self.springs.get(&EdgeKey::of(map, x)));
-        springs.fold(0.0, |a, s| a.max(s.stiffness).max(s.damping))
+        springs.fold(0.0, |a, s| max_keeping_nan(max_keeping_nan(a, s.stiffness), s.damping))
     }
 
     /// A bound of the stiffness and damping terms that the children of a 1→8 split of the tet of
@@ -727,7 +731,7 @@ impl LeveledMechanics {
             if worst.is_none_or(|(w, _)| own > w || own.is_nan()) {
                 worst = Some((own, d));
             }
-            (a, b) = (a.max(at), b.max(bt));
+            (a, b) = (max_keeping_nan(a, at), max_keeping_nan(b, bt));
         }
         refuse_past_max(worst.map(|(_, d)| d), 2.0 * a + 8.0 * b)
     }
@@ -742,6 +746,10 @@ impl LeveledMechanics {
     /// Errors unless every vertex insertion of the map was followed and the coupling holds one
     /// state per vertex id of the map. O(1).
     fn in_sync(&self, m: &LeveledMap<3>) -> Result<(), CouplingError> {
+        // The material is a public field: checked again here, before any operation, as
+        // `new` checks it (a NaN Young's modulus or damping would pass the headroom bounds and
+        // fail half way through the split: finding 205). O(1).
+        crate::mechanics::model::check_material(&self.material).map_err(CouplingError::Material)?;
         let logged = m.edge_split_log().len();
         if logged != self.applied {
             return Err(CouplingError::OutOfSync { applied: self.applied, logged });
@@ -754,6 +762,15 @@ impl LeveledMechanics {
             return Err(CouplingError::Unfollowed { followed: self.followed, version: m.version() });
         }
         Ok(())
+    }
+}
+
+/// max(a, b), NaN when either is (`f64::max` drops a NaN). O(1).
+fn max_keeping_nan(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.max(b)
     }
 }
 

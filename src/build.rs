@@ -134,6 +134,39 @@ pub struct BuildReport {
     pub extra_vertices: Vec<(u32, u32)>,
 }
 
+impl BuildReport {
+    /// Values given per point (positions, masses, tags) extended to every vertex id of the map:
+    /// the first `per_point.len()` ids are the points themselves, and each extra vertex of a
+    /// pinched point takes its point's value ([`BuildReport::extra_vertices`]). This is what
+    /// [`crate::subdivide::LeveledMap::new`] needs as positions for a map built from a mesh with
+    /// pinched points. `None` when `per_point` is shorter than a point the report names (values
+    /// for another mesh). O(points + extra vertices).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::GMap;
+    ///
+    /// let (map, report) = GMap::<3>::from_tets(7, &[[0, 1, 2, 3], [0, 4, 5, 6]]).unwrap();
+    /// let tags: Vec<u32> = (100..107).collect();
+    /// let per_vertex = report.per_vertex(&tags).unwrap();
+    /// assert_eq!(per_vertex.len(), map.cell_id_bound(0));
+    /// assert_eq!(per_vertex[7], 100); // the second vertex at point 0
+    /// assert_eq!(report.per_vertex(&tags[..3]), None);
+    /// ```
+    pub fn per_vertex<T: Copy>(&self, per_point: &[T]) -> Option<Vec<T>> {
+        let mut out = per_point.to_vec();
+        for &(id, point) in &self.extra_vertices {
+            let value = *per_point.get(point as usize)?;
+            if out.len() <= id as usize {
+                out.resize(id as usize + 1, value);
+            }
+            out[id as usize] = value;
+        }
+        Some(out)
+    }
+}
+
 /// The combinatorial template of one tetrahedron's 24 darts.
 ///
 /// Dart `6f + k` lies on face f (the face opposite local vertex f), whose corners are the other

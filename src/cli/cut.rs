@@ -15,7 +15,7 @@ use topomech::mesh::TetMesh;
 use topomech::vtk::{body_tets, Frame};
 use topomech::{BuildReport, CellId};
 
-use super::simulate::{check_pin_region, file_vertex, step_error};
+use super::simulate::{check_pin_region, file_vertex, step_error, used_points};
 use super::{
     at_least_one, build_body, check_ids, other, parse_finite, print_warnings, with_extra_vertices, CellCensus, CliError,
 };
@@ -238,7 +238,10 @@ pub fn run_remove(args: RemoveArgs) -> Result<(), CliError> {
 pub fn run_tear(args: TearArgs) -> Result<(), CliError> {
     let (mut body, mesh, built, load_us) = load_body(&args.common)?;
     let before = stats(&body, 0.0);
-    let rest = body.attrs().rest_position().as_slice().to_vec();
+    // The rest positions of the vertices the tets use: an unreferenced point keeps a vertex
+    // slot whose rest position is never set (the origin), which would move the range and pin a
+    // phantom (finding 206, as 201 in `simulate`). Extra vertices of pinched points are kept.
+    let rest = used_points(body.attrs().rest_position().as_slice(), &built.unreferenced_points);
     let (lo, hi) = rest.iter().fold((f64::MAX, f64::MIN), |(lo, hi), p| (lo.min(p[2]), hi.max(p[2])));
     // An explicit --pin-z under the whole body would let it fall unpinned: refuse it.
     if let Some(z) = args.pin_z {

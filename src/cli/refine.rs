@@ -171,7 +171,13 @@ pub fn run(args: RefineArgs) -> Result<(), CliError> {
         Some(plane) => Some(cut_body(&loaded.mesh.points, &loaded.mesh.tets, material, plane, &args, "unrefined")?),
         None => None,
     };
-    let mut m = LeveledMap::new(loaded.map, loaded.mesh.points);
+    // One position per vertex id: the extra vertices of pinched points take their point's
+    // (finding 207; without them the refinement refused every such mesh).
+    let positions = loaded
+        .build
+        .per_vertex(&loaded.mesh.points)
+        .ok_or_else(|| other("the build report names a point the mesh lacks"))?;
+    let mut m = LeveledMap::new(loaded.map, positions);
     m.set_max_darts(args.max_darts);
     let (refinement, masses, mech, refine_ms) = refine(&args, &mut m, material)?;
     let laws = Laws::check(&m);

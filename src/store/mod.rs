@@ -177,10 +177,11 @@ pub enum StoreError {
         /// The system error.
         source: std::io::Error,
     },
-    /// The file starts with neither magic.
+    /// The file starts with neither magic (the text one on its first significant line).
     #[error("not a topomech map file: it starts with \"{found}\", not {TEXT_MAGIC:?} or the binary magic")]
     BadMagic {
-        /// The first bytes, escaped.
+        /// The first bytes of the first significant line (the first bytes of the file if it has
+        /// none), escaped.
         found: String,
     },
     /// The file was written by another version of the format.
@@ -643,15 +644,20 @@ fn check_levels_representable(map: &RawMap, l: &LevelParts) -> Result<(), String
 /// assert!(matches!(store::decode(b"hello"), Err(store::StoreError::BadMagic { .. })));
 /// ```
 pub fn decode(bytes: &[u8]) -> Result<Document, StoreError> {
+    // A UTF-8 byte-order mark (which some editors write) is no part of the text (finding 210).
+    let text = bytes.strip_prefix(UTF8_BOM).unwrap_or(bytes);
     if bytes.starts_with(&BINARY_MAGIC) {
         binary::decode(bytes)
-    } else if text::header_comes_first(bytes) {
-        text::decode(bytes)
+    } else if text::header_comes_first(text) {
+        text::decode(text)
     } else {
-        let head = &bytes[..bytes.len().min(16)];
-        Err(StoreError::BadMagic { found: head.escape_ascii().to_string() })
+        let line = text::first_significant_line(text).unwrap_or(text);
+        Err(StoreError::BadMagic { found: line[..line.len().min(16)].escape_ascii().to_string() })
     }
 }
+
+/// The UTF-8 encoding of U+FEFF, the byte-order mark.
+const UTF8_BOM: &[u8] = b"\xEF\xBB\xBF";
 
 /// Reads and decodes a file (raw: laws unchecked). O(size).
 ///

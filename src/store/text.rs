@@ -270,10 +270,10 @@ fn arity(tokens: &[&str], n: usize, line: usize, what: &str) -> Result<(), Store
 }
 
 /// Parses the text form into a raw document with its structure checked.
-/// Whether the first significant line of `bytes` (as [`Lines`] reads lines: blank and `#`
-/// comment lines skipped, spaces and tabs trimmed, LF or CRLF ends) starts with [`TEXT_MAGIC`],
-/// so that [`decode`] is the decoder to try. Needs no valid UTF-8. O(bytes up to that line).
-pub(super) fn header_comes_first(bytes: &[u8]) -> bool {
+/// The first significant line of `bytes` as [`Lines`] reads lines (blank and `#` comment lines
+/// skipped, spaces and tabs trimmed, LF or CRLF ends), if there is one. Needs no valid UTF-8.
+/// O(bytes up to that line).
+pub(super) fn first_significant_line(bytes: &[u8]) -> Option<&[u8]> {
     let blank = |b: &u8| SEPARATORS.contains(&char::from(*b));
     bytes
         .split(|&b| b == b'\n')
@@ -283,7 +283,12 @@ pub(super) fn header_comes_first(bytes: &[u8]) -> bool {
             &line[start..]
         })
         .find(|t| !t.iter().all(blank) && !t.starts_with(b"#"))
-        .is_some_and(|t| t.starts_with(TEXT_MAGIC.as_bytes()))
+}
+
+/// Whether the first significant line of `bytes` ([`first_significant_line`]) starts with
+/// [`TEXT_MAGIC`], so that [`decode`] is the decoder to try. O(bytes up to that line).
+pub(super) fn header_comes_first(bytes: &[u8]) -> bool {
+    first_significant_line(bytes).is_some_and(|t| t.starts_with(TEXT_MAGIC.as_bytes()))
 }
 
 pub(super) fn decode(bytes: &[u8]) -> Result<Document, StoreError> {

@@ -511,6 +511,23 @@ impl FrameWriter {
 mod tests {
     use super::*;
 
+    /// A slot past the file's points is named as one of several vertices at its point; a slot
+    /// that is a point of the file is not (mutation sample 42: the test of `slot >= points`
+    /// flipped went unseen by the CLI tests, which read the tag only).
+    #[test]
+    fn file_vertex_marks_only_the_extra_vertices_as_copies() {
+        let (tags, file_point) = ([101, 102, 103], [0, 1, 2, 0, u32::MAX]);
+        for slot in 0..3 {
+            let name = file_vertex(&tags, &file_point, 3, slot);
+            assert!(name.starts_with(&format!("file node tag {}", tags[slot])), "{name}");
+            assert!(!name.contains("one of several"), "{name}");
+        }
+        let extra = file_vertex(&tags, &file_point, 3, 3);
+        assert!(extra.starts_with("file node tag 101") && extra.contains("one of several vertices there"), "{extra}");
+        assert!(file_vertex(&tags, &file_point, 3, 4).contains("not a point of the file"));
+        assert!(file_vertex(&[], &file_point, 3, 3).starts_with("point 0 of the file (0-based, one of several"));
+    }
+
     /// A short run keeps every time: the median is the plain median.
     #[test]
     fn step_times_keep_a_short_run_whole() {

@@ -27,6 +27,7 @@
 //! does so itself when positions or velocities were handed out for writing).
 
 use std::str::FromStr;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use rayon::prelude::*;
 
@@ -260,8 +261,10 @@ pub enum StepError {
         step: u64,
         /// Iterations made.
         iterations: usize,
-        /// ‖r‖/‖b‖ reached; ‖b‖ itself (∞ or NaN, with 0 iterations) when the right-hand side is
-        /// not finite (the forces overflowed).
+        /// Relative residual reached: max |zᵢ| / max(max |(P b)ᵢ|, max |Δvᵢ|) over the free slots'
+        /// coordinates, z = P r the Jacobi-preconditioned residual (Δv's units, see
+        /// [`StepConfig::cg_tolerance`]); ‖b‖ itself (∞ or NaN, with 0 iterations) when the
+        /// right-hand side is not finite (the forces overflowed).
         residual: f64,
     },
     /// The time step is not a positive finite number.
@@ -332,8 +335,12 @@ pub struct StepConfig {
     pub parallel: bool,
     /// Kinetic energy above this many times the starting energy scale counts as a blow-up.
     pub runaway_factor: f64,
-    /// Relative residual ‖r‖/‖b‖ at which conjugate gradient stops, in (0, 1); a solve that
-    /// does not reach it within `cg_max_iterations` is [`StepError::SolverFailed`].
+    /// Relative residual at which conjugate gradient stops, in (0, 1): CG is Jacobi
+    /// preconditioned (P = D⁻¹, D the diagonal of M + h(Γ + C) + h² K) and stops when every
+    /// coordinate of every free slot of the preconditioned residual z = P r — the correction
+    /// to Δv the diagonal alone would still make, in velocity units — is at most
+    /// `cg_tolerance` · max(max |(P b)ᵢ|, max |Δvᵢ|). A solve that does not reach it within
+    /// `cg_max_iterations` (or breaks down) is [`StepError::SolverFailed`].
     pub cg_tolerance: f64,
     /// Iteration cap of conjugate gradient.
     pub cg_max_iterations: usize,
@@ -427,10 +434,19 @@ struct CgBuffers {
     coef: Vec<[f64; 3]>,
     /// Per slot 2^-α (mᵢ + h νᵢ) during the solve (0 on fixed slots).
     diag: Vec<f64>,
+    /// Jacobi preconditioner: per free slot and coordinate the inverse of the scaled operator's
+    /// diagonal entry, 1 / (2^-α (mᵢ + h νᵢ + Σ_s (h² kt + (h² (k − kt) + h c) n_j²))); 0 on
+    /// fixed slots (`jacobi`).
+    pre: Vec<Vec3>,
     r: Vec<Vec3>,
     p: Vec<Vec3>,
+    /// A p during an iteration, then the preconditioned residual z = P r.
     q: Vec<Vec3>,
     dv: Vec<Vec3>,
+    /// Wide-float spring products and right-hand side of `wide_rhs` (kept to step without
+    /// allocating).
+    wide_y: Vec<[Wide; 3]>,
+    wide_b: Vec<[Wide; 3]>,
 }
 
 impl Stepper {
@@ -1060,18 +1076,21 @@ fn check_len(sys: &SpringSystem, x: &[Vec3]) -> Result<(), StepError> {
     }
 }
 
-/// Kinetic + elastic energy + M |g| D (D = bounding-box diagonal of x); if that is 0, Σ ½ k L²
-/// (the elastic energy of every spring at twice its rest length): a body at rest in its rest
-/// shape without gravity keeps a runaway test of the material's scale. O(slots + springs).
+/// Kinetic + elastic energy + M |g| D (D = bounding-box diagonal of the slots that have mass:
+/// a massless slot has no potential energy, and a body's slot of a vertex id no tet uses rests
+/// at the origin, which would stretch the box and loosen the runaway test by the body's distance
+/// from it, finding 217); if that is 0, Σ ½ k L² (the elastic energy of every spring at twice its
+/// rest length): a body at rest in its rest shape without gravity keeps a runaway test of the
+/// material's scale. O(slots + springs).
 fn energy_scale(sys: &SpringSystem, x: &[Vec3], v: &[Vec3]) -> f64 {
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for p in x {
+    for (p, _) in x.iter().zip(&sys.mass).filter(|(_, &m)| m > 0.0) {
         for k in 0..3 {
             lo[k] = lo[k].min(p[k]);
             hi[k] = hi[k].max(p[k]);
         }
     }
-    let diag = if x.is_empty() { 0.0 } else { norm(sub(hi, lo)) };
+    let diag = if lo[0] > hi[0] { 0.0 } else { norm(sub(hi, lo)) };
     let total_mass: f64 = sys.mass.iter().sum();
     let scale = sys.kinetic_energy_raw(v) + sys.elastic_energy_raw(x) + total_mass * norm(sys.gravity) * diag;
     if scale != 0.0 {
@@ -1115,7 +1134,7 @@ impl Stepper {
         let (h, par) = (self.config.dt, self.config.parallel);
         let n = x.len();
         let cg = &mut self.cg;
-        for buf in [&mut cg.r, &mut cg.p, &mut cg.q, &mut cg.dv] {
+        for buf in [&mut cg.r, &mut cg.p, &mut cg.q, &mut cg.dv, &mut cg.pre] {
             buf.resize(n, [0.0; 3]);
         }
         cg.dir.resize(sys.springs(), [0.0; 3]);
@@ -1124,26 +1143,44 @@ impl Stepper {
         linearise(sys, x, &mut cg.dir, &mut cg.coef);
         // b = h f0 + h² K-gather(v0)  (K v0 enters with a minus: −h² K v0, K = −∂f/∂x ⇒ + gather).
         sys.forces_raw(x, v, &mut self.sf, &mut self.acc, par);
-        spring_products(sys, &cg.dir, &cg.coef, v, 0.0, 1.0, &mut self.sf);
+        let products_lost = spring_products(sys, &cg.dir, &cg.coef, v, 0.0, 1.0, &mut self.sf);
         let sf: &[Vec3] = &self.sf;
         let f0: &[Vec3] = &self.acc;
+        let hh = h * h;
+        let terms_lost = AtomicBool::new(false);
         sys.per_slot(&mut cg.r, par, |i| {
             let g = gather(sys, i, sf);
             if sys.inv_mass[i] > 0.0 {
-                [h * f0[i][0] + h * h * g[0], h * f0[i][1] + h * h * g[1], h * f0[i][2] + h * h * g[2]]
+                [0, 1, 2].map(|j| {
+                    let (hf, hhg) = (h * f0[i][j], hh * g[j]);
+                    let b = hf + hhg;
+                    // A term (h f₀, h² g, h² itself) or b below the normal range while its
+                    // factors are not 0: underflowed, not exact.
+                    let lost = (f0[i][j] != 0.0 && !hf.is_normal())
+                        || (g[j] != 0.0 && !(hh.is_normal() && hhg.is_normal()))
+                        || (b != 0.0 && !b.is_normal());
+                    if lost {
+                        terms_lost.store(true, Ordering::Relaxed);
+                    }
+                    b
+                })
             } else {
                 [0.0; 3]
             }
         });
         // A b that is not finite in f64 while the forces are: an intermediate overflowed (K ẋ₀
-        // for a stiffness near f64::MAX, h² for a huge h, h f₀ for h > 1). Formed again in wide
-        // floats and handed to CG already scaled, unless b itself is past f64::MAX (refused, as
-        // a b that is not finite always was). Cold: the plain b stands wherever it is finite.
+        // for a stiffness near f64::MAX, h² for a huge h, h f₀ for h > 1); or a b one of whose
+        // terms underflowed (finding 209: h f₀, h², h² K ẋ₀ or a product of K ẋ₀ below the
+        // normal range — b = 0 or a few bits where the forces and Δv are ordinary). Formed again
+        // in wide floats and handed to CG already scaled, unless b itself is past f64::MAX
+        // (refused, as a b that is not finite always was). Cold: the plain b stands wherever
+        // it is finite and every term of it normal or exactly 0.
         let plain = cg.r.iter().flatten().all(|c| c.is_finite());
+        let lost = products_lost || terms_lost.into_inner();
         let forces_finite = (0..n).all(|i| sys.inv_mass[i] == 0.0 || f0[i].iter().all(|c| c.is_finite()));
-        let pre_scaled = match plain || !forces_finite {
+        let pre_scaled = match (plain && !lost) || !forces_finite {
             true => None,
-            false => wide_rhs(sys, &cg.dir, &cg.coef, v, f0, h, &mut cg.r),
+            false => wide_rhs(sys, &cg.dir, &cg.coef, v, f0, h, &mut cg.wide_y, &mut cg.wide_b, &mut cg.r),
         };
         let iterations = self.conjugate_gradient(sys, h, pre_scaled)?;
         self.last_cg_iterations = iterations;
@@ -1156,27 +1193,46 @@ impl Stepper {
     }
 
     /// Solves A Δv = r (r holds b on entry, or 2^-β b when `pre_scaled` is `Some(β)`, from
-    /// `wide_rhs`) by CG on the free slots; Δv in `cg.dv`.
+    /// `wide_rhs`) by Jacobi-preconditioned CG on the free slots; Δv in `cg.dv`.
     ///
-    /// Scale-safe: CG runs on 2^-β b and 2^-α A, with 2^β the binade of max |bᵢ| and 2^α
+    /// Preconditioner and stop test (finding 208): P = D⁻¹, D the diagonal of A (per free slot
+    /// and coordinate mᵢ + h νᵢ + Σ_s h² kt_s + (h² (k_s − kt_s) + h c_s) n_j², `jacobi`), and
+    /// CG stops when the preconditioned residual z = P r — the correction to Δv that the
+    /// diagonal alone would make, in velocity units — is at most `cg_tolerance` times
+    /// max(‖P b‖∞, ‖Δv‖∞) in every coordinate of every free slot. The error of Δv is
+    /// (P A)⁻¹ z, so every slot's Δv is within tol·‖(P A)⁻¹‖∞ of that scale: exact after one
+    /// iteration for unconnected slots (A diagonal), and near the tolerance as long as the
+    /// springs are not much stiffer than the masses they join (h² k / m moderate). Before, the
+    /// test was ‖r‖₂ ≤ tol ‖b‖₂ in force units, and a slot (or part) whose share of b was below
+    /// tol of the largest — a light slot beside a heavy one — was left unsolved.
+    ///
+    /// Scale-safe: CG runs on 2^-β b and 2^-α A, with 2^β the binade of max |(P b)ᵢ| (to a
+    /// factor 2, from the exponents of P and b: no product formed) and 2^α
     /// (`operator_exponent`) midway, in binades, between the smallest diagonal mass term
     /// mᵢ + h νᵢ of a free slot and the largest term of the operator (mᵢ + h νᵢ, h c_s, h² k_s
-    /// over the free slots and their springs), so that ‖b‖², pᵀAp and the step lengths stay near 1
-    /// for a body of any size (finding 179: ‖b‖² under- or overflowed for edges beyond about
-    /// 1e±33, and an underflowed ‖b‖ ended the solve with Δv = 0, every force dropped). The
+    /// over the free slots and their springs), so that z (Δv's units) starts near 1 and
+    /// rᵀz, pᵀAp and the step lengths stay inside f64's range for a body of any size (finding
+    /// 179: ‖b‖² under- or overflowed for edges beyond about 1e±33, and an underflowed ‖b‖ ended
+    /// the solve with Δv = 0, every force dropped; round 23: with b rather than P b scaled to 1,
+    /// z underflowed when the operator's terms spanned 2^1700). The
     /// factor 2^-α goes into the operator's coefficients — 2^-α (mᵢ + h νᵢ), 2^-α h² (k − kt),
     /// 2^-α h² kt and 2^-α h c, each formed in wide floats and rounded once — before any of them
     /// meets a vector, so no product of the unscaled operator is formed (finding 198: A p was
     /// formed first and scaled after, and mᵢ pᵢ overflowed for a free slot of mass ≈ 1e308;
-    /// h² k, m + h ν overflowed for a stiffness or viscosity near `f64::MAX`). Powers of two
-    /// scale exactly, so wherever the unscaled solve would neither over- nor underflow the
-    /// iterates are its bits times powers of two, and Δv = 2^(β−α) y at the end is its Δv bit
-    /// for bit; elsewhere the scaled solve keeps the operator's terms inside f64's range as long
-    /// as they span less than about 2^1900 (a term below 2^-1074 of the largest is lost as an
-    /// underflow, a Δv past `f64::MAX` is ±∞ and ends the step as a blow-up). Only an exactly
-    /// zero b has nothing to solve.
+    /// h² k, m + h ν overflowed for a stiffness or viscosity near `f64::MAX`). The preconditioner
+    /// is built from these scaled coefficients, so it is 2^α D⁻¹. Powers of two scale exactly,
+    /// so wherever the unscaled solve would neither over- nor underflow the iterates are its bits
+    /// times powers of two, and Δv = 2^(β−α) y at the end is its Δv bit for bit; elsewhere the
+    /// scaled solve keeps the operator's terms inside f64's range as long as they span less than
+    /// about 2^1900 (a term below 2^-1074 of the largest is lost as an underflow, a Δv past
+    /// `f64::MAX` is ±∞ and ends the step as a blow-up; a coordinate of 2^-β b below 2^-1074 —
+    /// b's coordinates spanning more than that — is lost the same way). A breakdown (pᵀAp ≤ 0 or
+    /// not finite, possible only past that span) is [`StepError::SolverFailed`]. Only an exactly
+    /// zero b has nothing to solve (a b that underflowed was formed again in wide floats by
+    /// `implicit`). O(iterations · (slots + springs)), plus O(slots + springs) for the scaling
+    /// and the preconditioner.
     fn conjugate_gradient(&mut self, sys: &SpringSystem, h: f64, pre_scaled: Option<i32>) -> Result<usize, StepError> {
-        let par = self.config.parallel;
+        let (par, tol) = (self.config.parallel, self.config.cg_tolerance);
         let cg = &mut self.cg;
         cg.dv.iter_mut().for_each(|d| *d = [0.0; 3]);
         let b_max = cg.r.iter().flatten().fold(0.0f64, |m, c| m.max(c.abs()));
@@ -1188,46 +1244,113 @@ impl Stepper {
             let residual = dot_all(&cg.r, &cg.r).sqrt();
             return Err(StepError::SolverFailed { step: self.step, iterations: 0, residual });
         }
-        let alpha = operator_exponent(sys, &cg.coef, h);
-        scale_operator(sys, h, alpha, &mut cg.coef, &mut cg.diag);
-        let beta = match pre_scaled {
-            Some(beta) => beta,
-            None => {
-                let beta = exponent(b_max);
-                scale_all(&mut cg.r, -beta);
-                beta
-            }
-        };
-        cg.p.copy_from_slice(&cg.r);
-        let b_norm = dot_all(&cg.r, &cg.r).sqrt();
-        let mut rr = dot_all(&cg.r, &cg.r);
+        let op_exp = operator_exponent(sys, &cg.coef, h);
+        scale_operator(sys, h, op_exp, &mut cg.coef, &mut cg.diag);
+        jacobi(sys, &cg.dir, &cg.coef, &cg.diag, &mut cg.pre, par);
+        // r = 2^-β b with 2^β the binade of max |(P b)ᵢ| (to a factor 2), so that the
+        // preconditioned residual z — Δv's units — starts near 1: estimated from exponents, no
+        // product of P and b formed (either may be far outside 1).
+        let shift =
+            cg.r.iter()
+                .zip(&cg.pre)
+                .flat_map(|(r, p)| (0..3).map(move |j| (r[j], p[j])))
+                .filter(|&(r, p)| r != 0.0 && p != 0.0)
+                .map(|(r, p)| exponent(r.abs()) + exponent(p))
+                .max()
+                .unwrap_or(exponent(b_max));
+        scale_all(&mut cg.r, -shift);
+        let b_exp = pre_scaled.unwrap_or(0) + shift;
+        // z₀ = P b, p₀ = z₀.
+        let (mut rz, mut z_max) = (0.0, 0.0);
+        for i in 0..cg.r.len() {
+            let z = times(cg.pre[i], cg.r[i]);
+            rz += dot(cg.r[i], z);
+            z_max = max_abs(z_max, z);
+            cg.p[i] = z;
+        }
+        let z_b = z_max;
+        let mut dv_max = 0.0;
         let solved = |cg: &mut CgBuffers, it: usize| {
-            scale_all(&mut cg.dv, beta - alpha);
+            scale_all(&mut cg.dv, b_exp - op_exp);
             Ok(it)
         };
         for it in 0..self.config.cg_max_iterations {
-            if rr.sqrt() <= self.config.cg_tolerance * b_norm {
+            if z_max <= tol * max_of(z_b, dv_max) {
                 return solved(cg, it);
             }
             apply_system(sys, &cg.dir, &cg.coef, &cg.diag, &cg.p, &mut self.sf, &mut cg.q, par);
-            let alpha = rr / dot_all(&cg.p, &cg.q);
+            let pq = dot_all(&cg.p, &cg.q);
+            if !(pq > 0.0 && pq.is_finite()) {
+                // Breakdown: A is positive definite in exact arithmetic, so pᵀAp ≤ 0 (or not
+                // finite) means its terms have left f64's range (beyond the documented span).
+                let residual = z_max / max_of(z_b, dv_max);
+                return Err(StepError::SolverFailed { step: self.step, iterations: it, residual });
+            }
+            let alpha = rz / pq;
+            let (mut rz_new, mut zm, mut dm) = (0.0, 0.0, 0.0);
             for i in 0..cg.p.len() {
                 cg.dv[i] = madd(cg.dv[i], alpha, cg.p[i]);
                 cg.r[i] = madd(cg.r[i], -alpha, cg.q[i]);
+                let z = times(cg.pre[i], cg.r[i]);
+                rz_new += dot(cg.r[i], z);
+                zm = max_abs(zm, z);
+                dm = max_abs(dm, cg.dv[i]);
+                cg.q[i] = z;
             }
-            let rr_new = dot_all(&cg.r, &cg.r);
-            let beta = rr_new / rr;
-            rr = rr_new;
+            let beta = rz_new / rz;
+            (rz, z_max, dv_max) = (rz_new, zm, dm);
             for i in 0..cg.p.len() {
-                cg.p[i] = madd(cg.r[i], beta, cg.p[i]);
+                cg.p[i] = madd(cg.q[i], beta, cg.p[i]);
             }
         }
-        let residual = rr.sqrt() / b_norm;
-        if residual <= self.config.cg_tolerance {
+        let residual = z_max / max_of(z_b, dv_max);
+        if residual <= tol {
             return solved(cg, self.config.cg_max_iterations);
         }
         Err(StepError::SolverFailed { step: self.step, iterations: self.config.cg_max_iterations, residual })
     }
+}
+
+/// The Jacobi preconditioner of the scaled operator (after [`scale_operator`]): per free slot i
+/// and coordinate j, 1 / Dᵢⱼ with Dᵢⱼ = `diag`ᵢ + Σ_{s ∋ i} (kt_s + (ka_s + c_s) n_sj²), the
+/// diagonal entry of the operator [`apply_system`] applies (`coef` = (ka, kt, c) scaled); 0 on
+/// fixed slots. A Dᵢⱼ that is not a normal number (the operator's terms spanning more than f64
+/// holds, beyond the documented limit) gets 1, so that its coordinate is still searched and
+/// tested. Each slot on its own, in the order of its incident springs: the same bits at any
+/// thread count. O(slots + springs).
+fn jacobi(sys: &SpringSystem, dir: &[Vec3], coef: &[[f64; 3]], diag: &[f64], pre: &mut [Vec3], par: bool) {
+    sys.per_slot(pre, par, |i| {
+        if sys.inv_mass[i] == 0.0 {
+            return [0.0; 3];
+        }
+        let mut d = [diag[i]; 3];
+        for (s, _) in sys.incident(i) {
+            let ([ka, kt, c], n) = (coef[s], dir[s]);
+            let axial = ka + c;
+            for j in 0..3 {
+                d[j] += kt + axial * n[j] * n[j];
+            }
+        }
+        d.map(|e| if e.is_normal() { 1.0 / e } else { 1.0 })
+    });
+}
+
+/// (aᵢ bᵢ)ᵢ.
+#[inline(always)]
+fn times(a: Vec3, b: Vec3) -> Vec3 {
+    [a[0] * b[0], a[1] * b[1], a[2] * b[2]]
+}
+
+/// max(m, |aⱼ|) over j, NaN once m or any aⱼ is NaN (so that a NaN never passes a stop test).
+#[inline(always)]
+fn max_abs(m: f64, a: Vec3) -> f64 {
+    a.iter().fold(m, |m, c| if c.abs() > m || c.is_nan() { c.abs() } else { m })
+}
+
+/// max(a, b), NaN when either is.
+#[inline(always)]
+fn max_of(a: f64, b: f64) -> f64 {
+    max_abs(a, [b, 0.0, 0.0])
 }
 
 /// Per spring: unit direction n and (k_axial, k_transverse, c) for the K and C blocks.
@@ -1250,6 +1373,9 @@ fn linearise(sys: &SpringSystem, x: &[Vec3], dir: &mut [Vec3], coef: &mut [[f64;
 }
 
 /// out_s = wc·C_s w + wk·K_s w with w = u_b − u_a (C_s = c n nᵀ, K_s as in the module docs).
+/// Returns whether a product of a spring with a free end underflowed: fell below the normal
+/// range (to a subnormal or 0) while neither of its factors is 0, so that out_s is not the
+/// product's rounding (finding 209: K ẋ₀ of a tiny stiffness). O(springs).
 fn spring_products(
     sys: &SpringSystem,
     dir: &[Vec3],
@@ -1258,16 +1384,28 @@ fn spring_products(
     wc: f64,
     wk: f64,
     out: &mut [Vec3],
-) {
+) -> bool {
+    // p = a b, below the normal range while a, b ≠ 0.
+    let lost = |p: f64, a: f64, b: f64| p.abs() < f64::MIN_POSITIVE && a != 0.0 && b != 0.0;
+    let mut any = false;
     for s in 0..sys.springs() {
         let [a, b] = sys.ends[s];
         let w = sub(u[b as usize], u[a as usize]);
         let n = dir[s];
         let [k, kt, c] = coef[s];
         let along = dot(n, w);
-        let axial = wk * (k - kt) * along + wc * c * along;
-        out[s] = [wk * kt * w[0] + axial * n[0], wk * kt * w[1] + axial * n[1], wk * kt * w[2] + axial * n[2]];
+        let (ka, ca, kw) = (wk * (k - kt), wc * c, wk * kt);
+        let axial = ka * along + ca * along;
+        out[s] = [kw * w[0] + axial * n[0], kw * w[1] + axial * n[1], kw * w[2] + axial * n[2]];
+        if sys.inv_mass[a as usize] > 0.0 || sys.inv_mass[b as usize] > 0.0 {
+            let mut l = lost(ka * along, ka, along) || lost(ca * along, ca, along);
+            for j in 0..3 {
+                l |= lost(n[j] * w[j], n[j], w[j]) || lost(kw * w[j], kw, w[j]) || lost(axial * n[j], axial, n[j]);
+            }
+            any |= l;
+        }
     }
+    any
 }
 
 /// Σ_{v = a} y_s − Σ_{v = b} y_s.
@@ -1326,8 +1464,13 @@ fn operator_exponent(sys: &SpringSystem, coef: &[[f64; 3]], h: f64) -> i32 {
 /// gathered, then h f₀ + (h h) g): when max |bᵢ| is at most `f64::MAX`, writes 2^-β b to `r`,
 /// with 2^β the binade of max |bᵢ|, and returns β; else (b itself past `f64::MAX`, refused as
 /// before) leaves `r` alone and returns `None`. For the rare b whose plain evaluation is not
-/// finite while f₀ is: an intermediate (K ẋ₀, h², h f₀) overflowed. The plain bits wherever the
-/// plain evaluation is finite and normal. O(slots + springs).
+/// finite while f₀ is — an intermediate (K ẋ₀, h², h f₀) overflowed — or one of whose terms
+/// underflowed (h f₀, h², h² g or a product of K ẋ₀ below the normal range with factors ≠ 0:
+/// b = 0 or a few bits where the exact b is ordinary, finding 209). The plain bits wherever the
+/// plain evaluation is finite and normal. `y` and `b` are work buffers (spring products and b
+/// in wide floats), kept by the caller so that a step allocates nothing once they have grown.
+/// O(slots + springs).
+#[allow(clippy::too_many_arguments)]
 fn wide_rhs(
     sys: &SpringSystem,
     dir: &[Vec3],
@@ -1335,40 +1478,41 @@ fn wide_rhs(
     v: &[Vec3],
     f0: &[Vec3],
     h: f64,
+    y: &mut Vec<[Wide; 3]>,
+    b: &mut Vec<[Wide; 3]>,
     r: &mut [Vec3],
 ) -> Option<i32> {
     let zero = Wide::new(0.0);
-    let y: Vec<[Wide; 3]> = (0..sys.springs())
-        .map(|s| {
-            let [a, b] = sys.ends[s];
-            let w = crate::wide::difference(v[b as usize], v[a as usize]);
-            let n = dir[s].map(Wide::new);
-            let [k, kt, _] = coef[s];
-            let axial = Wide::new(k - kt).mul(crate::wide::dot(n, w));
-            let kt = Wide::new(kt);
-            [0, 1, 2].map(|j| kt.mul(w[j]).add(axial.mul(n[j])))
-        })
-        .collect();
+    y.clear();
+    y.extend((0..sys.springs()).map(|s| {
+        let [a, b] = sys.ends[s];
+        let w = crate::wide::difference(v[b as usize], v[a as usize]);
+        let n = dir[s].map(Wide::new);
+        let [k, kt, _] = coef[s];
+        let axial = Wide::new(k - kt).mul(crate::wide::dot(n, w));
+        let kt = Wide::new(kt);
+        [0, 1, 2].map(|j| kt.mul(w[j]).add(axial.mul(n[j])))
+    }));
+    let y: &[[Wide; 3]] = y;
     let (wh, wh2) = (Wide::new(h), Wide::new(h).mul(Wide::new(h)));
-    let b: Vec<[Wide; 3]> = (0..sys.slots())
-        .map(|i| {
-            if sys.inv_mass[i] == 0.0 {
-                return [zero; 3];
-            }
-            let mut g = [zero; 3];
-            for (s, sign) in sys.incident(i) {
-                g = [0, 1, 2].map(|j| g[j].add(if sign < 0.0 { y[s][j].neg() } else { y[s][j] }));
-            }
-            [0, 1, 2].map(|j| wh.mul(Wide::new(f0[i][j])).add(wh2.mul(g[j])))
-        })
-        .collect();
+    b.clear();
+    b.extend((0..sys.slots()).map(|i| {
+        if sys.inv_mass[i] == 0.0 {
+            return [zero; 3];
+        }
+        let mut g = [zero; 3];
+        for (s, sign) in sys.incident(i) {
+            g = [0, 1, 2].map(|j| g[j].add(if sign < 0.0 { y[s][j].neg() } else { y[s][j] }));
+        }
+        [0, 1, 2].map(|j| wh.mul(Wide::new(f0[i][j])).add(wh2.mul(g[j])))
+    }));
     let b_max = b.iter().flatten().fold(zero, |m, c| if m.less_than(c.abs()) { c.abs() } else { m });
     if !b_max.to_f64().is_finite() {
         return None;
     }
     let beta = if b_max.is_zero() { 0 } else { wide_exponent(b_max) };
     let scale = wide_pow2(-beta);
-    for (ri, bi) in r.iter_mut().zip(&b) {
+    for (ri, bi) in r.iter_mut().zip(b.iter()) {
         *ri = bi.map(|c| c.mul(scale).to_f64());
     }
     Some(beta)
@@ -1524,6 +1668,11 @@ mod tests {
         assert_eq!(energy_scale(&sys, &x, &[[0.0; 3]; 2]), 0.5 * 10.0 * 25.0); // Σ ½ k L²
         let stretched = vec![[0.0; 3], [9.0, 12.0, 0.0]]; // l = 15: ½ k (l − L)² = 500
         assert_eq!(energy_scale(&sys, &stretched, &[[0.0; 3]; 2]), 500.0);
+        // A massless slot far away (a vertex id no tet uses) does not stretch D (finding 217).
+        sys.set_gravity([0.0, 0.0, -10.0]).unwrap();
+        sys.push_slot(0.0, false, 0.0).unwrap();
+        let far = vec![[0.0; 3], [3.0, 4.0, 0.0], [1e6, 0.0, 0.0]];
+        assert_eq!(energy_scale(&sys, &far, &[[0.0; 3]; 3]), 4.0 * 10.0 * 5.0);
     }
 
     /// A chain of `n` unit masses on springs, the first pinned, hanging under gravity.

@@ -139,8 +139,9 @@ impl BuildReport {
     /// the first `per_point.len()` ids are the points themselves, and each extra vertex of a
     /// pinched point takes its point's value ([`BuildReport::extra_vertices`]). This is what
     /// [`crate::subdivide::LeveledMap::new`] needs as positions for a map built from a mesh with
-    /// pinched points. `None` when `per_point` is shorter than a point the report names (values
-    /// for another mesh). O(points + extra vertices).
+    /// pinched points. The extra vertices' ids follow the points (the build hands them out from
+    /// the point count up), so `None` when they do not follow `per_point.len()` or name a point
+    /// past it: values for another mesh. O(points + extra vertices).
     ///
     /// # Examples
     ///
@@ -152,16 +153,16 @@ impl BuildReport {
     /// let per_vertex = report.per_vertex(&tags).unwrap();
     /// assert_eq!(per_vertex.len(), map.cell_id_bound(0));
     /// assert_eq!(per_vertex[7], 100); // the second vertex at point 0
-    /// assert_eq!(report.per_vertex(&tags[..3]), None);
+    /// assert_eq!(report.per_vertex(&tags[..3]), None); // values for 3 points: another mesh
+    /// assert_eq!(report.per_vertex(&[0; 8]), None);
     /// ```
     pub fn per_vertex<T: Copy>(&self, per_point: &[T]) -> Option<Vec<T>> {
         let mut out = per_point.to_vec();
         for &(id, point) in &self.extra_vertices {
-            let value = *per_point.get(point as usize)?;
-            if out.len() <= id as usize {
-                out.resize(id as usize + 1, value);
+            if id as usize != out.len() {
+                return None;
             }
-            out[id as usize] = value;
+            out.push(*per_point.get(point as usize)?);
         }
         Some(out)
     }

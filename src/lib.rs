@@ -35,6 +35,7 @@ pub mod build;
 pub mod conformance;
 pub mod cut;
 pub mod embedding;
+mod exact;
 pub mod generate;
 pub mod gmap;
 pub mod graph;

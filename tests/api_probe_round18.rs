@@ -169,9 +169,12 @@ fn f146_write_errors_name_the_file_once() {
     let obj = dir.join("surface.obj");
     let e = boundary_surface_of_tets(&points, &tets).unwrap().write_obj(&obj).unwrap_err().to_string();
     assert_eq!(e.matches("surface.obj").count(), 1, "{e}");
-    // A map file's bad magic is escaped once: a newline shows as \n, not \\n.
+    // A map file's bad magic is escaped once: a control byte shows as \x07, not \\x07. The
+    // message quotes the first significant line (finding 210), without its line end.
     let e = topomech::store::decode(b"$MeshFormat\n2.2 0 8\n").unwrap_err().to_string();
-    assert!(e.contains(r#""$MeshFormat\n2.2"#) && !e.contains(r"\\"), "{e}");
+    assert!(e.contains(r#""$MeshFormat""#) && !e.contains(r"\\"), "{e}");
+    let e = topomech::store::decode(b"\x07bell\n").unwrap_err().to_string();
+    assert!(e.contains(r#""\x07bell""#) && !e.contains(r"\\"), "{e}");
 }
 
 /// Finding 142, its mesh part: a tet listed twice (the same corners, in any order) is an error

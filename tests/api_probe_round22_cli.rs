@@ -25,20 +25,7 @@ fn cube(dir: &Path, name: &str, unused: bool) -> String {
 
 /// Two tets that meet only at point 0 (file node tag 1), in either order of the tets.
 fn bowtie(dir: &Path, name: &str, swapped: bool) -> String {
-    let points = [
-        [0.0, 0.0, 0.0],
-        [1.0, 0.0, 0.0],
-        [0.0, 1.0, 0.0],
-        [0.0, 0.0, 1.0],
-        [-0.3, 0.0, 0.0],
-        [0.0, -0.3, 0.0],
-        [0.0, 0.0, -0.3],
-    ];
-    let mut tets = vec![[0, 1, 2, 3], [0, 5, 4, 6]];
-    if swapped {
-        tets.reverse();
-    }
-    write_msh(&dir.join(name), &points, &tets);
+    cli_common::write_bowtie(&dir.join(name), swapped);
     name.to_string()
 }
 

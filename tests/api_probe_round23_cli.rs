@@ -62,16 +62,7 @@ fn f206_tear_pins_the_body_not_an_unreferenced_point() {
 
 /// Two tets that meet only at point 0 (a pinched point: two map vertices there).
 fn bowtie(dir: &Path) -> String {
-    let points = [
-        [0.0, 0.0, 0.0],
-        [1.0, 0.0, 0.0],
-        [0.0, 1.0, 0.0],
-        [0.0, 0.0, 1.0],
-        [-0.3, 0.0, 0.0],
-        [0.0, -0.3, 0.0],
-        [0.0, 0.0, -0.3],
-    ];
-    write_msh(&dir.join("bowtie.msh"), &points, &[[0, 1, 2, 3], [0, 5, 4, 6]]);
+    cli_common::write_bowtie(&dir.join("bowtie.msh"), false);
     "bowtie.msh".to_string()
 }
 
@@ -123,6 +114,7 @@ fn f207_per_vertex_gives_every_extra_vertex_its_points_value() {
     }
     assert_eq!(report.extra_vertices.len(), 2);
     assert_eq!(report.per_vertex(&values[..0]), None);
+    assert_eq!(report.per_vertex(&values[..9]), None, "one value short: the extra ids do not follow");
 }
 
 /// Finding 210: a `.tmap` text file that starts with a UTF-8 byte-order mark was "not a topomech

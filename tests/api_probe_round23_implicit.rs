@@ -17,6 +17,8 @@
 
 use topomech::mechanics::{Integrator, SpringSystem, StepConfig, Stepper};
 
+mod rng_common;
+
 type V3 = [f64; 3];
 
 /// One implicit step of h from (x, v); the runaway test is off (the laws are about Δv).
@@ -105,15 +107,12 @@ fn f208_a_light_slot_hanging_from_a_heavy_one_is_solved() {
     }
 }
 
-/// A deterministic xorshift.
+/// A deterministic generator (xorshift64*, `rng_common`).
 struct Rng(u64);
 
 impl Rng {
     fn unit(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        rng_common::next_unit(&mut self.0)
     }
 }
 

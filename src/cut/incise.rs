@@ -4,8 +4,10 @@
 use crate::mechanics::{Body, TouchedCells, Vec3};
 use crate::{CellId, DartId};
 
-use super::sweep::Scaled;
+use std::cmp::Ordering;
+
 use super::{dissociate_face, CutError, Dissociation};
+use crate::exact::plane_sign;
 
 /// A cutting plane through `point` with normal `normal` (any length but zero).
 ///
@@ -29,23 +31,30 @@ pub struct Plane {
 }
 
 impl Plane {
-    /// Whether `x` is strictly on the positive side: (x − point) · normal > 0. O(1).
+    /// Whether `x` is strictly on the positive side: (x − point) · normal > 0, decided exactly.
+    /// O(1).
     ///
-    /// The tie rule: a point whose dot product is 0 (on the plane, or so close that the product
-    /// rounds to 0) is *not* positive, i.e. it is on the negative side. [`incise_plane`] cuts a
-    /// glued face when exactly one of its two tets' centroids is positive, so a centroid on the
-    /// plane goes with the tets below it. (Conformance vectors never rely on this rule: their
-    /// planes keep every live centroid at least
-    /// [`PLANE_MARGIN`](crate::conformance::PLANE_MARGIN) × the bounding-box diagonal away, and
-    /// a vector that does not is refused as ambiguous; `docs/CONFORMANCE.md`.)
+    /// The sign is that of the exact real number (x − point) · normal formed from the `f64`
+    /// inputs, never of a rounded one (`src/cut/exact.rs`: a float evaluation with
+    /// a forward error bound decides unless the value is within that bound of zero, then an
+    /// exact fixed-point sum of the products decides). So the tie rule holds exactly: a point
+    /// exactly on the plane is *not* positive, i.e. it is on the negative side, and a point one
+    /// ulp off it is on the side it is on. [`incise_plane`] cuts a glued face when exactly one
+    /// of its two tets is positive, so a tet whose centroid is on the plane goes with the tets
+    /// below it. (Conformance vectors never rely on this rule: their planes keep every live
+    /// centroid at least [`PLANE_MARGIN`](crate::conformance::PLANE_MARGIN) × the bounding-box
+    /// diagonal away, and a vector that does not is refused as ambiguous;
+    /// `docs/CONFORMANCE.md`.)
     ///
-    /// The answer does not depend on the length of the normal nor on the scale of the
-    /// coordinates (for finite ones): x − point and the normal are each scaled by a power of two
-    /// (exactly) so that their largest component is in [1, 2) before the dot product, so a tiny
-    /// normal does not underflow (with `[5e-324, 0, 0]` every point 0.25 from the plane was
-    /// "on" it) and a huge one or huge coordinates do not overflow (∞ − ∞ = NaN, "not
-    /// positive"); a difference that overflows is taken of halved coordinates. Where nothing
-    /// overflows or underflows, the decision is bit for bit that of the plain dot product.
+    /// Being exact, the answer depends only on the plane as a point set and on which side the
+    /// normal points to: normals that are exact positive multiples of each other give the same
+    /// side for every point, whatever the factor (2^k, or 0.1, 1/3 … whenever c·n is
+    /// representable, e.g. `[-2.0, -1.0, -2.0]` and `[-0.2, -0.1, -0.2]`, the latter exactly
+    /// f64(0.1) times the former). A normal scaled in floating point is rounded component by
+    /// component and then is, in general, a slightly different plane: the decision is exact
+    /// for the plane given. Nothing depends on the scale of the coordinates either: nothing is
+    /// rounded, so nothing underflows (a normal `[5e-324, 0, 0]`) or overflows (coordinates and
+    /// normals up to ±`f64::MAX`). A non-finite `x`, point or normal gives `false`.
     ///
     /// # Examples
     ///
@@ -61,11 +70,13 @@ impl Plane {
     /// assert!(tiny.positive([1.25, 0.0, 0.0]) && !tiny.positive([0.75, 0.0, 0.0]));
     /// let huge = Plane { point: [1.0; 3], normal: [f64::MAX, -f64::MAX, 0.0] };
     /// assert!(huge.positive([4.0, 3.0, 1.0])); // 3·MAX − 2·MAX > 0, unscaled ∞ − ∞ = NaN
+    /// // (1.25, 2.5, 3.75) is exactly on this plane: (−1.5)(−0.2) + 2(−0.1) + 0.5(−0.2) = 0 in
+    /// // the f64 values; the rounded dot product says 2.8e-17 ("positive").
+    /// let decimal = Plane { point: [2.75, 0.5, 3.25], normal: [-0.2, -0.1, -0.2] };
+    /// assert!(!decimal.positive([1.25, 2.5, 3.75]));
     /// ```
     pub fn positive(&self, x: Vec3) -> bool {
-        let n = Scaled::new(self.normal, 0, 0).dir;
-        let r = Scaled::diff(x, self.point, 0).dir;
-        (0..3).map(|k| r[k] * n[k]).sum::<f64>() > 0.0
+        plane_sign(&[x], self.point, self.normal) == Some(Ordering::Greater)
     }
 
     /// [`CutError::BadPlane`] unless the point and normal are finite and the normal is not zero.
@@ -122,8 +133,16 @@ impl Incision {
     }
 }
 
-/// For every live volume id, whether its centroid (mean of its vertices' current positions) is on
-/// the positive side of `plane`; `None` for dead ids. O(darts).
+/// For every live volume id, whether its centroid (the exact mean of its distinct vertices'
+/// current positions) is strictly on the positive side of `plane`; `None` for dead ids.
+/// O(darts).
+///
+/// The side is decided exactly from the corners, without forming a rounded centroid: it is the
+/// sign of Σ_corners (c − point) · normal = k · (centroid − point) · normal (k distinct
+/// corners), evaluated exactly as in [`Plane::positive`] (float filter, exact fallback). So a
+/// tet whose exact centroid is on the plane is on the negative side, and the answer depends
+/// neither on the length of the normal (exact multiples, [`Plane::positive`]) nor on how the
+/// points or the tets are numbered (no summation order enters an exact sum).
 ///
 /// # Errors
 /// [`CutError::NonFinitePosition`] for the smallest live vertex with a NaN or infinite position
@@ -143,7 +162,22 @@ impl Incision {
 /// assert_eq!(sides.iter().filter(|s| **s == Some(false)).count(), 24);
 /// ```
 pub fn tet_sides(body: &Body, plane: &Plane) -> Result<Vec<Option<bool>>, CutError> {
-    Ok(tet_centroids(body)?.into_iter().map(|c| c.map(|c| plane.positive(c))).collect())
+    check_positions_finite(body)?;
+    let (map, mech) = (body.map(), body.attrs());
+    let mut side = vec![None; map.cell_id_bound(3)];
+    let mut ids: Vec<CellId> = Vec::with_capacity(24);
+    let mut corners: Vec<Vec3> = Vec::with_capacity(4);
+    for d in map.one_dart_per_cell(3) {
+        ids.clear();
+        ids.extend(map.cell_darts(3, d).into_iter().map(|x| map.vertex_id(x)));
+        ids.sort_unstable();
+        ids.dedup();
+        corners.clear();
+        corners.extend(ids.iter().map(|&v| mech.position[v]));
+        let positive = plane_sign(&corners, plane.point, plane.normal) == Some(Ordering::Greater);
+        side[map.cell_id(3, d).index()] = Some(positive);
+    }
+    Ok(side)
 }
 
 /// [`CutError::NonFinitePosition`] for the smallest live vertex id whose position is NaN or
@@ -182,10 +216,12 @@ pub(crate) fn tet_centroids(body: &Body) -> Result<Vec<Option<Vec3>>, CutError> 
 }
 
 /// Dissociates every inner face whose two tets' centroids lie on opposite sides of `plane`, as
-/// [`Plane::positive`] decides them (a centroid on the plane is on the negative side, so such a
-/// face is cut when the other centroid is on the positive side) (seed §3.2 face separation; a
-/// precise cut through tets needs refinement). The faces are found
-/// first, then dissociated one by one, so the result does not depend on the order.
+/// [`tet_sides`] decides them: exactly, on the exact centroids (a centroid on the plane is on
+/// the negative side, so such a face is cut when the other centroid is on the positive side)
+/// (seed §3.2 face separation; a precise cut through tets needs refinement). The faces are found
+/// first, then dissociated one by one, so the result does not depend on the order of
+/// dissociation; and the set of faces cut (as vertex-position triples) depends only on the
+/// geometry: not on the numbering of the points or the tets, nor on the length of the normal.
 ///
 /// Cost: O(darts) to classify, plus one [`dissociate_face`] per cut face.
 ///

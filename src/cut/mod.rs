@@ -135,7 +135,7 @@ pub enum CutError {
     #[error("tear direction {0:?} must be finite and non-zero")]
     BadDirection(Vec3),
     /// A polyline sweep that is not a well-formed cut surface (too few points, non-finite,
-    /// repeated points, zero sweep, a segment along the sweep).
+    /// two consecutive equal points, zero sweep, a segment along the sweep).
     #[error("bad polyline sweep: {reason}")]
     BadSweep {
         /// What is wrong, naming the point or segment.

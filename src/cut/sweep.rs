@@ -10,28 +10,38 @@
 //! sweep long enough to cross the whole body). Unlike a plane it need not divide space, so the
 //! face-separation rule is stated per face, not per tet: an inner face is cut when the segment
 //! joining the centroids of its two tets crosses some Qᵢ (closed parameter ranges). For a plane
-//! crossing the whole body this is exactly [`incise_plane`](super::incise_plane)'s rule; for a
-//! slit that stops inside the body the tissue stays connected around the slit's end. One tie
-//! differs: a centroid lying exactly on the surface counts as crossing here (closed ranges), while
-//! the plane rule puts it on the negative side.
+//! crossing the whole body this is [`incise_plane`](super::incise_plane)'s rule but for ties and
+//! near ties: a centroid lying exactly on the surface counts as crossing here (closed ranges),
+//! while the plane rule puts it on the negative side; and the centroids here are the `f64` ones
+//! (each coordinate the sum, in increasing vertex id, of the corners' coordinates divided by
+//! their count), while the plane rule decides the side of the exact centroid. For a slit that
+//! stops inside the body the tissue stays connected around the slit's end.
 //!
-//! The crossing test solves c₀ + u (c₁ − c₀) = Pᵢ + s eᵢ + t w for (u, s, t) by Cramer's rule
-//! (one 3×3 determinant per quad); a segment parallel to Qᵢ (determinant below a relative 1e-12)
-//! does not cross it. Cost: O(darts) for the centroids plus O(inner faces × n) tests, each
-//! skipped when the segment's box misses the surface's box.
+//! The crossing test solves c₀ + u (c₁ − c₀) = Pᵢ + s eᵢ + t w for (u, s, t) by Cramer's rule; a
+//! segment parallel to Qᵢ (determinant below a relative 1e-12: a tolerance, the only one) does
+//! not cross it. Otherwise the six comparisons 0 ≤ u, s, t ≤ 1 are decided **exactly** from the
+//! `f64` inputs (the two centroids, the points, w): each is the sign of a determinant whose
+//! columns are differences of inputs, taken by a float filter with a forward error bound and,
+//! on a near tie, by an exact sum (`crosses_quad`). So a segment ending exactly on the surface —
+//! at a Pᵢ, at Pᵢ + w, on an edge or inside — crosses, for decimal data as for dyadic.
+//! Cost: O(darts) for the centroids plus O(inner faces × n) tests, each skipped when the
+//! segment's box misses the surface's box.
 //!
 //! # Scale invariance
 //! No test here (the well-formedness checks of [`PolylineSweep::check`] and the crossing test)
-//! depends on the scale of the coordinates, for any finite coordinates: no squared length or
-//! product is formed from raw coordinates, so nothing overflows for huge ones (up to `f64::MAX`)
-//! or underflows for tiny ones. A difference that overflows is taken of halved coordinates
-//! instead (exact, and finite even between ±`f64::MAX`); each vector is scaled by a power of two
-//! (exactly) so that its largest component has a fixed magnitude before any cross product or
-//! determinant; and the crossing parameters are compared with their bounds through the exponents
-//! of those scales. Multiplying every coordinate by a power of two therefore gives bit-identical
-//! decisions, ties included (a centroid exactly on the surface), unless a component of some
-//! vector is about 2^1000 times smaller than its largest one; any other factor changes them only
-//! through the rounding of the scaled coordinates themselves.
+//! depends on the scale of the coordinates, for any finite coordinates. The tolerances (the
+//! parallel tests of `check` and of the crossing) are computed on vectors each scaled by a power
+//! of two (exactly) so that its largest component has a fixed magnitude, so no squared length
+//! or product is formed from raw coordinates and nothing overflows for huge ones (up to
+//! `f64::MAX`) or underflows for tiny ones; a difference that overflows is taken of halved
+//! coordinates instead (a direction, finite even between ±`f64::MAX`). The exact comparisons
+//! need no scaling: their exact path has the whole range of products of three `f64`s.
+//! Multiplying every coordinate by a power of two therefore gives identical decisions, ties
+//! included (a centroid exactly on the surface), unless a component of some vector is about
+//! 2^1000 times smaller than its largest one (the parallel test); any other factor changes them
+//! only through the rounding of the scaled coordinates themselves.
+
+use std::cmp::Ordering;
 
 use crate::mechanics::geom::{self, exponent, pow2};
 use crate::mechanics::{Body, Vec3};
@@ -39,6 +49,7 @@ use crate::DartId;
 
 use super::incise::{dissociate_all, tet_centroids};
 use super::{CutError, Incision};
+use crate::exact::{det_sign, Term};
 
 /// A polyline swept along a vector: the cut surface of [`incise_sweep`] (module docs).
 ///
@@ -105,7 +116,7 @@ impl PolylineSweep {
         if self.sweep.iter().any(|c| !c.is_finite()) || self.sweep.iter().all(|&c| c == 0.0) {
             return bad(format!("sweep vector {:?} is not finite or is zero", self.sweep));
         }
-        let w = Scaled::new(self.sweep, 0, 0).dir;
+        let w = Scaled::new(self.sweep, 0).dir;
         for (i, p) in self.points.windows(2).enumerate() {
             if p[0] == p[1] {
                 return bad(format!("segment {i} has zero length (points {i} and {} coincide)", i + 1));
@@ -119,8 +130,10 @@ impl PolylineSweep {
         Ok(())
     }
 
-    /// Whether the closed segment a–b meets the surface (module docs). O(n). Scale-invariant: the
-    /// answer is the same when a, b and the surface are all scaled by one factor (module docs).
+    /// Whether the closed segment a–b meets the surface (module docs): an end exactly on the
+    /// surface counts, decided exactly from the `f64` inputs (only the parallel test is a
+    /// tolerance). O(n). Scale-invariant: the answer is the same when a, b and the surface are
+    /// all scaled by one power of two (module docs).
     ///
     /// # Examples
     ///
@@ -135,11 +148,20 @@ impl PolylineSweep {
     /// assert!(wall.crosses([0.5, 0.0, 1.0], [1.5, 0.0, 1.0])); // first leg
     /// assert!(wall.crosses([2.0, 0.5, 1.0], [2.0, 1.5, 1.0])); // second leg
     /// assert!(!wall.crosses([0.5, 2.0, 1.0], [0.8, 2.0, 1.0])); // outside the L
+    /// // A segment ending exactly at the point P₂ of a bent slit with a decimal sweep: (u, s, t)
+    /// // = (1, 1, 0) exactly, a crossing (rounded, u came out just above 1).
+    /// let slit = PolylineSweep {
+    ///     points: vec![[2.5, 0.25, 2.75], [3.0, 3.0, 2.0], [2.25, 0.75, 1.5]],
+    ///     sweep: [0.3, 0.3, 0.3],
+    /// };
+    /// assert!(slit.crosses([1.75, 0.5, 1.25], [2.25, 0.75, 1.5]));
     /// ```
     pub fn crosses(&self, a: Vec3, b: Vec3) -> bool {
         let d = Scaled::diff(b, a, QUAD_EXP);
-        let w = Scaled::new(self.sweep, 0, QUAD_EXP);
-        self.points.windows(2).any(|p| crosses_quad(a, d, p[0], Scaled::diff(p[1], p[0], QUAD_EXP), w))
+        let w = Scaled::new(self.sweep, QUAD_EXP);
+        self.points
+            .windows(2)
+            .any(|p| crosses_quad([a, b], d, [p[0], p[1]], Scaled::diff(p[1], p[0], QUAD_EXP), (self.sweep, w)))
     }
 
     /// The axis-aligned box of the surface. O(n).
@@ -157,29 +179,42 @@ impl PolylineSweep {
     }
 }
 
-/// Whether a + u d (u ∈ [0, 1]) meets p + s e + t w (s, t ∈ [0, 1]): Cramer's rule on
-/// [d, −e, −w] (u, s, t)ᵀ = p − a, with d, e, w scaled by [`Scaled`] to `QUAD_EXP`. O(1).
+/// Whether a + u d (u ∈ [0, 1], d = b − a) meets p₀ + s e + t w (s, t ∈ [0, 1], e = p₁ − p₀):
+/// [d, −e, −w] (u, s, t)ᵀ = p₀ − a, by Cramer's rule. O(1).
 ///
-/// Scale-invariant: each of d, e, w and r = p − a is used as 2^k times a direction whose largest
-/// component lies in [2^`QUAD_EXP`, 2^(`QUAD_EXP`+1)) (exact power-of-two scalings), so that the
-/// determinants (products of three components) neither overflow nor lose their leading terms to
-/// underflow. By multilinearity u = 2^(k_r − k_d) det[r̂, −ê, −ŵ] / det[d̂, −ê, −ŵ], and likewise
-/// s (k_e) and t (k_w); each is tested for 0 ≤ x ≤ 1 as X ≥ 0 and X ≤ 2^(k_λ − k_r), with the
-/// power of two exact or saturated ([`pow2`]), so a centroid exactly on the surface stays a tie
-/// at every scale.
-fn crosses_quad(a: Vec3, d: Scaled, p: Vec3, e: Scaled, w: Scaled) -> bool {
-    let r = Scaled::diff(p, a, QUAD_EXP);
-    let (ne, nw) = (geom::scale(e.dir, -1.0), geom::scale(w.dir, -1.0));
-    let det = triple(d.dir, ne, nw);
+/// Two steps. (1) The parallel test, a tolerance: the segment misses the quad when
+/// |det[d, e, w]| ≤ 1e-12 |d| |e| |w|, computed on d, e, w each scaled by [`Scaled`] to
+/// `QUAD_EXP` (exact power-of-two scalings, so the test does not depend on the scale of the
+/// coordinates and nothing overflows or underflows). Past it the sign σ of D = det[d, e, w] is
+/// certain (far above the rounding of the scaled determinant). (2) The closed ranges, decided
+/// exactly: with r = p₀ − a, u = det[r, e, w] / D, s = det[d, −r, w] / D and
+/// t = det[d, e, −r] / D, and by multilinearity D − det[r, e, w] = det[b − p₀, e, w],
+/// D − det[d, −r, w] = det[d, p₁ − a, w] and D − det[d, e, −r] = det[d, e, p₀ + w − a]: six
+/// determinants whose columns are sums of at most three input `f64` vectors. The segment
+/// crosses when σ times each is ≥ 0, each sign taken exactly from the inputs
+/// ([`det_sign`]: a float filter, an exact sum on near ties). So a centroid exactly on the
+/// surface (u, s or t exactly 0 or 1) counts as crossing for any data, dyadic or not.
+fn crosses_quad([a, b]: [Vec3; 2], d: Scaled, [p0, p1]: [Vec3; 2], e: Scaled, (w_raw, w): (Vec3, Scaled)) -> bool {
+    let det = triple(d.dir, e.dir, w.dir);
     let size = geom::norm(d.dir) * geom::norm(e.dir) * geom::norm(w.dir);
     if det.abs() <= 1e-12 * size {
         return false;
     }
-    // A zero r (a = p) gives X = 0 for all three: inside, whatever its exponent.
-    let inside = |x: f64, by: Scaled| x >= 0.0 && x <= pow2(by.exp - r.exp);
-    inside(triple(r.dir, ne, nw) / det, d)
-        && inside(triple(d.dir, r.dir, nw) / det, e)
-        && inside(triple(d.dir, ne, r.dir) / det, w)
+    let sigma = if det > 0.0 { Ordering::Greater } else { Ordering::Less };
+    let (pos, neg) = (false, true);
+    let cd: &[Term] = &[(pos, b), (neg, a)];
+    let ce: &[Term] = &[(pos, p1), (neg, p0)];
+    let cw: &[Term] = &[(pos, w_raw)];
+    let quantities: [[&[Term]; 3]; 6] = [
+        [&[(pos, p0), (neg, a)], ce, cw],               // u ≥ 0
+        [&[(pos, b), (neg, p0)], ce, cw],               // u ≤ 1
+        [cd, &[(pos, a), (neg, p0)], cw],               // s ≥ 0
+        [cd, &[(pos, p1), (neg, a)], cw],               // s ≤ 1
+        [cd, ce, &[(pos, a), (neg, p0)]],               // t ≥ 0
+        [cd, ce, &[(pos, p0), (pos, w_raw), (neg, a)]], // t ≤ 1
+    ];
+    // Finite inputs (checked by the callers' `check` and finite positions): `det_sign` is Some.
+    quantities.iter().all(|&cols| det_sign(cols).is_some_and(|x| x == Ordering::Equal || x == sigma))
 }
 
 /// The exponent the largest component of each vector of the crossing test is scaled to: three of
@@ -187,40 +222,40 @@ fn crosses_quad(a: Vec3, d: Scaled, p: Vec3, e: Scaled, w: Scaled) -> bool {
 /// largest stays a normal number.
 const QUAD_EXP: i32 = 300;
 
-/// A vector v = 2^(`exp` − target) · `dir`, with the largest absolute component of `dir` in
-/// [2^target, 2^(target+1)) (or `dir` zero and `exp` 0 for the zero vector). The scaling is by a
-/// power of two, so it is exact unless a component is about 2^1000 or more times smaller than
-/// the largest one, and cross and triple products of `dir`s neither overflow nor lose their
-/// leading terms to underflow, whatever the magnitude of v.
+/// A vector v scaled by a power of two to `dir`, whose largest absolute component is in
+/// [2^target, 2^(target+1)) (or `dir` zero for the zero vector). The scaling is exact unless a
+/// component is about 2^1000 or more times smaller than the largest one, and cross and triple
+/// products of `dir`s neither overflow nor lose their leading terms to underflow, whatever the
+/// magnitude of v: the parallel test of the crossing, the well-formedness checks and the tear's
+/// face normals use it.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Scaled {
     pub(super) dir: Vec3,
-    exp: i32,
 }
 
 impl Scaled {
-    /// `v` · 2^`extra` as above, scaled to `target` (|target| ≤ 300). O(1).
-    pub(super) fn new(v: Vec3, extra: i32, target: i32) -> Self {
+    /// `v` scaled as above to `target` (|target| ≤ 300). O(1).
+    pub(super) fn new(v: Vec3, target: i32) -> Self {
         let m = v.iter().fold(0.0f64, |m, c| m.max(c.abs()));
         if m == 0.0 {
-            return Scaled { dir: v, exp: 0 };
+            return Scaled { dir: v };
         }
         let k = exponent(m);
         // target − k ∈ [−1323, 1374]: two steps, each a normal power of two.
         let shift = target - k;
         let (f1, f2) = (pow2(shift / 2), pow2(shift - shift / 2));
-        Scaled { dir: v.map(|c| c * f1 * f2), exp: k + extra }
+        Scaled { dir: v.map(|c| c * f1 * f2) }
     }
 
     /// x − y for finite x, y, scaled to `target`. When the difference overflows it is taken of
-    /// halved coordinates (finite even between ±`f64::MAX`, and exact) and the exponent raised
-    /// by one. Zero only when x = y. O(1).
+    /// halved coordinates (finite even between ±`f64::MAX`, and exact up to the halving of
+    /// subnormal coordinates): a direction, whose length is not kept. Zero only when x = y. O(1).
     pub(super) fn diff(x: Vec3, y: Vec3, target: i32) -> Self {
         let v = geom::sub(x, y);
         if v.iter().all(|c| c.is_finite()) {
-            return Scaled::new(v, 0, target);
+            return Scaled::new(v, target);
         }
-        Scaled::new(geom::sub(geom::scale(x, 0.5), geom::scale(y, 0.5)), 1, target)
+        Scaled::new(geom::sub(geom::scale(x, 0.5), geom::scale(y, 0.5)), target)
     }
 }
 

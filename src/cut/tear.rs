@@ -7,6 +7,17 @@
 //! other edge of that face at v. No α0 is used, so every dart stays on v. The walk stops when it
 //! comes back to d0, or before an α3 that is free (the surface); in that case it starts again from
 //! α1(d0) to collect the other half of the fan.
+//!
+//! d0 is "one of the two darts belonging to both face and vertex orbits" (seed §5.1) — four
+//! darts in fact, two per tet at the face, and the walks from the two tets give different fans.
+//! It is chosen by the geometry, not by dart numbering (finding 215): the tet on the side of the
+//! start face that the direction points into (exact orientation signs; the direction signed as
+//! [`Stress::direction`] is, largest component positive, so ±direction tear alike), and in it
+//! the dart whose edge leads to the lexicographically smaller corner; exact ties of the face
+//! scores go to the lexicographically smallest corner positions. So the same geometry tears the
+//! same faces whatever the order of the tet list.
+
+use std::cmp::Ordering;
 
 use crate::mechanics::geom::{self, cross, dot, sub};
 use crate::mechanics::model::{closed_triangle_vertices, triangle_vertices};
@@ -15,6 +26,7 @@ use crate::{AlphaMask, CellId, DartId, GMap};
 
 use super::sweep::Scaled;
 use super::{dissociate_face, CutError, Dissociation};
+use crate::exact::{det_sign, Term};
 
 /// The tensile stress at a vertex: the largest principal value of σ_v = Σ_s T_s n_s n_sᵀ over the
 /// springs at v, with T_s = max(0, k_s (l_s − L_s)) the spring's tension and n_s its unit
@@ -306,7 +318,7 @@ fn triangle_normal(body: &Body, [a, b, c]: [CellId; 3]) -> Vec3 {
     // [1, 2) (exact): no overflow or underflow at any coordinate scale (finding 85). For ordinary
     // coordinates the unit normal is the unscaled one bit for bit.
     let (e1, e2) = (Scaled::diff(p(b), p(a), 0).dir, Scaled::diff(p(c), p(a), 0).dir);
-    let n = Scaled::new(cross(e1, e2), 0, 0).dir;
+    let n = Scaled::new(cross(e1, e2), 0).dir;
     let len = dot(n, n).sqrt();
     if len == 0.0 {
         return [0.0; 3];
@@ -315,18 +327,28 @@ fn triangle_normal(body: &Body, [a, b, c]: [CellId; 3]) -> Vec3 {
 }
 
 /// Unit normal of the face of `d` from current positions (zero if it is not a triangle with
-/// three distinct vertices, or degenerate). O(face).
+/// three distinct vertices, or degenerate). O(face). The unit tests' reference.
+#[cfg(test)]
 fn face_normal(body: &Body, d: DartId) -> Vec3 {
     triangle_vertices(body.map(), d).map_or([0.0; 3], |t| triangle_normal(body, t))
 }
 
-/// [`face_normal`] for a dart `x` of the vertex being torn, reading the face's vertices off
+/// The unit normal of the face of `x` (a dart of the vertex being torn; zero if the face has not
+/// three distinct vertices, or is degenerate), reading the face's vertices off
 /// three darts instead of walking its orbit: when the face ⟨α0, α1⟩(x) closes after six darts
 /// (x, α0 x, α1 α0 x, α0 α1 α0 x = α1 α0 α1 x, α0 α1 x, α1 x) its vertices are those of x,
 /// α0 x and α0 α1 x ([`closed_triangle_vertices`]); if they are distinct, that is
 /// [`triangle_vertices`]' sorted triple and the normal is the same bit for bit. Otherwise falls
-/// back to [`face_normal`]. O(1).
+/// back to walking the face ([`triangle_vertices`]). O(1).
 fn face_normal_at(body: &Body, x: DartId) -> Vec3 {
+    face_vertices_at(body, x).map_or([0.0; 3], |t| triangle_normal(body, t))
+}
+
+/// The sorted vertex ids of the face of `x` (a dart of the vertex being torn) as
+/// [`face_normal_at`] reads them: three ids off three darts when the face closes as a hexagon,
+/// else [`triangle_vertices`]; `None` when it has not three distinct vertices. O(1) (O(face)
+/// in the fallback).
+fn face_vertices_at(body: &Body, x: DartId) -> Option<[CellId; 3]> {
     let map = body.map();
     // A face of a tet as built is a closed hexagon (the layout law), so the test is skipped then.
     let closed = map.tets_as_built() || {
@@ -335,20 +357,24 @@ fn face_normal_at(body: &Body, x: DartId) -> Vec3 {
         a != x && b != x && c != b && map.alpha_local(0, map.alpha_local(1, a)) == map.alpha_local(1, c)
     };
     match closed.then(|| closed_triangle_vertices(map, x)).flatten() {
-        Some(ids) => triangle_normal(body, ids),
-        None => face_normal(body, x),
+        Some(ids) => Some(ids),
+        None => triangle_vertices(map, x),
     }
 }
 
-/// The dart starting the fan of the vertex of `start`: among its inner darts, the one whose face
-/// normal is closest to ±`direction` (highest |n · direction|), the smallest dart on ties;
-/// `None` if every face at the vertex is on the boundary.
+/// The start face of the fan of the vertex of `start`, as its smallest dart at the vertex: among
+/// the inner faces at the vertex, the one whose normal is closest to ±`direction` (highest
+/// |n · direction|); on an exact tie of scores, the face whose corner positions, sorted
+/// lexicographically, are lexicographically smallest (a geometric rule: the same face whatever
+/// the numbering of the darts, i.e. the order of the tets); the smallest dart only between
+/// faces with the same three corner positions (coincident vertices). `None` if every face at
+/// the vertex is on the boundary.
 ///
 /// A face's score depends only on its vertices, shared by x, α1(x), α3(x), α1α3(x): only the
 /// smallest of the four is scored, with the O(1) normal of [`face_normal_at`]. The choice is
-/// that of scoring every inner dart (unit test): every dart left out has a smaller one with the
-/// same score that is kept. The vertex orbit is walked once, corner by corner, with no list.
-/// O(vertex orbit).
+/// that of scoring every inner dart (unit test). Which of the two tets at the face the fan starts
+/// from is [`start_side`]'s choice. The vertex orbit is walked once, corner by corner, with no
+/// list. O(vertex orbit).
 fn start_face(body: &Body, start: DartId, direction: Vec3) -> Result<Option<DartId>, CutError> {
     let map = body.map();
     let mut best: Option<(DartId, f64)> = None;
@@ -368,13 +394,85 @@ fn start_face(body: &Body, start: DartId, direction: Vec3) -> Result<Option<Dart
             bad = bad.or(Some(x));
             return;
         }
-        if best.is_none_or(|(d, s)| score.total_cmp(&s).then(d.cmp(&x)).is_gt()) {
+        let better = |(d, s): (DartId, f64)| match score.total_cmp(&s) {
+            Ordering::Equal => cmp_points(&face_key(body, x), &face_key(body, d)).then(x.cmp(&d)).is_lt(),
+            order => order.is_gt(),
+        };
+        if best.is_none_or(better) {
             best = Some((x, score));
         }
     });
     match bad.and_then(|x| nonfinite_corner(body, x)) {
         Some(e) => Err(e),
         None => Ok(best.map(|(d, _)| d)),
+    }
+}
+
+/// The corner positions of the face of `x`, sorted lexicographically ([`cmp_points`]); all
+/// three the vertex's own position when the face has not three distinct vertices. O(1).
+fn face_key(body: &Body, x: DartId) -> [Vec3; 3] {
+    let pos = body.attrs().position();
+    let mut key = match face_vertices_at(body, x) {
+        Some(ids) => ids.map(|v| pos[v]),
+        None => [pos[body.map().vertex_id(x)]; 3],
+    };
+    key.sort_by(|a, b| cmp_points(std::slice::from_ref(a), std::slice::from_ref(b)));
+    key
+}
+
+/// Lexicographic order of point lists, coordinate by coordinate ([`f64::total_cmp`]). O(len).
+fn cmp_points(a: &[Vec3], b: &[Vec3]) -> Ordering {
+    a.iter()
+        .flatten()
+        .zip(b.iter().flatten())
+        .map(|(x, y)| x.total_cmp(y))
+        .find(|o| o.is_ne())
+        .unwrap_or(Ordering::Equal)
+}
+
+/// The dart d0 the fan walk starts from, given an inner dart `x` of the start face at the
+/// vertex: the side is chosen by the geometry, never by dart numbering.
+///
+/// - The tet: of the two tets at the face (that of `x` and that of α3 x), the one lying on the
+///   side of the face's plane that `direction` points into, `direction` taken with the sign
+///   convention of [`Stress::direction`] (its largest component positive, the lowest index on
+///   ties), so that ±`direction` tear alike, as they choose the same face: with f₀, f₁, f₂ the face's corners
+///   and c a tet's fourth corner, the tet whose sign of det[f₁ − f₀, f₂ − f₀, c − f₀] is that of
+///   det[f₁ − f₀, f₂ − f₀, direction] (both signs exact, [`det_sign`]; the product does not depend
+///   on the order of the corners). On a tie (a direction in the face's plane, a flat or inverted
+///   tet, a non-finite position) the tet whose fourth corner is lexicographically smaller
+///   ([`cmp_points`]); only coincident fourth corners fall back to the smaller dart.
+/// - In that tet, of the two darts at the vertex on the face (on its two edges there), the one
+///   whose edge's other end is lexicographically smaller (the same fan either way: the walks
+///   from d0 and α1 d0 visit the same faces; this fixes the walk order); coincident ends fall
+///   back to the smaller dart.
+///
+/// O(1).
+fn start_side(body: &Body, x: DartId, direction: Vec3) -> DartId {
+    let (map, pos) = (body.map(), body.attrs().position());
+    // ±direction alike: the sign convention of `Stress::direction`.
+    let big = (1..3).fold(0, |b, i| if direction[i].abs() > direction[b].abs() { i } else { b });
+    let direction = if direction[big] < 0.0 { direction.map(|c| -c) } else { direction };
+    let y = map.alpha::<3>(x);
+    let at = |d: DartId| pos[map.vertex_id(d)];
+    let fourth = |d: DartId| at(map.alpha::<0>(map.alpha::<1>(map.alpha::<2>(d))));
+    let (cx, cy) = (fourth(x), fourth(y));
+    let into = |c: Vec3| -> i8 {
+        let Some([f0, f1, f2]) = face_vertices_at(body, x).map(|t| t.map(|v| pos[v])) else { return 0 };
+        let (e1, e2): (&[Term], &[Term]) = (&[(false, f1), (true, f0)], &[(false, f2), (true, f0)]);
+        match (det_sign([e1, e2, &[(false, c), (true, f0)]]), det_sign([e1, e2, &[(false, direction)]])) {
+            (Some(g), Some(h)) => g as i8 * h as i8,
+            _ => 0,
+        }
+    };
+    let tet = match into(cx).cmp(&into(cy)).then_with(|| cmp_points(&[cy], &[cx])).then(y.cmp(&x)) {
+        Ordering::Less => y,
+        _ => x,
+    };
+    let other = map.alpha::<1>(tet);
+    match cmp_points(&[at(map.alpha::<0>(tet))], &[at(map.alpha::<0>(other))]).then(tet.cmp(&other)) {
+        Ordering::Greater => other,
+        _ => tet,
     }
 }
 
@@ -392,8 +490,10 @@ fn nonfinite_corner(body: &Body, x: DartId) -> Option<CutError> {
 }
 
 /// Tears vertex `v` along `direction`: among the inner faces around v, the one whose normal is
-/// closest to ±`direction` starts the fan ([`fan_darts`]); every inner face of the fan is then
-/// dissociated. `v` is a vertex id; `hint`, when given and still on v, saves the O(darts) search.
+/// closest to ±`direction` starts the fan ([`fan_darts`]), walked from the tet at that face on
+/// the side `direction` points into (module docs: the start face's ties and the side are decided
+/// by positions, so the faces torn do not depend on the order of the tet list); every inner face
+/// of the fan is then dissociated. `v` is a vertex id; `hint`, when given and still on v, saves the O(darts) search.
 /// Only the direction counts, not its length: the direction scaled by any power of two (down to
 /// a subnormal, up to near `f64::MAX`) chooses the same face, as the face scores are formed from
 /// it scaled to a largest component in [1, 2).
@@ -433,7 +533,7 @@ pub fn tear_vertex(body: &mut Body, v: CellId, direction: Vec3, hint: Option<Dar
     let start = start.ok_or(CutError::NoSuchVertex(v))?;
     // Scaled by a power of two (exact) to a largest component in [1, 2): the scores neither
     // underflow for a tiny direction nor overflow for a huge one, and keep their order.
-    let best = start_face(body, start, Scaled::new(direction, 0, 0).dir)?;
+    let best = start_face(body, start, Scaled::new(direction, 0).dir)?.map(|x| start_side(body, x, direction));
     let mut tear =
         Tear { vertex: v, fan: Vec::new(), dissociations: Vec::new(), split: false, touched: TouchedCells::default() };
     let from = body.version();
@@ -528,7 +628,9 @@ mod tests {
     use proptest::prelude::*;
 
     /// The start face is the one the full scan (every inner dart of the vertex scored, highest
-    /// score then smallest dart) picks, also with exact ties (the unjittered cube) and after cuts.
+    /// score, then the lexicographically smallest sorted corner positions, then the smallest
+    /// dart) picks, also with exact ties (the unjittered cube) and after cuts; the fan starts
+    /// on that face.
     #[test]
     fn start_face_is_the_full_scan_choice() {
         let dirs = [[1.0, 0.0, 0.0], [0.3, -0.7, 0.2], [0.0, 0.0, 1.0], [1.0, 1.0, 1.0]];
@@ -545,13 +647,26 @@ mod tests {
             let mut checked = 0;
             for start in map.one_dart_per_cell(0) {
                 for dir in dirs {
+                    let key = |d: DartId| {
+                        let mut k = triangle_vertices(map, d).unwrap().map(|v| body.attrs().position[v]);
+                        k.sort_by(|a, b| {
+                            a.iter().zip(b).map(|(x, y)| x.total_cmp(y)).find(|o| o.is_ne()).unwrap_or(Ordering::Equal)
+                        });
+                        k
+                    };
                     let full = map.cell_darts(0, start).into_iter().filter(|&d| !map.is_free(3, d)).max_by(|&a, &b| {
                         let score = |d| dot(face_normal(&body, d), dir).abs();
-                        score(a).total_cmp(&score(b)).then(b.cmp(&a))
+                        score(a).total_cmp(&score(b)).then_with(|| cmp_points(&key(b), &key(a))).then(b.cmp(&a))
                     });
                     let mut copy = body.clone();
                     let tear = tear_vertex(&mut copy, map.vertex_id(start), dir, Some(start)).unwrap();
-                    assert_eq!(tear.fan.first().copied(), full, "vertex {} direction {dir:?}", map.vertex_id(start));
+                    let face = |d: Option<DartId>| d.map(|d| map.cell_id(2, d));
+                    assert_eq!(
+                        face(tear.fan.first().copied()),
+                        face(full),
+                        "vertex {} direction {dir:?}",
+                        map.vertex_id(start)
+                    );
                     checked += usize::from(full.is_some());
                 }
             }

@@ -53,6 +53,7 @@
 //! (k − 2) cone tets, one Steiner point per closed tet.
 
 use crate::mechanics::geom::{cross, dot, norm, sub};
+use crate::wide::{self, Wide, WideVec};
 use std::collections::hash_map::Entry;
 
 use rustc_hash::{FxHashMap, FxHashSet};
@@ -94,22 +95,58 @@ pub struct ConformingMesh {
     pub closed: usize,
 }
 
-/// Newell's normal of a closed polygon (twice its vector area). O(k).
-fn newell_normal(poly: &[[f64; 3]]) -> [f64; 3] {
-    let mut n = [0.0; 3];
+/// Whether every value is 0 or has a magnitude in [2^−`e`, 2^`e`] (then products of a few of
+/// them neither over- nor underflow, and the plain formulas give the wide ones' bits). O(values).
+fn within(values: &[f64], e: i32) -> bool {
+    let (lo, hi) = (2f64.powi(-e), 2f64.powi(e));
+    values.iter().all(|&x| x == 0.0 || (lo..=hi).contains(&x.abs()))
+}
+
+/// Newell's normal of a closed polygon (twice its vector area), in wide floats (an `f64`
+/// mantissa with an unbounded exponent, `crate::wide`): the same bits as the plain formula
+/// wherever no plain intermediate over- or underflows (then it is computed plainly), and no
+/// over- or underflow at any scale of finite coordinates (finding 216: at 1e80 the plain
+/// products were ∞, at 1e-90 0). O(k).
+fn newell_normal(poly: &[[f64; 3]]) -> WideVec {
+    let terms =
+        |p: [f64; 3], q: [f64; 3]| [p[1] - q[1], p[2] + q[2], p[2] - q[2], p[0] + q[0], p[0] - q[0], p[1] + q[1]];
+    let plain = (0..poly.len()).all(|k| within(&terms(poly[k], poly[(k + 1) % poly.len()]), 400));
+    if plain {
+        let mut n = [0.0; 3];
+        for (k, &p) in poly.iter().enumerate() {
+            let t = terms(p, poly[(k + 1) % poly.len()]);
+            n[0] += t[0] * t[1];
+            n[1] += t[2] * t[3];
+            n[2] += t[4] * t[5];
+        }
+        return n.map(Wide::new);
+    }
+    let mut n = [Wide::new(0.0); 3];
+    let w = Wide::new;
     for (k, &p) in poly.iter().enumerate() {
         let q = poly[(k + 1) % poly.len()];
-        n[0] += (p[1] - q[1]) * (p[2] + q[2]);
-        n[1] += (p[2] - q[2]) * (p[0] + q[0]);
-        n[2] += (p[0] - q[0]) * (p[1] + q[1]);
+        n[0] = n[0].add(w(p[1]).sub(w(q[1])).mul(w(p[2]).add(w(q[2]))));
+        n[1] = n[1].add(w(p[2]).sub(w(q[2])).mul(w(p[0]).add(w(q[0]))));
+        n[2] = n[2].add(w(p[0]).sub(w(q[0])).mul(w(p[1]).add(w(q[1]))));
     }
     n
 }
 
-/// Whether the turn a → b → c is strictly convex with respect to the normal `n`.
-fn convex(a: [f64; 3], b: [f64; 3], c: [f64; 3], n: [f64; 3]) -> bool {
+/// Whether the turn a → b → c is strictly convex with respect to the normal `n`:
+/// (u × v) · n > [`CONVEX_TOL`] · |u| · |v| · |n| for u = b − a, v = c − b. A product of four
+/// lengths: plain where its operands are between 2^∓200 (lengths) and 2^∓400 (the normal, a
+/// squared length) so that nothing over- or underflows, else the same operations in wide floats
+/// (the same bits where both apply), so the test holds at any scale (finding 216). O(1).
+fn convex(a: [f64; 3], b: [f64; 3], c: [f64; 3], n: WideVec) -> bool {
     let (u, v) = (sub(b, a), sub(c, b));
-    dot(cross(u, v), n) > CONVEX_TOL * norm(u) * norm(v) * norm(n)
+    let nf = n.map(Wide::to_f64);
+    if within(&u, 200) && within(&v, 200) && within(&nf, 400) && nf.iter().all(|x| x.is_finite()) {
+        return dot(cross(u, v), nf) > CONVEX_TOL * norm(u) * norm(v) * norm(nf);
+    }
+    let (u, v) = (wide::difference(b, a), wide::difference(c, b));
+    let lhs = wide::dot(wide::cross(u, v), n);
+    let rhs = Wide::new(CONVEX_TOL).mul(wide::norm(u)).mul(wide::norm(v)).mul(wide::norm(n));
+    rhs.less_than(lhs)
 }
 
 /// Triangulates a planar polygon that is convex up to collinear vertices (a triangle whose sides
@@ -133,7 +170,7 @@ pub fn triangulate_polygon(cycle: &[u32], points: &[[f64; 3]]) -> Option<Vec<[u3
     let pos = |v: u32| points.get(v as usize).copied();
     let coords: Option<Vec<[f64; 3]>> = cycle.iter().map(|&v| pos(v)).collect();
     let n = newell_normal(&coords?);
-    if cycle.len() < 3 || norm(n) == 0.0 {
+    if cycle.len() < 3 || wide::norm(n).is_zero() {
         return None;
     }
     let mut poly: Vec<u32> = cycle.to_vec();
@@ -331,7 +368,9 @@ impl LeveledMap<3> {
                 continue;
             }
             let corners = self.tet_vertices(d)?.map(|v| self.points.get(v as usize).copied().unwrap_or([0.0; 3]));
-            let centroid = [0, 1, 2].map(|k| corners.iter().map(|c| c[k]).sum::<f64>() / 4.0);
+            // Each corner divided by 4 before the sum (exact, and the same bits as the sum divided
+            // by 4, for normal coordinates): no overflow near `f64::MAX`.
+            let centroid = crate::mesh::centroid_of(corners.into_iter());
             let apex = out.points.len() as u32;
             out.points.push(centroid);
             for f in self.face_sides(d) {
@@ -441,16 +480,16 @@ impl LeveledMap<3> {
         }
     }
 
-    /// `t` ordered for a positive signed volume over `points`; a zero volume is an error naming
-    /// `d`.
+    /// `t` ordered for a positive signed volume over `points`, by the exact orientation sign of
+    /// the positions (at any scale, finding 216: the plain volume underflowed to 0 at 1e-108 and
+    /// its sign could be wrong); a zero volume (or a non-finite position) is an error naming `d`.
+    /// O(1).
     fn oriented(&self, mut t: [u32; 4], points: &[[f64; 3]], d: DartId) -> Result<[u32; 4], SubdivideError> {
         let p = t.map(|v| points.get(v as usize).copied().unwrap_or([0.0; 3]));
-        let vol = crate::mesh::signed_volume(p[0], p[1], p[2], p[3]);
-        if vol.is_nan() || vol == 0.0 {
-            return Err(SubdivideError::DegenerateFace(d));
-        }
-        if vol < 0.0 {
-            t.swap(2, 3);
+        match crate::exact::orient3d(p[0], p[1], p[2], p[3]) {
+            0 => return Err(SubdivideError::DegenerateFace(d)),
+            s if s < 0 => t.swap(2, 3),
+            _ => {}
         }
         Ok(t)
     }

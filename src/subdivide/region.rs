@@ -287,15 +287,27 @@ pub(super) fn share(m: f64, v: f64, total: f64) -> f64 {
     }
 }
 
-/// Distance from `p` to the closed tetrahedron with corners `t`: 0 inside, else the distance to
-/// the nearest face; NaN when a coordinate of `p` or `t` is NaN (not the infinity a minimum
-/// that skips NaN would give). At any scale of finite coordinates: when the largest coordinate
-/// difference is outside [2⁻²⁵⁰, 2²⁵⁰] (squares of products of differences would over- or
-/// underflow), the corners are translated to `p` and scaled by one power of two, and the distance
-/// is scaled back (∞ only for a distance past `f64::MAX`); inside that range nothing is
-/// translated or scaled (the same bits as the plain computation). The inside test reads the
-/// signs of the volumes in wide floats where a plain product could underflow, so a point inside
-/// a needle 1e-200 thin beside a unit edge is at distance 0. O(1).
+/// Distance from `p` to the closed tetrahedron with corners `t`: **exactly 0 when `p` lies in the
+/// closed tet** (inside, or on a face, an edge or a corner), else the distance to the nearest
+/// face, which is then > 0; NaN when a coordinate of `p` or `t` is NaN (not the infinity a
+/// minimum that skips NaN would give).
+///
+/// The in-or-out decision is exact (finding 214): the signs of the four volumes
+/// [face, `p`] against that of the tet are exact orientation signs of the given coordinates (a
+/// float filter, integers when it cannot decide), so it does not depend on the order of the
+/// corners nor on the scale, and a point on the tet is never measured as 1e-17 away (the
+/// rounded signed volumes of a corner gave ±1e-33 instead of 0, so `refine_around(v, 0.0, …)`
+/// left part of the star of v coarse). A tet of exactly zero volume (flat) has no inside: its
+/// distance is that of its faces, as below.
+///
+/// The distance of an outside point is computed in floating point, to a few ulps (its rounding
+/// depends on the corner order; a point outside is given at least the smallest positive `f64`, so
+/// a ball of radius 0 meets exactly the tets that contain its centre). At any scale of finite
+/// coordinates: when the largest coordinate difference is outside [2⁻²⁵⁰, 2²⁵⁰] (squares of
+/// products of differences would over- or underflow), the corners are translated to `p` and
+/// scaled by one power of two for the distance, which is scaled back (∞ only for a distance past
+/// `f64::MAX`); inside that range nothing is translated or scaled. With an infinite coordinate
+/// (and none NaN) the faces' distances decide (∞ or NaN). O(1).
 ///
 /// # Examples
 ///
@@ -303,6 +315,8 @@ pub(super) fn share(m: f64, v: f64, total: f64) -> f64 {
 /// use topomech::subdivide::tet_distance;
 /// let t = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 /// assert_eq!(tet_distance([0.1, 0.1, 0.1], t), 0.0);
+/// assert_eq!(tet_distance(t[2], t), 0.0); // a corner
+/// assert_eq!(tet_distance([0.25, 0.5, 0.25], t), 0.0); // on the slanted face
 /// assert!((tet_distance([0.0, 0.0, -3.0], t) - 3.0).abs() < 1e-12);
 /// assert!(tet_distance([f64::NAN, 0.0, 0.0], t).is_nan());
 /// let huge = t.map(|c| c.map(|x| x * 1e110)); // squared differences would overflow
@@ -314,42 +328,50 @@ pub fn tet_distance(p: [f64; 3], t: [[f64; 3]; 4]) -> f64 {
         return f64::NAN;
     }
     if p.iter().chain(t.iter().flatten()).any(|c| c.is_infinite()) {
-        return plain_tet_distance(p, t); // as before: ∞ or NaN, decided by the plain formula
+        return faces_distance(p, t); // ∞ or NaN, decided by the plain formula
+    }
+    // Exact, on the coordinates as given (the fitting below rounds its translation).
+    if closed_tet_contains(p, t) {
+        return 0.0;
     }
     // p first: a fitted p is the origin. Nothing moves for a plain extent (k = 0).
     let mut points = [p, t[0], t[1], t[2], t[3]];
     let k = crate::mesh::fit_for_products(&mut points);
     let [p, t @ ..] = points;
-    crate::mesh::times_pow2(plain_tet_distance(p, t), -k)
-}
-
-/// The sign of the signed volume of the tet `c` (1, −1 or 0): plain for
-/// [`crate::mechanics::geom::plain_corners`] (no product underflows there), else in wide floats,
-/// so a needle whose volume underflows f64 still has the sign of its determinant. O(1).
-fn volume_sign(c: [[f64; 3]; 4]) -> f64 {
-    if crate::mechanics::geom::plain_corners(c) {
-        let s = crate::mesh::signed_volume(c[0], c[1], c[2], c[3]);
-        return if s == 0.0 { 0.0 } else { s.signum() };
+    let d = crate::mesh::times_pow2(faces_distance(p, t), -k);
+    // p is outside (exactly): a rounded or underflowed 0 would put it in a ball of radius 0.
+    if d == 0.0 {
+        f64::from_bits(1)
+    } else {
+        d
     }
-    crate::wide::six_volume(c[0], c[1], c[2], c[3]).signum()
 }
 
-/// [`tet_distance`] without scaling: finite results for coordinate differences in
-/// [2⁻²⁵⁰, 2²⁵⁰]. O(1).
-fn plain_tet_distance(p: [f64; 3], t: [[f64; 3]; 4]) -> f64 {
+/// The exact sign of the signed volume of the tet `c` (1, −1 or 0; 0 for a non-finite
+/// coordinate), by exact orientation (`crate::exact::orient3d`), at any scale. O(1).
+fn volume_sign(c: [[f64; 3]; 4]) -> f64 {
+    f64::from(crate::exact::orient3d(c[0], c[1], c[2], c[3]))
+}
+
+/// Whether `p` lies in the closed tet `t` (finite coordinates), exactly: the tet has a nonzero
+/// volume and `p` is on the inner side of, or on, each of the four face planes. The answer is a
+/// property of the point set, the same for every order of the corners. O(1).
+fn closed_tet_contains(p: [f64; 3], t: [[f64; 3]; 4]) -> bool {
     let faces = [[t[1], t[2], t[3]], [t[0], t[3], t[2]], [t[0], t[1], t[3]], [t[0], t[2], t[1]]];
     let vol = volume_sign(t);
     // Each face is listed so that the opposite corner gives the sign of −vol: p is inside when it
-    // is on that side (or on the plane) of all four faces.
-    // Signs compared, not multiplied: a product of two volumes (a sixth power of the lengths)
-    // underflows to 0 for tets of edge 1e-54 already, and 0 ≤ 0 put every point inside.
-    let same_side = |f: &[[f64; 3]; 3]| {
-        let s = volume_sign([f[0], f[1], f[2], p]);
-        s == 0.0 || s != vol
-    };
-    if vol != 0.0 && faces.iter().all(same_side) {
-        return 0.0;
-    }
+    // is on that side (or on the plane) of all four faces. Signs compared, never multiplied.
+    vol != 0.0
+        && faces.iter().all(|f| {
+            let s = volume_sign([f[0], f[1], f[2], p]);
+            s == 0.0 || s != vol
+        })
+}
+
+/// The distance from `p` to the nearest face of `t` (the four closed triangles), without
+/// scaling: finite results for coordinate differences in [2⁻²⁵⁰, 2²⁵⁰]. O(1).
+fn faces_distance(p: [f64; 3], t: [[f64; 3]; 4]) -> f64 {
+    let faces = [[t[1], t[2], t[3]], [t[0], t[3], t[2]], [t[0], t[1], t[3]], [t[0], t[2], t[1]]];
     faces.iter().map(|&f| triangle_distance(p, f)).fold(f64::INFINITY, f64::min)
 }
 
@@ -866,8 +888,9 @@ impl LeveledMap<3> {
         Ok(out)
     }
 
-    /// The tets of the finest map as vertex quadruples (positive orientation) with their μt, for
-    /// output. O(darts).
+    /// The tets of the finest map as vertex quadruples (positive orientation: the exact sign of
+    /// the signed volume of the stored positions, at any scale, finding 216; a tet of exactly zero
+    /// volume keeps its increasing order) with their μt, for output. O(darts).
     ///
     /// # Examples
     ///
@@ -888,7 +911,7 @@ impl LeveledMap<3> {
         for d in self.map.one_dart_per_cell(3) {
             let mut t = self.tet_vertices(d)?;
             let p = self.corner_positions(t)?;
-            if crate::mesh::signed_volume(p[0], p[1], p[2], p[3]) < 0.0 {
+            if volume_sign(p) < 0.0 {
                 t.swap(2, 3);
             }
             out.push((t, self.mu[d.index()].tet, self.map.cell_id(3, d)));

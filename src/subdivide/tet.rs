@@ -68,26 +68,48 @@ pub(super) fn child_tets(diag: u8) -> Vec<[u8; 4]> {
     tets
 }
 
+/// Relative tolerance of the diagonal choice: a diagonal whose squared length is within this
+/// fraction of its own of the shortest one ties with it.
+pub(super) const DIAGONAL_TIE: f64 = 1e-12;
+
 /// The midpoint label (4, 5 or 6) of the shortest of the three diagonals of the octahedron, from
-/// the positions and vertex ids of the six midpoints (index = label − 4). Ties (within 1e-12
-/// relative) go to the diagonal whose endpoint positions are lexicographically smaller (smaller
-/// end first, then larger end), then to the smaller pair of vertex ids. The tie-break reads
-/// positions before ids so that every refinement path (op by op or bulk, whatever order it numbers
-/// the midpoints in) makes the same choice; ids only decide between coincident midpoints. O(1).
+/// the positions and vertex ids of the six midpoints (index = label − 4). The candidates are the
+/// diagonals whose squared length ℓ is within [`DIAGONAL_TIE`] of the shortest one, m:
+/// ℓ − m ≤ 1e-12 · ℓ (each compared with the minimum, never with each other, so the relation does
+/// not depend on which diagonal is looked at first: finding 211); among them the one whose
+/// endpoint positions are lexicographically smaller (smaller end first, then larger end) wins,
+/// then the smaller pair of vertex ids. The squared lengths are functions of the two endpoints
+/// alone (|p − q|² with a fixed coordinate order; p − q is −(q − p) exactly), so the choice is a
+/// function of the six midpoints as a set of opposite pairs: every refinement path (op by op or
+/// bulk, whatever order it numbers the corners and midpoints in) makes the same choice; ids only
+/// decide between coincident midpoints. Lengths are plain `f64` when every squared length is
+/// finite and ≥ 2⁻⁹⁰⁰, else wide floats (no over- or underflow at any scale). O(1).
 pub(super) fn choose_diagonal(pos: &[[f64; 3]; 6], vid: &[u32; 6]) -> u8 {
-    // Squared lengths of huge or tiny diagonals would be ∞ or 0 for all three: compared on one
-    // common scale (the same bits for ordinary sizes).
-    let mut fitted = *pos;
-    crate::mesh::fit_for_products(&mut fitted);
-    let pos = &fitted;
-    let key = |l: u8| {
-        let (i, j) = ((l - 4) as usize, (opposite(l) - 4) as usize);
-        let (p, q) = (pos[i], pos[j]);
-        let len2: f64 = (0..3).map(|k| (p[k] - q[k]) * (p[k] - q[k])).sum();
-        let (lo, hi) = if lex_less(q, p) { (q, p) } else { (p, q) };
-        (len2, lo, hi, vid[i].min(vid[j]), vid[i].max(vid[j]))
+    let ends = |l: u8| ((l - 4) as usize, (opposite(l) - 4) as usize);
+    let plain = [4u8, 5, 6].map(|l| {
+        let (i, j) = ends(l);
+        let d = [0, 1, 2].map(|k| pos[i][k] - pos[j][k]);
+        d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+    });
+    // Relative sizes: the plain squared lengths, or (out of their safe range) the wide ones
+    // divided by the shortest; a zero shortest length ties only with zeros.
+    let rel = if plain.iter().all(|&x| x.is_finite() && x >= SMALLEST_PLAIN_LEN2) {
+        plain
+    } else {
+        wide_relative_lengths(pos, ends)
     };
-    let tie_less = |a: &([f64; 3], [f64; 3], u32, u32), b: &([f64; 3], [f64; 3], u32, u32)| {
+    let shortest = rel.iter().copied().filter(|x| !x.is_nan()).fold(f64::INFINITY, f64::min);
+    if shortest.is_infinite() && !rel.contains(&shortest) {
+        return 4; // every length NaN
+    }
+    let candidate = |x: f64| x == shortest || (x.is_finite() && x - shortest <= DIAGONAL_TIE * x);
+    let key = |l: u8| {
+        let (i, j) = ends(l);
+        let (p, q) = (pos[i], pos[j]);
+        let (lo, hi) = if lex_less(q, p) { (q, p) } else { (p, q) };
+        (lo, hi, vid[i].min(vid[j]), vid[i].max(vid[j]))
+    };
+    let less = |a: &([f64; 3], [f64; 3], u32, u32), b: &([f64; 3], [f64; 3], u32, u32)| {
         if a.0 != b.0 {
             return lex_less(a.0, b.0);
         }
@@ -96,16 +118,56 @@ pub(super) fn choose_diagonal(pos: &[[f64; 3]; 6], vid: &[u32; 6]) -> u8 {
         }
         (a.2, a.3) < (b.2, b.3)
     };
-    let mut best = 4u8;
-    for l in [mid_label(0, 2), mid_label(0, 3)] {
-        let (kb, kl) = (key(best), key(l));
-        let tol = 1e-12 * kb.0.max(kl.0);
-        let tie = (kl.0 - kb.0).abs() <= tol;
-        if kl.0 < kb.0 - tol || (tie && tie_less(&(kl.1, kl.2, kl.3, kl.4), &(kb.1, kb.2, kb.3, kb.4))) {
-            best = l;
+    let mut best: Option<u8> = None;
+    for l in [4u8, 5, 6] {
+        if !candidate(rel[(l - 4) as usize]) {
+            continue;
         }
+        best = match best {
+            Some(b) if !less(&key(l), &key(b)) => Some(b),
+            _ => Some(l),
+        };
     }
-    best
+    best.unwrap_or(4)
+}
+
+/// 2⁻⁹⁰⁰: a plain squared length at least this large lost nothing that matters to underflow
+/// (an underflowed square is below 2⁻¹²² of it).
+const SMALLEST_PLAIN_LEN2: f64 = 1.1830521861667747e-271;
+
+/// The squared lengths of the three diagonals in wide floats, divided by the shortest (so the
+/// shortest is 1): for midpoints whose plain squared lengths over- or underflow. A zero shortest
+/// length gives 0 for the zero ones and ∞ for the others; NaN stays NaN. O(1).
+fn wide_relative_lengths(pos: &[[f64; 3]; 6], ends: impl Fn(u8) -> (usize, usize)) -> [f64; 3] {
+    use crate::wide::{difference, dot};
+    let len2 = [4u8, 5, 6].map(|l| {
+        let (i, j) = ends(l);
+        let d = difference(pos[i], pos[j]);
+        dot(d, d)
+    });
+    let mut shortest = None;
+    for &x in &len2 {
+        if x.to_f64().is_nan() {
+            continue;
+        }
+        shortest = match shortest {
+            Some(s) if !x.less_than(s) => Some(s),
+            _ => Some(x),
+        };
+    }
+    let Some(shortest) = shortest else { return [f64::NAN; 3] };
+    if shortest.is_zero() {
+        return len2.map(|x| {
+            if x.is_zero() {
+                0.0
+            } else if x.to_f64().is_nan() {
+                f64::NAN
+            } else {
+                f64::INFINITY
+            }
+        });
+    }
+    len2.map(|x| x.div(shortest).to_f64())
 }
 
 /// Lexicographic order of two points (NaN coordinates compare as equal).

@@ -57,3 +57,22 @@ pub fn wait_at_most_a_minute(mut child: Child) -> Option<Output> {
     }
     Some(child.wait_with_output().unwrap())
 }
+
+/// Writes two tets that meet only at point 0 (file node tag 1: a pinched point, two vertices of
+/// the map there), in either order of the tets.
+pub fn write_bowtie(path: &Path, swapped: bool) {
+    let points = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [-0.3, 0.0, 0.0],
+        [0.0, -0.3, 0.0],
+        [0.0, 0.0, -0.3],
+    ];
+    let mut tets = vec![[0, 1, 2, 3], [0, 5, 4, 6]];
+    if swapped {
+        tets.reverse();
+    }
+    write_msh(path, &points, &tets);
+}

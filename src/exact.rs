@@ -27,9 +27,10 @@ const LIMBS: usize = 101;
 /// u = 2^-53, the unit roundoff.
 const U: f64 = 1.0 / 9_007_199_254_740_992.0;
 
-/// An absolute allowance for underflow in a filter: every product that underflows is off by at
-/// most 2^-1075 ≈ 2.5e-324, and a filter forms fewer than a hundred of them (values this small
-/// simply take the exact path).
+/// An allowance for underflow in a filter: every product that underflows is off by at most
+/// 2^-1075 ≈ 2.5e-324, and a filter forms fewer than a hundred of them (values this small simply
+/// take the exact path). A product that multiplies such an error by a large factor (the
+/// determinant's dot) scales the allowance by that factor ([`det_sign`]).
 const TINY: f64 = 1e-290;
 
 /// A fixed-point sum of signed products of `f64`s: the positive and the negative terms in two
@@ -188,10 +189,19 @@ pub(crate) fn det_sign(cols: [&[Term]; 3]) -> Option<Ordering> {
     }
     let det = dot(val[0], cross(val[1], val[2]));
     let perm = dot(mag[0], abs_cross(mag[1], mag[2]));
-    let bound = (16.0 * U) * perm + TINY;
+    // A product of the cross product that underflows is off by up to 2^-1075 absolutely, and the
+    // dot multiplies that error by |c₀| (up to 2^1024): the underflow allowance scales with the
+    // first column (finding 219), TINY covering the dot's own underflow.
+    let bound = (16.0 * U) * perm + TINY * (1.0 + mag[0][0] + mag[0][1] + mag[0][2]);
     if det.is_finite() && bound.is_finite() && det.abs() > bound {
         return Some(if det > 0.0 { Ordering::Greater } else { Ordering::Less });
     }
+    Some(det_exact(cols))
+}
+
+/// The sign of det[c₀, c₁, c₂] from the exact sum of its expanded products (no filter): the
+/// reference [`det_sign`]'s filter must agree with. Finite inputs. O(27 · 6) products.
+fn det_exact(cols: [&[Term]; 3]) -> Ordering {
     let mut acc = Accumulator::new();
     const PERMS: [([usize; 3], bool); 6] = [
         ([0, 1, 2], false),
@@ -210,7 +220,7 @@ pub(crate) fn det_sign(cols: [&[Term]; 3]) -> Option<Ordering> {
             }
         }
     }
-    Some(acc.sign())
+    acc.sign()
 }
 
 /// The sign of det[b − a, c − a, d − a] (6 × the signed volume of the tet (a, b, c, d)) for the
@@ -348,5 +358,70 @@ mod tests {
         assert_eq!(orient3d(needle[1], needle[0], needle[2], needle[3]), -1);
         let big = [[-f64::MAX, 0.0, 0.0], [f64::MAX, 0.0, 0.0], [0.0, f64::MAX, 0.0], [0.0, 0.0, 5e-324]];
         assert_eq!(orient3d(big[0], big[1], big[2], big[3]), 1);
+    }
+    /// Finding 219: a product of the cross product that underflows (5·2^-1076 → 2^-1074) is then
+    /// multiplied by 2^1000; the determinant is +2^-77 exactly, the float value −2^-77.
+    #[test]
+    fn filter_allows_for_an_underflow_times_a_large_factor() {
+        let p = |k: i32| 2f64.powi(k);
+        let (a, b) = ([0.0; 3], [p(1000), -p(460), 0.0]);
+        let (c, d) = ([0.0, 5.0 * p(-538), p(-537)], [1.0, p(-537), p(-538)]);
+        assert_eq!(orient3d(a, b, c, d), 1);
+        assert_eq!(orient3d(a, c, b, d), -1);
+    }
+
+    /// xorshift64: the next state (nonzero seed).
+    fn xorshift(state: &mut u64) -> u64 {
+        *state ^= *state << 13;
+        *state ^= *state >> 7;
+        *state ^= *state << 17;
+        *state
+    }
+
+    /// The filter never disagrees with the exact sum, on columns mixing every scale from
+    /// subnormal to 2^1000 (a third of the entries zero, so products underflow and cancel).
+    #[test]
+    fn filter_agrees_with_the_exact_sum_at_mixed_scales() {
+        let mut state = 0x219u64;
+        let mut next = move || xorshift(&mut state);
+        let exps = [-1074, -1060, -1000, -600, -538, -537, -460, -200, 0, 200, 460, 600, 1000];
+        let mut value = || {
+            let r = next();
+            if r % 3 == 0 {
+                return 0.0;
+            }
+            let mantissa = 1.0 + (r >> 40) as f64 / (1u64 << 24) as f64;
+            let sign = if r & 2 == 0 { 1.0 } else { -1.0 };
+            let e = exps[((r >> 8) % exps.len() as u64) as usize] + ((r >> 16) % 5) as i32;
+            sign * mantissa * 2f64.powi(e.max(-1074))
+        };
+        let mut vec3 = || [value(), value(), value()];
+        for _ in 0..200_000 {
+            let (a, b, c, d) = (vec3(), vec3(), vec3(), vec3());
+            let cols: [&[Term]; 3] = [&[(false, b), (true, a)], &[(false, c), (true, a)], &[(false, d), (true, a)]];
+            assert_eq!(det_sign(cols), Some(det_exact(cols)), "{a:?} {b:?} {c:?} {d:?}");
+        }
+    }
+
+    /// The filter never disagrees with the exact sum near ties: a fourth point put on the plane
+    /// of three others and rounded, coordinates from 1e-3 to 1e3 in every component, so that any
+    /// term of the error bound may be the one that matters.
+    #[test]
+    fn filter_agrees_with_the_exact_sum_near_ties() {
+        let mut state = 0x2190u64;
+        let mut unit = move || (xorshift(&mut state) >> 11) as f64 / (1u64 << 53) as f64;
+        let mut disagree = 0;
+        for case in 0..100_000 {
+            let scale = [0, 1, 2].map(|k| 10f64.powi(((case / 3usize.pow(k)) % 3) as i32 * 3 - 3));
+            let mut point = || [0, 1, 2].map(|k| (unit() - 0.5) * scale[k]);
+            let (a, b, c) = (point(), point(), point());
+            let (s, t) = (unit(), unit());
+            let d = [0, 1, 2].map(|k| a[k] + s * (b[k] - a[k]) + t * (c[k] - a[k]));
+            let cols: [&[Term]; 3] = [&[(false, b), (true, a)], &[(false, c), (true, a)], &[(false, d), (true, a)]];
+            if det_sign(cols) != Some(det_exact(cols)) {
+                disagree += 1;
+            }
+        }
+        assert_eq!(disagree, 0);
     }
 }

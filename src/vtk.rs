@@ -414,7 +414,8 @@ impl Series {
 }
 
 /// The tets of a body as four vertex ids each (one per volume orbit), ordered so that their rest
-/// signed volume is positive. O(darts).
+/// signed volume is positive: by the exact orientation of the rest positions (a sliver is never
+/// written inside out by rounding), as [`crate::subdivide::LeveledMap::finest_tets`]. O(darts).
 ///
 /// # Examples
 ///
@@ -441,8 +442,8 @@ pub fn body_tets(body: &Body) -> Vec<[u32; 4]> {
         ids.dedup();
         let Ok(mut t) = <[u32; 4]>::try_from(ids.as_slice()) else { continue };
         let p = t.map(|v| rest[CellId(v)]);
-        if crate::mesh::signed_volume(p[0], p[1], p[2], p[3]) < 0.0 {
-            t.swap(2, 3);
+        if crate::exact::orient3d(p[0], p[1], p[2], p[3]) < 0 {
+            t.swap(2, 3); // the exact orientation, as `finest_tets` (finding 222)
         }
         out.push(t);
     }

@@ -304,8 +304,8 @@ impl Oracle {
         ([v, e, 4 * t - glued.len(), t], 4 * t - 2 * glued.len(), comps)
     }
 
-    /// Centroid of tet t computed as the cut module documents it: mean over its sorted vertices.
-    /// O(1).
+    /// Centroid of tet t, rounded: the mean over its sorted vertices (the harness places its
+    /// planes near it; which side a tet is on is [`Self::positive`]'s exact decision). O(1).
     ///
     /// # Examples
     ///
@@ -326,6 +326,26 @@ impl Oracle {
             }
         }
         c
+    }
+
+    /// Whether tet t lies strictly on the positive side of `plane` by the rule the cut module
+    /// documents: the exact sign of Σ (corner − point) · normal over its four corners, i.e. its
+    /// exact centroid's side (finding 221: no rounded centroid). O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::cut::ops::Oracle;
+    /// use topomech::cut::Plane;
+    ///
+    /// let points = vec![[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0], [0.0, 0.0, 4.0]];
+    /// let oracle = Oracle::new(points, vec![[0, 1, 2, 3]]);
+    /// assert!(oracle.positive(0, &Plane { point: [0.5; 3], normal: [1.0, 0.0, 0.0] }));
+    /// assert!(!oracle.positive(0, &Plane { point: [1.0; 3], normal: [1.0, 0.0, 0.0] })); // on it
+    /// ```
+    pub fn positive(&self, t: usize, plane: &Plane) -> bool {
+        let corners = self.tets[t].map(|v| self.points[v as usize]);
+        crate::exact::plane_sign(&corners, plane.point, plane.normal) == Some(std::cmp::Ordering::Greater)
     }
 }
 
@@ -556,7 +576,7 @@ impl Harness {
                 let inc = super::incise_plane(&mut self.body, &plane).map_err(|e| e.to_string())?;
                 let mut expected = 0;
                 for (key, [(a, _), (b, _)]) in self.oracle.glued() {
-                    if plane.positive(self.oracle.centroid(a)) != plane.positive(self.oracle.centroid(b)) {
+                    if self.oracle.positive(a, &plane) != self.oracle.positive(b, &plane) {
                         self.oracle.cut.insert(key);
                         expected += 1;
                     }

@@ -309,15 +309,17 @@ fn walk(map: &GMap<3>, start: DartId, mut visit: impl FnMut(DartId)) -> bool {
     false
 }
 
-/// Unit normal of the triangle with sorted vertex ids `[a, b, c]` from current positions (zero
-/// if degenerate). O(1).
-fn triangle_normal(body: &Body, [a, b, c]: [CellId; 3]) -> Vec3 {
+/// Unit normal (up to sign) of the triangle with vertex ids `[a, b, c]` from current positions
+/// (zero if degenerate). The corners are taken in lexicographic order of their positions, so the
+/// rounding of the normal depends on the geometry, never on the numbering (finding 220). O(1).
+fn triangle_normal(body: &Body, ids: [CellId; 3]) -> Vec3 {
     let mech = body.attrs();
-    let p = |v: CellId| mech.position[v];
+    let mut p = ids.map(|v| mech.position[v]);
+    p.sort_by(|x, y| cmp_points(std::slice::from_ref(x), std::slice::from_ref(y)));
     // The edges and their cross product scaled by powers of two to a largest component in
     // [1, 2) (exact): no overflow or underflow at any coordinate scale (finding 85). For ordinary
     // coordinates the unit normal is the unscaled one bit for bit.
-    let (e1, e2) = (Scaled::diff(p(b), p(a), 0).dir, Scaled::diff(p(c), p(a), 0).dir);
+    let (e1, e2) = (Scaled::diff(p[1], p[0], 0).dir, Scaled::diff(p[2], p[0], 0).dir);
     let n = Scaled::new(cross(e1, e2), 0).dir;
     let len = dot(n, n).sqrt();
     if len == 0.0 {
@@ -604,13 +606,20 @@ pub fn tear_step(
     order.sort_by(|&a, &b| stress[b].magnitude.total_cmp(&stress[a].magnitude).then(a.cmp(&b)));
     let mut out = TearStep::default();
     let mut touched = TouchedCells::default();
+    // Vertices a tear of this pass touched (their stress is stale): marked, not searched for
+    // in the touched list, which would make a pass quadratic in its tears (finding 226).
+    let mut stale = vec![false; stress.len()];
     for v in order.into_iter().take(max_vertices) {
-        let id = CellId(v as u32);
         let Some(hint) = sim.projection.dart_of_vertex(v) else { continue };
-        if touched.vertices.iter().any(|&(t, _)| t == id) {
+        if stale[v] {
             continue;
         }
-        let tear = tear_vertex(body, id, stress[v].direction, Some(hint))?;
+        let tear = tear_vertex(body, CellId(v as u32), stress[v].direction, Some(hint))?;
+        for &(t, _) in &tear.touched.vertices {
+            if let Some(mark) = stale.get_mut(t.index()) {
+                *mark = true;
+            }
+        }
         touched.extend(&tear.touched);
         out.tears.push(tear);
     }

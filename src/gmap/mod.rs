@@ -587,13 +587,21 @@ impl<const N: usize> GMap<N> {
     }
 
     /// Allocates `count` darts at once with every link free and every cell id unset: the start of
-    /// a bulk build. Returns the first index. The caller must link and label them all.
+    /// a bulk build, or one dart of an operation. Returns the first index. The caller must link
+    /// and label them all. An empty map gets exactly the room asked for (a build knows its size);
+    /// a map that grows gets amortized room (at least doubling), so darts added one at a time
+    /// cost O(1) each, not a reallocation of the whole map each (finding 224). O(count) amortized.
     pub(crate) fn alloc_darts_raw(&mut self, count: usize) -> u32 {
         self.tets_as_built = false;
         let first = self.capacity();
         let total = first + count;
-        self.alpha.reserve_exact(count * (N + 1));
-        self.cell.reserve_exact(count * (N + 1));
+        if first == 0 {
+            self.alpha.reserve_exact(count * (N + 1));
+            self.cell.reserve_exact(count * (N + 1));
+        } else {
+            self.alpha.reserve(count * (N + 1));
+            self.cell.reserve(count * (N + 1));
+        }
         for d in first..total {
             self.alpha.extend(std::iter::repeat_n(d as u32, N + 1));
         }

@@ -991,42 +991,119 @@ impl RingCell {
         }
     }
 
-    /// Appends the darts of the cell of the i-free dart `x` to `out`: the path ⟨αj, αi⟩(x),
-    /// then its αk image when that is another path. O(cell).
-    fn append_cell<const N: usize>(&self, map: &GMap<N>, x: DartId, out: &mut Vec<DartId>) {
-        let start = out.len();
-        map.for_each_dihedral(x, self.j, self.i, |y| out.push(y));
-        if let Some(k) = self.k {
-            let end = out.len();
-            if !out[start..].contains(&map.alpha_local(k, x)) {
-                for p in start..end {
-                    out.push(map.alpha_local(k, out[p]));
-                }
-            }
-        }
-    }
-
     /// [`GMap::split_side`] of the i-free darts `a` (the anchor) and `z`: `None` if they are one
     /// cell (`out` unchanged), else the smaller side (a's on a tie) appended to `out` and whether
-    /// it is z's. Both cells are read into `out`, the larger then dropped: no list of its own.
-    /// O(cells of a and z).
+    /// it is z's.
+    ///
+    /// The law: the cell of an i-free x is path(x) ∪ αk(path(x)) (one path ⟨αj, αi⟩ walked from
+    /// x, αj first; αk(path(x)) is path(x) itself iff αk(x) is on it), so a whole side has
+    /// len × 1 or × 2 darts, and z is in a's cell iff z or αk(z) (i-free: an end) is on path(a).
+    /// The two paths are walked in lockstep, a first in each round, their darts pushed to `out`
+    /// interleaved (the invariant: while both run, a's darts at even offsets from the start, z's
+    /// at odd ones, each in path order). In one cell both paths have one length, so a's walk
+    /// meets z or αk(z) before z's can end; once a path ends without that, they are two cells
+    /// and its side's size is known, and the other walk goes on only until it ends or its path
+    /// alone is at least as large (strictly larger against z's side: a's side wins ties). The
+    /// chosen side is then compacted in place and its αk image appended if that is another path.
+    /// No list of its own. O(smaller side) when split (at most 2 steps per dart of it), O(cell)
+    /// when joined.
     fn split_side<const N: usize>(&self, map: &GMap<N>, a: DartId, z: DartId, out: &mut Vec<DartId>) -> Option<bool> {
+        let (mut wa, mut wz) = (PathWalk::new(map, self, a), PathWalk::new(map, self, z));
+        if z == a || z == wa.twin {
+            return None;
+        }
         let start = out.len();
-        self.append_cell(map, a, out);
-        if out[start..].contains(&z) {
+        out.extend([a, z]);
+        let joined = loop {
+            match wa.step(map, self) {
+                Some(y) if y == z || y == wz.twin => break true,
+                Some(y) => out.push(y),
+                None => break false,
+            }
+            match wz.step(map, self) {
+                Some(y) => out.push(y), // one cell: a's walk, a step ahead, meets it first
+                None => break false,
+            }
+        };
+        if joined {
             out.truncate(start);
             return None;
         }
-        let mid = out.len();
-        self.append_cell(map, z, out);
-        let (len_a, len_z) = (mid - start, out.len() - mid);
-        if len_a <= len_z {
-            out.truncate(mid);
-            return Some(false);
+        // Two cells: one path ended after `pairs` darts; the other's later darts follow the
+        // interleaved prefix of 2 × `pairs` darts.
+        let a_ended = wa.ended;
+        let pairs = if a_ended { wa.len } else { wz.len };
+        let z_side = if a_ended {
+            let size_a = wa.size();
+            while !wz.ended && wz.len < size_a {
+                out.extend(wz.step(map, self));
+            }
+            wz.ended && wz.size() < size_a
+        } else {
+            let size_z = wz.size();
+            while !wa.ended && wa.len <= size_z {
+                out.extend(wa.step(map, self));
+            }
+            !wa.ended || wa.size() > size_z
+        };
+        let side = if z_side { &wz } else { &wa };
+        for t in 0..pairs {
+            out[start + t] = out[start + 2 * t + usize::from(z_side)];
         }
-        out.copy_within(mid.., start);
-        out.truncate(start + len_z);
-        Some(true)
+        if z_side == a_ended {
+            out.copy_within(start + 2 * pairs.., start + pairs); // the walk that went on
+        }
+        out.truncate(start + side.len);
+        if let (Some(k), false) = (self.k, side.single) {
+            for p in start..start + side.len {
+                out.push(map.alpha_local(k, out[p]));
+            }
+        }
+        Some(z_side)
+    }
+}
+
+/// One side of a [`RingCell::split_side`] walk: the path ⟨αj, αi⟩ from an i-free anchor,
+/// walked one way (αj first) one dart at a time.
+struct PathWalk {
+    /// The anchor's αk image (the anchor itself without αk).
+    twin: DartId,
+    /// The last dart reached.
+    at: DartId,
+    /// Darts reached, the anchor included.
+    len: usize,
+    /// Whether `twin` was reached: then the cell is the path alone, else also its αk image.
+    single: bool,
+    /// Whether the path ended at `at` (its next link is free).
+    ended: bool,
+}
+
+impl PathWalk {
+    fn new<const N: usize>(map: &GMap<N>, ring: &RingCell, anchor: DartId) -> Self {
+        let twin = ring.k.map_or(anchor, |k| map.alpha_local(k, anchor));
+        PathWalk { twin, at: anchor, len: 1, single: twin == anchor, ended: false }
+    }
+
+    /// The path's next dart, or `None` at its end (then `ended`). O(1).
+    fn step<const N: usize>(&mut self, map: &GMap<N>, ring: &RingCell) -> Option<DartId> {
+        #[cfg(test)]
+        tests::RING_STEPS.with(|n| n.set(n.get() + 1));
+        let y = map.alpha_local(if self.len % 2 == 1 { ring.j } else { ring.i }, self.at);
+        if y == self.at {
+            self.ended = true;
+            return None;
+        }
+        (self.at, self.len, self.single) = (y, self.len + 1, self.single || y == self.twin);
+        Some(y)
+    }
+
+    /// The darts of the side's cell, once the path `ended`.
+    fn size(&self) -> usize {
+        if self.single {
+            self.len
+        } else {
+            2 * self.len
+        }
     }
 }
 
@@ -1487,6 +1564,8 @@ mod tests {
         /// Cells whose split the unsews of this thread decided by a walk (the lockstep walk
         /// or a shortcut), not by the quick proofs.
         pub(super) static CELL_WALKS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+        /// Darts [`RingCell::split_side`] looked up (one per step of either path walk).
+        pub(super) static RING_STEPS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
     }
 
     /// The quick proofs do their job: an α3-unsew of an inner face that splits nothing (every
@@ -1822,45 +1901,125 @@ mod tests {
         assert!(CornerCell::of(2, 2, 0).is_none() && CornerCell::of(3, 3, 3).is_none());
     }
 
+    /// A fan of `n` triangles around point 0 (a closed disk) and a needle of `n` tets around the
+    /// edge of points 0 and 1 (a closed ring), with the dart of element t that is sewn to element
+    /// t + 1 across the spoke (the edge 0–(t+1)) or the face (0, 1, t + 2) of both.
+    fn fan_and_needle(n: u32) -> ((GMap<2>, Vec<DartId>), (GMap<3>, Vec<DartId>)) {
+        let (points, triangles) = crate::generate::disk_fan(n);
+        let (fan, _) = GMap::<2>::from_triangles(points.len(), &triangles).unwrap();
+        let tets: Vec<[u32; 4]> = (0..n).map(|t| [0, 1, 2 + t, 2 + (t + 1) % n]).collect();
+        let (needle, _) = GMap::<3>::from_tets(n as usize + 2, &tets).unwrap();
+        let next = |size: usize, t: usize, d: DartId, alpha: DartId| {
+            d.index() / size == t && alpha.index() / size == (t + 1) % n as usize
+        };
+        let spokes = (0..n as usize)
+            .map(|t| fan.darts().find(|&d| fan.cell_id(0, d) == CellId(0) && next(6, t, d, fan.alpha::<2>(d))).unwrap())
+            .collect();
+        let on_axis = |d: DartId| needle.cell_id(0, d).0 < 2 && needle.cell_id(0, needle.alpha::<0>(d)).0 < 2;
+        let faces = (0..n as usize)
+            .map(|t| needle.darts().find(|&d| on_axis(d) && next(24, t, d, needle.alpha::<3>(d))).unwrap())
+            .collect();
+        ((fan, spokes), (needle, faces))
+    }
+
     /// [`RingCell::split_side`] is [`GMap::split_side`] (the same side as a set, the same flag)
     /// on every pair of i-free darts of a map with boundaries and cuts, in every cell dimension
-    /// that has a ring form, for 3-maps unsewn by α3 (edges), α2 or α1 and 2-maps unsewn by α2
-    /// (vertices and edges) or α1. The pairs include joined ones, split ones of equal and of
-    /// different sizes, and darts of one cell.
+    /// that has a ring form, for 3-maps unsewn by α3 (edges), α2, α1 or α0 and 2-maps unsewn by
+    /// α2 (vertices and edges) or α1. The pairs include joined ones, split ones of equal sizes
+    /// (ties) and of very different sizes (a fan and a needle cut in a few places), and darts of
+    /// one cell; the sides include paths that are their cell alone because αk fixes the anchor
+    /// (a boundary) or because αk maps the path onto itself (a face α3-sewn to itself).
     #[test]
     fn ring_split_is_split_side() {
-        fn check<const N: usize>(map: &GMap<N>, i: usize) -> [usize; 3] {
-            let mut seen = [0; 3]; // joined, split on a's side, split on z's side
+        /// Joined, split on a's side, on z's side, ties, sizes ≥ 4 × apart, folded paths.
+        type Seen = [usize; 6];
+        fn check<const N: usize>(map: &GMap<N>, i: usize, every: usize) -> Seen {
+            let mut seen = [0; 6];
             for dim in (0..=N).filter(|&dim| dim != i) {
                 let Some(ring) = RingCell::of(N, i, dim) else { continue };
                 let free: Vec<DartId> = map.darts().filter(|&d| map.is_free(i, d)).collect();
                 for (n, &a) in free.iter().enumerate() {
-                    for &z in free.iter().skip(n % 5).step_by(5) {
+                    let mut walk = PathWalk::new(map, &ring, a);
+                    while walk.step(map, &ring).is_some() {}
+                    seen[5] += usize::from(walk.single && walk.twin != a);
+                    for &z in free.iter().skip(n % every).step_by(every) {
                         let want = as_set(map.split_side(a, z, AlphaMask::cell(N, dim)));
                         assert_eq!(
                             appended(|out| ring.split_side(map, a, z, out)),
                             want,
                             "alpha{i} dim {dim}: {a:?} {z:?}"
                         );
-                        seen[want.map_or(0, |w| 1 + usize::from(w.1))] += 1;
+                        seen[want.as_ref().map_or(0, |w| 1 + usize::from(w.1))] += 1;
+                        if let Some((side, is_z)) = want {
+                            let other = map.cell_darts(dim, if is_z { a } else { z }).len();
+                            seen[3] += usize::from(other == side.len());
+                            seen[4] += usize::from(other >= 4 * side.len());
+                        }
                     }
                 }
             }
             seen
         }
-        let mut totals = [0; 3];
-        let mut add = |seen: [usize; 3]| totals.iter_mut().zip(seen).for_each(|(t, s)| *t += s);
+        let mut totals = [0; 6];
+        let mut add = |seen: Seen| totals.iter_mut().zip(seen).for_each(|(t, s)| *t += s);
         let (points, tets) = kuhn_cube(2);
         let (cube, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
-        for i in 1..=3 {
-            add(check(&cut_at_random(&cube, i, 3 + i as u64, 4), i));
+        for i in 0..=3 {
+            add(check(&cut_at_random(&cube, i, 3 + i as u64, 4), i, 5));
         }
         let (points, triangles) = crate::generate::grid_triangles(4);
         let (grid, _) = GMap::<2>::from_triangles(points.len(), &triangles).unwrap();
         for i in 1..=2 {
-            add(check(&cut_at_random(&grid, i, 5 + i as u64, 3), i));
+            add(check(&cut_at_random(&grid, i, 5 + i as u64, 3), i, 5));
         }
-        assert!(totals.iter().all(|&n| n > 20), "joined / a's side / z's side: {totals:?}");
+        let ((mut fan, spokes), (mut needle, faces)) = fan_and_needle(40);
+        for t in [0, 1, 2, 9, 17, 33] {
+            fan.unsew::<2>(spokes[t]).unwrap();
+            needle.unsew::<3>(faces[t]).unwrap();
+        }
+        add(check(&fan, 2, 3));
+        add(check(&needle, 3, 7));
+        // A tet with one face α3-sewn to itself, cut in its α0 or α1 links: the face's path
+        // ⟨α0, α1⟩ or ⟨α1, α0⟩ is then its own α3 image.
+        let (tet, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+        for (d, e) in tet.darts().flat_map(|d| tet.darts().map(move |e| (d, e))) {
+            if tet.is_sewable::<3>(d, e) {
+                let mut glued = tet.clone();
+                glued.sew::<3>(d, e).unwrap();
+                for i in 0..=1 {
+                    add(check(&cut_at_random(&glued, i, u64::from(d.0 + e.0), 2), i, 1));
+                }
+            }
+        }
+        assert!(totals.iter().all(|&n| n > 20), "joined / a's / z's side / ties / lopsided / folded: {totals:?}");
+    }
+
+    /// [`RingCell::split_side`] costs the smaller side, not the larger: cutting 2-dart pieces
+    /// off the centre of a fan of 10 000 triangles (α2), and one tet off a needle of 10 000 tets
+    /// around one edge (α3, the edge's ring), the walk steps at most twice per dart of the
+    /// piece, with either endpoint as the anchor. (Reading both cells whole, it stepped through
+    /// the 20 000 or 40 000 darts of the rest.)
+    #[test]
+    fn ring_split_costs_the_smaller_side() {
+        fn cut<const N: usize>(map: &mut GMap<N>, i: usize, dim: usize, d: DartId, piece: usize) {
+            let z = map.alpha_dyn(i, d);
+            map.unsew_with(i, d, false).unwrap();
+            let ring = RingCell::of(N, i, dim).unwrap();
+            for (a, z, is_z) in [(d, z, false), (z, d, true)] {
+                RING_STEPS.set(0);
+                let mut out = Vec::new();
+                assert_eq!(ring.split_side(map, a, z, &mut out), Some(is_z), "alpha{i} unsew of {d}");
+                assert_eq!(out.len(), piece, "alpha{i} unsew of {d}");
+                assert!(RING_STEPS.get() <= 2 * piece, "{} steps for a side of {piece} darts", RING_STEPS.get());
+            }
+        }
+        let ((mut fan, spokes), (mut needle, faces)) = fan_and_needle(10_000);
+        fan.unsew::<2>(spokes[0]).unwrap(); // opens the disk: no piece yet
+        needle.unsew::<3>(faces[0]).unwrap();
+        for &spoke in &spokes[1..20] {
+            cut(&mut fan, 2, 0, spoke, 2); // the two darts at the centre of the spoke's triangle
+        }
+        cut(&mut needle, 3, 1, faces[1], 4); // tet 1's four darts on the axis
     }
 
     /// The same on a 2-map (rings ⟨α1, α2⟩ and ⟨α0, α1⟩, ⟨α2, α1⟩), cut edge by edge.

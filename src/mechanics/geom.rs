@@ -99,6 +99,20 @@ pub(crate) fn pow2(e: i32) -> f64 {
     }
 }
 
+/// Σ `values` with Neumaier's compensation: the rounding of the running sum is carried in a
+/// second term, so the result is within about 2 ulp of the exact sum (plus n² ε² of Σ|x|)
+/// however many terms there are, where a plain sum drifts by up to n ε Σ|x|. The conservation
+/// checks compare totals of 10⁵–10⁶ terms to 1e-12 (finding 228). O(n).
+pub(crate) fn compensated_sum(values: impl IntoIterator<Item = f64>) -> f64 {
+    let (mut sum, mut carry) = (0.0f64, 0.0f64);
+    for x in values {
+        let t = sum + x;
+        carry += if sum.abs() >= x.abs() { (sum - t) + x } else { (x - t) + sum };
+        sum = t;
+    }
+    sum + carry
+}
+
 /// Whether `a` and `b` agree to a relative tolerance `rel` (absolute below `f64::MIN_POSITIVE`).
 pub(crate) fn close(a: f64, b: f64, rel: f64) -> bool {
     (a - b).abs() <= rel * a.abs().max(b.abs()).max(f64::MIN_POSITIVE)

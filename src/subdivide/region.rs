@@ -132,7 +132,8 @@ impl TetMasses {
         Ok(TetMasses { mass })
     }
 
-    /// Σ of the tet masses of the live volumes. O(darts).
+    /// Σ of the tet masses of the live volumes, summed with compensation (within about 2 ulp of
+    /// the exact sum at any size: finding 228). O(darts).
     ///
     /// # Examples
     ///
@@ -151,7 +152,9 @@ impl TetMasses {
     /// ```
     pub fn total(&self, m: &LeveledMap<3>) -> f64 {
         let map = m.map();
-        map.one_dart_per_cell(3).into_iter().map(|d| self.of(map.cell_id(3, d))).sum()
+        crate::mechanics::geom::compensated_sum(
+            map.one_dart_per_cell(3).into_iter().map(|d| self.of(map.cell_id(3, d))),
+        )
     }
 
     /// The mass of volume `t`, 0 past the end of `mass`. O(1).

@@ -25,9 +25,15 @@
 //!   its own (outside a 1→8) leaves its inner springs at k = 0 until a tet on either side is split.
 //! - **Masses**: a tet of mass m split 1→8 gives child k the mass m · V_k / ΣV
 //!   ([`LeveledMap::subdivide_tet_with_mass`]); vertex masses are derived, never stored:
-//!   m_v = Σ_{volumes t ∋ v} m_t / n_t, n_t the number of vertices of t in the finest map (4 for a
-//!   plain tet, the seed's m_t/4; more when neighbours inserted vertices on its sides, which then
-//!   get a share), so Σ_v m_v = Σ_t m_t.
+//!   each volume t lumps its mass m_t on the vertices of its finest boundary
+//!   ([`LeveledMechanics::vertex_masses`]): m_t/4 on each of its four corners (the seed's law 1)
+//!   when no neighbour inserted a vertex on its sides; with n_t vertices of which h_t were
+//!   inserted on its sides (*hanging*), each hanging vertex gets w_t = m_t / (4 n_t), drawn from
+//!   the corners in proportion to its barycentric coordinates (a midpoint of (a, b) takes w/2 from
+//!   each end, recursively). So Σ_v m_v = Σ_t m_t, every share is ≥ m_t / n_t > 0 (no vertex is
+//!   massless), and the lumped first moment Σ_v m_v x_v equals Σ_t m_t · centroid_t for every
+//!   state in which the inserted vertices sit at their interpolated places: **refining moves
+//!   neither the centre of mass nor the momentum** (finding 218).
 //!
 //! Consequences: a chain in tension, its midpoints at equilibrium (equal links), stores exactly its
 //! root's energy, so edge splits alone keep the static response; the inner springs of a 1→8 add
@@ -688,14 +694,15 @@ impl LeveledMechanics {
         Ok(())
     }
 
-    /// The largest stiffness or damping of the springs on the edges of the live `darts`; NaN
+    /// The largest |stiffness| or |damping| of the springs on the edges of the live `darts`; NaN
     /// if one of them is NaN (written through [`Self::spring_mut`]), so that the headroom
     /// checks refuse it rather than drop it (finding 205). O(darts · log E).
     fn largest_spring(&self, m: &LeveledMap<3>, darts: &[DartId]) -> f64 {
         let map = m.map();
         let springs =
             darts.iter().filter(|&&x| map.contains(x)).filter_map(|&x| self.springs.get(&EdgeKey::of(map, x)));
-        springs.fold(0.0, |a, s| max_keeping_nan(max_keeping_nan(a, s.stiffness), s.damping))
+        // Magnitudes: a half of −f64::MAX overflows as surely as one of f64::MAX (finding 223).
+        springs.fold(0.0, |a, s| max_keeping_nan(max_keeping_nan(a, s.stiffness.abs()), s.damping.abs()))
     }
 
     /// A bound of the stiffness and damping terms that the children of a 1→8 split of the tet of
@@ -1146,8 +1153,12 @@ impl LeveledMechanics {
 }
 
 impl LeveledMechanics {
-    /// Vertex masses m_v = Σ_{volumes t ∋ v} m_t / n_t (n_t: vertices of t in the finest map), by
-    /// vertex id: a scatter from the volumes. Σ_v m_v = Σ_t m_t. O(darts).
+    /// Vertex masses by vertex id, a scatter of every volume's mass shares: m_t/4 on
+    /// each corner of a plain tet; a coarse volume with h_t hanging vertices (inserted by its
+    /// neighbours on its sides) among its n_t gives each of them m_t / (4 n_t), taken from its
+    /// corners along their barycentric coordinates. Σ_v m_v = Σ_t m_t and
+    /// Σ_v m_v x_v = Σ_t m_t · centroid_t (so a refinement keeps the centre of mass and the
+    /// momentum); every share > 0. O(darts + splits).
     ///
     /// # Errors
     /// [`CouplingError::OutOfSync`], [`CouplingError::StateCount`] or
@@ -1164,9 +1175,13 @@ impl LeveledMechanics {
     /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
     /// let mut m = LeveledMap::new(map, pts);
     /// let mut mech = LeveledMechanics::new(&m, Material { density: 6.0, ..Material::default() }).unwrap();
-    /// let d = m.map().darts().next().unwrap();
-    /// mech.split_edge(&mut m, d, 1).unwrap(); // one tet with 5 vertices: 1/5 each
-    /// assert!(mech.vertex_masses(&m).unwrap().iter().all(|&x| (x - 0.2).abs() < 1e-12));
+    /// let e = mech.edge(0, 1).unwrap();
+    /// let d = m.map().darts().find(|&d| m.map().cell_id(1, d).0 == e.id).unwrap();
+    /// mech.split_edge(&mut m, d, 1).unwrap(); // a midpoint (vertex 4) on the edge of 0 and 1
+    /// let mass = mech.vertex_masses(&m).unwrap();
+    /// // the midpoint takes 1/(4·5) = 0.05, half from each end; the other corners keep 1/4
+    /// let want = [0.225, 0.225, 0.25, 0.25, 0.05];
+    /// assert!(mass.iter().zip(want).all(|(&x, w)| (x - w).abs() < 1e-12));
     /// ```
     pub fn vertex_masses(&self, m: &LeveledMap<3>) -> Result<Vec<f64>, CouplingError> {
         self.in_sync(m)?;
@@ -1177,11 +1192,11 @@ impl LeveledMechanics {
     /// have made it). O(darts).
     pub(super) fn vertex_masses_raw(&self, m: &LeveledMap<3>) -> Vec<f64> {
         let map = m.map();
+        let parents = split_parents(m);
         let mut out = vec![0.0; map.cell_id_bound(0)];
         for t in map.one_dart_per_cell(3) {
-            let vertices = volume_vertices(m, t);
-            let share = self.masses.mass.get(map.cell_id(3, t).index()).copied().unwrap_or(0.0) / vertices.len() as f64;
-            for v in vertices {
+            let mass = self.masses.mass.get(map.cell_id(3, t).index()).copied().unwrap_or(0.0);
+            for (v, share) in volume_mass_shares(&volume_vertices(m, t), mass, &parents) {
                 out[v as usize] += share;
             }
         }
@@ -1237,6 +1252,67 @@ impl LeveledMechanics {
         SpringSystem::new(ends, rest, stiffness, damping, mass, &pinned, viscosity, gravity)
             .map_err(CouplingError::System)
     }
+}
+
+/// For every vertex id, the split that inserted it: (its index in [`LeveledMap::split_log`], the
+/// ends of the split edge); `None` for a vertex of level 0. O(vertices + splits).
+pub(super) fn split_parents(m: &LeveledMap<3>) -> Vec<Option<(usize, [u32; 2])>> {
+    let mut out = vec![None; m.map().cell_id_bound(0)];
+    for (i, &[mid, a, b]) in m.split_log().iter().enumerate() {
+        if let Some(slot) = out.get_mut(mid as usize) {
+            *slot = Some((i, [a, b]));
+        }
+    }
+    out
+}
+
+/// The hanging vertices among a volume's sorted vertex ids: those inserted on an edge whose two
+/// ends are vertices of the same volume (a midpoint lies between its ends, so it is no corner).
+/// The rest are the volume's corners. O(log n) (`vertices` sorted).
+pub(super) fn is_hanging(vertices: &[u32], parents: &[Option<(usize, [u32; 2])>], v: u32) -> bool {
+    match parents.get(v as usize).copied().flatten() {
+        Some((_, [a, b])) => vertices.binary_search(&a).is_ok() && vertices.binary_search(&b).is_ok(),
+        None => false,
+    }
+}
+
+/// How a volume of mass `mass` with the sorted vertex ids `vertices` lumps its mass (finding 218):
+/// with k corners and n vertices, each hanging vertex h gets w = mass / (k n), and the corners
+/// start at mass / k and give up w · λ_c(h) for each h (λ: h's barycentric coordinates, pushed
+/// down the split tree: a midpoint passes half of what it owes to each end, children before
+/// parents). Hence Σ shares = mass, every share ≥ mass / n, and Σ share · x = mass · (mean of the
+/// corners) for any affine placement of the hanging vertices. O(n log n).
+pub(super) fn volume_mass_shares(
+    vertices: &[u32],
+    mass: f64,
+    parents: &[Option<(usize, [u32; 2])>],
+) -> Vec<(u32, f64)> {
+    let mut hanging: Vec<(usize, u32)> = vertices
+        .iter()
+        .filter(|&&v| is_hanging(vertices, parents, v))
+        .map(|&v| (parents[v as usize].map_or(0, |(i, _)| i), v))
+        .collect();
+    let (n, k) = (vertices.len(), vertices.len() - hanging.len());
+    if k == 0 {
+        return vertices.iter().map(|&v| (v, mass / n as f64)).collect();
+    }
+    let (base, w) = (mass / k as f64, mass / (k as f64 * n as f64));
+    let at = |v: u32| vertices.binary_search(&v).unwrap_or(0);
+    let mut owed = vec![0.0; n];
+    hanging.sort_unstable_by(|x, y| y.cmp(x)); // latest split first: children before parents
+    for &(_, h) in &hanging {
+        let debt = owed[at(h)] + w;
+        owed[at(h)] = 0.0;
+        if let Some((_, [a, b])) = parents[h as usize] {
+            owed[at(a)] += debt / 2.0;
+            owed[at(b)] += debt / 2.0;
+        }
+    }
+    vertices
+        .iter()
+        .zip(&owed)
+        .map(|(&v, &debt)| (v, if is_hanging(vertices, parents, v) { w } else { base - debt }))
+        .collect()
 }
 
 /// The distinct vertex ids of the volume of `t` in the finest map. O(volume).

@@ -16,15 +16,18 @@
 //!    and the finest tets of level μt ≥ 1 whose volume holds the edge cell e between two of its
 //!    corners, and c = β k (each term measured in wide floats when the tet's corners are outside
 //!    the ordinary range, so a tet of edge 1e-110 or a needle has its finite terms);
-//! 6. Σ_t m_t equals its value when the coupling was built, and every vertex mass gathered from the
-//!    volumes around the vertex (m_v = Σ m_t / n_t) equals the scatter of
-//!    [`LeveledMechanics::vertex_masses`], so Σ_v m_v = Σ_t m_t.
+//! 6. Σ_t m_t equals its value when the coupling was built; every vertex mass gathered from the
+//!    volumes around the vertex (its share of each, as [`LeveledMechanics::vertex_masses`] lumps
+//!    them) equals the scatter of [`LeveledMechanics::vertex_masses`], so Σ_v m_v = Σ_t m_t; and
+//!    the lumped centre of mass on the rest positions, Σ_v m_v P_v / Σ_v m_v, equals the tets'
+//!    Σ_t m_t c_t / Σ_t m_t (c_t the mean of t's corners), to 1e-12 of the largest |P| (finding
+//!    218: a refinement moves neither the centre of mass nor the momentum).
 //!
 //! Every comparison is to a relative 1e-12 ([`TOLERANCE`]).
 
 use std::collections::{BTreeMap, BTreeSet};
 
-use super::springs::{tet_edges, volume_vertices, EdgeKey, Tet0};
+use super::springs::{is_hanging, split_parents, tet_edges, volume_mass_shares, volume_vertices, EdgeKey, Tet0};
 use super::{LeveledMap, LeveledMechanics};
 use crate::gmap::AlphaMask;
 use crate::mechanics::geom::rest_length;
@@ -145,6 +148,16 @@ pub enum SpringLawError {
         /// Σ m_t now.
         after: f64,
     },
+    /// The lumped centre of mass (rest positions) is not the tets' (finding 218).
+    #[error("centre of mass, axis {axis}: {lumped} lumped on the vertices, {tets} from the tets")]
+    CentreOfMass {
+        /// 0, 1 or 2.
+        axis: usize,
+        /// Σ_v m_v P_v / Σ_v m_v.
+        lumped: f64,
+        /// Σ_t m_t c_t / Σ_t m_t.
+        tets: f64,
+    },
     /// A vertex mass gathered around the vertex differs from the scatter.
     #[error("vertex {vertex}: mass {scattered} scattered from the tets, {gathered} gathered around it")]
     VertexMass {
@@ -152,7 +165,7 @@ pub enum SpringLawError {
         vertex: u32,
         /// From [`LeveledMechanics::vertex_masses`].
         scattered: f64,
-        /// Σ m_t / n_t over the volumes around it.
+        /// Its share of every volume around it.
         gathered: f64,
     },
 }
@@ -320,21 +333,75 @@ impl LeveledMechanics {
             return Err(SpringLawError::TotalMass { before: self.total_mass, after });
         }
         let scattered = self.vertex_masses_raw(m);
+        let parents = split_parents(m);
         for d in map.one_dart_per_cell(0) {
             let mut volumes: Vec<_> =
                 map.orbit(d, AlphaMask::cell(3, 0)).iter().map(|&x| (map.cell_id(3, x), x)).collect();
             volumes.sort_unstable_by_key(|&(id, _)| id);
             volumes.dedup_by_key(|&mut (id, _)| id);
+            let vertex = map.vertex_id(d).0;
             let gathered: f64 = volumes
                 .iter()
                 .map(|&(id, x)| {
-                    self.masses.mass.get(id.index()).copied().unwrap_or(0.0) / volume_vertices(m, x).len() as f64
+                    let mass = self.masses.mass.get(id.index()).copied().unwrap_or(0.0);
+                    let shares = volume_mass_shares(&volume_vertices(m, x), mass, &parents);
+                    shares.iter().filter(|&&(v, _)| v == vertex).map(|&(_, s)| s).sum::<f64>()
                 })
                 .sum();
-            let vertex = map.vertex_id(d).0;
             let s = scattered[vertex as usize];
             if !close(s, gathered) {
                 return Err(SpringLawError::VertexMass { vertex, scattered: s, gathered });
+            }
+        }
+        self.check_centre_of_mass(m, &scattered, &parents)
+    }
+
+    /// Law 6's first moment: Σ_v m_v P_v / Σ_v m_v against Σ_t m_t c_t / Σ_t m_t on the rest
+    /// positions, each mass divided by its total and each point by a power of two at least its
+    /// largest coordinate (exact), so neither sum can overflow; compared to
+    /// max(1e-12, 2 n ε) of that power of two (n the terms summed). O(darts).
+    fn check_centre_of_mass(
+        &self,
+        m: &LeveledMap<3>,
+        scattered: &[f64],
+        parents: &[Option<(usize, [u32; 2])>],
+    ) -> Result<(), SpringLawError> {
+        let (map, points) = (m.map(), m.points());
+        let lumped_total: f64 = scattered.iter().sum();
+        let tets_total = self.masses.total(m);
+        let largest = points.iter().flatten().fold(0.0f64, |a, &x| a.max(x.abs()));
+        if !(lumped_total > 0.0 && tets_total > 0.0 && largest.is_finite() && largest > 0.0) {
+            return Ok(()); // massless, or every point at the origin: nothing to compare
+        }
+        let scale = 2f64.powi(largest.log2().ceil() as i32);
+        let mut lumped = [0.0; 3];
+        for (v, &mv) in scattered.iter().enumerate() {
+            for (axis, sum) in lumped.iter_mut().enumerate() {
+                *sum += (mv / lumped_total) * (points[v][axis] / scale);
+            }
+        }
+        let mut tets = [0.0; 3];
+        for t in map.one_dart_per_cell(3) {
+            let vertices = volume_vertices(m, t);
+            let corners: Vec<u32> = vertices.iter().copied().filter(|&v| !is_hanging(&vertices, parents, v)).collect();
+            let mass = self.masses.mass.get(map.cell_id(3, t).index()).copied().unwrap_or(0.0) / tets_total;
+            for (axis, sum) in tets.iter_mut().enumerate() {
+                let mean =
+                    corners.iter().map(|&c| points[c as usize][axis] / scale).sum::<f64>() / corners.len() as f64;
+                *sum += mass * mean;
+            }
+        }
+        // Each sum has terms of magnitude ≤ 1, so its rounding is below n ε (n terms): a bound
+        // that stays sound on a million vertices and is TOLERANCE on any small map.
+        let terms = scattered.len() + map.cell_id_bound(3);
+        let bound = TOLERANCE.max(2.0 * terms as f64 * f64::EPSILON);
+        for axis in 0..3 {
+            if (lumped[axis] - tets[axis]).abs() > bound {
+                return Err(SpringLawError::CentreOfMass {
+                    axis,
+                    lumped: lumped[axis] * scale,
+                    tets: tets[axis] * scale,
+                });
             }
         }
         Ok(())

@@ -325,10 +325,10 @@ mod tests {
     /// Finding 229: a point no tet uses, far from the mesh, does not move the pinned band.
     #[test]
     fn the_pinned_band_ignores_unreferenced_points() {
-        let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [-100.0, 0.0, 0.0]];
+        let points = [[1.0, 0.0, 0.0], [5.0, 0.0, 0.0], [1.0, 1.0, 0.0], [1.0, 0.0, 1.0], [-100.0, 0.0, 0.0]];
         let tets = [[0, 1, 2, 3]];
-        assert_eq!(low_x_tenth(&points, &tets), 0.1);
-        assert_eq!(low_x_tenth(&points[..4], &tets), 0.1);
+        assert_eq!(low_x_tenth(&points, &tets), 1.4); // x from 1 to 5: a tenth above 1
+        assert_eq!(low_x_tenth(&points[..4], &tets), 1.4);
     }
 
     /// Finding 170: `bench order`'s flat cases step at half each scheme's own limit (they took

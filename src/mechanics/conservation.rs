@@ -13,7 +13,7 @@
 use crate::gmap::DartSet;
 use crate::{AlphaMask, CellId, DartId, GMap};
 
-use super::geom::{close, compensated_sum};
+use super::geom::{close, compensated_sum, CompensatedSum};
 use super::model::{distinct, stiffness_contribution, Mechanics};
 
 /// Relative tolerance of every conservation comparison.
@@ -198,8 +198,8 @@ struct Expected {
     edge_stiffness: Vec<f64>,
     edge_dart: Vec<Option<DartId>>,
     edge_length: Vec<f64>,
-    /// The mass of every tet met, in the order met (summed compensated at the end).
-    tet_masses: Vec<f64>,
+    /// Σ of the masses of the tets met, compensated (finding 228).
+    tet_mass_total: CompensatedSum,
 }
 
 /// Verifies laws 1–5 of [`model`](super::model) on every live cell of `map` (see the module
@@ -271,7 +271,7 @@ pub fn conservation_violations(map: &GMap<3>, mech: &Mechanics, limit: usize) ->
             .filter(|(_, d)| d.is_some())
             .map(|(v, _)| mech.vertex_mass(CellId(v as u32))),
     );
-    let tets = compensated_sum(exp.tet_masses.iter().copied());
+    let tets = exp.tet_mass_total.value();
     if !close(vertices, tets, TOLERANCE) {
         sink.push(ConservationError::TotalMass { vertices, tets });
     }
@@ -303,7 +303,7 @@ fn scatter_from_volumes(map: &GMap<3>, mech: &Mechanics, sink: &mut Sink) -> Exp
         edge_stiffness: vec![0.0; map.cell_id_bound(1)],
         edge_dart: vec![None; map.cell_id_bound(1)],
         edge_length: vec![0.0; map.cell_id_bound(1)],
-        tet_masses: Vec::with_capacity(map.cell_id_bound(3)),
+        tet_mass_total: CompensatedSum::default(),
     };
     let mut seen = DartSet::with_capacity(map.capacity());
     for d in map.darts() {
@@ -327,7 +327,7 @@ fn scatter_one(map: &GMap<3>, mech: &Mechanics, darts: &[DartId], exp: &mut Expe
     if !close(mass, expected, TOLERANCE) {
         sink.push(ConservationError::TetMass { tet: t, stored: mass, expected });
     }
-    exp.tet_masses.push(mass);
+    exp.tet_mass_total.add(mass);
     for v in distinct(darts.iter().map(|&x| map.vertex_id(x))) {
         exp.vertex_mass[v.index()] += mass / 4.0;
         let dart = darts.iter().copied().find(|&x| map.vertex_id(x) == v);

@@ -104,13 +104,30 @@ pub(crate) fn pow2(e: i32) -> f64 {
 /// however many terms there are, where a plain sum drifts by up to n ε Σ|x|. The conservation
 /// checks compare totals of 10⁵–10⁶ terms to 1e-12 (finding 228). O(n).
 pub(crate) fn compensated_sum(values: impl IntoIterator<Item = f64>) -> f64 {
-    let (mut sum, mut carry) = (0.0f64, 0.0f64);
-    for x in values {
-        let t = sum + x;
-        carry += if sum.abs() >= x.abs() { (sum - t) + x } else { (x - t) + sum };
-        sum = t;
+    let mut acc = CompensatedSum::default();
+    values.into_iter().for_each(|x| acc.add(x));
+    acc.value()
+}
+
+/// A running [`compensated_sum`]: the sum and the rounding it has lost so far.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct CompensatedSum {
+    sum: f64,
+    carry: f64,
+}
+
+impl CompensatedSum {
+    /// Adds `x`. O(1).
+    pub(crate) fn add(&mut self, x: f64) {
+        let t = self.sum + x;
+        self.carry += if self.sum.abs() >= x.abs() { (self.sum - t) + x } else { (x - t) + self.sum };
+        self.sum = t;
     }
-    sum + carry
+
+    /// The sum so far. O(1).
+    pub(crate) fn value(&self) -> f64 {
+        self.sum + self.carry
+    }
 }
 
 /// Whether `a` and `b` agree to a relative tolerance `rel` (absolute below `f64::MIN_POSITIVE`).

@@ -1298,21 +1298,18 @@ pub(super) fn volume_mass_shares(
     }
     let (base, w) = (mass / k as f64, mass / (k as f64 * n as f64));
     let at = |v: u32| vertices.binary_search(&v).unwrap_or(0);
-    let mut owed = vec![0.0; n];
+    let (mut share, mut owed) = (vec![base; n], vec![0.0; n]);
     hanging.sort_unstable_by(|x, y| y.cmp(x)); // latest split first: children before parents
     for &(_, h) in &hanging {
-        let debt = owed[at(h)] + w;
-        owed[at(h)] = 0.0;
+        // every debt into h has arrived (its children came first); h passes it on, keeps w
+        let debt = std::mem::take(&mut owed[at(h)]) + w;
+        share[at(h)] = w;
         if let Some((_, [a, b])) = parents[h as usize] {
             owed[at(a)] += debt / 2.0;
             owed[at(b)] += debt / 2.0;
         }
     }
-    vertices
-        .iter()
-        .zip(&owed)
-        .map(|(&v, &debt)| (v, if is_hanging(vertices, parents, v) { w } else { base - debt }))
-        .collect()
+    vertices.iter().zip(share.iter().zip(&owed)).map(|(&v, (&s, &debt))| (v, s - debt)).collect()
 }
 
 /// The distinct vertex ids of the volume of `t` in the finest map. O(volume).

@@ -16,20 +16,13 @@ use topomech::mechanics::{Body, Material};
 use topomech::subdivide::{LeveledMap, TetMasses};
 use topomech::{CellId, GMap};
 
+#[path = "../tests/subdivide_common/mod.rs"]
+mod subdivide_common;
+
 /// Text of every record of `m` (one line per dart slot, then the logs).
 fn records<const N: usize>(m: &LeveledMap<N>) -> String {
     let map = m.map();
-    let mut out = String::new();
-    for k in 0..map.capacity() as u32 {
-        let d = topomech::DartId(k);
-        if !map.contains(d) {
-            out.push_str(&format!("{k} dead\n"));
-            continue;
-        }
-        let alpha: Vec<u32> = (0..=N).map(|i| map.alpha_dyn(i, d).0).collect();
-        let cell: Vec<u32> = (0..=N).map(|i| map.cell_id(i, d).0).collect();
-        out.push_str(&format!("{k} a{alpha:?} c{cell:?}\n"));
-    }
+    let mut out = subdivide_common::dart_rows(map);
     for i in 0..=N {
         let live = (0..map.cell_id_bound(i) as u32).filter(|&c| map.is_live_cell(i, CellId(c))).count();
         out.push_str(&format!("dim {i}: bound {} live {live}\n", map.cell_id_bound(i)));

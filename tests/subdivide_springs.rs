@@ -10,23 +10,12 @@ use topomech::subdivide::{CouplingError, EdgeKey, LeveledMap, LeveledMechanics, 
 use topomech::{DartId, GMap};
 
 mod subdivide_common;
-use subdivide_common::tet_mesh;
+use subdivide_common::{jitter, tet_mesh};
 
 const TET: [[f64; 3]; 4] = [[0.0, 0.0, 0.0], [1.0, 0.1, 0.0], [0.2, 1.0, 0.1], [0.1, 0.3, 1.0]];
 
 fn material() -> Material {
     Material { density: 2.0, young: 500.0, damping: 0.01, viscosity: 0.5 }
-}
-
-/// A deterministic pseudo-random vector in [−1, 1]³.
-fn jitter(seed: u64) -> Vec3 {
-    let mut s = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15).wrapping_add(1);
-    [0, 1, 2].map(|_| {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        (s % 2001) as f64 / 1000.0 - 1.0
-    })
 }
 
 fn level_of(m: &LeveledMap<3>, up: bool) -> u8 {
@@ -213,13 +202,11 @@ fn a_relaxed_refined_chain_network_has_the_coarse_static_response() {
         let j = jitter(7 * v as u64);
         mech.position[v] = [0, 1, 2].map(|k| mech.position[v][k] + 0.05 * j[k]);
     }
-    let coarse = LeveledMechanics::new(&tet_mesh(TET.to_vec(), &[[0, 1, 2, 3]]), heavy).unwrap();
+    let coarse_map = tet_mesh(TET.to_vec(), &[[0, 1, 2, 3]]);
+    let coarse = LeveledMechanics::new(&coarse_map, heavy).unwrap();
     let mut x_coarse = coarse.position.clone();
     (0..4).for_each(|v| x_coarse[v] = mech.position[v]);
-    let f_coarse = spring_forces(
-        &coarse.spring_system(&tet_mesh(TET.to_vec(), &[[0, 1, 2, 3]]), [0.0; 3], &[]).unwrap(),
-        &x_coarse,
-    );
+    let f_coarse = spring_forces(&coarse.spring_system(&coarse_map, [0.0; 3], &[]).unwrap(), &x_coarse);
     let sys = mech.spring_system(&m, [0.0; 3], &[true; 4]).unwrap();
     let mut stepper =
         Stepper::new(StepConfig::new(Integrator::Implicit, 1e-2), &sys, &mech.position, &mech.velocity).unwrap();

@@ -34,7 +34,8 @@ pub struct RefineArgs {
     #[arg(long, allow_hyphen_values = true)]
     pub radius: f64,
     /// Finest level to reach (1 = one 1→8 step).
-    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true,
+          value_parser = clap::value_parser!(u8).range(0..=i64::from(topomech::subdivide::MAX_LEVEL)))]
     pub levels: u8,
     /// Refuse a level that would grow the map past this many darts (about 91 bytes each): the
     /// command stops with an error naming the estimate before that level starts.
@@ -191,6 +192,13 @@ pub fn run(args: RefineArgs) -> Result<(), CliError> {
             super::number(args.radius)
         );
     }
+    if let Some(first) = first_empty_level(&refinement.subdivided_per_level) {
+        eprintln!(
+            "topomech: warning: levels {first}..={} refined nothing: no tet of level {} is left in the zone",
+            args.levels,
+            first - 1
+        );
+    }
     let spring_laws = mech.as_ref().map(|(before, x)| fill_springs(&mut report, *before, x, &m));
     let closure = if args.conforming || args.cut.is_some() {
         let c = m.conforming_tets().map_err(|e| other(format!("{}: conforming closure: {e}", args.mesh.display())))?;
@@ -217,6 +225,13 @@ pub fn run(args: RefineArgs) -> Result<(), CliError> {
         None => Ok(()),
         Some(e) => Err(other(format!("{}: the refined map breaks a law (a topomech bug): {e}", args.mesh.display()))),
     }
+}
+
+/// The first level that refined nothing after one that refined something (the zone ran out
+/// of tets: e.g. a radius-0 ball whose point the children no longer tile). O(levels).
+fn first_empty_level(per_level: &[usize]) -> Option<usize> {
+    let first_busy = per_level.iter().position(|&n| n > 0)?;
+    (first_busy + 1..per_level.len()).find(|&k| per_level[k] == 0)
 }
 
 /// Pads `tets_per_level` to `levels` entries (levels 0..levels−1) with its last count: a level the
@@ -424,4 +439,36 @@ fn write_vtu(m: &LeveledMap<3>, dir: &std::path::Path) -> Result<(), CliError> {
         m.finest_tets().map_err(|e| other(e.to_string()))?.into_iter().map(|(t, _, _)| t).collect();
     let frame = Frame { points: m.points(), tets: &tets, vectors: Vec::new() };
     frame.write(&dir.join("refined.vtu")).map_err(|e| other(e.to_string()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    /// A level that refined nothing after a busy one is named; none before the first busy one.
+    #[test]
+    fn the_first_empty_level_after_a_busy_one_is_named() {
+        assert_eq!(first_empty_level(&[0, 1, 8, 0, 0]), Some(3));
+        assert_eq!(first_empty_level(&[0, 0, 4, 32]), None);
+        assert_eq!(first_empty_level(&[0, 0, 0]), None);
+        assert_eq!(first_empty_level(&[2, 0, 16]), Some(1));
+    }
+
+    /// `--levels` above the maximum level is a usage error naming the range (251 was accepted
+    /// by the parser and refused later with another message).
+    #[test]
+    fn levels_past_the_maximum_are_a_usage_error() {
+        #[derive(Debug, Parser)]
+        struct Line {
+            #[command(flatten)]
+            args: RefineArgs,
+        }
+        let parse = |levels: &str| {
+            Line::try_parse_from(["refine", "m.msh", "--around", "0,0,0", "--radius", "1", "--levels", levels])
+        };
+        assert!(parse("250").is_ok());
+        let e = parse("251").unwrap_err().to_string();
+        assert!(e.contains("0..=250"), "{e}");
+    }
 }

@@ -107,7 +107,7 @@ pub struct Tear {
 /// ```
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TearStep {
-    /// One entry per torn vertex.
+    /// One entry per vertex whose tear dissociated faces (empty tears are not listed).
     pub tears: Vec<Tear>,
 }
 
@@ -559,10 +559,14 @@ pub fn tear_vertex(body: &mut Body, v: CellId, direction: Vec3, hint: Option<Dar
 }
 
 /// One tearing pass inside a simulation loop: computes [`principal_stress`], tears the vertices
-/// whose stress exceeds `threshold`, strongest first (at most `max_vertices`; a vertex already
-/// split this pass is skipped), then lets `sim` follow the changes ([`Simulation::update`]).
+/// whose stress exceeds `threshold`, strongest first, until `max_vertices` tears dissociated
+/// something (a vertex already touched by a tear of this pass is skipped; a vertex with no inner
+/// face, whose tear would be empty, is passed over without spending the budget: round 25, the
+/// fragments of a torn body had starved every tearable vertex), then lets `sim` follow the
+/// changes ([`Simulation::update`]). [`TearStep::tears`] lists the tears that dissociated faces.
 ///
-/// Cost: O(springs + slots) for the stresses, plus the tears and the update.
+/// Cost: O(springs + slots) for the stresses, plus the tears tried (each O(vertex star) when
+/// empty) and the update.
 ///
 /// # Errors
 /// [`CutError::BadThreshold`] for a NaN, infinite or negative threshold, and
@@ -609,12 +613,18 @@ pub fn tear_step(
     // Vertices a tear of this pass touched (their stress is stale): marked, not searched for
     // in the touched list, which would make a pass quadratic in its tears (finding 226).
     let mut stale = vec![false; stress.len()];
-    for v in order.into_iter().take(max_vertices) {
+    for v in order {
+        if out.tears.len() == max_vertices {
+            break;
+        }
         let Some(hint) = sim.projection.dart_of_vertex(v) else { continue };
         if stale[v] {
             continue;
         }
         let tear = tear_vertex(body, CellId(v as u32), stress[v].direction, Some(hint))?;
+        if tear.dissociations.is_empty() {
+            continue; // no inner face at v (an empty tear): nothing changed, no budget spent
+        }
         for &(t, _) in &tear.touched.vertices {
             if let Some(mark) = stale.get_mut(t.index()) {
                 *mark = true;

@@ -339,6 +339,20 @@ impl<T> std::ops::IndexMut<CellId> for CellSliceMut<'_, T> {
 /// Every method receives the map *after* the topological operation, so both resulting cells can
 /// be walked.
 ///
+/// The methods are called by the embedding layer ([`Embedded::sew`], [`Embedded::unsew`]), in
+/// that order, once per operation; called by hand on attributes that an [`Embedded`] owns they
+/// rewrite those attributes from whatever map they are given, and [`Embedded::check`] names the
+/// law that breaks (for [`crate::mechanics::Mechanics`]: a face flag, a sum).
+///
+/// # Panics
+///
+/// A rule that panics unwinds out of [`Embedded::sew`] or [`Embedded::unsew`] *after* the
+/// topological change: the map is the new one and the attributes are updated only up to the
+/// rule that panicked. The layer does not roll back; an [`Embedded`] caught across such an
+/// unwind (`catch_unwind`) is inconsistent and must be dropped ([`Embedded::check`] then reports
+/// the broken law when the rules' laws can see it). The rules of this crate do not panic on a
+/// map that the `check_*` methods accepted.
+///
 /// # Examples
 ///
 /// ```
@@ -533,6 +547,31 @@ pub struct Embedded<const N: usize, E> {
     /// For a clone: the identity and version of the body it was cloned from (its lineage, which
     /// a version alone — an operation count — cannot tell).
     source: Option<(u64, u64)>,
+}
+
+/// A 64-bit digest of a report's lists (changes, pairs and the recorded new sides), for
+/// [`Embedded::returned_last`]: lists edited after the stamp almost surely change it. Not
+/// cryptographic; it guards against mistakes, not adversaries. O(changes · walked splits +
+/// pairs + side darts) (a few dozen words for a face).
+fn fingerprint(changes: &CellChanges) -> u64 {
+    let mut h = 0x243f_6a88_85a3_08d3_u64;
+    let mut mix = |x: u64| h = (h.rotate_left(5) ^ x).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    let pair = |a: u32, b: u32| (u64::from(a) << 32) | u64::from(b);
+    mix(pair(changes.changes.len() as u32, changes.pairs.len() as u32));
+    for (k, change) in changes.changes.iter().enumerate() {
+        let words = match *change {
+            CellChange::Split { dim, kept, new, dart_kept, dart_new } => {
+                [1 + dim as u64, pair(kept.0, new.0), pair(dart_kept.0, dart_new.0)]
+            }
+            CellChange::Merged { dim, kept, absorbed } => [16 + dim as u64, pair(kept.0, absorbed.0), 0],
+        };
+        words.into_iter().for_each(&mut mix);
+        let side = changes.new_side(k);
+        mix(side.len() as u64);
+        side.iter().for_each(|d| mix(d.0.into()));
+    }
+    changes.pairs.iter().for_each(|&(a, b)| mix(pair(a.0, b.0)));
+    h
 }
 
 /// A number no earlier call returned in this process (1, 2, 3, …). O(1).
@@ -730,6 +769,8 @@ impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
     }
 
     /// i-sews `d1` and `d2` ([`GMap::sew_dyn`]) and applies the merge rules to every merged cell.
+    /// The report is stamped as this map's operation (identity, version after it, a fingerprint
+    /// of its lists), which [`crate::mechanics::TouchedCells::record_change`] checks.
     /// Cost: the kernel's sew plus the rules (for the mechanical model, O(size of merged cells)).
     ///
     /// # Errors
@@ -759,13 +800,15 @@ impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
             dart: d1,
             source,
         })?;
-        let changes = self.map.link_sew_pairs(i, d1, pairs);
+        let mut changes = self.map.link_sew_pairs(i, d1, pairs);
         self.apply(&changes);
         self.after("sew", d1)?;
+        self.stamp(&mut changes);
         Ok(changes)
     }
 
-    /// i-unsews `d` ([`GMap::unsew_dyn`]) and applies the split rules to every split cell.
+    /// i-unsews `d` ([`GMap::unsew_dyn`]) and applies the split rules to every split cell; the
+    /// report is stamped as for [`Embedded::sew`].
     /// Cost: the kernel's unsew plus the rules (O(size of the split cells) for mechanics).
     ///
     /// # Errors
@@ -792,10 +835,32 @@ impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
             dart: d,
             source,
         })?;
-        let changes = self.map.unsew_dyn(i, d)?;
+        let mut changes = self.map.unsew_dyn(i, d)?;
         self.apply(&changes);
         self.after("unsew", d)?;
+        self.stamp(&mut changes);
         Ok(changes)
+    }
+
+    /// Marks `changes` as the report of this map's last operation: (identity, version,
+    /// [`fingerprint`]), which [`Embedded::returned_last`] compares. O(the report's lists).
+    fn stamp(&self, changes: &mut CellChanges) {
+        changes.stamp = Some((self.identity, self.version, fingerprint(changes)));
+    }
+
+    /// Whether `changes` is, unedited, the report that this map's last [`Embedded::sew`] or
+    /// [`Embedded::unsew`] returned: its stamp names this identity and the present version, and
+    /// its lists still have the fingerprint they were stamped with. A kernel report, a default
+    /// one, an earlier one, another map's or an edited one is not. O(the report's lists).
+    pub(crate) fn returned_last(&self, changes: &CellChanges) -> bool {
+        changes.stamp == Some((self.identity, self.version, fingerprint(changes)))
+    }
+
+    /// The map (read-only) and the attributes (mutable) at once, for updates of the attributes
+    /// that read the topology (the map stays untouchable, so this is not a topological change:
+    /// the version stays). O(1).
+    pub(crate) fn map_and_attrs_mut(&mut self) -> (&GMap<N>, &mut E) {
+        (&self.map, &mut self.attrs)
     }
 
     /// Runs the rules of `changes` (already applied to the map).

@@ -36,6 +36,7 @@ pub use cmap::CombinatorialMap;
 pub use dart::{CellId, DartId};
 pub use mark::{DartSet, Mark};
 pub use mask::AlphaMask;
+pub use orbit::release_thread_caches;
 pub use sew::{CellChange, CellChanges, SewError, SplitSides};
 pub use validate::{InvariantViolation, Law};
 
@@ -282,7 +283,13 @@ impl<const N: usize> GMap<N> {
         self.alpha_dyn(I, d)
     }
 
-    /// αi(d) with i given at run time. O(1). Panics if i > n.
+    /// αi(d) with i given at run time. O(1).
+    ///
+    /// # Panics
+    /// If `i > n` or `d` is not below [`GMap::capacity`] (the hot-path accessor: a release build
+    /// panics with the slice index, a debug build names the dart; [`GMap::try_alpha`] returns
+    /// an error instead). A dead dart below the capacity: a debug build panics naming it, a
+    /// release build reads its row (a dart is deleted isolated, so: itself).
     ///
     /// # Examples
     ///
@@ -345,6 +352,9 @@ impl<const N: usize> GMap<N> {
 
     /// Whether d is i-free (αi(d) = d). O(1).
     ///
+    /// # Panics
+    /// As [`GMap::alpha_dyn`]: if `i > n` or `d` is not below [`GMap::capacity`].
+    ///
     /// # Examples
     ///
     /// ```
@@ -362,6 +372,9 @@ impl<const N: usize> GMap<N> {
     }
 
     /// Whether d is free for every αi. O(n).
+    ///
+    /// # Panics
+    /// As [`GMap::alpha_dyn`]: if `d` is not below [`GMap::capacity`].
     ///
     /// # Examples
     ///
@@ -401,8 +414,9 @@ impl<const N: usize> GMap<N> {
     /// The id of the i-cell that contains d. O(1).
     ///
     /// # Panics
-    /// If `i > n` or `d` is not below [`GMap::capacity`] (the hot-path accessor; a dead dart
-    /// below the capacity returns the id it last had).
+    /// If `i > n` or `d` is not below [`GMap::capacity`] (the hot-path accessor: a release build
+    /// panics with the slice index, a debug build with the dimension or the index). A dead dart
+    /// below the capacity returns `CellId(u32::MAX)`: no cell (deleting a dart clears its ids).
     ///
     /// # Examples
     ///

@@ -15,12 +15,23 @@ use super::{AlphaMask, CellId, DartId, GMap};
 /// visited iff its mark equals the tag. Nothing is cleared between walks (a new tag makes every
 /// old mark stale), so a test or a mark is one load or store with no hashing. The array grows to
 /// the largest map capacity the thread walks (4 bytes per dart slot), and is wiped only when
-/// the 32-bit tags wrap.
+/// the 32-bit tags wrap. It shrinks back after [`SHRINK_AFTER`] walks in a row on maps below a
+/// quarter of its size (a thread that walked a 30 M-dart map and went on with small ones kept
+/// 120 MB: round 25), and [`release_thread_caches`] frees it at once.
 #[derive(Default)]
 pub(crate) struct Stamps {
     marks: Vec<u32>,
     last: u32,
+    /// Walks in a row that addressed less than a quarter of `marks`.
+    small_walks: u32,
 }
+
+/// Walks in a row on maps below a quarter of the stamp array before it shrinks: a thread that
+/// alternates between a large map and small ones regrows it at most once per this many walks.
+const SHRINK_AFTER: u32 = 4096;
+
+/// Stamp arrays up to this many slots (256 KiB) are never shrunk.
+const KEEP_SLOTS: usize = 1 << 16;
 
 impl Stamps {
     /// `tags` consecutive tags never written since the last wipe, the first returned; `len`
@@ -28,6 +39,13 @@ impl Stamps {
     pub(crate) fn fresh(&mut self, len: usize, tags: u32) -> u32 {
         if self.marks.len() < len {
             self.marks.resize(len, 0);
+        }
+        self.small_walks = if len < self.marks.len() / 4 { self.small_walks + 1 } else { 0 };
+        if self.small_walks >= SHRINK_AFTER && self.marks.len() > KEEP_SLOTS {
+            // the tags of the slots kept stay valid: nothing to wipe
+            self.marks.truncate(len.max(KEEP_SLOTS));
+            self.marks.shrink_to_fit();
+            self.small_walks = 0;
         }
         if self.last > u32::MAX - tags {
             self.marks.fill(0);
@@ -53,6 +71,32 @@ impl Stamps {
 
 thread_local! {
     static STAMPS: std::cell::RefCell<Stamps> = std::cell::RefCell::new(Stamps::default());
+}
+
+/// Frees this thread's walk scratch: the orbit walks' visited marks (4 bytes per dart slot of
+/// the largest map the thread walked since; they shrink by themselves only after many walks on
+/// smaller maps). Call it on a long-lived thread that is done with a large map; the next walk
+/// allocates again. Results are unchanged either way. O(1) (a deallocation).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate::kuhn_cube;
+/// use topomech::{AlphaMask, GMap};
+///
+/// let (points, tets) = kuhn_cube(3);
+/// let (map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+/// let d = map.darts().next().unwrap();
+/// let before = map.orbit(d, AlphaMask::all(3)).len();
+/// topomech::gmap::release_thread_caches();
+/// assert_eq!(map.orbit(d, AlphaMask::all(3)).len(), before);
+/// ```
+pub fn release_thread_caches() {
+    STAMPS.with(|cell| {
+        if let Ok(mut stamps) = cell.try_borrow_mut() {
+            *stamps = Stamps::default();
+        }
+    });
 }
 
 /// Runs `f` with this thread's [`Stamps`] (a private, fresh set if they are in use already, so a

@@ -170,6 +170,12 @@ pub struct CellChanges {
     /// For the splits an unsew found by walking, every dart of the new side (the cell that got
     /// the fresh id): [`CellChanges::new_side`]. Empty for a sew. Not compared by `==`.
     pub new_sides: SplitSides,
+    /// Which operation returned the report, set by the embedding layer
+    /// ([`crate::embedding::Embedded::sew`] / [`crate::embedding::Embedded::unsew`]): the
+    /// embedded map's identity, its version after the operation and a fingerprint of the lists
+    /// above (so an edited report no longer matches). `None` for the kernel's own reports and
+    /// for `Default`. Not compared by `==`.
+    pub(crate) stamp: Option<(u64, u64, u64)>,
 }
 
 /// The darts of the new side of the splits an unsew found by walking (the lockstep walk of
@@ -270,7 +276,7 @@ impl CellChanges {
     /// An empty report on this thread's spare lists. O(1).
     fn on_spare_lists() -> Self {
         let ((changes, pairs), (ends, darts)) = crate::spare::take(&SPARE_LISTS);
-        CellChanges { changes, pairs, new_sides: SplitSides { ends, darts } }
+        CellChanges { changes, pairs, new_sides: SplitSides { ends, darts }, stamp: None }
     }
 }
 
@@ -580,7 +586,7 @@ impl<const N: usize> GMap<N> {
             self.link_raw(i, x, y);
         }
         let keep: Vec<u32> = (0..=N).map(|dim| self.cell_id(dim, d1).0).collect();
-        let mut report = CellChanges { changes: Vec::new(), pairs, new_sides: SplitSides::default() };
+        let mut report = CellChanges { changes: Vec::new(), pairs, new_sides: SplitSides::default(), stamp: None };
         for k in 0..report.pairs.len() {
             let (x, y) = report.pairs[k];
             for dim in (0..=N).filter(|&dim| dim != i) {
@@ -671,7 +677,7 @@ impl<const N: usize> GMap<N> {
         // allocation in the steady state; they are cleared before use).
         let mut scratch = SPLIT_SCRATCH.take();
         for dim in (0..=N).filter(|&dim| dim != i) {
-            let CellChanges { changes, pairs, new_sides } = &mut report;
+            let CellChanges { changes, pairs, new_sides, .. } = &mut report;
             self.split_cells((i, dim, quick), pairs, &links, &mut scratch, (changes, new_sides));
         }
         SPLIT_SCRATCH.set(scratch);

@@ -189,6 +189,28 @@ pub enum ConservationError {
         /// The volume of `other`.
         other_volume: CellId,
     },
+    /// A face's boundary flag is not whether the face is α3-free in the map
+    /// ([`Mechanics::check_faces`]).
+    #[error("face {} (e.g. {dart}) is flagged {} but is {} face of the map", .face.0,
+        if *.flagged_boundary { "boundary" } else { "inner" }, if *.flagged_boundary { "an inner" } else { "a boundary" })]
+    FaceFlag {
+        /// The face id.
+        face: CellId,
+        /// A dart of the face.
+        dart: DartId,
+        /// The stored flag (the map says the opposite).
+        flagged_boundary: bool,
+    },
+    /// An inner (α3-sewn) face has a nonzero normal ([`Mechanics::check_faces`]).
+    #[error("inner face {} (e.g. {dart}) has the normal {normal:?}, not zero", .face.0)]
+    InnerFaceNormal {
+        /// The face id.
+        face: CellId,
+        /// A dart of the face.
+        dart: DartId,
+        /// The stored normal.
+        normal: [f64; 3],
+    },
 }
 
 /// What the volume-centred scatter recomputes.

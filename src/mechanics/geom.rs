@@ -117,16 +117,25 @@ pub(crate) struct CompensatedSum {
 }
 
 impl CompensatedSum {
-    /// Adds `x`. O(1).
+    /// Adds `x`. Once the running sum is not finite (an overflow, or an infinite or NaN term)
+    /// it stays what a plain sum gives (±∞ or NaN) and the carry is no longer updated: the
+    /// carry of an overflowed sum would be ∓∞ and turn the value into NaN (finding F3 of round
+    /// 25). O(1).
     pub(crate) fn add(&mut self, x: f64) {
         let t = self.sum + x;
-        self.carry += if self.sum.abs() >= x.abs() { (self.sum - t) + x } else { (x - t) + self.sum };
+        if t.is_finite() {
+            self.carry += if self.sum.abs() >= x.abs() { (self.sum - t) + x } else { (x - t) + self.sum };
+        }
         self.sum = t;
     }
 
-    /// The sum so far. O(1).
+    /// The sum so far: the plain sum itself when that is not finite. O(1).
     pub(crate) fn value(&self) -> f64 {
-        self.sum + self.carry
+        if self.sum.is_finite() {
+            self.sum + self.carry
+        } else {
+            self.sum
+        }
     }
 }
 
@@ -181,6 +190,24 @@ mod tests {
         }
         let flat = [[0.0; 3], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 1e-300, 0.0]];
         assert_eq!(volume_ratios([flat, flat]), [0.0, 0.0]);
+    }
+
+    /// An overflowing or infinite sum is what a plain sum gives (+∞, −∞ or NaN), never the NaN
+    /// of ∞ + (−∞) from an overflowed carry (round 25, F3); finite sums keep their compensation.
+    #[test]
+    fn compensated_sum_overflows_like_a_plain_sum() {
+        let (max, inf) = (f64::MAX, f64::INFINITY);
+        assert_eq!(compensated_sum([max, max]), inf);
+        assert_eq!(compensated_sum([-max, -max, 1.0]), -inf);
+        assert_eq!(compensated_sum([1.0, inf, 2.0]), inf);
+        assert_eq!(compensated_sum([inf, 1.0]), inf);
+        assert!(compensated_sum([inf, -inf]).is_nan());
+        assert!(compensated_sum([1.0, f64::NAN]).is_nan());
+        assert_eq!(compensated_sum([max, -max, max]), max);
+        // compensation kept: 1 + 1e-16 × 10 loses every term in a plain sum
+        let plain: f64 = std::iter::once(1.0).chain([1e-16; 10]).sum();
+        assert_eq!(plain, 1.0);
+        assert_eq!(compensated_sum(std::iter::once(1.0).chain([1e-16; 10])), 1.0 + 1e-15);
     }
 
     #[test]

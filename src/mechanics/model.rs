@@ -517,8 +517,8 @@ impl Mechanics {
         self.face_boundary.get(f).copied().unwrap_or(false)
     }
 
-    /// Outward unit normal of boundary face `f` at the last [`Mechanics::update_normals`] (zero
-    /// for inner faces). O(1).
+    /// Outward unit normal of boundary face `f` from the positions at the body's last
+    /// topological change or [`Body::update_normals`] (zero for inner faces). O(1).
     ///
     /// # Panics
     /// If `f` is not below [`Mechanics::attribute_len`]`(2)` (no face id of this body's map is).
@@ -713,32 +713,12 @@ impl Mechanics {
         }
     }
 
-    /// Recomputes every boundary face normal from the current positions. O(darts).
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use topomech::generate::kuhn_cube;
-    /// use topomech::mechanics::{Body, Material};
-    ///
-    /// let (points, tets) = kuhn_cube(1);
-    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
-    /// let map = body.map().clone();
-    /// let faces: Vec<_> = map.one_dart_per_cell(2).into_iter().map(|d| map.cell_id(2, d)).collect();
-    /// let top = *faces.iter().find(|&&f| body.attrs().face_normal(f) == [0.0, 0.0, 1.0]).unwrap();
-    /// body.attrs_mut().position_mut().as_mut_slice().iter_mut().for_each(|p| p[2] = -p[2]); // mirror in z
-    /// body.attrs_mut().update_normals(&map).unwrap();
-    /// assert_eq!(body.attrs().face_normal(top), [0.0, 0.0, -1.0]); // the top face now faces down
-    /// ```
-    pub fn update_normals(&mut self, map: &GMap<3>) -> Result<(), ConservationError> {
-        self.check_covers(map)?;
-        self.update_normals_raw(map);
-        Ok(())
-    }
-
     /// Whether the attribute arrays hold an entry for every cell id of `map`, in every
-    /// dimension: what every function taking the map beside the attributes needs (a map and
-    /// attributes from two different bodies are refused here). O(1).
+    /// dimension: what every function taking the map beside the attributes needs, so that none
+    /// indexes past an array. A bound check, not an identity check: a map with more ids than
+    /// the arrays (e.g. a larger body's) is refused, but another body's map of the same size or
+    /// smaller, or a copy of this body's map taken before a cut, passes (a map alone does not
+    /// say whose it is); the [`Body`] methods use the body's own map. O(1).
     ///
     /// # Errors
     /// [`ConservationError::MissingAttributes`] for the first dimension whose arrays are short.
@@ -766,7 +746,10 @@ impl Mechanics {
         Ok(())
     }
 
-    /// [`Mechanics::update_normals`] for a map the attributes cover. O(darts).
+    /// Sets every live face's boundary flag to whether it is α3-free in `map` and its normal to
+    /// the outward unit normal (boundary) or zero (inner), for a map the attributes cover: the
+    /// body's own ([`Body::update_normals`]). Crate-private: from outside, a stale or foreign
+    /// map of the same size would rewrite the flags from the wrong topology. O(darts).
     pub(crate) fn update_normals_raw(&mut self, map: &GMap<3>) {
         for d in map.one_dart_per_cell(2) {
             let f = map.cell_id(2, d);
@@ -1261,8 +1244,51 @@ impl CellRules<3> for Mechanics {
         }
     }
 
+    /// The conservation laws ([`check_conservation`]), then the face law
+    /// ([`Mechanics::check_faces`]).
     fn check(&self, map: &GMap<3>) -> Result<(), ConservationError> {
-        check_conservation(map, self)
+        check_conservation(map, self)?;
+        self.check_faces(map)
+    }
+}
+
+impl Mechanics {
+    /// The face law: every live face f of `map` is flagged boundary iff it is α3-free (the flag
+    /// is derived from the topology; the surface and the boundary forces read it), and an inner
+    /// face's normal is zero. (A boundary face's normal is computed from the positions at the
+    /// last change, which may be anything, so its value is not checked here; the store checks
+    /// that it is a unit vector or zero before saving.) O(darts).
+    ///
+    /// # Errors
+    /// [`ConservationError::MissingAttributes`] for a map the arrays do not cover,
+    /// [`ConservationError::FaceFlag`] or [`ConservationError::InnerFaceNormal`] naming the
+    /// first face that breaks the law.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(2);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+    /// body.unsew3(d).unwrap(); // both sides become boundary faces
+    /// assert!(body.attrs().check_faces(body.map()).is_ok());
+    /// ```
+    pub fn check_faces(&self, map: &GMap<3>) -> Result<(), ConservationError> {
+        self.check_covers(map)?;
+        for dart in map.one_dart_per_cell(2) {
+            let (face, free) = (map.cell_id(2, dart), map.is_free(3, dart));
+            if self.face_boundary[face] != free {
+                return Err(ConservationError::FaceFlag { face, dart, flagged_boundary: !free });
+            }
+            let normal = self.face_normal[face];
+            if !free && normal != [0.0; 3] {
+                return Err(ConservationError::InnerFaceNormal { face, dart, normal });
+            }
+        }
+        Ok(())
     }
 }
 
@@ -1496,6 +1522,46 @@ impl Embedded<3, Mechanics> {
         self.sew(3, d1, d2)
     }
 
+    /// Recomputes the face attributes from the body's own map and the current positions: each
+    /// live face's boundary flag is whether it is α3-free, its normal the outward unit normal
+    /// (a boundary face; zero if degenerate) or zero (an inner face). Not a topological change:
+    /// the version stays. O(darts).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let map = body.map();
+    /// let faces: Vec<_> = map.one_dart_per_cell(2).into_iter().map(|d| map.cell_id(2, d)).collect();
+    /// let top = *faces.iter().find(|&&f| body.attrs().face_normal(f) == [0.0, 0.0, 1.0]).unwrap();
+    /// body.attrs_mut().position_mut().as_mut_slice().iter_mut().for_each(|p| p[2] = -p[2]); // mirror in z
+    /// body.update_normals();
+    /// assert_eq!(body.attrs().face_normal(top), [0.0, 0.0, -1.0]); // the top face now faces down
+    /// assert_eq!(body.version(), 0);
+    /// ```
+    ///
+    /// The attributes alone take no map for this any more (a copy of the map taken before a cut,
+    /// or another body's map of the same size, passed the size check and rewrote the flags from
+    /// the wrong topology), so this does not compile:
+    ///
+    /// ```compile_fail
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// let stale = body.map().clone();
+    /// body.attrs_mut().update_normals(&stale).unwrap();
+    /// ```
+    pub fn update_normals(&mut self) {
+        let (map, mech) = self.map_and_attrs_mut();
+        mech.update_normals_raw(map);
+    }
+
     /// Total kinetic energy ½ Σ m_v |v_v|² over live vertices. O(darts).
     ///
     /// # Examples
@@ -1634,6 +1700,24 @@ mod tests {
         assert!(body.check().is_ok());
         body.attrs_mut().rest_position[CellId(0)][0] += 0.25;
         assert!(matches!(body.check(), Err(ConservationError::RestLength { .. })));
+    }
+
+    /// The face law of `Body::check`: a nonzero normal on an inner face (possible only inside
+    /// the crate) is named, as a flipped flag is.
+    #[test]
+    fn check_names_an_inner_face_normal_and_a_flipped_flag() {
+        let (points, tets) = crate::generate::kuhn_cube(1);
+        let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+        let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
+        let f = body.map().cell_id(2, d);
+        body.attrs_mut().face_normal[f] = [1.0, 0.0, 0.0];
+        let e = body.check().unwrap_err();
+        assert!(matches!(e, ConservationError::InnerFaceNormal { face, .. } if face == f), "{e:?}");
+        body.attrs_mut().face_normal[f] = [0.0; 3];
+        assert!(body.check().is_ok());
+        body.attrs_mut().face_boundary[f] = true;
+        let e = body.check().unwrap_err();
+        assert!(matches!(e, ConservationError::FaceFlag { face, flagged_boundary: true, .. } if face == f), "{e:?}");
     }
 
     /// The O(1) outward normal equals the orbit-based one, bit for bit, at every dart of a body

@@ -883,13 +883,19 @@ impl TouchedCells {
     /// ([`crate::mechanics::Body::sew3`], [`crate::mechanics::Body::unsew3`], …), called right
     /// after it: the records are stamped as that one change (versions `body.version() − 1` to
     /// `body.version()`), so that [`Projection::update`] can take them incrementally, alone or
-    /// after the lists of the operations before it. O(changes + stars of renamed vertices).
+    /// after the lists of the operations before it. The body stamps each report it returns
+    /// (its identity, its version after the operation, a fingerprint of the lists): any other
+    /// report — empty or default, an earlier operation's, another body's, the kernel's
+    /// ([`GMap::sew_dyn`]) or one edited since — is recorded with unknown coverage
+    /// ([`Self::versions`] `None`), and [`Projection::update`] rebuilds from it. O(changes +
+    /// stars of renamed vertices).
     ///
     /// # Examples
     ///
     /// ```
     /// use topomech::cut::dissociate_face;
     /// use topomech::generate::kuhn_cube;
+    /// use topomech::gmap::CellChanges;
     /// use topomech::mechanics::{Body, Material, Projection, TouchedCells};
     ///
     /// let (points, tets) = kuhn_cube(2);
@@ -904,11 +910,18 @@ impl TouchedCells {
     /// assert_eq!(touched.versions(&body), Some((0, 2)));
     /// assert!(p.update(&body, &touched)); // incremental, both changes at once
     /// assert!(p.equivalent(&Projection::build(&body, [0.0; 3]).unwrap()).is_ok());
+    /// let mut wrong = TouchedCells::default();
+    /// wrong.record_change(&body, &CellChanges::default()); // not what the body returned
+    /// assert_eq!(wrong.versions(&body), None); // unknown coverage: an update would rebuild
     /// ```
     pub fn record_change(&mut self, body: &Body, changes: &CellChanges) {
         let before = (self.span, self.is_empty());
         self.record(body.map(), changes);
-        let step = Span::Versions { body: body.identity(), from: body.version().saturating_sub(1), to: body.version() };
+        let step = if body.returned_last(changes) {
+            Span::Versions { body: body.identity(), from: body.version().saturating_sub(1), to: body.version() }
+        } else {
+            Span::Unknown
+        };
         self.span = Span::joined(before, (step, false));
     }
 

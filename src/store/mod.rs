@@ -394,7 +394,10 @@ impl Document {
         }
     }
 
-    /// The document of a body (map + mechanics). O(capacity + cells).
+    /// The document of a body (map + mechanics), as it is, unchecked: a body whose state
+    /// [`Document::into_body`] refuses (a face flag rewritten by a [`crate::embedding::CellRules`]
+    /// method called by hand, a boundary normal not of length 1) gives a document it refuses;
+    /// [`save_body`] checks before writing. O(capacity + cells).
     ///
     /// # Examples
     ///
@@ -797,10 +800,16 @@ pub fn save_map<const N: usize>(map: &GMap<N>, path: &Path, format: Format) -> R
     save_document(&Document::from_map(map), path, format)
 }
 
-/// Saves a body in `format`, atomically. O(capacity + cells).
+/// Saves a body in `format`, atomically, after the body-state checks of
+/// [`Document::into_body`] (material, E_t of every volume, each face's boundary flag against
+/// the map, face normals zero or of length 1), so that no file is written that [`load_body`]
+/// would refuse for them (the conservation laws, which the body's operations keep, are checked
+/// by [`crate::embedding::Embedded::check`]). O(capacity + darts).
 ///
 /// # Errors
-/// As [`save_document`].
+/// [`StoreError::Inconsistent`] (at [`Where::Document`]) naming the volume or face whose state
+/// the reader would refuse, or [`StoreError::Conservation`] for attributes that do not cover
+/// the map (nothing is written); then as [`save_document`].
 ///
 /// # Examples
 ///
@@ -816,6 +825,7 @@ pub fn save_map<const N: usize>(map: &GMap<N>, path: &Path, format: Format) -> R
 /// # std::fs::remove_file(&path).unwrap();
 /// ```
 pub fn save_body(body: &Body, path: &Path, format: Format) -> Result<(), StoreError> {
+    check_body_state(body.map(), body.attrs())?;
     save_document(&Document::from_body(body), path, format)
 }
 

@@ -61,10 +61,11 @@ pub const MAX_LEVEL: u8 = 250;
 /// few levels exhaust the memory of any machine; the refinement is refused before it starts.
 pub const DEFAULT_MAX_DARTS: usize = 100_000_000;
 
-/// Darts a 1→8 subdivision of one tet adds at most in [`LeveledMap::refine_around`]'s estimate:
-/// its own 24 darts become 192 (+168), its four faces' neighbours get a 1→4 face (+18 each), and
-/// the tets around its six edges get an edge split (+4 each, for rings of up to 6 tets). An
-/// estimate for the budget, not a bound: rings of more tets add more, zone tets sharing
+/// Darts per tet of the coarse estimate `check_zone_limit` (kept for the spring coupling's
+/// catch-up only; every level of [`LeveledMap::refine_around`] and its catch-up count exactly,
+/// see `zone_darts_added`): its own 24 darts become 192 (+168), its four faces' neighbours get a
+/// 1→4 face (+18 each), and the tets around its six edges get an edge split (+4 each, for rings
+/// of up to 6 tets). An estimate, not a bound: rings of more tets add more, zone tets sharing
 /// neighbours add less.
 pub(crate) const DARTS_PER_SPLIT_TET: usize = 168 + 4 * 18 + 6 * 6 * 4;
 
@@ -137,8 +138,8 @@ pub struct Mu {
 
 /// Errors of the subdivision operations. The map (and the masses, springs and points that go
 /// with it) is unchanged when one is returned, with one documented exception: a multi-level
-/// refinement (`refine_around`, and the CLI's levels) that meets [`SubdivideError::DartLimit`] at
-/// a later level keeps the levels it finished.
+/// refinement (`refine_around`, and the CLI's levels) that meets [`SubdivideError::DartLimit`] or
+/// [`SubdivideError::BelowPrecision`] at a later level keeps the levels it finished.
 ///
 /// # Examples
 ///
@@ -308,7 +309,13 @@ pub enum SubdivideError {
         total: f64,
     },
     /// A refinement would grow the map past its dart limit ([`LeveledMap::set_max_darts`]):
-    /// refused before anything changed at that level (the levels done before it are kept).
+    /// refused before anything changed at that level (the levels done before it are kept). The
+    /// darts after the level are counted exactly, before it starts (a bulk level: 2ⁿ × the darts;
+    /// an op-by-op level or a catch-up: 96 per zone tet, 12 per side of each face it splits 1→4,
+    /// and the whole orbit of each edge it splits, 4 darts per tet of the edge's ring), so a level
+    /// that fits is never refused and an accepted one never passes the limit. (A catch-up whose
+    /// zone mixes levels may add a few darts more than counted; it checks the limit again after
+    /// its splits and puts the map back.)
     #[error(
         "refining {tets} cells at level {level} would grow the map from {darts} to about {estimate} darts, \
          over the limit of {limit} darts (raise it with LeveledMap::set_max_darts or --max-darts)"
@@ -320,10 +327,36 @@ pub enum SubdivideError {
         tets: usize,
         /// Live darts now.
         darts: usize,
-        /// Estimated darts after the level.
+        /// Darts after the level (exact; the spring coupling's catch-up still estimates it
+        /// with 384 per tet).
         estimate: usize,
         /// The limit.
         limit: usize,
+    },
+    /// A split past the precision of the `f64` coordinates: the rounded midpoint of the edge's
+    /// end positions (the position its new vertex would get) is not strictly between them along
+    /// the edge's main axis (the coordinate where they differ most): it is an end, or the ends
+    /// coincide. Accepting it would make tets of zero
+    /// or inverted volume that keep a positive mass (m ≠ ρ·V) and lose the point a refinement is
+    /// around. Halving an edge of length ℓ at coordinates of size |x| works about
+    /// 52 − log2(|x| / ℓ) times: a unit tet at (1, 1, 1) refines to level 52 and level 53 is
+    /// refused. Refused before any change (at a level of a refinement, before its first split);
+    /// not checked on a map without points.
+    #[error(
+        "splitting the edge of {dart} (vertices {} and {}) at level {level} is past the precision of f64: \
+         the rounded midpoint of {:?} and {:?} is not strictly between them along the edge (edges can be \
+         halved about 52 - log2(|coordinates| / edge length) times)",
+        .vertices[0], .vertices[1], .positions[0], .positions[1]
+    )]
+    BelowPrecision {
+        /// The level refused.
+        level: u8,
+        /// A dart of the edge, at `vertices[0]`.
+        dart: DartId,
+        /// The edge's end vertex ids.
+        vertices: [u32; 2],
+        /// Their positions.
+        positions: [[f64; 3]; 2],
     },
 }
 
@@ -473,6 +506,14 @@ pub struct LeveledMap<const N: usize> {
     max_darts: usize,
     /// Operations that changed the map so far ([`LeveledMap::version`]).
     version: u64,
+    /// A process-wide unique stamp of the map's present state ([`LeveledMap::stamp`]).
+    stamp: u64,
+}
+
+/// The next state stamp of a [`LeveledMap`]: unique in the process (a counter). O(1).
+pub(crate) fn next_stamp() -> u64 {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+    NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
 }
 
 impl<const N: usize> LeveledMap<N> {
@@ -515,7 +556,25 @@ impl<const N: usize> LeveledMap<N> {
             op: ops::OpLog::default(),
             max_darts: DEFAULT_MAX_DARTS,
             version: 0,
+            stamp: next_stamp(),
         }
+    }
+
+    /// A stamp of the map's present state, unique in the process: a new map and every operation
+    /// that changes it (each one that adds to [`LeveledMap::version`]) take a fresh one; a clone
+    /// keeps it (it holds the same state). A [`LeveledMechanics`] records the stamp of the map it
+    /// followed, so a map built apart — even of the same mesh, size and version — or a clone
+    /// that went its own way is refused (round 25: a coupling ran on another map of the same
+    /// size). O(1).
+    pub(crate) fn stamp(&self) -> u64 {
+        self.stamp
+    }
+
+    /// Counts one operation that changed the map: [`LeveledMap::version`] + 1 and a fresh
+    /// [`LeveledMap::stamp`]. O(1).
+    pub(crate) fn bump_version(&mut self) {
+        self.version += 1;
+        self.stamp = next_stamp();
     }
 
     /// Number of operations that changed the map since [`LeveledMap::new`] (or
@@ -544,8 +603,9 @@ impl<const N: usize> LeveledMap<N> {
 
     /// Sets the limit on the live darts the level-by-level refinements
     /// ([`LeveledMap::refine_around`], [`LeveledMap::refine_uniform`],
-    /// [`LeveledMechanics::refine_around`]) may grow the map to; a level whose estimated result
-    /// exceeds it is refused with [`SubdivideError::DartLimit`] before it changes anything.
+    /// [`LeveledMechanics::refine_around`]) may grow the map to; a level whose result (its darts
+    /// counted exactly before it starts, see [`SubdivideError::DartLimit`]) exceeds it is refused
+    /// with [`SubdivideError::DartLimit`] before it changes anything.
     /// Default [`DEFAULT_MAX_DARTS`]. Single operations (`subdivide_tet`, …) are not limited.
     /// O(1).
     ///
@@ -584,8 +644,8 @@ impl<const N: usize> LeveledMap<N> {
         self.max_darts
     }
 
-    /// Refuses a refinement of `tets` cells at `level` that would leave about `estimate` live
-    /// darts, when that is over the limit ([`LeveledMap::set_max_darts`]). O(1).
+    /// Refuses a refinement of `tets` cells at `level` that would leave `estimate` live darts,
+    /// when that is over the limit ([`LeveledMap::set_max_darts`]). O(1).
     pub(crate) fn check_dart_limit(&self, level: u8, tets: usize, estimate: usize) -> Result<(), SubdivideError> {
         if estimate <= self.max_darts {
             return Ok(());

@@ -231,7 +231,7 @@ impl<const N: usize> LeveledMap<N> {
             }
         }
         self.max_level = self.max_level.max(self.op.level);
-        self.version += 1;
+        self.bump_version();
         if cfg!(debug_assertions) {
             let touched: Vec<DartId> = self.op.touched.iter().chain(&self.op.created).copied().collect();
             debug_assert!(

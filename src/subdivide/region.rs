@@ -19,7 +19,7 @@
 //! §3.1), so Σ_v m_v = Σ_t m_t holds by construction.
 
 use super::{LeveledMap, SubdivideError};
-use crate::gmap::{CellId, DartId};
+use crate::gmap::{AlphaMask, CellId, DartId};
 use crate::mechanics::geom::{cross, dot, sub};
 
 /// ρ · |V| of the tet with finite corners `p`: plain for ordinary corners
@@ -214,7 +214,14 @@ impl TetMasses {
         }
     }
 
-    /// Vertex masses m_v = Σ_{t ∋ v} m_t / 4, indexed by vertex id. O(darts).
+    /// Vertex masses indexed by vertex id, lumped as [`super::LeveledMechanics::vertex_masses`]
+    /// lumps them: m_v = Σ_{t ∋ v} m_t / 4 on a conforming map; a coarse volume with hanging
+    /// vertices (inserted on its sides by a refined neighbour) gives each of them a share drawn
+    /// from its corners, so no vertex is massless and Σ_v m_v = Σ_t m_t (round 25, F4: hanging
+    /// vertices had no mass here). O(darts + splits).
+    ///
+    /// # Errors
+    /// As [`Self::check`].
     ///
     /// # Examples
     ///
@@ -224,23 +231,34 @@ impl TetMasses {
     /// # use topomech::subdivide::TetMasses;
     /// let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
     /// let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-    /// let m = LeveledMap::new(map, pts);
+    /// let mut m = LeveledMap::new(map, pts);
     /// let masses = TetMasses::from_density(&m, 6.0).unwrap();
     /// let v = masses.vertex_masses(&m).unwrap();
     /// assert!(v.iter().all(|&x| (x - 0.25).abs() < 1e-12));
     /// assert!(TetMasses::default().vertex_masses(&m).is_err()); // no mass for volume 0
+    /// let d = m.map().darts().next().unwrap();
+    /// m.split_edge(d, 1).unwrap(); // vertex 4 hangs on a side of the tet
+    /// let v = masses.vertex_masses(&m).unwrap();
+    /// assert!((v[4] - 0.05).abs() < 1e-12 && (v.iter().sum::<f64>() - 1.0).abs() < 1e-12);
     /// ```
     pub fn vertex_masses(&self, m: &LeveledMap<3>) -> Result<Vec<f64>, SubdivideError> {
         self.check(m)?;
+        Ok(self.lumped(m))
+    }
+
+    /// [`Self::vertex_masses`] without the check (a volume without an entry weighs nothing).
+    /// O(darts + splits).
+    pub(crate) fn lumped(&self, m: &LeveledMap<3>) -> Vec<f64> {
         let map = m.map();
+        let parents = super::springs::split_parents(m);
         let mut out = vec![0.0; map.cell_id_bound(0)];
-        for d in map.one_dart_per_cell(3) {
-            let share = self.of(map.cell_id(3, d)) / 4.0;
-            for v in m.tet_vertices(d)? {
+        for t in map.one_dart_per_cell(3) {
+            let vertices = super::springs::volume_vertices(m, t);
+            for (v, share) in super::springs::volume_mass_shares(&vertices, self.of(map.cell_id(3, t)), &parents) {
                 out[v as usize] += share;
             }
         }
-        Ok(out)
+        out
     }
 }
 
@@ -478,8 +496,8 @@ impl LeveledMap<3> {
     /// Errors: those of [`Self::tet_volume`] for the tet of `d` (no such dart, a corner without a
     /// finite position: the volumes are needed), [`SubdivideError::NoMass`] when some live
     /// volume has no entry in `masses` (O(1) when they reach the volume id bound),
-    /// [`SubdivideError::BadMass`] for the parent's, and those of [`Self::subdivide_tet`]; the
-    /// map and the masses are unchanged on error.
+    /// [`SubdivideError::BadMass`] for the parent's, and those of [`Self::subdivide_tet`] (among
+    /// them [`SubdivideError::BelowPrecision`]); the map and the masses are unchanged on error.
     ///
     /// # Examples
     ///
@@ -570,14 +588,18 @@ impl LeveledMap<3> {
     /// of [`TetMasses::check`], before any change; in a catch-up, the dart limit and the refusals
     /// of [`Self::subdivide_tet_with_mass`] (e.g. [`SubdivideError::FaceRefinedTooFar`] for a tet
     /// whose face a finer neighbour refined twice), the map and masses put back; at a level,
-    /// [`SubdivideError::DartLimit`] for a level over the dart limit and the refusals of [`Self::subdivide_tet_with_mass`] for any tet
-    /// of its zone (e.g. [`SubdivideError::AlreadyAtLevel`] for an unsplit face that a finer
-    /// neighbour, split at a skipped level, brought to μf = L), all checked on the whole level
-    /// before its first split, so an error leaves the map and the masses as the levels before it
-    /// left them. For a map made by the operations that is unchanged, except after a
-    /// [`SubdivideError::DartLimit`] at a level after the first (the levels before stay done):
-    /// every other refusal comes at the first level the call refines (after a level L, a tet at
-    /// μt = L has only unsplit faces, with μf ≤ L, and finite corners).
+    /// [`SubdivideError::DartLimit`] for a level whose darts (counted exactly before it starts)
+    /// would pass the dart limit, and the refusals of [`Self::subdivide_tet_with_mass`] for any
+    /// tet of its zone (e.g. [`SubdivideError::AlreadyAtLevel`] for an unsplit face that a finer
+    /// neighbour, split at a skipped level, brought to μf = L; [`SubdivideError::BelowPrecision`]
+    /// for an edge too short for its midpoint to be representable strictly between its ends:
+    /// about 52 − log2(|coordinates| / edge length) levels can be made), all checked on the whole
+    /// level before its first split, so an error leaves the map and the masses as the levels
+    /// before it left them. For a map made by the operations that is unchanged, except after a
+    /// [`SubdivideError::DartLimit`] or [`SubdivideError::BelowPrecision`] at a level after the
+    /// first (the levels before stay done): every other refusal comes at the first level the call
+    /// refines (after a level L, a tet at μt = L has only unsplit faces, with μf ≤ L, and finite
+    /// corners).
     ///
     /// ```
     /// use topomech::subdivide::{LeveledMap, TetMasses};
@@ -644,7 +666,7 @@ impl LeveledMap<3> {
         if skipped.is_empty() {
             return self.refine_levels(center, radius, levels, masses, bulk, None);
         }
-        self.check_zone_limit(self.max_level, skipped.len())?;
+        self.check_zone_darts(self.max_level, &skipped)?;
         let saved = (self.clone(), masses.clone());
         let before = masses.total(self);
         let result = self
@@ -681,8 +703,8 @@ impl LeveledMap<3> {
                         after = Some(r.total_mass_after);
                         continue;
                     }
-                    // Its estimate is exact (2ⁿ × the darts); the op-by-op level would make as
-                    // many darts and refuse too, with its coarser per-tet bound.
+                    // Its count is exact (2ⁿ × the darts); the op-by-op level would make as
+                    // many darts and refuse too, with its own exact count.
                     Err(e @ SubdivideError::DartLimit { .. }) => return Err(e),
                     // Any other precondition: the op-by-op path decides.
                     Err(_) => {}
@@ -721,12 +743,15 @@ impl LeveledMap<3> {
 
     /// The zone of one op-by-op level of [`Self::refine_around`] (the tets at μt = level − 1 meeting
     /// the ball), once everything that could refuse during the level, or at the start of the next
-    /// one short of [`SubdivideError::DartLimit`], has been checked on the map as it is: the zone
-    /// itself ([`Self::zone_tets`]), the dart limit, every zone tet ([`Self::check_zone`]) and,
+    /// one short of [`SubdivideError::DartLimit`] and [`SubdivideError::BelowPrecision`], has been
+    /// checked on the map as it is: the zone itself ([`Self::zone_tets`]), the dart limit (the
+    /// darts after the level counted exactly, [`Self::check_zone_darts`]), every zone tet
+    /// ([`Self::check_zone`], with the precision of the midpoints it makes) and,
     /// when `level` < `levels`, the corners of the tets already at μt = level before it (the
     /// next level's zone looks at them; the tets the level makes have the corners of their
     /// parents and finite midpoints). So the level is all or nothing, and an error at a later
-    /// level can only be the dart limit: the tets at μt = L after a level L have unsplit faces
+    /// level can only be the dart limit or the precision of its midpoints (which depend on the
+    /// midpoints the levels before made): the tets at μt = L after a level L have unsplit faces
     /// with μf ≤ L only, which every zone check accepts (see [`Self::check_zone`]). O(darts +
     /// Σ zone volumes).
     pub(super) fn check_level(
@@ -738,7 +763,7 @@ impl LeveledMap<3> {
         masses: &TetMasses,
     ) -> Result<Vec<DartId>, SubdivideError> {
         let zone = self.zone_tets(level - 1, center, radius)?;
-        self.check_zone_limit(level, zone.len())?;
+        self.check_zone_darts(level, &zone)?;
         self.check_zone(level, &zone, masses)?;
         if level < levels {
             self.zone_tets(level, center, radius)?;
@@ -751,9 +776,11 @@ impl LeveledMap<3> {
     /// as it is, before any of them is split: the mass entries, the tet's volume (live dart,
     /// corners at its level, finite corner positions), its faces (the checks of
     /// [`Self::subdivide_tet`]: each a triangle, unsplit or a child of one 1→4 split with single
-    /// inner sides, else `FaceRefinedTooFar`; an unsplit face with μf ≥ level is `AlreadyAtLevel`)
-    /// and the finite positions of the vertices that become corners of its children (the flat
-    /// vertices reused as midpoints, the corners of its split faces). O(Σ zone volumes).
+    /// inner sides, else `FaceRefinedTooFar`; an unsplit face with μf ≥ level is `AlreadyAtLevel`),
+    /// the midpoints of the edges it splits (`BelowPrecision`: the edges are the sides without an
+    /// inserted vertex of its unsplit faces, whose ends do not move during the level) and the
+    /// finite positions of the vertices that become corners of its children (the flat vertices
+    /// reused as midpoints, the corners of its split faces). O(Σ zone volumes).
     ///
     /// Why it suffices: splitting zone tets in any order at `level` cannot make another zone tet N
     /// refuse once every one has passed here.
@@ -808,6 +835,7 @@ impl LeveledMap<3> {
             let cell_level = self.mu[f.index()].face;
             return Err(SubdivideError::AlreadyAtLevel { dart: f, dim: 2, cell_level, level });
         }
+        self.check_split_midpoints(&unsplit, level)?;
         for v in midpoints {
             self.corner_positions([v; 4])?;
         }
@@ -835,10 +863,19 @@ impl LeveledMap<3> {
     /// [`Self::skipped_zone`]) subdivided 1→8 at level k by a level skip (its children at
     /// μt = k), its mass shared by [`Self::subdivide_tet_with_mass`]. Not all or nothing on its
     /// own (a split may refuse for what an earlier split of the zone did to a face it shares,
-    /// a face then refined twice): [`Self::refine_zone`] keeps a copy. O(Σ zone volumes).
+    /// a face then refined twice): [`Self::refine_zone`] keeps a copy. The dart limit is checked
+    /// again after the splits ([`SubdivideError::DartLimit`], the copy then put back): the count
+    /// before ([`Self::zone_darts_added`]) is exact for a zone of one level, but a zone mixing
+    /// levels can make it short (a coarse tet split first adds a face along an inner edge of its
+    /// split face that a finer zone tet then splits: 4 darts more for that edge). O(Σ zone volumes).
     fn catch_up(&mut self, zone: &[DartId], masses: &mut TetMasses) -> Result<(), SubdivideError> {
+        let darts = self.map.dart_count();
         for &d in zone {
             self.subdivide_tet_with_mass(d, self.max_level, masses)?;
+        }
+        let (estimate, limit) = (self.map.dart_count(), self.max_darts);
+        if estimate > limit {
+            return Err(SubdivideError::DartLimit { level: self.max_level, tets: zone.len(), darts, estimate, limit });
         }
         Ok(())
     }
@@ -851,11 +888,71 @@ impl LeveledMap<3> {
         Err(SubdivideError::BadBall { center, radius })
     }
 
-    /// Refuses a level that subdivides `zone` tets when the estimated darts after it
-    /// ([`super::DARTS_PER_SPLIT_TET`] per tet) exceed the limit. O(1).
+    /// Refuses a level that subdivides `zone` tets when the *estimated* darts after it
+    /// ([`super::DARTS_PER_SPLIT_TET`] per tet) exceed the limit: neither a bound nor exact
+    /// (a ring of more than 6 tets adds more, zone tets sharing neighbours add less). Only the
+    /// spring coupling's catch-up still uses it; [`Self::check_zone_darts`] counts exactly. O(1).
     pub(super) fn check_zone_limit(&self, level: u8, zone: usize) -> Result<(), SubdivideError> {
         let estimate = self.map.dart_count().saturating_add(zone.saturating_mul(super::DARTS_PER_SPLIT_TET));
         self.check_dart_limit(level, zone, estimate)
+    }
+
+    /// Refuses splitting every tet of `zone` 1→8 at `level` (a level of `refine_around`, or a
+    /// catch-up) when the darts after it, counted exactly by [`Self::zone_darts_added`], exceed
+    /// the limit ([`SubdivideError::DartLimit`]). O(Σ zone volumes + rings of the edges it splits).
+    pub(super) fn check_zone_darts(&self, level: u8, zone: &[DartId]) -> Result<(), SubdivideError> {
+        let after = self.map.dart_count().saturating_add(self.zone_darts_added(zone));
+        self.check_dart_limit(level, zone.len(), after)
+    }
+
+    /// The darts that splitting every tet of `zone` 1→8 adds, counted on the map as it is:
+    ///
+    /// Δ = 96 · |zone| + Σ_{faces F} 12 · sides(F) + Σ_{edges E} |orbit(E)|
+    ///
+    /// - 96 per tet: its 8 inner triangles, two sides of 6 darts each;
+    /// - F over the distinct unsplit faces of zone tets (three corners of the tet): each side
+    ///   (2 if α3-sewn, else 1) gets the 3 inner edges of a 1→4 split, 4 darts each;
+    /// - E over the distinct edges those splits split (their sides without an inserted vertex):
+    ///   every dart of the orbit gets a partner, 4 per tet of the edge's ring (zone or not).
+    ///
+    /// Exact for a zone of one level (a level of `refine_around`), whatever the order of the
+    /// splits: a face or edge is split once, by the first zone tet that has it (the others then
+    /// see it split and reuse it), and the orbit of such an edge does not change before it is
+    /// split (the splits meanwhile add faces only along edges between midpoints, which no unsplit
+    /// face of a zone tet has as a side: [`Self::check_zone`]). A catch-up zone mixing levels can
+    /// pass it by 4 darts per edge ([`Self::catch_up`] checks again). A tet some zone check
+    /// refuses counts for the faces it passes (the level is refused anyway).
+    /// O(Σ zone volumes + Σ_E |orbit(E)|).
+    fn zone_darts_added(&self, zone: &[DartId]) -> usize {
+        let (mut faces, mut edges) = (Vec::new(), Vec::new());
+        for &d in zone {
+            self.zone_tet_splits(d, &mut faces, &mut edges);
+        }
+        faces.sort_unstable();
+        faces.dedup_by_key(|f| f.0);
+        edges.sort_unstable_by_key(|e| e.0);
+        edges.dedup_by_key(|e| e.0);
+        let face_darts: usize = faces.iter().map(|&(_, sides)| 12 * sides).sum();
+        let edge_orbit = |&(_, x): &(u32, DartId)| self.map.orbit(x, AlphaMask::cell(3, 1)).len();
+        let edge_darts: usize = edges.iter().map(edge_orbit).sum();
+        zone.len().saturating_mul(96).saturating_add(face_darts).saturating_add(edge_darts)
+    }
+
+    /// The faces that the split of the tet of `d` splits 1→4 (its unsplit faces, as (face id,
+    /// sides)) and the edges those split (their sides without an inserted vertex, as (edge id, a
+    /// dart)); the faces before the first one [`Self::check_tet_faces_visiting`] refuses.
+    /// O(volume).
+    fn zone_tet_splits(&self, d: DartId, faces: &mut Vec<(u32, usize)>, edges: &mut Vec<(u32, DartId)>) {
+        let Ok(corners) = self.tet_corners(d, self.mu[d.index()].tet) else { return };
+        let _ = self.check_tet_faces_visiting(d, &corners, |sides, is_corner| {
+            if !is_corner.iter().all(|&c| c) {
+                return;
+            }
+            let f = sides[0].start;
+            faces.push((self.map.cell_id(2, f).0, if self.map.is_free(3, f) { 1 } else { 2 }));
+            let split = sides.iter().filter(|s| s.flats.is_empty());
+            edges.extend(split.map(|s| (self.map.cell_id(1, s.start).0, s.start)));
+        });
     }
 
     /// Whether a level of `refine_around` may take the bulk path: the ball holds every vertex and

@@ -31,9 +31,30 @@
 //!   inserted on its sides (*hanging*), each hanging vertex gets w_t = m_t / (4 n_t), drawn from
 //!   the corners in proportion to its barycentric coordinates (a midpoint of (a, b) takes w/2 from
 //!   each end, recursively). So Σ_v m_v = Σ_t m_t, every share is ≥ m_t / n_t > 0 (no vertex is
-//!   massless), and the lumped first moment Σ_v m_v x_v equals Σ_t m_t · centroid_t for every
-//!   state in which the inserted vertices sit at their interpolated places: **refining moves
-//!   neither the centre of mass nor the momentum** (finding 218).
+//!   massless), and per volume Σ_v share_v y_v = m_t · (mean of its corners' y) for any y affine
+//!   on the volume (its hanging vertices at the interpolation of their parents).
+//! - **Momentum** (finding F2 of round 25): an operation moves mass between vertices, Δ_v =
+//!   m_v after − m_v before (a new vertex: its whole mass), which alone changes Σ_v m_v u_v by
+//!   E = Σ_v Δ_v u_v. Every operation ([`LeveledMechanics::split_edge`],
+//!   [`LeveledMechanics::subdivide_triangle`], [`LeveledMechanics::subdivide_tet`],
+//!   [`LeveledMechanics::refine_around`]) then sets u_v ← u_v − E / M_A on
+//!   A = {v : Δ_v ≠ 0}, M_A = Σ_{v ∈ A} m_v after: the least change of Σ_v m_v |δu_v|² that
+//!   removes E, so **Σ_v m_v u_v is kept in every state** (up to rounding: E is a compensated
+//!   sum; Δ_v is taken as computed, so a vertex whose recomputed mass differs by a rounding
+//!   joins A). E = 0 exactly when the velocities of A are all equal (a rigid translation: the
+//!   correction is skipped, velocities bit-identical), and E = 0 up to rounding when u is affine
+//!   in the rest positions P on the volumes concerned (Σ Δ_v = 0 and Σ Δ_v P_v = 0 by the lumping
+//!   law above, e.g. an affine field at rest with the inserted vertices interpolated: finding
+//!   218's behaviour is unchanged).
+//! - **Centre of mass and angular momentum** cannot be kept by a velocity change. On the rest
+//!   positions (and on any placement x affine on the volumes concerned, e.g. a state whose
+//!   inserted vertices sit where the interpolation put them) Σ_v m_v x_v = Σ_t m_t · centroid_t
+//!   is kept (finding 218); otherwise an operation moves Σ_v m_v x_v by Σ_v Δ_v x_v (x the current
+//!   positions, which no operation changes). The lumped angular momentum Σ_v m_v x_v × u_v is
+//!   kept when it is a function of these two sums (u uniform on A, or at rest), not in general:
+//!   the lumped second moment Σ m x xᵀ changes with every split (a midpoint of (a, b) taking w
+//!   from a and b changes it by −w (x_a − x_b)(x_a − x_b)ᵀ / 4), so a spinning body changes its
+//!   L = Σ m x × u, and the correction changes L by −(Σ_{v ∈ A} m_v x_v) × E / M_A.
 //!
 //! Consequences: a chain in tension, its midpoints at equilibrium (equal links), stores exactly its
 //! root's energy, so edge splits alone keep the static response; the inner springs of a 1→8 add
@@ -45,7 +66,7 @@ use std::collections::{BTreeMap, BTreeSet};
 
 use super::{EdgeSplit, LeveledMap, Refinement, SubdivideError, TetMasses};
 use crate::gmap::{AlphaMask, DartId, GMap};
-use crate::mechanics::geom::{is_flat, rest_length, Vec3};
+use crate::mechanics::geom::{compensated_sum, is_flat, rest_length, CompensatedSum, Vec3};
 use crate::mechanics::model::tet_stiffnesses;
 use crate::mechanics::{Material, SpringSystem};
 
@@ -240,6 +261,13 @@ pub enum CouplingError {
         /// The map's version now.
         version: u64,
     },
+    /// The map is not the one the coupling follows: built apart (even from the same mesh, with
+    /// the same size and version) or a clone that changed on its own since the coupling last
+    /// followed it ([`LeveledMap`] carries a stamp of its state; round 25: a coupling refined
+    /// another map of the same size with `Ok` and rest lengths of the first). Refused before the
+    /// map changes.
+    #[error("the map is not the one this coupling follows (another map, or a copy changed on its own)")]
+    OtherMap,
     /// A material constant is refused ([`crate::mechanics::ModelError::BadMaterial`], as for a
     /// [`crate::mechanics::Body`]): by the constructors, and by every operation before the map
     /// changes, since [`LeveledMechanics::material`] is a public field.
@@ -352,8 +380,13 @@ pub struct LeveledMechanics {
     pub(super) applied: usize,
     /// The [`LeveledMap::version`] of the map after the last operation followed.
     pub(super) followed: u64,
+    /// The map's state stamp after the last operation followed (`LeveledMap::stamp`).
+    pub(super) followed_stamp: u64,
     /// Σ m_t when the coupling was built.
     pub(super) total_mass: f64,
+    /// [`split_parents`] of the map, kept up to date split by split (as [`Self::applied`]), so
+    /// that an operation lumps the masses of the volumes it touches without an O(vertices) pass.
+    pub(super) parents: Vec<Option<(usize, [u32; 2])>>,
 }
 
 impl LeveledMechanics {
@@ -456,6 +489,8 @@ impl LeveledMechanics {
             tets0: Vec::new(),
             applied: m.edge_split_log().len(),
             followed: m.version(),
+            followed_stamp: m.stamp(),
+            parents: split_parents(m),
         };
         for (volume, t) in &tets0 {
             mech.add_tet(m, t, *volume)?;
@@ -768,6 +803,9 @@ impl LeveledMechanics {
         if m.version() != self.followed {
             return Err(CouplingError::Unfollowed { followed: self.followed, version: m.version() });
         }
+        if m.stamp() != self.followed_stamp {
+            return Err(CouplingError::OtherMap);
+        }
         Ok(())
     }
 }
@@ -833,8 +871,10 @@ fn check_start(m: &LeveledMap<3>) -> Result<(), CouplingError> {
 }
 
 impl LeveledMechanics {
-    /// [`LeveledMap::split_edge`] with the series rule on the edge's spring and the new vertex
-    /// interpolated (module docs). Returns the map's result. O(edge · n + log E).
+    /// [`LeveledMap::split_edge`] with the series rule on the edge's spring, the new vertex
+    /// interpolated and Σ m u kept (module docs). Returns the map's result.
+    /// O(edge · n + ring + log E), ring the darts of the volumes around the vertices of the
+    /// edge's volumes (M_A of the momentum correction, gathered only when E ≠ 0).
     ///
     /// Errors: [`CouplingError::OutOfSync`], [`CouplingError::StateCount`] (another map's
     /// coupling), [`CouplingError::Unfollowed`] (the map was changed alone),
@@ -864,14 +904,18 @@ impl LeveledMechanics {
     pub fn split_edge(&mut self, m: &mut LeveledMap<3>, d: DartId, level: u8) -> Result<DartId, CouplingError> {
         self.in_sync(m)?;
         self.check_halves_headroom(m, &[d])?;
+        let patch = self.patch_before(m, &[d]);
         let mid = m.split_edge(d, level)?;
         self.follow(m, &[], &[])?;
+        self.conserve_momentum(m, patch, &[]);
         self.expensive_check(m);
         Ok(mid)
     }
 
-    /// [`LeveledMap::subdivide_triangle`] with the series rule on its split sides and zero-stiffness
-    /// springs on its three inner edges (no tet is split; module docs). O(face + touched + log E).
+    /// [`LeveledMap::subdivide_triangle`] with the series rule on its split sides, zero-stiffness
+    /// springs on its three inner edges (no tet is split) and Σ m u kept (module docs).
+    /// O(face + touched + ring + log E), touched the volumes around its sides, ring as
+    /// [`Self::split_edge`].
     ///
     /// Errors: as [`Self::split_edge`].
     ///
@@ -898,18 +942,23 @@ impl LeveledMechanics {
         level: u8,
     ) -> Result<[DartId; 4], CouplingError> {
         self.in_sync(m)?;
+        let mut patch = None;
         if m.map().contains(d) {
-            self.check_halves_headroom(m, &m.map().orbit(d, AlphaMask::of(&[0, 1])))?;
+            let face = m.map().orbit(d, AlphaMask::of(&[0, 1]));
+            self.check_halves_headroom(m, &face)?;
+            patch = self.patch_before(m, &face);
         }
         let faces = m.subdivide_triangle(d, level)?;
         self.follow(m, &faces, &[])?;
+        self.conserve_momentum(m, patch, &[]);
         self.expensive_check(m);
         Ok(faces)
     }
 
     /// [`LeveledMap::subdivide_tet_with_mass`] with the series rule on the split edges, new springs
-    /// on the new edges and law 2's contributions of the eight children (module docs).
-    /// O(volume + touched + log E).
+    /// on the new edges, law 2's contributions of the eight children and Σ m u kept (module
+    /// docs). O(volume + touched + ring + log E), touched the volumes around its six edges, ring
+    /// as [`Self::split_edge`].
     ///
     /// Errors: as [`Self::split_edge`]; [`CouplingError::SplitOverflow`] when a value the split
     /// would store could pass `f64::MAX`: with A the largest stiffness or damping on the tet's
@@ -943,7 +992,13 @@ impl LeveledMechanics {
     fn split_tet(&mut self, m: &mut LeveledMap<3>, d: DartId, level: u8) -> Result<[DartId; 8], CouplingError> {
         self.in_sync(m)?;
         self.check_split_headroom(m, &[d])?;
-        self.split_followed(m, d, level)
+        let mut patch = None;
+        if m.map().contains(d) {
+            patch = self.patch_before(m, &m.map().orbit(d, AlphaMask::cell(3, 3)));
+        }
+        let children = self.split_followed(m, d, level)?;
+        self.conserve_momentum(m, patch, &children);
+        Ok(children)
     }
 
     /// [`Self::split_tet`] without the headroom check ([`Self::refine_around`] made it for the
@@ -961,8 +1016,10 @@ impl LeveledMechanics {
     /// The levels run from max(1, k), k the map's max level; after `Ok`, every tet of the finest
     /// map that meets the ball has μt = `levels` (tets at μt < k − 1 in the ball are first caught
     /// up by a level skip at level k, as by [`LeveledMap::refine_around`]; the call is then all or
-    /// nothing: map and coupling are copied first and put back on any error).
-    /// O(Σ_L (volumes + refined · touched)).
+    /// nothing: map and coupling are copied first and put back on any error). Σ m u is kept
+    /// over the whole call, also when a level refuses after earlier ones were done (module docs;
+    /// the vertex masses before and after are recomputed over the whole map).
+    /// O(darts + Σ_L (volumes + refined · touched)).
     ///
     /// Errors: [`SubdivideError::LevelTooHigh`] for `levels` above the maximum,
     /// [`SubdivideError::BadBall`], those of the coupling's sync check, before any change; in a
@@ -1001,6 +1058,21 @@ impl LeveledMechanics {
         m.check_op_level(levels)?;
         LeveledMap::check_ball(center, radius)?;
         self.in_sync(m)?;
+        let masses = self.vertex_masses_raw(m);
+        let result = self.refine_in_step(m, center, radius, levels);
+        self.conserve_momentum_whole(m, &masses);
+        result
+    }
+
+    /// [`Self::refine_around`] after its checks of the arguments and of the sync, before the
+    /// momentum correction.
+    fn refine_in_step(
+        &mut self,
+        m: &mut LeveledMap<3>,
+        center: [f64; 3],
+        radius: f64,
+        levels: u8,
+    ) -> Result<Refinement, CouplingError> {
         let skipped = m.skipped_zone(center, radius)?;
         let before = self.masses.total(m);
         if skipped.is_empty() {
@@ -1089,11 +1161,12 @@ impl LeveledMechanics {
     /// `children`.
     fn follow(&mut self, m: &LeveledMap<3>, faces: &[DartId], children: &[DartId]) -> Result<(), CouplingError> {
         let log = m.edge_split_log();
-        for &s in &log[self.applied..] {
-            self.split_spring(m, s)?;
+        for (i, &s) in log.iter().enumerate().skip(self.applied) {
+            self.split_spring(m, i, s)?;
         }
         self.applied = log.len();
         self.followed = m.version();
+        self.followed_stamp = m.stamp();
         let mut region: Vec<DartId> = Vec::new();
         for &f in faces {
             region.extend(m.map().orbit(f, AlphaMask::of(&[0, 1])));
@@ -1125,9 +1198,9 @@ impl LeveledMechanics {
         let _ = m;
     }
 
-    /// The series rule for one vertex insertion of the map (the edge cell it split, the cells of the
-    /// halves), and the new vertex's state.
-    fn split_spring(&mut self, m: &LeveledMap<3>, split: EdgeSplit) -> Result<(), CouplingError> {
+    /// The series rule for one vertex insertion of the map (entry `index` of its split log: the
+    /// edge cell it split, the cells of the halves), the new vertex's state and split parents.
+    fn split_spring(&mut self, m: &LeveledMap<3>, index: usize, split: EdgeSplit) -> Result<(), CouplingError> {
         let (v, [a, b]) = (split.vertex, split.ends);
         let e = EdgeKey::new(split.edge, a, b);
         let s = self.springs.remove(&e).ok_or(CouplingError::NoSpring(e))?;
@@ -1144,6 +1217,8 @@ impl LeveledMechanics {
         let n = m.map().cell_id_bound(0).max(v as usize + 1);
         self.position.resize(n, [0.0; 3]);
         self.velocity.resize(n, [0.0; 3]);
+        self.parents.resize(n.max(self.parents.len()), None);
+        self.parents[v as usize] = Some((index, [a, b]));
         let mean = |x: &[Vec3]| crate::mesh::midpoint(x[a as usize], x[b as usize]);
         let (x, u) = (mean(&self.position), mean(&self.velocity));
         self.position[v as usize] = x;
@@ -1156,9 +1231,12 @@ impl LeveledMechanics {
     /// Vertex masses by vertex id, a scatter of every volume's mass shares: m_t/4 on
     /// each corner of a plain tet; a coarse volume with h_t hanging vertices (inserted by its
     /// neighbours on its sides) among its n_t gives each of them m_t / (4 n_t), taken from its
-    /// corners along their barycentric coordinates. Σ_v m_v = Σ_t m_t and
-    /// Σ_v m_v x_v = Σ_t m_t · centroid_t (so a refinement keeps the centre of mass and the
-    /// momentum); every share > 0. O(darts + splits).
+    /// corners along their barycentric coordinates. Σ_v m_v = Σ_t m_t, every share > 0, and
+    /// Σ_v m_v P_v = Σ_t m_t · centroid_t on the rest positions P (and on any placement affine on
+    /// each volume), so a refinement keeps the rest centre of mass (finding 218). Every
+    /// operation keeps Σ_v m_v u_v exactly (up to rounding) in every state by a velocity
+    /// correction; in a deformed state it moves Σ_v m_v x_v by Σ_v Δm_v x_v and changes the
+    /// angular momentum (module docs, "Momentum"). O(darts).
     ///
     /// # Errors
     /// [`CouplingError::OutOfSync`], [`CouplingError::StateCount`] or
@@ -1188,19 +1266,24 @@ impl LeveledMechanics {
         Ok(self.vertex_masses_raw(m))
     }
 
-    /// [`Self::vertex_masses`] without the check (the law checks and the spring system, which
-    /// have made it). O(darts).
+    /// [`Self::vertex_masses`] without the check (the law checks, the spring system and
+    /// [`Self::refine_around`], which have made it), with the coupling's split parents. O(darts).
     pub(super) fn vertex_masses_raw(&self, m: &LeveledMap<3>) -> Vec<f64> {
         let map = m.map();
-        let parents = split_parents(m);
         let mut out = vec![0.0; map.cell_id_bound(0)];
         for t in map.one_dart_per_cell(3) {
-            let mass = self.masses.mass.get(map.cell_id(3, t).index()).copied().unwrap_or(0.0);
-            for (v, share) in volume_mass_shares(&volume_vertices(m, t), mass, &parents) {
+            for (v, share) in self.volume_shares(m, t) {
                 out[v as usize] += share;
             }
         }
         out
+    }
+
+    /// The mass shares of the volume of `t` ([`volume_mass_shares`] with its mass and the
+    /// coupling's split parents). O(volume + n log n).
+    fn volume_shares(&self, m: &LeveledMap<3>, t: DartId) -> Vec<(u32, f64)> {
+        let mass = self.masses.mass.get(m.map().cell_id(3, t).index()).copied().unwrap_or(0.0);
+        volume_mass_shares(&volume_vertices(m, t), mass, &self.parents)
     }
 
     /// The finest level as a flat [`SpringSystem`] with slots = vertex ids (so [`Self::position`] and
@@ -1252,6 +1335,134 @@ impl LeveledMechanics {
         SpringSystem::new(ends, rest, stiffness, damping, mass, &pinned, viscosity, gravity)
             .map_err(CouplingError::System)
     }
+}
+
+/// The lumped masses of some volumes before an operation ([`LeveledMechanics::patch_before`]):
+/// one dart per volume, and Σ of their shares per vertex id.
+struct MassPatch {
+    volumes: Vec<DartId>,
+    before: BTreeMap<u32, f64>,
+}
+
+impl LeveledMechanics {
+    /// The patch of an operation that will split the edges of the live `darts` (and, for a 1→8,
+    /// the tet of those darts): every volume around one of those edges, the only volumes whose
+    /// vertices (and, for the tet, mass) the operation changes. `None` when a dart is not live
+    /// (the map refuses the operation). O(Σ edge orbits · volume).
+    fn patch_before(&self, m: &LeveledMap<3>, darts: &[DartId]) -> Option<MassPatch> {
+        let map = m.map();
+        if !darts.iter().all(|&d| map.contains(d)) {
+            return None;
+        }
+        let mut edges = BTreeSet::new();
+        let around = darts.iter().filter(|&&d| edges.insert(map.cell_id(1, d))).flat_map(|&d| {
+            map.orbit(d, AlphaMask::cell(3, 1)) // ⟨α0, α2, α3⟩: the edge, in every volume around it
+        });
+        let volumes = distinct_volumes(m, around);
+        let before = self.lumped(m, &volumes, |_| true);
+        Some(MassPatch { volumes, before })
+    }
+
+    /// Σ of the shares of the volumes of `volumes` (one dart each) per vertex id `keep` accepts,
+    /// each sum compensated. O(Σ volume · log n).
+    fn lumped(&self, m: &LeveledMap<3>, volumes: &[DartId], keep: impl Fn(u32) -> bool) -> BTreeMap<u32, f64> {
+        let mut sums: BTreeMap<u32, CompensatedSum> = BTreeMap::new();
+        for &t in volumes {
+            for (v, share) in self.volume_shares(m, t).into_iter().filter(|&(v, _)| keep(v)) {
+                sums.entry(v).or_default().add(share);
+            }
+        }
+        sums.into_iter().map(|(v, s)| (v, s.value())).collect()
+    }
+
+    /// Keeps Σ_v m_v u_v over an operation made since `patch` was taken (`children`: the tets it
+    /// made): Δ_v = (Σ shares of the patch's volumes and `children` now) − (before), then
+    /// [`Self::momentum_excess`] and [`Self::remove_momentum`], with M_A gathered from the volumes
+    /// around each vertex of A.
+    /// Every other volume kept its vertices and mass, so its shares are unchanged.
+    /// O(patch volumes + Σ_{v ∈ A} star(v) · volume).
+    fn conserve_momentum(&mut self, m: &LeveledMap<3>, patch: Option<MassPatch>, children: &[DartId]) {
+        let Some(patch) = patch else { return };
+        let volumes = distinct_volumes(m, patch.volumes.iter().chain(children).copied());
+        let mut delta = self.lumped(m, &volumes, |_| true);
+        for (v, old) in patch.before {
+            *delta.entry(v).or_insert(0.0) -= old;
+        }
+        let delta: Vec<(u32, f64)> = delta.into_iter().collect();
+        if let Some((e, a)) = self.momentum_excess(&delta) {
+            let total = self.star_mass(m, &volumes, &a);
+            self.remove_momentum(&a, e, total);
+        }
+    }
+
+    /// Σ_{v ∈ a} m_v (`a` sorted, every vertex of a volume of `volumes`): the shares of every
+    /// volume around each vertex of `a`, compensated. O(Σ_{v ∈ a} star(v) · volume).
+    fn star_mass(&self, m: &LeveledMap<3>, volumes: &[DartId], a: &[u32]) -> f64 {
+        let map = m.map();
+        let mut at: BTreeMap<u32, DartId> = BTreeMap::new();
+        for &t in volumes {
+            for x in map.orbit(t, AlphaMask::cell(3, 3)) {
+                let v = map.vertex_id(x).0;
+                if a.binary_search(&v).is_ok() {
+                    at.entry(v).or_insert(x);
+                }
+            }
+        }
+        let stars = at.values().flat_map(|&x| map.orbit(x, AlphaMask::cell(3, 0)));
+        let mass = self.lumped(m, &distinct_volumes(m, stars), |v| a.binary_search(&v).is_ok());
+        compensated_sum(mass.into_values())
+    }
+
+    /// The momentum E an operation created by moving the masses `delta` (Δ_v, sorted by vertex
+    /// id) between vertices, and A, the vertices with Δ_v ≠ 0: E = Σ_{v ∈ A} Δ_v (u_v − u_r), u_r
+    /// the velocity of the first vertex of A (equal to Σ Δ_v u_v as Σ Δ_v = 0 up to rounding,
+    /// and exactly 0 for a uniform velocity). `None` when E is exactly 0 or not finite. O(A).
+    fn momentum_excess(&self, delta: &[(u32, f64)]) -> Option<(Vec3, Vec<u32>)> {
+        let a: Vec<u32> = delta.iter().filter(|&&(_, d)| d != 0.0).map(|&(v, _)| v).collect();
+        let reference = self.velocity[*a.first()? as usize];
+        let u = &self.velocity;
+        let moved = |k: usize| {
+            let terms = delta.iter().filter(|&&(_, d)| d != 0.0);
+            compensated_sum(terms.map(|&(v, d)| d * (u[v as usize][k] - reference[k])))
+        };
+        let e = [0, 1, 2].map(moved);
+        (e != [0.0; 3] && e.iter().all(|x| x.is_finite())).then_some((e, a))
+    }
+
+    /// The velocity correction of the module docs: u_v −= E / M_A for every v ∈ `a` (M_A =
+    /// `total`, Σ_{v ∈ A} m_v after the operation), the least change in Σ_v m_v |δu_v|² that
+    /// removes E. Nothing unless M_A is positive and finite. O(A).
+    fn remove_momentum(&mut self, a: &[u32], e: Vec3, total: f64) {
+        if !(total > 0.0 && total.is_finite()) {
+            return;
+        }
+        let shift = e.map(|x| x / total);
+        for &v in a {
+            let u = &mut self.velocity[v as usize];
+            *u = [0, 1, 2].map(|k| u[k] - shift[k]);
+        }
+    }
+
+    /// [`Self::momentum_excess`] and [`Self::remove_momentum`] over a whole-map change: `before` the vertex masses before
+    /// ([`Self::vertex_masses_raw`]; new vertices 0), the masses now recomputed. Nothing unless
+    /// `m` and the coupling are in step. O(darts).
+    fn conserve_momentum_whole(&mut self, m: &LeveledMap<3>, before: &[f64]) {
+        if self.in_sync(m).is_err() {
+            return;
+        }
+        let after = self.vertex_masses_raw(m);
+        let delta: Vec<(u32, f64)> =
+            after.iter().enumerate().map(|(v, &x)| (v as u32, x - before.get(v).copied().unwrap_or(0.0))).collect();
+        if let Some((e, a)) = self.momentum_excess(&delta) {
+            self.remove_momentum(&a, e, compensated_sum(a.iter().map(|&v| after[v as usize])));
+        }
+    }
+}
+
+/// One dart per distinct volume (by volume id) of `darts`, in order of first meeting. O(darts · log).
+fn distinct_volumes(m: &LeveledMap<3>, darts: impl IntoIterator<Item = DartId>) -> Vec<DartId> {
+    let mut seen = BTreeSet::new();
+    darts.into_iter().filter(|&x| seen.insert(m.map().cell_id(3, x))).collect()
 }
 
 /// For every vertex id, the split that inserted it: (its index in [`LeveledMap::split_log`], the

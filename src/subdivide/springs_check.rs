@@ -6,10 +6,16 @@
 //! joining the same two vertices (a cut edge whose ends stayed joined) are two springs, each under
 //! every law below.
 //!
-//! 1. the coupling followed every vertex insertion of the map, and has a state for every vertex;
+//! 1. the coupling followed every vertex insertion of the map and its last operation (its
+//!    version and state stamp: a map changed alone or another map is reported), its table of
+//!    split parents is the map's split log, and it has a state for every vertex;
 //! 2. every edge cell of the finest map has exactly one spring, under its key (its cell id and the
 //!    vertex ids of its ends), and every spring is an edge cell of the finest map;
-//! 3. L_s = |P_a − P_b| on the rest positions (measured scale-safely: a length of 1e200 is not ∞);
+//! 3. L_s = |P_a − P_b| on the rest positions (measured scale-safely: a length of 1e200 is not ∞),
+//!    to 1e-12 of L plus the rounding of the inserted rest positions: a half keeps exactly L/2
+//!    while its midpoint was rounded to the nearest f64, up to ½ ulp per coordinate per split
+//!    level, so the law allows 4 (d + 1) ε (|P_a|∞ + |P_b|∞) more, d the deeper end's split
+//!    depth (round 25, F1: a mesh 5 000 edge lengths from the origin failed its first split);
 //! 4. series: along every root (an edge cell split when it was not a half), the chain of finest
 //!    springs has Σ 1/k_i = 1/k_root, Σ 1/c_i = 1/c_root and Σ L_i = L_root;
 //! 5. every spring that is not a half of a split: k = Σ_{t ∋ e} E V_t / L_e² over the level-0 tets
@@ -21,7 +27,8 @@
 //!    them) equals the scatter of [`LeveledMechanics::vertex_masses`], so Σ_v m_v = Σ_t m_t; and
 //!    the lumped centre of mass on the rest positions, Σ_v m_v P_v / Σ_v m_v, equals the tets'
 //!    Σ_t m_t c_t / Σ_t m_t (c_t the mean of t's corners), to 1e-12 of the largest |P| (finding
-//!    218: a refinement moves neither the centre of mass nor the momentum).
+//!    218: a refinement keeps the centre of mass of the rest configuration; Σ m v is kept by the
+//!    operations' velocity correction, round 25, which a check of one state cannot state).
 //!
 //! Every comparison is to a relative 1e-12 ([`TOLERANCE`]).
 
@@ -55,6 +62,22 @@ pub enum SpringLawError {
         applied: usize,
         /// Logged by the map.
         logged: usize,
+    },
+    /// The map is not in the state the coupling last followed: an operation was called on the
+    /// map alone, or it is another map (see [`super::CouplingError::OtherMap`]).
+    #[error("the map is not in the state the coupling followed (version {version}, followed {followed})")]
+    NotFollowed {
+        /// The map's version after the last operation the coupling followed.
+        followed: u64,
+        /// The map's version now.
+        version: u64,
+    },
+    /// The coupling's table of split parents (vertex → the split that inserted it) differs from
+    /// the map's split log.
+    #[error("vertex {vertex}: the coupling's split parents differ from the map's split log")]
+    SplitParents {
+        /// The first vertex id where they differ.
+        vertex: u32,
     },
     /// Position or velocity arrays shorter than the vertex ids.
     #[error("the vertex state covers {states} vertex ids, the map has {vertices}")]
@@ -175,6 +198,33 @@ fn close(a: f64, b: f64) -> bool {
     a == b || (a.is_finite() && b.is_finite() && (a - b).abs() <= TOLERANCE * a.abs().max(b.abs()))
 }
 
+/// Law 3's allowance for rounded midpoints: |L − measured| ≤ 1e-12 max(L, measured) +
+/// 4 (levels + 1) ε (|P_a|∞ + |P_b|∞). Each split level rounds a midpoint by at most ½ ulp per
+/// coordinate and a midpoint's error is at most the larger of its ends' plus its own, so an end
+/// of split depth d is within d ulp of its exact place per coordinate; the factor 4 covers the
+/// √3 of a Euclidean length and the rounding of the length itself. O(1).
+fn within_rounding(stored: f64, measured: f64, [a, b]: [[f64; 3]; 2], levels: u32) -> bool {
+    let norm = |p: [f64; 3]| p.iter().fold(0.0f64, |x, c| x.max(c.abs()));
+    let slack = 4.0 * f64::from(levels + 1) * f64::EPSILON * (norm(a) + norm(b));
+    stored.is_finite()
+        && measured.is_finite()
+        && (stored - measured).abs() <= TOLERANCE * stored.abs().max(measured.abs()) + slack
+}
+
+/// The split depth of every vertex id: 0 for a vertex of level 0, 1 + the deeper end's depth
+/// for a midpoint (the split log lists ends before their midpoints). O(vertices + splits).
+fn split_depths(m: &LeveledMap<3>) -> Vec<u32> {
+    let mut depth = vec![0u32; m.map().cell_id_bound(0)];
+    for &[mid, a, b] in m.split_log() {
+        let below = |v: u32| depth.get(v as usize).copied().unwrap_or(0);
+        let d = 1 + below(a).max(below(b));
+        if let Some(slot) = depth.get_mut(mid as usize) {
+            *slot = d;
+        }
+    }
+    depth
+}
+
 /// The series sum of a chain and the root's value: (Σ 1/x_i, 1/root) for a positive root, else
 /// (Σ x_i, 0) (a zero spring splits into zero halves).
 fn series(values: impl Iterator<Item = f64>, root: f64) -> (f64, f64) {
@@ -187,7 +237,7 @@ fn series(values: impl Iterator<Item = f64>, root: f64) -> (f64, f64) {
 
 impl LeveledMechanics {
     /// Checks every law of the module docs of `springs_check` against `m` (the map this coupling
-    /// follows). O(darts · volume + E log E).
+    /// follows). O(darts log darts + E log E).
     ///
     /// Errors: the first [`SpringLawError`] found, naming the edge or vertex.
     ///
@@ -222,6 +272,16 @@ impl LeveledMechanics {
         if logged != self.applied {
             return Err(SpringLawError::OutOfSync { applied: self.applied, logged });
         }
+        if m.version() != self.followed || m.stamp() != self.followed_stamp {
+            return Err(SpringLawError::NotFollowed { followed: self.followed, version: m.version() });
+        }
+        let from_log = split_parents(m);
+        let kept = |v: usize| self.parents.get(v).copied().flatten();
+        if let Some(v) =
+            (0..from_log.len().max(self.parents.len())).find(|&v| from_log.get(v).copied().flatten() != kept(v))
+        {
+            return Err(SpringLawError::SplitParents { vertex: v as u32 });
+        }
         let (vertices, states) = (m.map().cell_id_bound(0), self.position.len().min(self.velocity.len()));
         if states < vertices || m.points().len() < vertices {
             return Err(SpringLawError::MissingState { vertices, states: states.min(m.points().len()) });
@@ -232,14 +292,17 @@ impl LeveledMechanics {
     /// Laws 2 and 3.
     fn check_edges(&self, m: &LeveledMap<3>) -> Result<(), SpringLawError> {
         let map = m.map();
+        let depth = split_depths(m);
         let mut edges = BTreeSet::new();
         for d in map.one_dart_per_cell(1) {
             let e = EdgeKey::of(map, d);
             edges.insert(e);
             let (a, b, edge) = (e.a, e.b, e.id);
             let s = self.springs.get(&e).ok_or(SpringLawError::MissingSpring { a, b, edge })?;
-            let measured = rest_length(m.points()[a as usize], m.points()[b as usize]);
-            if !close(s.rest, measured) {
+            let (pa, pb) = (m.points()[a as usize], m.points()[b as usize]);
+            let measured = rest_length(pa, pb);
+            let levels = depth[a as usize].max(depth[b as usize]);
+            if !close(s.rest, measured) && !within_rounding(s.rest, measured, [pa, pb], levels) {
                 return Err(SpringLawError::RestLength { a, b, edge, stored: s.rest, measured });
             }
         }
@@ -334,26 +397,37 @@ impl LeveledMechanics {
         }
         let scattered = self.vertex_masses_raw(m);
         let parents = split_parents(m);
+        let shares = self.shares_by_volume(m, &parents);
         for d in map.one_dart_per_cell(0) {
-            let mut volumes: Vec<_> =
-                map.orbit(d, AlphaMask::cell(3, 0)).iter().map(|&x| (map.cell_id(3, x), x)).collect();
-            volumes.sort_unstable_by_key(|&(id, _)| id);
-            volumes.dedup_by_key(|&mut (id, _)| id);
+            let mut volumes: Vec<_> = map.orbit(d, AlphaMask::cell(3, 0)).iter().map(|&x| map.cell_id(3, x)).collect();
+            volumes.sort_unstable();
+            volumes.dedup();
             let vertex = map.vertex_id(d).0;
-            let gathered: f64 = volumes
-                .iter()
-                .map(|&(id, x)| {
-                    let mass = self.masses.mass.get(id.index()).copied().unwrap_or(0.0);
-                    let shares = volume_mass_shares(&volume_vertices(m, x), mass, &parents);
-                    shares.iter().filter(|&&(v, _)| v == vertex).map(|&(_, s)| s).sum::<f64>()
-                })
-                .sum();
+            let share_of = |id: crate::gmap::CellId| {
+                let of_volume: &[(u32, f64)] = shares.get(id.index()).map_or(&[], |s| s.as_slice());
+                of_volume.binary_search_by_key(&vertex, |&(v, _)| v).map_or(0.0, |i| of_volume[i].1)
+            };
+            let gathered: f64 = volumes.iter().map(|&id| share_of(id)).sum();
             let s = scattered[vertex as usize];
             if !close(s, gathered) {
                 return Err(SpringLawError::VertexMass { vertex, scattered: s, gathered });
             }
         }
         self.check_centre_of_mass(m, &scattered, &parents)
+    }
+
+    /// Every volume's shares (vertex id, share) in vertex order, by volume id, each volume lumped
+    /// once: law 6's gather reads them per vertex instead of lumping every volume around every
+    /// vertex again (round 25, F5: 5.5 s beside a face split to level 6). O(darts log).
+    fn shares_by_volume(&self, m: &LeveledMap<3>, parents: &[Option<(usize, [u32; 2])>]) -> Vec<Vec<(u32, f64)>> {
+        let map = m.map();
+        let mut out = vec![Vec::new(); map.cell_id_bound(3)];
+        for t in map.one_dart_per_cell(3) {
+            let id = map.cell_id(3, t);
+            let mass = self.masses.mass.get(id.index()).copied().unwrap_or(0.0);
+            out[id.index()] = volume_mass_shares(&volume_vertices(m, t), mass, parents);
+        }
+        out
     }
 
     /// Law 6's first moment: Σ_v m_v P_v / Σ_v m_v against Σ_t m_t c_t / Σ_t m_t on the rest
@@ -405,5 +479,31 @@ impl LeveledMechanics {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gmap::GMap;
+    use crate::mechanics::Material;
+
+    /// Law 6's first moment reports lumped masses whose centre is not the tets' (the law is
+    /// reachable only through a lumping bug, so it is tested on a scatter moved by hand: mass
+    /// taken from one corner to another keeps every total but moves the centre of mass).
+    #[test]
+    fn a_lumping_that_moves_the_centre_of_mass_is_reported() {
+        let (map, _) = GMap::<3>::from_tets(4, &[[0, 1, 2, 3]]).unwrap();
+        let pts = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        let m = LeveledMap::new(map, pts.iter().map(|p| p.map(|x| 3.0 + x)).collect());
+        let mech = LeveledMechanics::new(&m, Material::default()).unwrap();
+        let parents = split_parents(&m);
+        let mut scattered = mech.vertex_masses_raw(&m);
+        assert_eq!(mech.check_centre_of_mass(&m, &scattered, &parents), Ok(()));
+        let moved = 1e-6 * scattered[0];
+        scattered[0] -= moved;
+        scattered[1] += moved;
+        let e = mech.check_centre_of_mass(&m, &scattered, &parents).unwrap_err();
+        assert!(matches!(e, SpringLawError::CentreOfMass { axis: 0, .. }), "{e}");
     }
 }

@@ -197,7 +197,8 @@ impl LeveledMap<3> {
     /// of the volume is α0-, α1- or α2-free), [`SubdivideError::NotATetrahedron`] (the volume at
     /// its own level μt is not a tetrahedron), [`SubdivideError::FaceRefinedTooFar`] (a face of the
     /// volume was refined beyond one 1→4 step or an inner edge of a split face carries a vertex;
-    /// not supported yet). The map is unchanged on error.
+    /// not supported yet), [`SubdivideError::BelowPrecision`] (an edge to split whose midpoint
+    /// f64 cannot hold strictly between its ends). The map is unchanged on error.
     ///
     /// # Examples
     ///
@@ -231,6 +232,7 @@ impl LeveledMap<3> {
             let cell_level = self.mu[f.index()].face;
             return Err(SubdivideError::AlreadyAtLevel { dart: f, dim: 2, cell_level, level });
         }
+        self.check_split_midpoints(&unsplit, level)?;
         for f in unsplit {
             self.subdivide_triangle(f, level)?;
         }
@@ -241,6 +243,16 @@ impl LeveledMap<3> {
         }
         self.finish();
         Ok(children)
+    }
+
+    /// [`SubdivideError::BelowPrecision`] for the first edge the 1→8 split would split — a side
+    /// without inserted vertex of one of its `unsplit` faces (checked triangles) — whose midpoint
+    /// f64 cannot hold strictly between its ends. O(faces).
+    pub(super) fn check_split_midpoints(&self, unsplit: &[DartId], level: u8) -> Result<(), SubdivideError> {
+        for &f in unsplit {
+            self.check_side_midpoints(&self.triangle_sides(f)?, level)?;
+        }
+        Ok(())
     }
 
     /// The vertex ids of the four corners of the volume of `d` at its own level `lt`: the

@@ -16,6 +16,20 @@
 use super::{LeveledMap, Mu, SubdivideError};
 use crate::gmap::{AlphaMask, DartId};
 
+/// Whether the rounded midpoint m of `a` and `b` (`mesh::midpoint`, as stored for a new vertex)
+/// lies strictly between them along the edge's main axis k (the coordinate where they differ
+/// most): min(a_k, b_k) < m_k < max(a_k, b_k), so m ≠ a and m ≠ b (in the other coordinates m
+/// is within [min, max] by rounding, and may equal an end: a long edge whose ends differ by one
+/// ulp across is fine). False for a = b, and for an edge one ulp long along its main axis:
+/// halving an edge of length ℓ at coordinates of size |x| works about 52 − log2(|x| / ℓ) times
+/// (the mantissa has 52 bits); past that, midpoints land on an end and tets collapse. O(1).
+pub(super) fn midpoint_between(a: [f64; 3], b: [f64; 3]) -> bool {
+    let m = crate::mesh::midpoint(a, b);
+    let spread = |k: usize| (b[k] - a[k]).abs();
+    let k = (1..3).fold(0, |main, k| if spread(k) > spread(main) { k } else { main });
+    a[k].min(b[k]) < m[k] && m[k] < a[k].max(b[k])
+}
+
 /// One side of a triangle face: the corner dart it starts from and its inserted (flat) vertices
 /// in order, each as (dart on the incoming half, dart on the outgoing half).
 #[derive(Clone, Debug)]
@@ -29,10 +43,12 @@ impl<const N: usize> LeveledMap<N> {
     /// `subdividedge`). Every dart x of the edge gets a new dart x' with α0^level(x) = x'; the
     /// new darts are α1-linked pairwise at the new vertex and αj-linked (j ≥ 2) like their
     /// partners. All darts of the two halves take μa = level. Returns α0(d) afterwards.
-    /// O(edge · n).
+    /// O(edge · (n + log edge)): each dart's new partner is found in the orbit sorted once.
     ///
     /// Errors: [`SubdivideError::NoSuchDart`], [`SubdivideError::OpenEdge`],
-    /// [`SubdivideError::AlreadyAtLevel`] (μa(d) ≥ level), the level-order errors.
+    /// [`SubdivideError::AlreadyAtLevel`] (μa(d) ≥ level), [`SubdivideError::BelowPrecision`]
+    /// (the rounded midpoint of the edge's end positions is not strictly between them),
+    /// the level-order errors. The map is unchanged on error.
     ///
     /// # Examples
     ///
@@ -52,6 +68,7 @@ impl<const N: usize> LeveledMap<N> {
     pub fn split_edge(&mut self, d: DartId, level: u8) -> Result<DartId, SubdivideError> {
         self.check_op_level(level)?;
         self.check_edge(d, level)?;
+        self.check_midpoint(d, level)?;
         self.begin(level);
         let m = self.split_edge_raw(d);
         self.finish();
@@ -72,6 +89,27 @@ impl<const N: usize> LeveledMap<N> {
         Ok(())
     }
 
+    /// [`SubdivideError::BelowPrecision`] when the edge of `d` (closed) has end positions whose
+    /// rounded midpoint is not strictly between them ([`midpoint_between`]). Nothing is checked
+    /// without both positions, or with a non-finite one (the geometric checks refuse those). O(1).
+    pub(super) fn check_midpoint(&self, d: DartId, level: u8) -> Result<(), SubdivideError> {
+        let vertices = [d, self.map.alpha_dyn(0, d)].map(|x| self.map.vertex_id(x).0);
+        let [Some(&a), Some(&b)] = vertices.map(|v| self.points.get(v as usize)) else { return Ok(()) };
+        if !a.iter().chain(&b).all(|c| c.is_finite()) || midpoint_between(a, b) {
+            return Ok(());
+        }
+        Err(SubdivideError::BelowPrecision { level, dart: d, vertices, positions: [a, b] })
+    }
+
+    /// [`Self::check_midpoint`] on every side of a triangle that its 1→4 split splits (the sides
+    /// without an inserted vertex). O(sides).
+    pub(super) fn check_side_midpoints(&self, sides: &[Side], level: u8) -> Result<(), SubdivideError> {
+        for s in sides.iter().filter(|s| s.flats.is_empty()) {
+            self.check_midpoint(s.start, level)?;
+        }
+        Ok(())
+    }
+
     /// The topology of [`Self::split_edge`] inside a running operation. The edge must be closed.
     pub(super) fn split_edge_raw(&mut self, d: DartId) -> DartId {
         let level = self.op_level();
@@ -84,7 +122,14 @@ impl<const N: usize> LeveledMap<N> {
                 self.new_dart(Mu { edge: level, ..mu }, true)
             })
             .collect();
-        let prime = |x: DartId| fresh[edge.iter().position(|&e| e == x).expect("edge orbit is closed")];
+        // x ↦ x': the orbit indexed once, sorted by dart (a linear search per dart made a split
+        // O(edge² · n): 44 s for one tet beside an edge of valence 50 000, round 25 B).
+        let mut index: Vec<(DartId, usize)> = edge.iter().copied().zip(0..).collect();
+        index.sort_unstable();
+        let prime = |x: DartId| {
+            let k = index.binary_search_by_key(&x, |&(e, _)| e).expect("edge orbit is closed");
+            fresh[index[k].1]
+        };
         for k in 0..edge.len() {
             self.link(0, edge[k], fresh[k]);
         }
@@ -115,7 +160,9 @@ impl<const N: usize> LeveledMap<N> {
     ///
     /// Errors: [`SubdivideError::WrongDimension`] (n ∉ {2, 3}), [`SubdivideError::NoSuchDart`],
     /// [`SubdivideError::AlreadyAtLevel`] (μf(d) ≥ level), [`SubdivideError::NotATriangle`],
-    /// [`SubdivideError::OpenEdge`], the level-order errors. The map is unchanged on error.
+    /// [`SubdivideError::OpenEdge`], [`SubdivideError::BelowPrecision`] (a side to split whose
+    /// midpoint f64 cannot hold strictly between its ends), the level-order errors. The map is
+    /// unchanged on error.
     ///
     /// # Examples
     ///
@@ -146,6 +193,7 @@ impl<const N: usize> LeveledMap<N> {
         if let Some(s) = sides.iter().find(|s| self.map.is_free(0, s.start)) {
             return Err(SubdivideError::OpenEdge(s.start));
         }
+        self.check_side_midpoints(&sides, level)?;
         self.begin(level);
         let mids: Vec<(DartId, DartId)> = sides.iter().map(|s| self.side_midpoint(s)).collect();
         let (m_in, m_out): (Vec<DartId>, Vec<DartId>) = mids.into_iter().unzip();

@@ -426,6 +426,8 @@ struct Labelled {
     edges: Vec<(u32, u32)>,
     /// The edge cell id of each parent edge, by rank.
     edge_ids: Vec<u32>,
+    /// A dart of each parent edge, by rank (for the precision check of its midpoint).
+    edge_darts: Vec<u32>,
     /// Rank of each face id (3D).
     face_rank: Vec<u32>,
     faces: u32,
@@ -474,6 +476,7 @@ impl<const N: usize> LeveledMap<N> {
             edge_rank: vec![u32::MAX; edge_bound],
             edges: Vec::with_capacity(edge_bound),
             edge_ids: Vec::with_capacity(edge_bound),
+            edge_darts: Vec::with_capacity(edge_bound),
             face_rank: vec![u32::MAX; if N == 3 { self.map.cell_id_bound(2) } else { 0 }],
             faces: 0,
         };
@@ -531,11 +534,13 @@ impl<const N: usize> LeveledMap<N> {
     /// Ranks the parent's edges and faces at first meeting.
     fn rank_cells(&self, lab: &[u32], t0: &Template, vids: &[u32], out: &mut Labelled) {
         for (k, &(x, y)) in t0.pairs.iter().enumerate() {
-            let e = self.map.cell_id(1, DartId(lab[t0.pair_parent[k] as usize])).index();
+            let dart = lab[t0.pair_parent[k] as usize];
+            let e = self.map.cell_id(1, DartId(dart)).index();
             if out.edge_rank[e] == u32::MAX {
                 out.edge_rank[e] = out.edges.len() as u32;
                 out.edges.push((vids[x as usize], vids[y as usize]));
                 out.edge_ids.push(e as u32);
+                out.edge_darts.push(dart);
             }
         }
         if N == 3 {
@@ -562,6 +567,15 @@ impl<const N: usize> LeveledMap<N> {
             mid_vid[k] = self.map.cell_id(1, DartId(lab[t0.pair_parent[k] as usize])).0;
         }
         choose_diagonal(&pos, &mid_vid) - 4
+    }
+
+    /// [`SubdivideError::BelowPrecision`] for the first parent edge (in rank order) whose
+    /// midpoint f64 cannot hold strictly between its ends (`check_midpoint`). O(edges).
+    fn check_uniform_midpoints(&self, level: u8, lab: &Labelled) -> Result<(), SubdivideError> {
+        for &x in &lab.edge_darts {
+            self.check_midpoint(DartId(x), level)?;
+        }
+        Ok(())
     }
 
     fn vertex_pos(&self, v: u32) -> [f64; 3] {
@@ -663,7 +677,7 @@ impl<const N: usize> LeveledMap<N> {
         }
         self.write_midpoints(&next, lab);
         self.max_level = level;
-        self.version += 1;
+        self.bump_version();
         child_ids
     }
 
@@ -770,7 +784,9 @@ impl LeveledMap<3> {
     /// 24 darts with four distinct corner vertices); those of [`TetMasses::check`] (a live
     /// volume without a finite mass ≥ 0 in `masses`); [`SubdivideError::NoPosition`] and
     /// [`SubdivideError::NonFinitePosition`] (the smallest live vertex without a position, or
-    /// with a NaN or infinite one: the masses follow the children's volumes).
+    /// with a NaN or infinite one: the masses follow the children's volumes);
+    /// [`SubdivideError::BelowPrecision`] (an edge whose midpoint f64 cannot hold strictly
+    /// between its ends).
     ///
     /// # Examples
     ///
@@ -796,6 +812,7 @@ impl LeveledMap<3> {
         self.check_positions_finite()?;
         let tpl = templates(3);
         let lab = self.label_parents(&tpl)?;
+        self.check_uniform_midpoints(level, &lab)?;
         let parents = lab.template.len();
         let parent_mass: Vec<f64> = (0..parents)
             .map(|t| masses.mass.get(self.map.cell_id(3, DartId(lab.darts[t * 24])).index()).copied().unwrap_or(0.0))
@@ -852,7 +869,9 @@ impl LeveledMap<2> {
     /// Preconditions, refused with the map unchanged: the level-order errors;
     /// [`SubdivideError::NotUniform`]; [`SubdivideError::AlreadyAtLevel`];
     /// [`SubdivideError::OpenEdge`] (an α0- or α1-free dart); [`SubdivideError::NotATetrahedron`]
-    /// (here: a face that is not a triangle of 6 darts with three distinct corner vertices).
+    /// (here: a face that is not a triangle of 6 darts with three distinct corner vertices);
+    /// [`SubdivideError::BelowPrecision`] (an edge whose midpoint f64 cannot hold strictly
+    /// between its ends; with points only).
     ///
     /// # Examples
     ///
@@ -871,6 +890,7 @@ impl LeveledMap<2> {
         self.uniform_level(level)?;
         let tpl = templates(2);
         let lab = self.label_parents(&tpl)?;
+        self.check_uniform_midpoints(level, &lab)?;
         self.write_uniform(level, &tpl, &lab, false);
         self.after_uniform();
         Ok(lab.template.len())

@@ -54,3 +54,31 @@ pub fn check_levels<const N: usize>(m: &LeveledMap<N>) {
 pub fn level_counts<const N: usize>(m: &LeveledMap<N>) -> Vec<Vec<usize>> {
     (0..=m.max_level()).map(|i| m.level(i).unwrap().map.count_cells().0).collect()
 }
+
+/// A deterministic pseudo-random vector in [−1, 1]³ (xorshift of `seed`, steps of 0.001).
+pub fn jitter(seed: u64) -> [f64; 3] {
+    let mut s = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15).wrapping_add(1);
+    [0, 1, 2].map(|_| {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        (s % 2001) as f64 / 1000.0 - 1.0
+    })
+}
+
+/// One text line per dart slot of `map` (`k dead`, or `k a[α0..αn] c[cell ids]`), for
+/// fingerprints that must notice any change of the numbering. O(capacity · n).
+pub fn dart_rows<const N: usize>(map: &GMap<N>) -> String {
+    let mut out = String::new();
+    for k in 0..map.capacity() as u32 {
+        let d = topomech::DartId(k);
+        if !map.contains(d) {
+            out.push_str(&format!("{k} dead\n"));
+            continue;
+        }
+        let alpha: Vec<u32> = (0..=N).map(|i| map.alpha_dyn(i, d).0).collect();
+        let cell: Vec<u32> = (0..=N).map(|i| map.cell_id(i, d).0).collect();
+        out.push_str(&format!("{k} a{alpha:?} c{cell:?}\n"));
+    }
+    out
+}

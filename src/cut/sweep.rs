@@ -43,7 +43,7 @@
 
 use std::cmp::Ordering;
 
-use crate::mechanics::geom::{self, exponent, pow2};
+use crate::mechanics::geom::{self, Scaled};
 use crate::mechanics::{Body, Vec3};
 use crate::DartId;
 
@@ -221,43 +221,6 @@ fn crosses_quad([a, b]: [Vec3; 2], d: Scaled, [p0, p1]: [Vec3; 2], e: Scaled, (w
 /// them multiply to below 2^(3 · 301 + 3), far from overflow, and a component 2^-1000 times the
 /// largest stays a normal number.
 const QUAD_EXP: i32 = 300;
-
-/// A vector v scaled by a power of two to `dir`, whose largest absolute component is in
-/// [2^target, 2^(target+1)) (or `dir` zero for the zero vector). The scaling is exact unless a
-/// component is about 2^1000 or more times smaller than the largest one, and cross and triple
-/// products of `dir`s neither overflow nor lose their leading terms to underflow, whatever the
-/// magnitude of v: the parallel test of the crossing, the well-formedness checks and the tear's
-/// face normals use it.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Scaled {
-    pub(super) dir: Vec3,
-}
-
-impl Scaled {
-    /// `v` scaled as above to `target` (|target| ≤ 300). O(1).
-    pub(super) fn new(v: Vec3, target: i32) -> Self {
-        let m = v.iter().fold(0.0f64, |m, c| m.max(c.abs()));
-        if m == 0.0 {
-            return Scaled { dir: v };
-        }
-        let k = exponent(m);
-        // target − k ∈ [−1323, 1374]: two steps, each a normal power of two.
-        let shift = target - k;
-        let (f1, f2) = (pow2(shift / 2), pow2(shift - shift / 2));
-        Scaled { dir: v.map(|c| c * f1 * f2) }
-    }
-
-    /// x − y for finite x, y, scaled to `target`. When the difference overflows it is taken of
-    /// halved coordinates (finite even between ±`f64::MAX`, and exact up to the halving of
-    /// subnormal coordinates): a direction, whose length is not kept. Zero only when x = y. O(1).
-    pub(super) fn diff(x: Vec3, y: Vec3, target: i32) -> Self {
-        let v = geom::sub(x, y);
-        if v.iter().all(|c| c.is_finite()) {
-            return Scaled::new(v, target);
-        }
-        Scaled::new(geom::sub(geom::scale(x, 0.5), geom::scale(y, 0.5)), target)
-    }
-}
 
 /// The determinant of the matrix with columns a, b, c: a · (b × c). O(1).
 fn triple(a: Vec3, b: Vec3, c: Vec3) -> f64 {

@@ -24,9 +24,9 @@ use crate::mechanics::model::{closed_triangle_vertices, triangle_vertices};
 use crate::mechanics::{Body, SimError, Simulation, TouchedCells, Vec3};
 use crate::{AlphaMask, CellId, DartId, GMap};
 
-use super::sweep::Scaled;
 use super::{dissociate_face, CutError, Dissociation};
 use crate::exact::{det_sign, Term};
+use crate::mechanics::geom::Scaled;
 
 /// The tensile stress at a vertex: the largest principal value of σ_v = Σ_s T_s n_s n_sᵀ over the
 /// springs at v, with T_s = max(0, k_s (l_s − L_s)) the spring's tension and n_s its unit

@@ -342,7 +342,9 @@ impl<T> std::ops::IndexMut<CellId> for CellSliceMut<'_, T> {
 /// The methods are called by the embedding layer ([`Embedded::sew`], [`Embedded::unsew`]), in
 /// that order, once per operation; called by hand on attributes that an [`Embedded`] owns they
 /// rewrite those attributes from whatever map they are given, and [`Embedded::check`] names the
-/// law that breaks (for [`crate::mechanics::Mechanics`]: a face flag, a sum).
+/// law that breaks (for [`crate::mechanics::Mechanics`]: a face flag, a sum) — but not a state
+/// that keeps the laws (e.g. a vertex pinned by a merge rule), and a projection or simulation
+/// built before does not see it: rebuild them.
 ///
 /// # Panics
 ///
@@ -499,7 +501,7 @@ pub enum EmbedError<E: std::error::Error + 'static> {
     /// [`CellRules::check_unsew`]); map and attributes are unchanged.
     #[error("{op} of {dart} refused: {source}")]
     Refused {
-        /// "sew" or "unsew".
+        /// "sew", "unsew", or the higher operation that checked (e.g. "remove_volume").
         op: &'static str,
         /// The dart the operation was called with.
         dart: DartId,

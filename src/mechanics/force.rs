@@ -1381,6 +1381,10 @@ pub enum SystemError {
         /// The mass given.
         mass: f64,
     },
+    /// A body whose attribute arrays do not cover its map (possible only after the attributes
+    /// were replaced as a whole through `attrs_mut`): nothing can be projected.
+    #[error("the body's attributes do not fit its map: {0}")]
+    Attributes(crate::mechanics::ConservationError),
 }
 
 /// 1/m for a free slot of mass m > 0, else 0 (fixed or massless). O(1).

@@ -21,11 +21,6 @@ pub(crate) fn sub(a: Vec3, b: Vec3) -> Vec3 {
 }
 
 #[inline(always)]
-pub(crate) fn add(a: Vec3, b: Vec3) -> Vec3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-
-#[inline(always)]
 pub(crate) fn scale(a: Vec3, s: f64) -> Vec3 {
     [a[0] * s, a[1] * s, a[2] * s]
 }
@@ -222,5 +217,42 @@ mod tests {
         let s = 1e-110;
         assert!(!is_flat([[0.0; 3], [s, 0.0, 0.0], [0.0, s, 0.0], [0.0, 0.0, s]]));
         assert!(is_flat([[0.0; 3], [s, 0.0, 0.0], [0.0, s, 0.0], [s, s, 0.0]]));
+    }
+}
+
+/// A vector v scaled by a power of two to `dir`, whose largest absolute component is in
+/// [2^target, 2^(target+1)) (or `dir` zero for the zero vector). The scaling is exact unless a
+/// component is about 2^1000 or more times smaller than the largest one, and cross and triple
+/// products of `dir`s neither overflow nor lose their leading terms to underflow, whatever the
+/// magnitude of v: the sweep's parallel test and well-formedness checks, the tear's face normals
+/// and the stored boundary normals ([`super::Mechanics`]) use it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Scaled {
+    pub(crate) dir: Vec3,
+}
+
+impl Scaled {
+    /// `v` scaled as above to `target` (|target| ≤ 300). O(1).
+    pub(crate) fn new(v: Vec3, target: i32) -> Self {
+        let m = v.iter().fold(0.0f64, |m, c| m.max(c.abs()));
+        if m == 0.0 {
+            return Scaled { dir: v };
+        }
+        let k = exponent(m);
+        // target − k ∈ [−1323, 1374]: two steps, each a normal power of two.
+        let shift = target - k;
+        let (f1, f2) = (pow2(shift / 2), pow2(shift - shift / 2));
+        Scaled { dir: v.map(|c| c * f1 * f2) }
+    }
+
+    /// x − y for finite x, y, scaled to `target`. When the difference overflows it is taken of
+    /// halved coordinates (finite even between ±`f64::MAX`, and exact up to the halving of
+    /// subnormal coordinates): a direction, whose length is not kept. Zero only when x = y. O(1).
+    pub(crate) fn diff(x: Vec3, y: Vec3, target: i32) -> Self {
+        let v = sub(x, y);
+        if v.iter().all(|c| c.is_finite()) {
+            return Scaled::new(v, target);
+        }
+        Scaled::new(sub(scale(x, 0.5), scale(y, 0.5)), target)
     }
 }

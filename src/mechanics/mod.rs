@@ -56,6 +56,9 @@ pub enum SimError {
     /// A gravity vector with a NaN or infinite component.
     #[error("gravity {0:?} must be finite")]
     BadGravity(Vec3),
+    /// The body cannot be projected ([`SystemError::Attributes`]).
+    #[error(transparent)]
+    Projection(SystemError),
     /// The simulation was built for another body ([`crate::mechanics::Body::identity`]): its
     /// arrays describe that body's vertices and springs. Rebuild it for this one.
     #[error("the simulation was built for body {built_for}, not for body {given}: rebuild it for this body")]
@@ -64,6 +67,14 @@ pub enum SimError {
         built_for: u64,
         /// The identity of the body given.
         given: u64,
+    },
+    /// The simulation's projection does not describe this body: its attributes were replaced as
+    /// a whole since (`*body.attrs_mut() = other`), or the public `projection` was rebuilt for
+    /// another body. Rebuild the simulation ([`Simulation::rebuild`]).
+    #[error("the simulation's projection no longer describes body {body} (its attributes were replaced, or the projection was rebuilt for another body): rebuild the simulation")]
+    ProjectionNotForBody {
+        /// The identity of the body given.
+        body: u64,
     },
     /// The body changed topologically since the projection was built.
     #[error("the projection was built at body version {built} but the body is at version {now}: rebuild it")]
@@ -242,6 +253,11 @@ pub struct Simulation {
     /// The body's position epoch (`Mechanics::position_epoch`) at which the energy scale was
     /// last taken.
     position_epoch: u64,
+    /// The identity of the body the simulation was made for ([`Simulation::new`],
+    /// [`Simulation::rebuild`]): the public `projection` rebuilt for another body does not move
+    /// the simulation over to it (round 26: the stepper kept its step count and the other body's
+    /// pinned velocity moved its pinned vertex).
+    body: u64,
 }
 
 impl Simulation {
@@ -271,6 +287,7 @@ impl Simulation {
         if gravity.iter().any(|g| !g.is_finite()) {
             return Err(SimError::BadGravity(gravity));
         }
+        body.attrs().check_covers(body.map()).map_err(|e| SimError::Projection(SystemError::Attributes(e)))?;
         let projection = Projection::build_raw(body, gravity);
         let slots = projection.system.slots();
         let mech = body.attrs();
@@ -282,7 +299,7 @@ impl Simulation {
             &mech.position.as_slice()[..slots],
             &mech.velocity.as_slice()[..slots],
         )?;
-        let mut sim = Simulation { projection, stepper, velocity_epoch: 0, position_epoch: 0 };
+        let mut sim = Simulation { projection, stepper, velocity_epoch: 0, position_epoch: 0, body: body.identity() };
         sim.hold_fixed(body);
         sim.record_epochs(body);
         Ok(sim)
@@ -354,11 +371,14 @@ impl Simulation {
         Ok(())
     }
 
-    /// [`SimError::OtherBody`] unless the simulation was built for `body`. O(1).
+    /// [`SimError::OtherBody`] unless the simulation was built for `body` and its projection
+    /// still is (the `projection` field is public). O(1).
     pub(crate) fn check_body(&self, body: &Body) -> Result<(), SimError> {
-        match self.projection.is_for(body) {
-            true => Ok(()),
-            false => Err(SimError::OtherBody { built_for: self.projection.body_identity(), given: body.identity() }),
+        let given = body.identity();
+        match (self.body == given, self.projection.is_for(body)) {
+            (true, true) => Ok(()),
+            (false, _) => Err(SimError::OtherBody { built_for: self.body, given }),
+            (true, false) => Err(SimError::ProjectionNotForBody { body: given }),
         }
     }
 

@@ -43,7 +43,7 @@ use crate::gmap::CellChanges;
 use crate::{AlphaMask, BuildError, BuildReport, CellId, DartId, GMap};
 
 use super::conservation::{check_conservation, ConservationError};
-use super::geom::{add, cross, dot, norm, scale, sub, tet_volume, Vec3};
+use super::geom::{cross, dot, norm, scale, sub, tet_volume, Scaled, Vec3};
 
 /// Material constants of a homogeneous body.
 ///
@@ -258,6 +258,29 @@ pub struct Mechanics {
     /// ([`Mechanics::position_mut`]): the simulation then takes the state as the new start of
     /// its runaway test (energy put in by hand is not a blow-up).
     pub(crate) position_epoch: u64,
+    /// Which value this is: fresh when made and on every clone, so a projection built from
+    /// a body sees when its attributes were replaced as a whole (`*body.attrs_mut() = …`,
+    /// `mem::swap`) and is then not for that body any more (round 26).
+    pub(crate) instance: Instance,
+}
+
+/// The identity of one [`Mechanics`] value: process-wide unique, fresh on every clone (a clone
+/// is another value, which may be put in place of the first). Not part of the body's state
+/// (never stored, not compared). O(1).
+#[derive(Debug)]
+pub(crate) struct Instance(pub(crate) u64);
+
+impl Instance {
+    /// A number no other instance has. O(1).
+    pub(crate) fn fresh() -> Self {
+        Instance(crate::embedding::next_identity())
+    }
+}
+
+impl Clone for Instance {
+    fn clone(&self) -> Self {
+        Instance::fresh()
+    }
 }
 
 /// A mechanical body: a 3-G-map whose sew/unsew keep the [`Mechanics`] attributes lawful. Its
@@ -789,16 +812,21 @@ impl Mechanics {
         }
     }
 
-    /// Unit normal of the triangle `[a, b, c]` (sorted ids), oriented away from `apex`.
+    /// Unit normal of the triangle `[a, b, c]` (sorted ids), oriented away from `apex`. The
+    /// edges, their cross product and the apex direction are scaled by powers of two to a
+    /// largest component in [1, 2) (exact), so nothing over- or underflows at any coordinate
+    /// scale (round 26: at 1e-80 the normal was 1 + 6e-6 long, from 1e78 zero, from 1e155 NaN);
+    /// for ordinary coordinates the result is the unscaled formula's bit for bit. O(1).
     fn normal_away_from(&self, [a, b, c]: [CellId; 3], apex: Option<CellId>) -> Vec3 {
         let Some(apex) = apex else { return [0.0; 3] };
         let p = |v: CellId| self.position[v];
-        let n = cross(sub(p(b), p(a)), sub(p(c), p(a)));
+        let (e1, e2) = (Scaled::diff(p(b), p(a), 0).dir, Scaled::diff(p(c), p(a), 0).dir);
+        let n = Scaled::new(cross(e1, e2), 0).dir;
         let len = norm(n);
-        if len == 0.0 {
+        if len == 0.0 || !len.is_finite() {
             return [0.0; 3];
         }
-        let sign = if dot(n, sub(p(apex), p(a))) > 0.0 { -1.0 } else { 1.0 };
+        let sign = if dot(n, Scaled::diff(p(apex), p(a), 0).dir) > 0.0 { -1.0 } else { 1.0 };
         scale(n, sign / len)
     }
 
@@ -1031,7 +1059,10 @@ impl Mechanics {
         let (m1, m2) = (self.vertex_mass[kept], self.vertex_mass[absorbed]);
         let total = m1 + m2;
         let (w1, w2) = if total > 0.0 { (m1 / total, m2 / total) } else { (0.5, 0.5) };
-        let mix = |a: Vec3, b: Vec3| add(scale(a, w1), scale(b, w2));
+        // Component by component; equal components are kept as they are (w1 + w2 may differ
+        // from 1 by a rounding, and w1·p + w2·p moved a pinned vertex sewn back onto itself by
+        // one ulp: round 26).
+        let mix = |a: Vec3, b: Vec3| std::array::from_fn(|k| if a[k] == b[k] { a[k] } else { w1 * a[k] + w2 * b[k] });
         self.position[kept] = mix(self.position[kept], self.position[absorbed]);
         self.velocity[kept] = mix(self.velocity[kept], self.velocity[absorbed]);
         self.pinned[kept] = self.pinned[kept] || self.pinned[absorbed];
@@ -1165,6 +1196,8 @@ impl CellRules<3> for Mechanics {
     /// a split copies it), or the rest lengths of one side's edges would no longer be the
     /// distances of their ends ([`ConservationError::SewApart`]). O(pairs).
     fn check_sew(&self, map: &GMap<3>, i: usize, pairs: &[(DartId, DartId)]) -> Result<(), ConservationError> {
+        // Attributes replaced as a whole through `attrs_mut` may be short (round 26).
+        self.check_covers(map)?;
         if let (true, Some(&(x, y))) = (i <= 2, pairs.first()) {
             let (volume, other_volume) = (map.cell_id(3, x), map.cell_id(3, y));
             return Err(ConservationError::SewInsideVolume { dart: x, other: y, i, volume, other_volume });
@@ -1188,6 +1221,7 @@ impl CellRules<3> for Mechanics {
     /// term of law 2, creating stiffness): refused with [`ConservationError::UnsewOpensTet`].
     /// A dart that is not live or already i-free is left to the kernel's own error. O(1).
     fn check_unsew(&self, map: &GMap<3>, i: usize, d: DartId) -> Result<(), ConservationError> {
+        self.check_covers(map)?;
         if i > 2 || !map.contains(d) || map.is_free(i, d) {
             return Ok(());
         }
@@ -1527,6 +1561,10 @@ impl Embedded<3, Mechanics> {
     /// (a boundary face; zero if degenerate) or zero (an inner face). Not a topological change:
     /// the version stays. O(darts).
     ///
+    /// # Errors
+    /// [`ConservationError::MissingAttributes`] when the attributes do not cover the map (only
+    /// after they were replaced as a whole through `attrs_mut`); nothing changes then.
+    ///
     /// # Examples
     ///
     /// ```
@@ -1539,7 +1577,7 @@ impl Embedded<3, Mechanics> {
     /// let faces: Vec<_> = map.one_dart_per_cell(2).into_iter().map(|d| map.cell_id(2, d)).collect();
     /// let top = *faces.iter().find(|&&f| body.attrs().face_normal(f) == [0.0, 0.0, 1.0]).unwrap();
     /// body.attrs_mut().position_mut().as_mut_slice().iter_mut().for_each(|p| p[2] = -p[2]); // mirror in z
-    /// body.update_normals();
+    /// body.update_normals().unwrap();
     /// assert_eq!(body.attrs().face_normal(top), [0.0, 0.0, -1.0]); // the top face now faces down
     /// assert_eq!(body.version(), 0);
     /// ```
@@ -1557,9 +1595,11 @@ impl Embedded<3, Mechanics> {
     /// let stale = body.map().clone();
     /// body.attrs_mut().update_normals(&stale).unwrap();
     /// ```
-    pub fn update_normals(&mut self) {
+    pub fn update_normals(&mut self) -> Result<(), ConservationError> {
         let (map, mech) = self.map_and_attrs_mut();
+        mech.check_covers(map)?;
         mech.update_normals_raw(map);
+        Ok(())
     }
 
     /// Total kinetic energy ½ Σ m_v |v_v|² over live vertices. O(darts).
@@ -1639,6 +1679,7 @@ impl Mechanics {
             pins_epoch: 0,
             velocity_epoch: 0,
             position_epoch: 0,
+            instance: Instance::fresh(),
         }
     }
 

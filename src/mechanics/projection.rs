@@ -78,6 +78,9 @@ pub struct Projection {
     pins_epoch: u64,
     /// The [`Body::identity`] of the body it was built from.
     body: u64,
+    /// The instance of that body's attributes (`Mechanics::instance`): attributes replaced as
+    /// a whole through `attrs_mut` make the projection not for the body any more.
+    attrs: u64,
     /// The lists of [`Resolved::of`], kept between updates.
     scratch: Resolved,
 }
@@ -104,6 +107,7 @@ impl Projection {
         if gravity.iter().any(|g| !g.is_finite()) {
             return Err(SystemError::BadGravity(gravity));
         }
+        body.attrs().check_covers(body.map()).map_err(SystemError::Attributes)?;
         Ok(Projection::build_raw(body, gravity))
     }
 
@@ -141,6 +145,7 @@ impl Projection {
             version: body.version(),
             pins_epoch: mech.pins_epoch,
             body: body.identity(),
+            attrs: mech.instance.0,
             scratch: Resolved::default(),
         }
     }
@@ -182,6 +187,11 @@ impl Projection {
     }
 
     /// Rebuilds from scratch after topological changes (keeps the gravity). O(darts + E log E).
+    ///
+    /// # Panics
+    /// If the body's attributes do not cover its map, which only attributes replaced as a whole
+    /// through `attrs_mut` by shorter ones can cause ([`Body::check`] names it;
+    /// [`Projection::build`] returns the error instead).
     ///
     /// # Examples
     ///
@@ -261,7 +271,10 @@ impl Projection {
     }
 
     /// Whether the projection was built from `body` (and not from another body, or a clone of
-    /// it: [`Body::identity`]). O(1).
+    /// it: [`Body::identity`]), with the attributes it has now: attributes replaced as a whole
+    /// (`*body.attrs_mut() = other`, `std::mem::swap`; a `Mechanics` clone is another value)
+    /// make it not for the body (round 26: it said it was current with another body's masses).
+    /// O(1).
     ///
     /// # Examples
     ///
@@ -277,7 +290,7 @@ impl Projection {
     /// assert!(!p.is_for(&copy) && !p.is_current(&copy)); // same version, another body
     /// ```
     pub fn is_for(&self, body: &Body) -> bool {
-        self.body == body.identity()
+        self.body == body.identity() && self.attrs == body.attrs().instance.0
     }
 
     /// The [`Body::identity`] of the body the projection was built from. O(1).
@@ -324,6 +337,7 @@ impl Projection {
         }
         let mut out = self.clone();
         out.body = copy.identity();
+        out.attrs = copy.attrs().instance.0;
         Some(out)
     }
 
@@ -362,6 +376,9 @@ impl Projection {
     /// operation, lists filled by hand or by [`TouchedCells::record`] — cannot be trusted, and
     /// the projection is rebuilt from `body` instead (O(darts + E log E)); the result is `false`.
     /// Either way the projection ends current and equal to a fresh build.
+    ///
+    /// # Panics
+    /// As [`Projection::rebuild`], when it rebuilds.
     ///
     /// # Examples
     ///

@@ -860,3 +860,26 @@ pub fn save_document(doc: &Document, path: &Path, format: Format) -> Result<(), 
     let bytes = encode(doc, format)?;
     write_atomically(path, &bytes)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `save_body` refuses a boundary normal the reader would refuse (not of length 1), naming
+    /// the face, and writes nothing. The library computes unit normals at every scale (finding
+    /// 254), so the state is made by hand here.
+    #[test]
+    fn save_body_refuses_a_boundary_normal_not_of_length_one() {
+        let (points, tets) = crate::generate::kuhn_cube(1);
+        let (mut body, _) = Body::from_tets(&points, &tets, crate::mechanics::Material::default()).unwrap();
+        let d = body.map().darts().find(|&d| body.map().is_free(3, d)).unwrap();
+        let f = body.map().cell_id(2, d);
+        body.attrs_mut().face_normal[f] = [1.0 + 1e-6, 0.0, 0.0];
+        let path = std::env::temp_dir().join(format!("topomech-store-unit-{}.tmap", std::process::id()));
+        let _ = std::fs::remove_file(&path);
+        let e = save_body(&body, &path, Format::Text).unwrap_err();
+        let named = format!("face {} has the normal", f.0);
+        assert!(matches!(&e, StoreError::Inconsistent { message, .. } if message.contains(&named)), "{e:?}");
+        assert!(!path.exists(), "nothing written");
+    }
+}

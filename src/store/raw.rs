@@ -422,6 +422,7 @@ impl RawMechanics {
             pins_epoch: 0,
             velocity_epoch: 0,
             position_epoch: 0,
+            instance: crate::mechanics::model::Instance::fresh(),
         }
     }
 

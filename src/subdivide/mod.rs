@@ -61,14 +61,6 @@ pub const MAX_LEVEL: u8 = 250;
 /// few levels exhaust the memory of any machine; the refinement is refused before it starts.
 pub const DEFAULT_MAX_DARTS: usize = 100_000_000;
 
-/// Darts per tet of the coarse estimate `check_zone_limit` (kept for the spring coupling's
-/// catch-up only; every level of [`LeveledMap::refine_around`] and its catch-up count exactly,
-/// see `zone_darts_added`): its own 24 darts become 192 (+168), its four faces' neighbours get a
-/// 1→4 face (+18 each), and the tets around its six edges get an edge split (+4 each, for rings
-/// of up to 6 tets). An estimate, not a bound: rings of more tets add more, zone tets sharing
-/// neighbours add less.
-pub(crate) const DARTS_PER_SPLIT_TET: usize = 168 + 4 * 18 + 6 * 6 * 4;
-
 /// The edge cells of one vertex insertion ([`LeveledMap::edge_split_log`]): the edge with cell id
 /// `edge` joining `ends[0]` and `ends[1]` was split at the new vertex `vertex`; afterwards the half
 /// `(ends[0], vertex)` has edge id `halves[0]` and the half `(vertex, ends[1])` has `halves[1]`. One of
@@ -327,16 +319,15 @@ pub enum SubdivideError {
         tets: usize,
         /// Live darts now.
         darts: usize,
-        /// Darts after the level (exact; the spring coupling's catch-up still estimates it
-        /// with 384 per tet).
+        /// Darts after the level: exact, counted before it starts (a catch-up zone mixing
+        /// levels, refused after its splits, gives the darts it reached).
         estimate: usize,
         /// The limit.
         limit: usize,
     },
     /// A split past the precision of the `f64` coordinates: the rounded midpoint of the edge's
-    /// end positions (the position its new vertex would get) is not strictly between them along
-    /// the edge's main axis (the coordinate where they differ most): it is an end, or the ends
-    /// coincide. Accepting it would make tets of zero
+    /// end positions (the position its new vertex would get) is strictly between them along no
+    /// axis: it is an end, or the ends coincide. Accepting it would make tets of zero
     /// or inverted volume that keep a positive mass (m ≠ ρ·V) and lose the point a refinement is
     /// around. Halving an edge of length ℓ at coordinates of size |x| works about
     /// 52 − log2(|x| / ℓ) times: a unit tet at (1, 1, 1) refines to level 52 and level 53 is
@@ -647,10 +638,12 @@ impl<const N: usize> LeveledMap<N> {
     /// Refuses a refinement of `tets` cells at `level` that would leave `estimate` live darts,
     /// when that is over the limit ([`LeveledMap::set_max_darts`]). O(1).
     pub(crate) fn check_dart_limit(&self, level: u8, tets: usize, estimate: usize) -> Result<(), SubdivideError> {
-        if estimate <= self.max_darts {
+        let darts = self.map.dart_count();
+        // A level that adds no dart is never refused, even under a limit lowered below the map
+        // (round 26: an empty zone was refused "from 144 to about 144 darts").
+        if estimate <= self.max_darts || estimate <= darts {
             return Ok(());
         }
-        let darts = self.map.dart_count();
         Err(SubdivideError::DartLimit { level, tets, darts, estimate, limit: self.max_darts })
     }
 

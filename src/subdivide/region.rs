@@ -888,15 +888,6 @@ impl LeveledMap<3> {
         Err(SubdivideError::BadBall { center, radius })
     }
 
-    /// Refuses a level that subdivides `zone` tets when the *estimated* darts after it
-    /// ([`super::DARTS_PER_SPLIT_TET`] per tet) exceed the limit: neither a bound nor exact
-    /// (a ring of more than 6 tets adds more, zone tets sharing neighbours add less). Only the
-    /// spring coupling's catch-up still uses it; [`Self::check_zone_darts`] counts exactly. O(1).
-    pub(super) fn check_zone_limit(&self, level: u8, zone: usize) -> Result<(), SubdivideError> {
-        let estimate = self.map.dart_count().saturating_add(zone.saturating_mul(super::DARTS_PER_SPLIT_TET));
-        self.check_dart_limit(level, zone, estimate)
-    }
-
     /// Refuses splitting every tet of `zone` 1→8 at `level` (a level of `refine_around`, or a
     /// catch-up) when the darts after it, counted exactly by [`Self::zone_darts_added`], exceed
     /// the limit ([`SubdivideError::DartLimit`]). O(Σ zone volumes + rings of the edges it splits).

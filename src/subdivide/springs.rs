@@ -1078,7 +1078,7 @@ impl LeveledMechanics {
         if skipped.is_empty() {
             return self.refine_levels(m, center, radius, levels, (0, before));
         }
-        m.check_zone_limit(m.max_level(), skipped.len())?;
+        m.check_zone_darts(m.max_level(), &skipped)?;
         self.check_split_headroom(m, &skipped)?;
         let saved = (m.clone(), self.clone());
         let result = self
@@ -1126,8 +1126,15 @@ impl LeveledMechanics {
     /// (a split may refuse for what an earlier one did to a shared face): the caller keeps a
     /// copy. O(Σ zone volumes · log E).
     fn catch_up(&mut self, m: &mut LeveledMap<3>, zone: &[DartId]) -> Result<(), CouplingError> {
+        let darts = m.map().dart_count();
         for &d in zone {
             self.split_followed(m, d, m.max_level())?;
+        }
+        // As the map's catch-up: the exact count before may be short for a zone mixing levels.
+        let (estimate, limit) = (m.map().dart_count(), m.max_darts());
+        if estimate > limit {
+            let (level, tets) = (m.max_level(), zone.len());
+            return Err(SubdivideError::DartLimit { level, tets, darts, estimate, limit }.into());
         }
         Ok(())
     }
@@ -1416,30 +1423,43 @@ impl LeveledMechanics {
     /// The momentum E an operation created by moving the masses `delta` (Δ_v, sorted by vertex
     /// id) between vertices, and A, the vertices with Δ_v ≠ 0: E = Σ_{v ∈ A} Δ_v (u_v − u_r), u_r
     /// the velocity of the first vertex of A (equal to Σ Δ_v u_v as Σ Δ_v = 0 up to rounding,
-    /// and exactly 0 for a uniform velocity). `None` when E is exactly 0 or not finite. O(A).
-    fn momentum_excess(&self, delta: &[(u32, f64)]) -> Option<(Vec3, Vec<u32>)> {
+    /// and exactly 0 for a uniform velocity). Component by component, as (value, scale) with
+    /// E_k = value_k · scale_k: where the differences or their sum overflow, the sum is taken of
+    /// halved velocities (scale 2), and a component that is still not finite (a NaN or infinite
+    /// velocity in that component) is 0, left uncorrected — the other components are corrected
+    /// all the same (round 26: one NaN in x dropped the correction of y and z, and velocities of
+    /// ±1.5e308 dropped all of it). `None` when every component is 0. O(A).
+    fn momentum_excess(&self, delta: &[(u32, f64)]) -> Option<(Excess, Vec<u32>)> {
         let a: Vec<u32> = delta.iter().filter(|&&(_, d)| d != 0.0).map(|&(v, _)| v).collect();
         let reference = self.velocity[*a.first()? as usize];
         let u = &self.velocity;
-        let moved = |k: usize| {
+        let moved = |k: usize, half: f64| {
             let terms = delta.iter().filter(|&&(_, d)| d != 0.0);
-            compensated_sum(terms.map(|&(v, d)| d * (u[v as usize][k] - reference[k])))
+            compensated_sum(terms.map(|&(v, d)| d * (u[v as usize][k] * half - reference[k] * half)))
         };
-        let e = [0, 1, 2].map(moved);
-        (e != [0.0; 3] && e.iter().all(|x| x.is_finite())).then_some((e, a))
+        let component = |k: usize| match moved(k, 1.0) {
+            e if e.is_finite() => (e, 1.0),
+            _ => match moved(k, 0.5) {
+                e if e.is_finite() => (e, 2.0),
+                _ => (0.0, 1.0),
+            },
+        };
+        let e = [0, 1, 2].map(component);
+        e.iter().any(|&(x, _)| x != 0.0).then_some((e, a))
     }
 
     /// The velocity correction of the module docs: u_v −= E / M_A for every v ∈ `a` (M_A =
     /// `total`, Σ_{v ∈ A} m_v after the operation), the least change in Σ_v m_v |δu_v|² that
-    /// removes E. Nothing unless M_A is positive and finite. O(A).
-    fn remove_momentum(&mut self, a: &[u32], e: Vec3, total: f64) {
+    /// removes E, component by component ([`Self::momentum_excess`]; a component of E that is
+    /// 0 changes nothing). Nothing unless M_A is positive and finite. O(A).
+    fn remove_momentum(&mut self, a: &[u32], e: Excess, total: f64) {
         if !(total > 0.0 && total.is_finite()) {
             return;
         }
-        let shift = e.map(|x| x / total);
+        let shift = e.map(|(x, scale)| x / total * scale);
         for &v in a {
             let u = &mut self.velocity[v as usize];
-            *u = [0, 1, 2].map(|k| u[k] - shift[k]);
+            *u = [0, 1, 2].map(|k| if shift[k] == 0.0 || !shift[k].is_finite() { u[k] } else { u[k] - shift[k] });
         }
     }
 
@@ -1458,6 +1478,10 @@ impl LeveledMechanics {
         }
     }
 }
+
+/// A momentum excess E per component as (value, scale), E_k = value_k · scale_k
+/// (`LeveledMechanics::momentum_excess`).
+type Excess = [(f64, f64); 3];
 
 /// One dart per distinct volume (by volume id) of `darts`, in order of first meeting. O(darts · log).
 fn distinct_volumes(m: &LeveledMap<3>, darts: impl IntoIterator<Item = DartId>) -> Vec<DartId> {

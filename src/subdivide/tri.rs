@@ -17,17 +17,17 @@ use super::{LeveledMap, Mu, SubdivideError};
 use crate::gmap::{AlphaMask, DartId};
 
 /// Whether the rounded midpoint m of `a` and `b` (`mesh::midpoint`, as stored for a new vertex)
-/// lies strictly between them along the edge's main axis k (the coordinate where they differ
-/// most): min(a_k, b_k) < m_k < max(a_k, b_k), so m ≠ a and m ≠ b (in the other coordinates m
-/// is within [min, max] by rounding, and may equal an end: a long edge whose ends differ by one
-/// ulp across is fine). False for a = b, and for an edge one ulp long along its main axis:
-/// halving an edge of length ℓ at coordinates of size |x| works about 52 − log2(|x| / ℓ) times
-/// (the mantissa has 52 bits); past that, midpoints land on an end and tets collapse. O(1).
+/// lies strictly between them along some axis k: min(a_k, b_k) < m_k < max(a_k, b_k), so m ≠ a
+/// and m ≠ b (in the other coordinates m is within [min, max] by rounding, and may equal an end:
+/// a long edge whose ends differ by one ulp across is fine). False for a = b, and for an edge
+/// one ulp long along every axis where its ends differ: halving an edge of length ℓ at
+/// coordinates of size |x| works about 52 − log2(|x| / ℓ) times (the mantissa has 52 bits);
+/// past that, midpoints land on an end and tets collapse. Any axis, not only the one where the
+/// ends differ most: that one was chosen by axis order on ties, so an edge and its mirror
+/// image could be decided differently (round 26). O(1).
 pub(super) fn midpoint_between(a: [f64; 3], b: [f64; 3]) -> bool {
     let m = crate::mesh::midpoint(a, b);
-    let spread = |k: usize| (b[k] - a[k]).abs();
-    let k = (1..3).fold(0, |main, k| if spread(k) > spread(main) { k } else { main });
-    a[k].min(b[k]) < m[k] && m[k] < a[k].max(b[k])
+    (0..3).any(|k| a[k].min(b[k]) < m[k] && m[k] < a[k].max(b[k]))
 }
 
 /// One side of a triangle face: the corner dart it starts from and its inserted (flat) vertices
@@ -43,7 +43,8 @@ impl<const N: usize> LeveledMap<N> {
     /// `subdividedge`). Every dart x of the edge gets a new dart x' with α0^level(x) = x'; the
     /// new darts are α1-linked pairwise at the new vertex and αj-linked (j ≥ 2) like their
     /// partners. All darts of the two halves take μa = level. Returns α0(d) afterwards.
-    /// O(edge · (n + log edge)): each dart's new partner is found in the orbit sorted once.
+    /// O(edge · (n + log edge) + V): each dart's new partner is found in the orbit sorted once; V,
+    /// the darts of the vertices it touches, is the relabelling at the end of the operation.
     ///
     /// Errors: [`SubdivideError::NoSuchDart`], [`SubdivideError::OpenEdge`],
     /// [`SubdivideError::AlreadyAtLevel`] (μa(d) ≥ level), [`SubdivideError::BelowPrecision`]

@@ -1,0 +1,144 @@
+//! Round 26 (b): a body's attributes replaced as a whole, boundary normals at extreme scales, a
+//! sew that moved a pinned vertex by one ulp, a simulation moved to another body through its
+//! public projection.
+
+use topomech::cut::{dissociate_face, remove_volume};
+use topomech::generate::kuhn_cube;
+use topomech::mechanics::{
+    Body, ConservationError, Integrator, Material, Projection, SimError, Simulation, StepConfig, SystemError,
+};
+use topomech::store::{self, Format};
+use topomech::{CellId, DartId};
+
+fn cube_with(k: usize, material: Material) -> Body {
+    let (points, tets) = kuhn_cube(k);
+    Body::from_tets(&points, &tets, material).unwrap().0
+}
+
+fn cube(k: usize) -> Body {
+    cube_with(k, Material::default())
+}
+
+fn inner(b: &Body) -> DartId {
+    b.map().darts().find(|&d| !b.map().is_free(3, d)).unwrap()
+}
+
+fn temp(name: &str) -> std::path::PathBuf {
+    std::env::temp_dir().join(format!("topomech-r26-{}-{name}", std::process::id()))
+}
+
+/// F1a: attributes put back from before a cut do not cover the map: every entry that would
+/// index past them refuses with an error naming it (they panicked on an index, or padded the
+/// arrays with zeros and went on).
+#[test]
+fn short_attributes_put_back_whole_are_refused_not_a_panic() {
+    let mut a = cube(2);
+    let snap = a.attrs().clone();
+    let d = inner(&a);
+    dissociate_face(&mut a, d).unwrap();
+    *a.attrs_mut() = snap;
+    assert!(matches!(a.check(), Err(ConservationError::MissingAttributes { .. })));
+    assert!(matches!(Projection::build(&a, [0.0; 3]), Err(SystemError::Attributes(_))));
+    let config = StepConfig::new(Integrator::Symplectic, 1e-3);
+    assert!(matches!(Simulation::new(&mut a, [0.0; 3], config), Err(SimError::Projection(SystemError::Attributes(_)))));
+    assert!(matches!(a.update_normals(), Err(ConservationError::MissingAttributes { .. })));
+    let version = a.version();
+    assert!(remove_volume(&mut a, CellId(0)).is_err());
+    let d = inner(&a);
+    assert!(a.unsew3(d).is_err());
+    assert!(dissociate_face(&mut a, d).is_err());
+    assert_eq!(a.version(), version, "nothing was done");
+}
+
+/// F1b: attributes replaced by another body's of the same mesh (density 3): the projection and
+/// the simulation built before are no longer for the body; the update rebuilds, and the
+/// simulation refuses until rebuilt, then steps with the new masses.
+#[test]
+fn attributes_replaced_whole_make_projections_not_current() {
+    let mut a = cube(2);
+    let b = cube_with(2, Material { density: 3.0, ..Material::default() });
+    let mut p = Projection::build(&a, [0.0; 3]).unwrap();
+    let mut sim = Simulation::new(&mut a, [0.0, 0.0, -9.81], StepConfig::new(Integrator::Symplectic, 1e-3)).unwrap();
+    *a.attrs_mut() = b.attrs().clone();
+    assert!(a.check().is_ok());
+    assert!(!p.is_for(&a) && !p.is_current(&a));
+    assert!(!p.update(&a, &Default::default()), "rebuilt, not incremental");
+    assert!(p.equivalent(&Projection::build(&a, [0.0; 3]).unwrap()).is_ok());
+    assert!(matches!(sim.step(&mut a), Err(SimError::ProjectionNotForBody { .. })));
+    sim.rebuild(&mut a).unwrap();
+    sim.step(&mut a).unwrap();
+    let (k_sim, k_body) = (sim.kinetic_energy(&a).unwrap(), a.kinetic_energy());
+    assert!((k_sim - k_body).abs() <= 1e-12 * k_body, "{k_sim} vs {k_body}");
+    // swapping two bodies' attributes is seen the same way
+    let mut c = cube(2);
+    let q = Projection::build(&c, [0.0; 3]).unwrap();
+    std::mem::swap(a.attrs_mut(), c.attrs_mut());
+    assert!(!q.is_current(&c));
+}
+
+/// F2: boundary normals at every scale are unit vectors (or zero for a degenerate face), the
+/// same as at scale 1 up to rounding, and the body saves: at 1e-79 they were 1 + 8e-9 long,
+/// from 1e78 zero, from 1e155 NaN, and `save_body` refused the body.
+#[test]
+fn boundary_normals_are_unit_at_every_scale_and_the_body_saves() {
+    let reference = {
+        let b = cube(1);
+        let m = b.map();
+        m.one_dart_per_cell(2).into_iter().map(|d| b.attrs().face_normal(m.cell_id(2, d))).collect::<Vec<_>>()
+    };
+    for s in [1e-300, 1e-150, 1e-81, 1e-79, 1e78, 1e100, 1e155, 1e300] {
+        let mut b = cube(1);
+        b.attrs_mut().position_mut().as_mut_slice().iter_mut().for_each(|p| *p = p.map(|c| c * s));
+        b.update_normals().unwrap();
+        let m = b.map();
+        for (k, d) in m.one_dart_per_cell(2).into_iter().enumerate() {
+            let n = b.attrs().face_normal(m.cell_id(2, d));
+            let diff = (0..3).map(|i| (n[i] - reference[k][i]).abs()).fold(0.0, f64::max);
+            assert!(diff <= 1e-15, "scale {s:e}, face {k}: {n:?} vs {:?}", reference[k]);
+        }
+        assert!(b.check().is_ok());
+        let path = temp("scale.tmapb");
+        store::save_body(&b, &path, Format::Binary).unwrap_or_else(|e| panic!("scale {s:e}: {e}"));
+        assert!(store::load_body(&path).is_ok());
+        let _ = std::fs::remove_file(path);
+    }
+}
+
+/// F3: sewing back two sides at the same position keeps the position bit for bit (a pinned
+/// vertex moved by one ulp: w1·p + w2·p with w1 + w2 ≠ 1).
+#[test]
+fn a_sew_of_two_sides_at_one_position_keeps_it_exactly() {
+    let mut b = cube(2);
+    b.attrs_mut().pin_where(|_, _| true);
+    let before = b.attrs().position().as_slice().to_vec();
+    let (d1, d2) = (DartId(15), DartId(28));
+    let e1 = b.map().alpha::<3>(d1);
+    b.unsew3(d1).unwrap();
+    b.unsew3(d2).unwrap();
+    b.sew3(d1, e1).unwrap();
+    let after = b.attrs().position().as_slice();
+    for v in b.map().one_dart_per_cell(0).into_iter().map(|d| b.map().vertex_id(d)) {
+        assert_eq!(after[v.index()], before[v.index()], "vertex {}", v.0);
+    }
+    assert!(b.attrs().pinned().as_slice()[1]);
+}
+
+/// F4: a simulation whose public projection was rebuilt for another body refuses that body
+/// (it stepped it without `Simulation::rebuild`'s reset, moving a pinned vertex), and its own.
+#[test]
+fn a_simulation_does_not_follow_its_projection_to_another_body() {
+    let mut b = cube(1);
+    b.attrs_mut().pinned_mut().as_mut_slice()[0] = true;
+    let mut a = cube(1);
+    let mut sim = Simulation::new(&mut a, [0.0; 3], StepConfig::new(Integrator::Symplectic, 1e-2)).unwrap();
+    sim.projection.rebuild(&b);
+    assert!(matches!(sim.step(&mut b), Err(SimError::OtherBody { .. })));
+    assert!(matches!(sim.step(&mut a), Err(SimError::ProjectionNotForBody { .. })));
+    sim.rebuild(&mut b).unwrap();
+    b.attrs_mut().velocity_mut().as_mut_slice()[0] = [1.0, 0.0, 0.0];
+    for _ in 0..10 {
+        sim.step(&mut b).unwrap();
+    }
+    assert_eq!(sim.stepper.steps_done(), 10);
+    assert_eq!(b.attrs().position().as_slice()[0], [0.0; 3], "the pinned vertex stays");
+}

@@ -142,3 +142,25 @@ fn a_simulation_does_not_follow_its_projection_to_another_body() {
     assert_eq!(sim.stepper.steps_done(), 10);
     assert_eq!(b.attrs().position().as_slice()[0], [0.0; 3], "the pinned vertex stays");
 }
+
+/// F1b through `Projection::for_clone`: a clone whose attributes were replaced after cloning by
+/// others is not given the original's projection (it would describe the old masses); an
+/// untouched clone is.
+#[test]
+fn for_clone_refuses_a_clone_whose_attributes_were_replaced() {
+    let a = cube(2);
+    let b = cube_with(2, Material { density: 3.0, ..Material::default() });
+    let p = Projection::build(&a, [0.0; 3]).unwrap();
+    let copy = a.clone();
+    let q = p.for_clone(&a, &copy).expect("an untouched clone");
+    assert!(q.equivalent(&Projection::build(&copy, [0.0; 3]).unwrap()).is_ok());
+    let mut replaced = a.clone();
+    *replaced.attrs_mut() = b.attrs().clone();
+    assert!(p.for_clone(&a, &replaced).is_none());
+    // another clone of the attributes the projection read (the original is unchanged): the
+    // projection describes it, and is given
+    let mut again = a.clone();
+    *again.attrs_mut() = a.attrs().clone();
+    let r = p.for_clone(&a, &again).expect("a clone of the same attributes");
+    assert!(r.equivalent(&Projection::build(&again, [0.0; 3]).unwrap()).is_ok());
+}

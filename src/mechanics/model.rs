@@ -265,21 +265,27 @@ pub struct Mechanics {
 }
 
 /// The identity of one [`Mechanics`] value: process-wide unique, fresh on every clone (a clone
-/// is another value, which may be put in place of the first). Not part of the body's state
-/// (never stored, not compared). O(1).
+/// is another value, which may be put in place of the first), with the identity of the value it
+/// was cloned from (0 for none). Not part of the body's state (never stored, not compared).
+/// O(1).
 #[derive(Debug)]
-pub(crate) struct Instance(pub(crate) u64);
+pub(crate) struct Instance {
+    /// This value's identity.
+    pub(crate) id: u64,
+    /// The identity of the value this one was cloned from, or 0.
+    pub(crate) from: u64,
+}
 
 impl Instance {
     /// A number no other instance has. O(1).
     pub(crate) fn fresh() -> Self {
-        Instance(crate::embedding::next_identity())
+        Instance { id: crate::embedding::next_identity(), from: 0 }
     }
 }
 
 impl Clone for Instance {
     fn clone(&self) -> Self {
-        Instance::fresh()
+        Instance { id: crate::embedding::next_identity(), from: self.id }
     }
 }
 

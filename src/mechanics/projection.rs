@@ -145,7 +145,7 @@ impl Projection {
             version: body.version(),
             pins_epoch: mech.pins_epoch,
             body: body.identity(),
-            attrs: mech.instance.0,
+            attrs: mech.instance.id,
             scratch: Resolved::default(),
         }
     }
@@ -290,7 +290,7 @@ impl Projection {
     /// assert!(!p.is_for(&copy) && !p.is_current(&copy)); // same version, another body
     /// ```
     pub fn is_for(&self, body: &Body) -> bool {
-        self.body == body.identity() && self.attrs == body.attrs().instance.0
+        self.body == body.identity() && self.attrs == body.attrs().instance.id
     }
 
     /// The [`Body::identity`] of the body the projection was built from. O(1).
@@ -313,8 +313,9 @@ impl Projection {
     /// was current for it (same map, attributes and version): the copy's arrays are the same,
     /// only the body it answers for changes. `None` unless the projection is current for
     /// `original` and `copy` is a clone of `original` with no operation on either since
-    /// ([`Body::clone`] records its source's identity and version) and the same pins. O(slots +
-    /// springs) (the copy).
+    /// ([`Body::clone`] records its source's identity and version), the same pins, and the
+    /// attributes cloned with it (not replaced since through `attrs_mut`). O(slots + springs)
+    /// (the copy).
     ///
     /// # Examples
     ///
@@ -332,12 +333,15 @@ impl Projection {
     /// ```
     pub fn for_clone(&self, original: &Body, copy: &Body) -> Option<Projection> {
         let same_pins = copy.attrs().pins_epoch == original.attrs().pins_epoch;
-        if !self.is_current(original) || !copy.is_unchanged_clone_of(original) || !same_pins {
+        // The copy's attributes must be the clone of the ones this projection read, not put in
+        // its place since (round 26).
+        let same_attrs = copy.attrs().instance.from == self.attrs;
+        if !self.is_current(original) || !copy.is_unchanged_clone_of(original) || !same_pins || !same_attrs {
             return None;
         }
         let mut out = self.clone();
         out.body = copy.identity();
-        out.attrs = copy.attrs().instance.0;
+        out.attrs = copy.attrs().instance.id;
         Some(out)
     }
 

@@ -538,17 +538,25 @@ pub(super) fn check_body_state(map: &GMap<3>, mech: &crate::mechanics::Mechanics
             )));
         }
     }
-    for d in map.one_dart_per_cell(2) {
-        let (f, free) = (map.cell_id(2, d), map.is_free(3, d));
-        if mech.face_is_boundary(f) != free {
-            let (flag, truth) = if free { ("inner", "boundary") } else { ("boundary", "inner") };
-            return Err(inconsistent(format!("face {} is flagged {flag} but is a {truth} face of the map", f.0)));
+    // The face law of the body (flag = α3-free, inner normals zero), named as the reader names it.
+    let face_message = |e: ConservationError| match e {
+        ConservationError::FaceFlag { face, flagged_boundary, .. } => {
+            let (flag, truth) = if flagged_boundary { ("boundary", "inner") } else { ("inner", "boundary") };
+            format!("face {} is flagged {flag} but is a {truth} face of the map", face.0)
         }
+        ConservationError::InnerFaceNormal { face, normal, .. } => {
+            let len = normal.iter().map(|c| c * c).sum::<f64>().sqrt();
+            format!("face {} has the normal {normal:?} of length {len}, not zero (an inner face)", face.0)
+        }
+        other => other.to_string(),
+    };
+    mech.check_faces(map).map_err(|e| inconsistent(face_message(e)))?;
+    for d in map.one_dart_per_cell(2).into_iter().filter(|&d| map.is_free(3, d)) {
+        let f = map.cell_id(2, d);
         let n = mech.face_normal(f);
         let len = n.iter().map(|c| c * c).sum::<f64>().sqrt();
-        let zero = n == [0.0; 3];
-        if !(zero || free && (len - 1.0).abs() <= NORMAL_TOLERANCE) {
-            let rule = if free { "of length 1 (or zero for a degenerate face)" } else { "zero (an inner face)" };
+        if !(n == [0.0; 3] || (len - 1.0).abs() <= NORMAL_TOLERANCE) {
+            let rule = "of length 1 (or zero for a degenerate face)";
             return Err(inconsistent(format!("face {} has the normal {n:?} of length {len}, not {rule}", f.0)));
         }
     }

@@ -873,9 +873,16 @@ impl LeveledMap<3> {
         for &d in zone {
             self.subdivide_tet_with_mass(d, self.max_level, masses)?;
         }
+        self.check_caught_up(darts, zone.len())
+    }
+
+    /// After a catch-up of `tets` zone tets that started at `darts` live darts:
+    /// [`SubdivideError::DartLimit`] if the map now passes its limit (the exact count before a
+    /// catch-up can be short for a zone mixing levels; the caller puts its copy back). O(1).
+    pub(super) fn check_caught_up(&self, darts: usize, tets: usize) -> Result<(), SubdivideError> {
         let (estimate, limit) = (self.map.dart_count(), self.max_darts);
         if estimate > limit {
-            return Err(SubdivideError::DartLimit { level: self.max_level, tets: zone.len(), darts, estimate, limit });
+            return Err(SubdivideError::DartLimit { level: self.max_level, tets, darts, estimate, limit });
         }
         Ok(())
     }

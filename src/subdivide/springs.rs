@@ -1130,13 +1130,7 @@ impl LeveledMechanics {
         for &d in zone {
             self.split_followed(m, d, m.max_level())?;
         }
-        // As the map's catch-up: the exact count before may be short for a zone mixing levels.
-        let (estimate, limit) = (m.map().dart_count(), m.max_darts());
-        if estimate > limit {
-            let (level, tets) = (m.max_level(), zone.len());
-            return Err(SubdivideError::DartLimit { level, tets, darts, estimate, limit }.into());
-        }
-        Ok(())
+        Ok(m.check_caught_up(darts, zone.len())?)
     }
 
     /// One level of [`Self::refine_around`] by the map's bulk path ([`LeveledMap::refine_uniform`])

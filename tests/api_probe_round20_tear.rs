@@ -28,7 +28,8 @@ fn cube() -> (Body, Simulation, Vec<Vec3>) {
 /// (0, 0, 1) moved up by `h`.
 fn place(body: &mut Body, rest: &[Vec3], e: f64, h: f64) {
     let r = std::f64::consts::FRAC_1_SQRT_2;
-    let mut pos = body.attrs_mut().position_mut();
+    let mut attrs = body.attrs_mut();
+    let mut pos = attrs.position_mut();
     let s = pos.as_mut_slice();
     s.copy_from_slice(rest);
     s[3][0] += e * r;
@@ -126,7 +127,8 @@ proptest! {
         let sim = Simulation::new(&mut body, [0.0; 3], StepConfig::new(Integrator::Euler, 1e-4)).unwrap();
         let dirs = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 0.0], [1.0, 0.0, 1.0], [0.0, -1.0, 1.0]];
         for &(v, k, amount) in &pulls {
-            let mut pos = body.attrs_mut().position_mut();
+            let mut attrs = body.attrs_mut();
+            let mut pos = attrs.position_mut();
             let p = &mut pos.as_mut_slice()[v];
             for i in 0..3 {
                 p[i] += amount * dirs[k][i];

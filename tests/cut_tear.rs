@@ -18,7 +18,7 @@ fn stretched_cube(stretch: f64) -> (Body, Simulation) {
     let (points, tets) = kuhn_cube(K);
     let (mut body, _) = Body::from_tets(&points, &tets, material()).unwrap();
     let k = K as f64;
-    let mech = body.attrs_mut();
+    let mut mech = body.attrs_mut();
     mech.pin_where(|_, p| p[0] <= 0.0 || p[0] >= k);
     let rest = mech.rest_position().as_slice().to_vec();
     for (x, r) in mech.position_mut().as_mut_slice().iter_mut().zip(&rest) {

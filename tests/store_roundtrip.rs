@@ -72,13 +72,18 @@ fn assert_body_round_trips(body: &Body) {
         let again = store::encode(&Document::from_body(&back), Format::Binary).unwrap();
         assert!(again == reference, "{format:?}: attributes differ after the round trip");
         let (m0, m1) = (body.attrs(), back.attrs());
-        for v in 0..m0.position().len() {
-            let id = CellId(v as u32);
+        // Live vertex ids: a dead id's record is written blank (round 27, finding 257).
+        let mut live: Vec<CellId> = body.map().darts().map(|d| body.map().vertex_id(d)).collect();
+        live.sort_unstable();
+        live.dedup();
+        for &id in &live {
             assert_eq!(m0.position()[id].map(f64::to_bits), m1.position()[id].map(f64::to_bits));
             assert_eq!(m0.vertex_mass(id).to_bits(), m1.vertex_mass(id).to_bits());
         }
-        for e in 0..m0.attribute_len(1) {
-            let id = CellId(e as u32);
+        let mut live_edges: Vec<CellId> = body.map().darts().map(|d| body.map().cell_id(1, d)).collect();
+        live_edges.sort_unstable();
+        live_edges.dedup();
+        for &id in &live_edges {
             assert_eq!(m0.edge_stiffness(id).to_bits(), m1.edge_stiffness(id).to_bits());
         }
         back.check().unwrap();
@@ -88,7 +93,7 @@ fn assert_body_round_trips(body: &Body) {
 /// Moves every vertex by awkward amounts (subnormal, 0.1-like, negative zero) so the float
 /// encoding is really exercised.
 fn disturb(body: &mut Body) {
-    let m = body.attrs_mut();
+    let mut m = body.attrs_mut();
     for (k, p) in m.position_mut().as_mut_slice().iter_mut().enumerate() {
         p[0] += 0.1 * (k as f64).sin();
         p[1] += f64::MIN_POSITIVE / 3.0;

@@ -96,7 +96,7 @@ pub fn volume_dart(body: &Body, t: CellId) -> Option<DartId> {
 /// ```
 pub fn remove_volume(body: &mut Body, t: CellId) -> Result<Removal, CutError> {
     let d = volume_dart(body, t).ok_or(CutError::NoSuchVolume(t))?;
-    // Attributes replaced as a whole through `attrs_mut` may not cover the map (round 26).
+    // A defence: attributes that do not cover the map (replaced whole before round 27).
     let refused = |source| crate::embedding::EmbedError::Refused { op: "remove_volume", dart: d, source };
     body.attrs().check_covers(body.map()).map_err(refused)?;
     let darts = body.map().cell_darts(3, d);

@@ -340,11 +340,12 @@ impl<T> std::ops::IndexMut<CellId> for CellSliceMut<'_, T> {
 /// be walked.
 ///
 /// The methods are called by the embedding layer ([`Embedded::sew`], [`Embedded::unsew`]), in
-/// that order, once per operation; called by hand on attributes that an [`Embedded`] owns they
-/// rewrite those attributes from whatever map they are given, and [`Embedded::check`] names the
-/// law that breaks (for [`crate::mechanics::Mechanics`]: a face flag, a sum) — but not a state
-/// that keeps the laws (e.g. a vertex pinned by a merge rule), and a projection or simulation
-/// built before does not see it: rebuild them.
+/// that order, once per operation. An [`Embedded`]'s own attributes cannot be reached mutably
+/// from outside the crate (a body opens its free state only, [`crate::mechanics::AttrsMut`];
+/// round 27), so they cannot be called on them by hand; called on attributes taken out
+/// ([`Embedded::into_parts`]) they rewrite them from whatever map they are given, and
+/// [`Embedded::new`] names the law that breaks when the parts are put back together (for
+/// [`crate::mechanics::Mechanics`]: a face flag, a sum).
 ///
 /// # Panics
 ///
@@ -703,23 +704,11 @@ impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
         &self.attrs
     }
 
-    /// The attributes, mutable (state variables such as positions change every time step). The
-    /// map stays untouchable. O(1).
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use topomech::generate::kuhn_cube;
-    /// use topomech::mechanics::{Body, Material};
-    /// use topomech::CellId;
-    ///
-    /// let (points, tets) = kuhn_cube(1);
-    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
-    /// body.attrs_mut().position_mut()[CellId(0)] = [0.0, 0.0, -1.0];
-    /// assert_eq!(body.attrs().position()[CellId(0)], [0.0, 0.0, -1.0]);
-    /// assert_eq!(body.version(), 0); // attributes are not topology
-    /// ```
-    pub fn attrs_mut(&mut self) -> &mut E {
+    /// The attributes, mutable as a whole, inside the crate only: a caller outside gets a body's
+    /// free state through [`crate::mechanics::AttrsMut`] (`Body::attrs_mut`), which cannot
+    /// replace or swap the attributes whole (rounds 26–27: attributes put back from another
+    /// state broke the cover and the laws behind every check's back). O(1).
+    pub(crate) fn attrs_raw_mut(&mut self) -> &mut E {
         &mut self.attrs
     }
 

@@ -1,6 +1,8 @@
 //! `check_conservation`: the laws of [`model`](super::model) recomputed from the map's orbits.
 //!
-//! The check does not trust any stored mass or stiffness. It covers the volumes of the map (a
+//! The check does not trust any stored mass or stiffness. It first requires a lawful material
+//! (ρ > 0, E, β, ν ≥ 0, finite), and of each tet a positive finite rest volume and E_t = E (a
+//! body is homogeneous). It covers the volumes of the map (a
 //! traversal with a dart set, seed §4.2, independent of the kernel's cell ids for finding the
 //! volumes) and, from each tetrahedron, scatters m_t/4 to its four vertices and E_t·V_t/L_e² to
 //! its six edges, where L_e is measured again on the rest positions of the edge's two vertices.
@@ -107,6 +109,32 @@ pub enum ConservationError {
         /// The recomputed value.
         expected: f64,
     },
+    /// A tet's rest volume V_t is not positive and finite (a tet is built from four points
+    /// spanning a volume; its mass ρ·V_t and its springs' stiffnesses E·V_t/L² are its shares).
+    #[error("volume {} (e.g. {dart}): rest volume {volume} is not positive and finite", .tet.0)]
+    RestVolume {
+        /// The volume id.
+        tet: CellId,
+        /// A dart of the volume.
+        dart: DartId,
+        /// The stored value.
+        volume: f64,
+    },
+    /// A tet's Young's modulus E_t is not the material's E (a body is homogeneous: every tet's
+    /// springs are computed from E_t = E; compared bit for bit).
+    #[error("volume {}: Young's modulus {stored} but the material's E is {material}", .tet.0)]
+    TetYoung {
+        /// The volume id.
+        tet: CellId,
+        /// The stored value.
+        stored: f64,
+        /// The material's E.
+        material: f64,
+    },
+    /// The material constants break their law ([`crate::mechanics::Material`]: ρ > 0, E, β,
+    /// ν ≥ 0, all finite).
+    #[error("material: {0}")]
+    Material(crate::mechanics::ModelError),
     /// A dart given to a recomputation from the map is not live in that map.
     #[error("{0} is not a live dart of the map")]
     NoSuchDart(DartId),
@@ -281,6 +309,10 @@ pub fn conservation_violations(map: &GMap<3>, mech: &Mechanics, limit: usize) ->
         sink.push(e);
         return sink.out;
     }
+    if let Err(e) = super::model::check_material(mech.material()) {
+        sink.push(ConservationError::Material(e));
+        return sink.out;
+    }
     let exp = scatter_from_volumes(map, mech, &mut sink);
     check_vertices(mech, &exp, &mut sink);
     check_edges(mech, &exp, &mut sink);
@@ -345,6 +377,12 @@ fn scatter_from_volumes(map: &GMap<3>, mech: &Mechanics, sink: &mut Sink) -> Exp
 fn scatter_one(map: &GMap<3>, mech: &Mechanics, darts: &[DartId], exp: &mut Expected, sink: &mut Sink) {
     let t = map.cell_id(3, darts[0]);
     let (mass, volume, young) = (mech.tet_mass(t), mech.tet_rest_volume(t), mech.tet_young(t));
+    if !(volume.is_finite() && volume > 0.0) {
+        sink.push(ConservationError::RestVolume { tet: t, dart: darts[0], volume });
+    }
+    if young.to_bits() != mech.material().young.to_bits() {
+        sink.push(ConservationError::TetYoung { tet: t, stored: young, material: mech.material().young });
+    }
     let expected = mech.material().density * volume;
     if !close(mass, expected, TOLERANCE) {
         sink.push(ConservationError::TetMass { tet: t, stored: mass, expected });

@@ -1381,8 +1381,8 @@ pub enum SystemError {
         /// The mass given.
         mass: f64,
     },
-    /// A body whose attribute arrays do not cover its map (possible only after the attributes
-    /// were replaced as a whole through `attrs_mut`): nothing can be projected.
+    /// A body whose attribute arrays do not cover its map (a defence: possible only while the
+    /// attributes could be replaced whole, before round 27): nothing can be projected.
     #[error("the body's attributes do not fit its map: {0}")]
     Attributes(crate::mechanics::ConservationError),
 }

@@ -29,11 +29,12 @@ pub use flat::FlatModel;
 pub use force::{IncidenceError, ModeBounds, SpringSystem, SystemError};
 pub use geom::Vec3;
 pub use integrate::{Integrator, StepConfig, StepError, Stepper};
-pub use model::{Body, BodyError, Material, Mechanics, ModelError};
+pub use model::{AttrsMut, Body, BodyError, Material, Mechanics, ModelError};
 pub use projection::{forces_by_coverage, Projection, ProjectionMismatch, TouchedCells};
 pub use simd::Kernel;
 
 use crate::CellId;
+use std::borrow::Cow;
 
 /// Errors of a map-driven simulation.
 ///
@@ -68,9 +69,9 @@ pub enum SimError {
         /// The identity of the body given.
         given: u64,
     },
-    /// The simulation's projection does not describe this body: its attributes were replaced as
-    /// a whole since (`*body.attrs_mut() = other`), or the public `projection` was rebuilt for
-    /// another body. Rebuild the simulation ([`Simulation::rebuild`]).
+    /// The simulation's projection does not describe this body: the public `projection` was
+    /// rebuilt for another body (or, before round 27, the attributes were replaced whole).
+    /// Rebuild the simulation ([`Simulation::rebuild`]).
     #[error("the simulation's projection no longer describes body {body} (its attributes were replaced, or the projection was rebuilt for another body): rebuild the simulation")]
     ProjectionNotForBody {
         /// The identity of the body given.
@@ -260,6 +261,35 @@ pub struct Simulation {
     body: u64,
 }
 
+/// Puts slot `v` at the origin at rest when it is a dead vertex id (no dart: no cell reads it)
+/// holding a non-finite position or velocity, so that a value left in a slot no vertex uses
+/// neither blocks the step's checks nor spreads (finding 257). O(1).
+fn blank_dead(projection: &Projection, v: usize, position: &mut Vec3, velocity: &mut Vec3) {
+    let finite = position.iter().chain(velocity.iter()).all(|c| c.is_finite());
+    if !finite && projection.dart_of_vertex(v).is_none() {
+        (*position, *velocity) = ([0.0; 3], [0.0; 3]);
+    }
+}
+
+/// The positions and velocities of the projection's slots as the stepper will start from them:
+/// the body's own, borrowed, unless a dead slot holds a non-finite value; then a copy with the
+/// dead slots blanked as [`blank_dead`] blanks them in the body once the start is accepted (a
+/// refused start leaves the body unchanged). O(slots).
+fn start_state<'a>(projection: &Projection, mech: &'a Mechanics) -> (Cow<'a, [Vec3]>, Cow<'a, [Vec3]>) {
+    let slots = projection.system.slots();
+    let (x, v) = (&mech.position.as_slice()[..slots], &mech.velocity.as_slice()[..slots]);
+    let blanked = |k: usize| {
+        let (mut p, mut w) = (x[k], v[k]);
+        blank_dead(projection, k, &mut p, &mut w);
+        (p, w)
+    };
+    if (0..slots).all(|k| x[k].iter().chain(&v[k]).all(|c| c.is_finite()) || projection.dart_of_vertex(k).is_some()) {
+        return (Cow::Borrowed(x), Cow::Borrowed(v));
+    }
+    let (x, v): (Vec<Vec3>, Vec<Vec3>) = (0..slots).map(blanked).unzip();
+    (Cow::Owned(x), Cow::Owned(v))
+}
+
 impl Simulation {
     /// Projects `body` (gravity `gravity`) and prepares `config`'s integrator. Pinned vertices get
     /// zero velocity. O(darts + E log E).
@@ -289,16 +319,10 @@ impl Simulation {
         }
         body.attrs().check_covers(body.map()).map_err(|e| SimError::Projection(SystemError::Attributes(e)))?;
         let projection = Projection::build_raw(body, gravity);
-        let slots = projection.system.slots();
-        let mech = body.attrs();
         // Checked before any change (the energy scale counts free slots only, so the pinned
-        // velocities zeroed below do not enter it).
-        let stepper = Stepper::new(
-            config,
-            &projection.system,
-            &mech.position.as_slice()[..slots],
-            &mech.velocity.as_slice()[..slots],
-        )?;
+        // velocities zeroed below do not enter it; dead slots are checked as they will be).
+        let (x, v) = start_state(&projection, body.attrs());
+        let stepper = Stepper::new(config, &projection.system, &x, &v)?;
         let mut sim = Simulation { projection, stepper, velocity_epoch: 0, position_epoch: 0, body: body.identity() };
         sim.hold_fixed(body);
         sim.record_epochs(body);
@@ -306,23 +330,21 @@ impl Simulation {
     }
 
     /// Zeroes the velocity of every fixed slot — pinned vertices (the law "a pinned vertex does
-    /// not move") and dead vertex ids — as [`Simulation::update`] does. O(vertex ids).
+    /// not move") and dead vertex ids — as [`Simulation::update`] does, and puts a dead id with a
+    /// non-finite position at the origin ([`blank_dead`]). O(vertex ids).
     fn hold_fixed(&self, body: &mut Body) {
-        let mech = body.attrs_mut();
-        for (v, &w) in mech.velocity.as_mut_slice().iter_mut().zip(&self.projection.system.inv_mass) {
-            if w == 0.0 {
-                *v = [0.0; 3];
-            }
-        }
+        self.hold_fixed_among(body, (0..self.projection.system.slots()).map(|v| CellId(v as u32)));
     }
 
     /// [`Simulation::hold_fixed`] for the vertex ids `ids` only. O(|ids|).
     fn hold_fixed_among(&self, body: &mut Body, ids: impl Iterator<Item = CellId>) {
-        let velocity = body.attrs_mut().velocity.as_mut_slice();
-        for v in ids {
-            if self.projection.system.inv_mass[v.index()] == 0.0 {
-                velocity[v.index()] = [0.0; 3];
+        let mech = body.attrs_raw_mut();
+        let (position, velocity) = (mech.position.as_mut_slice(), mech.velocity.as_mut_slice());
+        for v in ids.map(CellId::index) {
+            if self.projection.system.inv_mass[v] == 0.0 {
+                velocity[v] = [0.0; 3];
             }
+            blank_dead(&self.projection, v, &mut position[v], &mut velocity[v]);
         }
     }
 
@@ -357,9 +379,8 @@ impl Simulation {
             // the epochs stay unrecorded: the next call checks again. The pins just followed
             // are put back then too, so a refused call leaves the simulation as it was
             // (finding 203).
-            let slots = self.projection.system.slots();
-            let (x, v) = (&mech.position.as_slice()[..slots], &mech.velocity.as_slice()[..slots]);
-            if let Err(e) = self.stepper.reset_energy_scale(&self.projection.system, x, v) {
+            let (x, v) = start_state(&self.projection, mech);
+            if let Err(e) = self.stepper.reset_energy_scale(&self.projection.system, &x, &v) {
                 if let Some(before) = before {
                     self.projection.restore_pins(before);
                 }
@@ -429,7 +450,7 @@ impl Simulation {
     pub fn step(&mut self, body: &mut Body) -> Result<(), SimError> {
         self.follow_writes(body)?;
         let slots = self.projection.system.slots();
-        let mech = body.attrs_mut();
+        let mech = body.attrs_raw_mut();
         let x = &mut mech.position.as_mut_slice()[..slots];
         let v = &mut mech.velocity.as_mut_slice()[..slots];
         self.stepper.step(&self.projection.system, x, v)?;
@@ -627,7 +648,7 @@ impl Simulation {
         let sys = &self.projection.system;
         let slots = sys.slots();
         let (mut sf, mut out) = (vec![[0.0; 3]; sys.springs()], vec![[0.0; 3]; slots]);
-        let mech = body.attrs_mut();
+        let mech = body.attrs_raw_mut();
         let (x, v) = (&mech.position.as_slice()[..slots], &mech.velocity.as_slice()[..slots]);
         sys.forces_raw(x, v, &mut sf, &mut out, self.stepper.config().parallel);
         let force = mech.force.as_mut_slice();

@@ -32,8 +32,9 @@
 //! - edge split: both sides copy the rest length; stiffness and damping are recomputed from the
 //!   tets now around each side (k = k1 + k2).
 //! - face split / merge: boundary flags and normals of the faces touched are recomputed.
-//! - vertex merge: position and velocity become the mass-weighted means (momentum is kept), mass
-//!   is recomputed (= m1 + m2); edge merge: stiffness recomputed (= k1 + k2).
+//! - vertex merge: position and velocity become the mass-weighted means (momentum is kept), or
+//!   the pinned side's when exactly one side is pinned (a pin holds its vertex); the mass is
+//!   recomputed (= m1 + m2); edge merge: stiffness recomputed (= k1 + k2).
 //! - only 3-unsews and 3-sews (face dissociation and gluing) reach these rules: every i-unsew
 //!   and i-sew with i ≤ 2 would open a tet or join volumes, for which the model has no law, and
 //!   is refused before the map changes ([`CellRules::check_unsew`], [`CellRules::check_sew`]).
@@ -220,7 +221,7 @@ pub enum ModelError {
 ///
 /// let (points, tets) = kuhn_cube(1);
 /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
-/// body.attrs_mut().rest_position()[CellId(0)][0] += 0.25; // read-only
+/// body.attrs_raw_mut().rest_position()[CellId(0)][0] += 0.25; // read-only
 /// ```
 #[derive(Clone, Debug)]
 pub struct Mechanics {
@@ -258,9 +259,9 @@ pub struct Mechanics {
     /// ([`Mechanics::position_mut`]): the simulation then takes the state as the new start of
     /// its runaway test (energy put in by hand is not a blow-up).
     pub(crate) position_epoch: u64,
-    /// Which value this is: fresh when made and on every clone, so a projection built from
-    /// a body sees when its attributes were replaced as a whole (`*body.attrs_mut() = …`,
-    /// `mem::swap`) and is then not for that body any more (round 26).
+    /// Which value this is: fresh when made and on every clone, so a projection records which
+    /// attributes it read (round 26, when they could still be replaced whole; since round 27
+    /// [`AttrsMut`] opens the free state only, and the stamp is a second defence).
     pub(crate) instance: Instance,
 }
 
@@ -311,6 +312,109 @@ impl Clone for Instance {
 /// assert_eq!(body.version(), 1);
 /// ```
 pub type Body = Embedded<3, Mechanics>;
+
+/// A body's attributes opened for writing what is free state — positions, velocities and pins
+/// — and readable whole (it dereferences to [`Mechanics`]). Everything else (masses,
+/// stiffnesses, rest shape, face flags) is derived from the topology and changes only through
+/// the body's operations, which keep the laws; and the attributes cannot be replaced or swapped
+/// as a whole, so that the arrays always cover the map and follow its state (rounds 26–27:
+/// attributes put back from another state made a dozen entries panic or use stale values).
+/// Each writer records that it was handed out, so that projections and simulations take the
+/// writes up. O(1) to make.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Material};
+/// use topomech::CellId;
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let mut attrs = body.attrs_mut();
+/// attrs.position_mut()[CellId(0)] = [0.0, 0.0, -1.0];
+/// attrs.velocity_mut()[CellId(0)] = [0.0, 0.0, -2.0];
+/// attrs.pinned_mut()[CellId(1)] = true;
+/// assert_eq!(attrs.position()[CellId(0)], [0.0, 0.0, -1.0]); // reads go through
+/// assert_eq!(body.version(), 0); // attributes are not topology
+/// ```
+///
+/// The attributes of another state cannot be put in:
+///
+/// ```compile_fail
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Material};
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let older = body.attrs().clone();
+/// *body.attrs_mut() = older; // no `DerefMut`: does not compile
+/// ```
+///
+/// ```compile_fail
+/// use topomech::generate::kuhn_cube;
+/// use topomech::mechanics::{Body, Material};
+///
+/// let (points, tets) = kuhn_cube(1);
+/// let (mut a, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// let (mut b, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+/// std::mem::swap(&mut *a.attrs_mut(), &mut *b.attrs_mut()); // does not compile either
+/// ```
+#[derive(Debug)]
+pub struct AttrsMut<'a> {
+    mech: &'a mut Mechanics,
+}
+
+impl std::ops::Deref for AttrsMut<'_> {
+    type Target = Mechanics;
+
+    fn deref(&self) -> &Mechanics {
+        self.mech
+    }
+}
+
+impl AttrsMut<'_> {
+    /// [`Mechanics::position_mut`]. O(1).
+    pub fn position_mut(&mut self) -> CellSliceMut<'_, Vec3> {
+        self.mech.position_mut()
+    }
+
+    /// [`Mechanics::velocity_mut`]. O(1).
+    pub fn velocity_mut(&mut self) -> CellSliceMut<'_, Vec3> {
+        self.mech.velocity_mut()
+    }
+
+    /// [`Mechanics::pinned_mut`]. O(1).
+    pub fn pinned_mut(&mut self) -> CellSliceMut<'_, bool> {
+        self.mech.pinned_mut()
+    }
+
+    /// [`Mechanics::pin_where`]. O(vertex ids).
+    pub fn pin_where(&mut self, pin: impl FnMut(CellId, Vec3) -> bool) {
+        self.mech.pin_where(pin)
+    }
+}
+
+impl Embedded<3, Mechanics> {
+    /// The body's free state, writable: positions, velocities and pins ([`AttrsMut`]; the rest
+    /// changes only through the operations). The map stays untouchable. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use topomech::generate::kuhn_cube;
+    /// use topomech::mechanics::{Body, Material};
+    /// use topomech::CellId;
+    ///
+    /// let (points, tets) = kuhn_cube(1);
+    /// let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
+    /// body.attrs_mut().position_mut()[CellId(0)] = [0.0, 0.0, -1.0];
+    /// assert_eq!(body.attrs().position()[CellId(0)], [0.0, 0.0, -1.0]);
+    /// ```
+    pub fn attrs_mut(&mut self) -> AttrsMut<'_> {
+        AttrsMut { mech: self.attrs_raw_mut() }
+    }
+}
 
 /// Errors of the body's topological operations.
 ///
@@ -1069,8 +1173,20 @@ impl Mechanics {
         // from 1 by a rounding, and w1·p + w2·p moved a pinned vertex sewn back onto itself by
         // one ulp: round 26).
         let mix = |a: Vec3, b: Vec3| std::array::from_fn(|k| if a[k] == b[k] { a[k] } else { w1 * a[k] + w2 * b[k] });
-        self.position[kept] = mix(self.position[kept], self.position[absorbed]);
-        self.velocity[kept] = mix(self.velocity[kept], self.velocity[absorbed]);
+        // A pin holds its vertex: when exactly one side is pinned, the merged vertex is where
+        // that side is, with its velocity (round 27: a sew moved a pin by the other side's
+        // offset, weighted by mass). Both pinned at two places: the weighted mean, as unpinned.
+        match (self.pinned[kept], self.pinned[absorbed]) {
+            (true, false) => {}
+            (false, true) => {
+                self.position[kept] = self.position[absorbed];
+                self.velocity[kept] = self.velocity[absorbed];
+            }
+            _ => {
+                self.position[kept] = mix(self.position[kept], self.position[absorbed]);
+                self.velocity[kept] = mix(self.velocity[kept], self.velocity[absorbed]);
+            }
+        }
         self.pinned[kept] = self.pinned[kept] || self.pinned[absorbed];
         self.vertex_mass[absorbed] = 0.0;
         self.vertex_viscosity[absorbed] = 0.0;
@@ -1202,7 +1318,7 @@ impl CellRules<3> for Mechanics {
     /// a split copies it), or the rest lengths of one side's edges would no longer be the
     /// distances of their ends ([`ConservationError::SewApart`]). O(pairs).
     fn check_sew(&self, map: &GMap<3>, i: usize, pairs: &[(DartId, DartId)]) -> Result<(), ConservationError> {
-        // Attributes replaced as a whole through `attrs_mut` may be short (round 26).
+        // A defence: short attributes (replaced whole before round 27).
         self.check_covers(map)?;
         if let (true, Some(&(x, y))) = (i <= 2, pairs.first()) {
             let (volume, other_volume) = (map.cell_id(3, x), map.cell_id(3, y));
@@ -1537,7 +1653,8 @@ impl Embedded<3, Mechanics> {
     }
 
     /// Sews two boundary faces back together (the inverse of [`Body::unsew3`]): merged vertices
-    /// take mass-weighted positions and velocities, masses and stiffnesses are recomputed.
+    /// take mass-weighted positions and velocities (the pinned side's when only one side is
+    /// pinned), masses and stiffnesses are recomputed.
     ///
     /// # Errors
     /// As [`Body::unsew3`].
@@ -1568,8 +1685,8 @@ impl Embedded<3, Mechanics> {
     /// the version stays. O(darts).
     ///
     /// # Errors
-    /// [`ConservationError::MissingAttributes`] when the attributes do not cover the map (only
-    /// after they were replaced as a whole through `attrs_mut`); nothing changes then.
+    /// [`ConservationError::MissingAttributes`] when the attributes do not cover the map (a
+    /// defence: no public way leads there since round 27); nothing changes then.
     ///
     /// # Examples
     ///
@@ -1745,7 +1862,7 @@ mod tests {
         let (points, tets) = crate::generate::kuhn_cube(1);
         let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
         assert!(body.check().is_ok());
-        body.attrs_mut().rest_position[CellId(0)][0] += 0.25;
+        body.attrs_raw_mut().rest_position[CellId(0)][0] += 0.25;
         assert!(matches!(body.check(), Err(ConservationError::RestLength { .. })));
     }
 
@@ -1757,12 +1874,12 @@ mod tests {
         let (mut body, _) = Body::from_tets(&points, &tets, Material::default()).unwrap();
         let d = body.map().darts().find(|&d| !body.map().is_free(3, d)).unwrap();
         let f = body.map().cell_id(2, d);
-        body.attrs_mut().face_normal[f] = [1.0, 0.0, 0.0];
+        body.attrs_raw_mut().face_normal[f] = [1.0, 0.0, 0.0];
         let e = body.check().unwrap_err();
         assert!(matches!(e, ConservationError::InnerFaceNormal { face, .. } if face == f), "{e:?}");
-        body.attrs_mut().face_normal[f] = [0.0; 3];
+        body.attrs_raw_mut().face_normal[f] = [0.0; 3];
         assert!(body.check().is_ok());
-        body.attrs_mut().face_boundary[f] = true;
+        body.attrs_raw_mut().face_boundary[f] = true;
         let e = body.check().unwrap_err();
         assert!(matches!(e, ConservationError::FaceFlag { face, flagged_boundary: true, .. } if face == f), "{e:?}");
     }

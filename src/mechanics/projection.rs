@@ -78,8 +78,8 @@ pub struct Projection {
     pins_epoch: u64,
     /// The [`Body::identity`] of the body it was built from.
     body: u64,
-    /// The instance of that body's attributes (`Mechanics::instance`): attributes replaced as
-    /// a whole through `attrs_mut` make the projection not for the body any more.
+    /// The instance of that body's attributes (`Mechanics::instance`): a body cannot have its
+    /// attributes replaced since round 27 ([`crate::mechanics::AttrsMut`]); kept as a defence.
     attrs: u64,
     /// The lists of [`Resolved::of`], kept between updates.
     scratch: Resolved,
@@ -189,8 +189,8 @@ impl Projection {
     /// Rebuilds from scratch after topological changes (keeps the gravity). O(darts + E log E).
     ///
     /// # Panics
-    /// If the body's attributes do not cover its map, which only attributes replaced as a whole
-    /// through `attrs_mut` by shorter ones can cause ([`Body::check`] names it;
+    /// If the body's attributes do not cover its map, which no body built and changed through
+    /// the public API has (attributes can no longer be replaced whole since round 27;
     /// [`Projection::build`] returns the error instead).
     ///
     /// # Examples
@@ -271,9 +271,9 @@ impl Projection {
     }
 
     /// Whether the projection was built from `body` (and not from another body, or a clone of
-    /// it: [`Body::identity`]), with the attributes it has now: attributes replaced as a whole
-    /// (`*body.attrs_mut() = other`, `std::mem::swap`; a `Mechanics` clone is another value)
-    /// make it not for the body (round 26: it said it was current with another body's masses).
+    /// it: [`Body::identity`]), with the attributes it has now (each `Mechanics` value has its
+    /// own instance stamp; round 26: attributes replaced as a whole made it say it was current
+    /// with another body's masses — since round 27 a body's attributes cannot be replaced).
     /// O(1).
     ///
     /// # Examples
@@ -314,7 +314,7 @@ impl Projection {
     /// only the body it answers for changes. `None` unless the projection is current for
     /// `original` and `copy` is a clone of `original` with no operation on either since
     /// ([`Body::clone`] records its source's identity and version), the same pins, and the
-    /// attributes cloned with it (not replaced since through `attrs_mut`). O(slots + springs)
+    /// attributes cloned with it. O(slots + springs)
     /// (the copy).
     ///
     /// # Examples

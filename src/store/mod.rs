@@ -394,9 +394,11 @@ impl Document {
         }
     }
 
-    /// The document of a body (map + mechanics), as it is, unchecked: a body whose state
-    /// [`Document::into_body`] refuses (a face flag rewritten by a [`crate::embedding::CellRules`]
-    /// method called by hand, a boundary normal not of length 1) gives a document it refuses;
+    /// The document of a body (map + mechanics), as it is, unchecked, with the records of dead
+    /// cell ids blank ([`RawMechanics::blank_dead`]: no cell reads them): a body whose state
+    /// [`Document::into_body`] refuses (before round 27, a face flag rewritten by a
+    /// [`crate::embedding::CellRules`] method called by hand on the body's attributes) gives a
+    /// document it refuses;
     /// [`save_body`] checks before writing. O(capacity + cells).
     ///
     /// # Examples
@@ -412,8 +414,9 @@ impl Document {
     /// assert_eq!(Document::from_body(&back), doc);
     /// ```
     pub fn from_body(body: &Body) -> Self {
-        let mechanics = Some(RawMechanics::from_mechanics(body.attrs()));
-        Document { map: RawMap::from_map(body.map()), mechanics, levels: None }
+        let (map, mut mechanics) = (RawMap::from_map(body.map()), RawMechanics::from_mechanics(body.attrs()));
+        mechanics.blank_dead(&map);
+        Document { map, mechanics: Some(mechanics), levels: None }
     }
 
     /// The map, required to satisfy every law. O(darts · n²).
@@ -882,7 +885,7 @@ mod tests {
         let (mut body, _) = Body::from_tets(&points, &tets, crate::mechanics::Material::default()).unwrap();
         let d = body.map().darts().find(|&d| body.map().is_free(3, d)).unwrap();
         let f = body.map().cell_id(2, d);
-        body.attrs_mut().face_normal[f] = [1.0 + 1e-6, 0.0, 0.0];
+        body.attrs_raw_mut().face_normal[f] = [1.0 + 1e-6, 0.0, 0.0];
         let path = std::env::temp_dir().join(format!("topomech-store-unit-{}.tmap", std::process::id()));
         let _ = std::fs::remove_file(&path);
         let e = save_body(&body, &path, Format::Text).unwrap_err();

@@ -34,6 +34,7 @@ mod flat;
 pub mod fuzz;
 mod history;
 mod ops;
+mod orient;
 mod parts;
 mod region;
 mod springs;
@@ -348,6 +349,30 @@ pub enum SubdivideError {
         vertices: [u32; 2],
         /// Their positions.
         positions: [[f64; 3]; 2],
+    },
+    /// A 1→8 split past the precision of the `f64` coordinates: the tet is valid but so nearly
+    /// flat at its scale (corners within a few ulps of a plane) that, with its edge midpoints
+    /// rounded, a child would be flat or oriented against it — and keep a share of its mass
+    /// (finding 247). Checked for the 8 children of each of the 3 diagonals of the octahedron
+    /// (the choice among near ties may fall to vertex ids), by a float filter and else exact
+    /// orientation; an exactly flat tet is not refused (it has no orientation to keep).
+    /// Refused before any change (at a level of a refinement, before its first split); not
+    /// checked on a map without points.
+    #[error(
+        "splitting the tet of {dart} (corners {corners:?}) 1->8 at level {level} is past the precision of f64: \
+         with its midpoints rounded, the child of corner and midpoint labels {child:?} would be flat or \
+         inverted (the tet is nearly flat at the scale of its coordinates)"
+    )]
+    FlatChild {
+        /// The level refused.
+        level: u8,
+        /// A dart of the tet.
+        dart: DartId,
+        /// Its corner vertex ids (labels 0..3).
+        corners: [u32; 4],
+        /// The child's labels: corners 0..3, midpoint of corners x < y = 4 + index of (x, y) in
+        /// (0,1), (0,2), (0,3), (1,2), (1,3), (2,3).
+        child: [u8; 4],
     },
 }
 

@@ -587,7 +587,9 @@ impl LeveledMap<3> {
     /// [`SubdivideError::BadBall`] for a non-finite centre or radius or a negative radius, those
     /// of [`TetMasses::check`], before any change; in a catch-up, the dart limit and the refusals
     /// of [`Self::subdivide_tet_with_mass`] (e.g. [`SubdivideError::FaceRefinedTooFar`] for a tet
-    /// whose face a finer neighbour refined twice), the map and masses put back; at a level,
+    /// whose face a finer neighbour refined twice — an earlier call that refined a zone two or
+    /// more levels past a face neighbour leaves that neighbour so, for good: no 2:1 balance
+    /// across faces yet, finding 264), the map and masses put back; at a level,
     /// [`SubdivideError::DartLimit`] for a level whose darts (counted exactly before it starts)
     /// would pass the dart limit, and the refusals of [`Self::subdivide_tet_with_mass`] for any
     /// tet of its zone (e.g. [`SubdivideError::AlreadyAtLevel`] for an unsplit face that a finer
@@ -836,6 +838,7 @@ impl LeveledMap<3> {
             return Err(SubdivideError::AlreadyAtLevel { dart: f, dim: 2, cell_level, level });
         }
         self.check_split_midpoints(&unsplit, level)?;
+        self.check_children(d, level, &corners)?;
         for v in midpoints {
             self.corner_positions([v; 4])?;
         }

@@ -1451,9 +1451,20 @@ impl LeveledMechanics {
             return;
         }
         let shift = e.map(|(x, scale)| x / total * scale);
+        // A component is corrected on all of A or on none: not where the shift is 0 or not
+        // finite, nor where a corrected velocity would overflow (round 27: u − shift near
+        // ±f64::MAX gave −∞ while the checks passed).
+        let apply = [0, 1, 2].map(|k| {
+            shift[k] != 0.0
+                && shift[k].is_finite()
+                && a.iter().all(|&v| {
+                    let u = self.velocity[v as usize][k];
+                    !u.is_finite() || (u - shift[k]).is_finite()
+                })
+        });
         for &v in a {
             let u = &mut self.velocity[v as usize];
-            *u = [0, 1, 2].map(|k| if shift[k] == 0.0 || !shift[k].is_finite() { u[k] } else { u[k] - shift[k] });
+            *u = [0, 1, 2].map(|k| if apply[k] { u[k] - shift[k] } else { u[k] });
         }
     }
 

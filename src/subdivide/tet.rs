@@ -197,7 +197,8 @@ impl LeveledMap<3> {
     /// of the volume is α0-, α1- or α2-free), [`SubdivideError::NotATetrahedron`] (the volume at
     /// its own level μt is not a tetrahedron), [`SubdivideError::FaceRefinedTooFar`] (a face of the
     /// volume was refined beyond one 1→4 step or an inner edge of a split face carries a vertex;
-    /// not supported yet), [`SubdivideError::BelowPrecision`] (an edge to split whose midpoint
+    /// not supported yet), [`SubdivideError::NonFinitePosition`] (an end of an edge to
+    /// split at a NaN or infinite position), [`SubdivideError::BelowPrecision`] (an edge to split whose midpoint
     /// f64 cannot hold strictly between its ends). The map is unchanged on error.
     ///
     /// # Examples
@@ -233,6 +234,7 @@ impl LeveledMap<3> {
             return Err(SubdivideError::AlreadyAtLevel { dart: f, dim: 2, cell_level, level });
         }
         self.check_split_midpoints(&unsplit, level)?;
+        self.check_children(d, level, &corners)?;
         for f in unsplit {
             self.subdivide_triangle(f, level)?;
         }

@@ -47,7 +47,8 @@ impl<const N: usize> LeveledMap<N> {
     /// the darts of the vertices it touches, is the relabelling at the end of the operation.
     ///
     /// Errors: [`SubdivideError::NoSuchDart`], [`SubdivideError::OpenEdge`],
-    /// [`SubdivideError::AlreadyAtLevel`] (μa(d) ≥ level), [`SubdivideError::BelowPrecision`]
+    /// [`SubdivideError::AlreadyAtLevel`] (μa(d) ≥ level), [`SubdivideError::NonFinitePosition`] (an end of an edge to
+    /// split at a NaN or infinite position), [`SubdivideError::BelowPrecision`]
     /// (the rounded midpoint of the edge's end positions is not strictly between them),
     /// the level-order errors. The map is unchanged on error.
     ///
@@ -90,13 +91,20 @@ impl<const N: usize> LeveledMap<N> {
         Ok(())
     }
 
-    /// [`SubdivideError::BelowPrecision`] when the edge of `d` (closed) has end positions whose
-    /// rounded midpoint is not strictly between them ([`midpoint_between`]). Nothing is checked
-    /// without both positions, or with a non-finite one (the geometric checks refuse those). O(1).
+    /// [`SubdivideError::NonFinitePosition`] when an end of the edge of `d` (closed) has a NaN
+    /// or infinite position (its midpoint would be one too: round 27, the single operations made
+    /// such vertices), [`SubdivideError::BelowPrecision`] when the rounded midpoint of the two
+    /// is not strictly between them ([`midpoint_between`]). Nothing is checked without both
+    /// positions (a map without points). O(1).
     pub(super) fn check_midpoint(&self, d: DartId, level: u8) -> Result<(), SubdivideError> {
         let vertices = [d, self.map.alpha_dyn(0, d)].map(|x| self.map.vertex_id(x).0);
         let [Some(&a), Some(&b)] = vertices.map(|v| self.points.get(v as usize)) else { return Ok(()) };
-        if !a.iter().chain(&b).all(|c| c.is_finite()) || midpoint_between(a, b) {
+        for (vertex, position) in vertices.into_iter().zip([a, b]) {
+            if !position.iter().all(|c| c.is_finite()) {
+                return Err(SubdivideError::NonFinitePosition { vertex, position });
+            }
+        }
+        if midpoint_between(a, b) {
             return Ok(());
         }
         Err(SubdivideError::BelowPrecision { level, dart: d, vertices, positions: [a, b] })
@@ -161,7 +169,8 @@ impl<const N: usize> LeveledMap<N> {
     ///
     /// Errors: [`SubdivideError::WrongDimension`] (n ∉ {2, 3}), [`SubdivideError::NoSuchDart`],
     /// [`SubdivideError::AlreadyAtLevel`] (μf(d) ≥ level), [`SubdivideError::NotATriangle`],
-    /// [`SubdivideError::OpenEdge`], [`SubdivideError::BelowPrecision`] (a side to split whose
+    /// [`SubdivideError::OpenEdge`], [`SubdivideError::NonFinitePosition`] (an end of an edge to
+    /// split at a NaN or infinite position), [`SubdivideError::BelowPrecision`] (a side to split whose
     /// midpoint f64 cannot hold strictly between its ends), the level-order errors. The map is
     /// unchanged on error.
     ///

@@ -575,6 +575,21 @@ impl<const N: usize> LeveledMap<N> {
         for &x in &lab.edge_darts {
             self.check_midpoint(DartId(x), level)?;
         }
+        if N == 3 {
+            // And the children of every parent ([`SubdivideError::FlatChild`]), in parent order.
+            for darts in lab.darts.chunks_exact(24) {
+                let mut corners = [u32::MAX; 4];
+                let mut found = 0;
+                for &x in darts {
+                    let v = self.map.vertex_id(DartId(x)).0;
+                    if found < 4 && !corners[..found].contains(&v) {
+                        corners[found] = v;
+                        found += 1;
+                    }
+                }
+                self.check_children(DartId(darts[0]), level, &corners)?;
+            }
+        }
         Ok(())
     }
 
@@ -785,7 +800,8 @@ impl LeveledMap<3> {
     /// volume without a finite mass ≥ 0 in `masses`); [`SubdivideError::NoPosition`] and
     /// [`SubdivideError::NonFinitePosition`] (the smallest live vertex without a position, or
     /// with a NaN or infinite one: the masses follow the children's volumes);
-    /// [`SubdivideError::BelowPrecision`] (an edge whose midpoint f64 cannot hold strictly
+    /// [`SubdivideError::NonFinitePosition`] (an end of an edge to
+    /// split at a NaN or infinite position), [`SubdivideError::BelowPrecision`] (an edge whose midpoint f64 cannot hold strictly
     /// between its ends).
     ///
     /// # Examples
@@ -870,7 +886,8 @@ impl LeveledMap<2> {
     /// [`SubdivideError::NotUniform`]; [`SubdivideError::AlreadyAtLevel`];
     /// [`SubdivideError::OpenEdge`] (an α0- or α1-free dart); [`SubdivideError::NotATetrahedron`]
     /// (here: a face that is not a triangle of 6 darts with three distinct corner vertices);
-    /// [`SubdivideError::BelowPrecision`] (an edge whose midpoint f64 cannot hold strictly
+    /// [`SubdivideError::NonFinitePosition`] (an end of an edge to
+    /// split at a NaN or infinite position), [`SubdivideError::BelowPrecision`] (an edge whose midpoint f64 cannot hold strictly
     /// between its ends; with points only).
     ///
     /// # Examples

@@ -426,7 +426,9 @@ impl Simulation {
     /// # Errors
     /// [`SimError::OtherBody`] if the simulation was built for another body (nothing moves);
     /// [`SimError::StaleProjection`] if the body changed topologically (call
-    /// [`Simulation::rebuild`]); [`SimError::Step`] on blow-up (the slot is the vertex id).
+    /// [`Simulation::rebuild`]); [`SimError::Step`] on blow-up (the slot is the vertex id; the
+    /// body then holds the step's bad values, for inspection, as [`Stepper::step`] says: a new
+    /// simulation on it starts from them — put back a saved state or positions first).
     ///
     /// # Examples
     ///

@@ -384,9 +384,11 @@ impl RawMechanics {
     }
 
     /// Blanks the records of every id `map` lists as dead (its allocators' free lists): zero
-    /// numbers, not pinned, not boundary. No cell reads a dead id's attributes, so a value left
-    /// there (even a NaN) is not the body's state and is not written (finding 257); two bodies
-    /// that differ only there give the same file. O(dead ids).
+    /// numbers, not pinned, not boundary; and drops the records past the ids it handed out
+    /// (attributes longer than the map, which `Body::new` accepts). No cell reads those
+    /// attributes, so a value left there (even a NaN) is not the body's state and is not
+    /// written (findings 257 and round 28's); two bodies that differ only there give the same
+    /// file. O(dead ids + dropped records).
     ///
     /// # Examples
     ///
@@ -405,6 +407,11 @@ impl RawMechanics {
     /// assert_eq!(raw.volumes[0], [0.0; 3]);
     /// ```
     pub fn blank_dead(&mut self, map: &RawMap) {
+        let bound = |dim: usize| map.ids.get(dim).map_or(usize::MAX, |a| a.next as usize);
+        self.vertices.truncate(bound(0));
+        self.edges.truncate(bound(1));
+        self.faces.truncate(bound(2));
+        self.volumes.truncate(bound(3));
         let free = |dim: usize| map.ids.get(dim).into_iter().flat_map(|a| a.free.iter().map(|&id| id as usize));
         for id in free(0) {
             self.vertices.get_mut(id).into_iter().for_each(|r| *r = VertexRecord::default());

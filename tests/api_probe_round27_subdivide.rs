@@ -137,6 +137,11 @@ fn a_nearly_flat_tet_is_refused_or_split_into_children_oriented_as_it() {
             [1.0, 1.0 + big(r()), 1.0],
             [1.0 + big(r()) / 2.0, 1.0 + big(r()) / 2.0, 1.0 + (1.0 + (r() * 6.0).floor()) * ulp],
         ];
+        // Any axis thin, corners in any order (exact: a permutation of coordinates and points).
+        let axes = [[0, 1, 2], [1, 2, 0], [2, 0, 1], [0, 2, 1], [2, 1, 0], [1, 0, 2]][(r() * 6.0) as usize];
+        let order =
+            [[0, 1, 2, 3], [1, 0, 2, 3], [2, 3, 0, 1], [3, 1, 2, 0], [0, 3, 1, 2], [2, 1, 3, 0]][(r() * 6.0) as usize];
+        let p: [[f64; 3]; 4] = order.map(|i| axes.map(|k| p[i][k]));
         let parent = exact_sign(p);
         assert_ne!(parent, 0);
         let mut m = unit_tet(p);

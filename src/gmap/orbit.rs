@@ -825,6 +825,31 @@ pub(crate) fn join_with_smaller(forest: &mut [u32], d: u32, row: &[u32], gens: &
 mod tests {
     use std::collections::HashSet;
 
+    /// The shrink rule's boundary: walks addressing exactly a quarter of the stamp array are not
+    /// small (the array is kept however many there are); one slot less, and after
+    /// `SHRINK_AFTER` of them in a row it shrinks to what they address (at least `KEEP_SLOTS`).
+    /// Fresh tags stay fresh across the shrink.
+    #[test]
+    fn stamps_shrink_only_after_walks_below_a_quarter() {
+        use super::{Stamps, KEEP_SLOTS, SHRINK_AFTER};
+        let big = 8 * KEEP_SLOTS;
+        let mut s = Stamps::default();
+        let mut last = s.fresh(big, 1);
+        for _ in 0..2 * SHRINK_AFTER {
+            let t = s.fresh(big / 4, 1);
+            assert!(t > last);
+            last = t;
+        }
+        assert_eq!(s.marks.len(), big, "a quarter is not below a quarter");
+        for _ in 0..SHRINK_AFTER - 1 {
+            s.fresh(big / 4 - 1, 1);
+        }
+        assert_eq!(s.marks.len(), big, "not yet: one walk short");
+        let t = s.fresh(big / 4 - 1, 1);
+        assert_eq!(s.marks.len(), big / 4 - 1);
+        assert!(t > last);
+    }
+
     /// The tet words, built from the layout pattern with no map, are those of a breadth-first
     /// walk over a built lone tet's α0, α1, α2; and building them builds no map (that re-entered
     /// their own initialisation from `from_tets`' debug check: every debug build hung). Run with

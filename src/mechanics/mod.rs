@@ -265,10 +265,14 @@ pub struct Simulation {
 /// holding a non-finite position or velocity, so that a value left in a slot no vertex uses
 /// neither blocks the step's checks nor spreads (finding 257). O(1).
 fn blank_dead(projection: &Projection, v: usize, position: &mut Vec3, velocity: &mut Vec3) {
-    let finite = position.iter().chain(velocity.iter()).all(|c| c.is_finite());
-    if !finite && projection.dart_of_vertex(v).is_none() {
+    if dead_and_not_finite(projection, v, *position, *velocity) {
         (*position, *velocity) = ([0.0; 3], [0.0; 3]);
     }
+}
+
+/// Whether slot `v` is a dead vertex id holding a non-finite position or velocity. O(1).
+fn dead_and_not_finite(projection: &Projection, v: usize, position: Vec3, velocity: Vec3) -> bool {
+    !position.iter().chain(&velocity).all(|c| c.is_finite()) && projection.dart_of_vertex(v).is_none()
 }
 
 /// The positions and velocities of the projection's slots as the stepper will start from them:
@@ -278,15 +282,13 @@ fn blank_dead(projection: &Projection, v: usize, position: &mut Vec3, velocity: 
 fn start_state<'a>(projection: &Projection, mech: &'a Mechanics) -> (Cow<'a, [Vec3]>, Cow<'a, [Vec3]>) {
     let slots = projection.system.slots();
     let (x, v) = (&mech.position.as_slice()[..slots], &mech.velocity.as_slice()[..slots]);
-    let blanked = |k: usize| {
-        let (mut p, mut w) = (x[k], v[k]);
-        blank_dead(projection, k, &mut p, &mut w);
-        (p, w)
-    };
-    if (0..slots).all(|k| x[k].iter().chain(&v[k]).all(|c| c.is_finite()) || projection.dart_of_vertex(k).is_some()) {
+    if !(0..slots).any(|k| dead_and_not_finite(projection, k, x[k], v[k])) {
         return (Cow::Borrowed(x), Cow::Borrowed(v));
     }
-    let (x, v): (Vec<Vec3>, Vec<Vec3>) = (0..slots).map(blanked).unzip();
+    let (mut x, mut v) = (x.to_vec(), v.to_vec());
+    for (k, (p, w)) in x.iter_mut().zip(&mut v).enumerate() {
+        blank_dead(projection, k, p, w);
+    }
     (Cow::Owned(x), Cow::Owned(v))
 }
 

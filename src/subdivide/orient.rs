@@ -33,12 +33,6 @@ fn split_points(p: [Vec3; 4]) -> [Vec3; 10] {
     out
 }
 
-fn det(p: [Vec3; 4]) -> f64 {
-    let d = |k: usize| [p[k][0] - p[0][0], p[k][1] - p[0][1], p[k][2] - p[0][2]];
-    let (b, c, e) = (d(1), d(2), d(3));
-    b[0] * (c[1] * e[2] - c[2] * e[1]) - b[1] * (c[0] * e[2] - c[2] * e[0]) + b[2] * (c[0] * e[1] - c[1] * e[0])
-}
-
 /// Whether the float filter settles it: |det| of the parent (6V) exceeds, with a factor of 4
 /// to spare, 8 × the largest change rounded midpoints can make to a child's det (each of its
 /// corners moved by at most δ = ε·max|x| + the smallest normal: ≤ 3 · 2√3δ · (L + 4δ)² for
@@ -57,7 +51,8 @@ fn clearly_kept(p: [Vec3; 4]) -> bool {
     let l = l2.sqrt();
     let child_change = 3.0 * 2.0 * 3f64.sqrt() * delta * (l + 4.0 * delta).powi(2);
     let bound = 4.0 * (8.0 * child_change + 48.0 * eps * l * l2);
-    det(p).abs() > bound
+    // 6V in floats (the plain determinant; its error, and that of ×6 and ÷6, is in the bound).
+    (6.0 * crate::mesh::signed_volume(p[0], p[1], p[2], p[3])).abs() > bound
 }
 
 /// `Err(child)` with the labels of the first child of the 1→8 split of the tet with corner

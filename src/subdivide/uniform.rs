@@ -570,23 +570,19 @@ impl<const N: usize> LeveledMap<N> {
     }
 
     /// [`SubdivideError::BelowPrecision`] for the first parent edge (in rank order) whose
-    /// midpoint f64 cannot hold strictly between its ends (`check_midpoint`). O(edges).
-    fn check_uniform_midpoints(&self, level: u8, lab: &Labelled) -> Result<(), SubdivideError> {
+    /// midpoint f64 cannot hold strictly between its ends (`check_midpoint`); in 3D then
+    /// [`SubdivideError::FlatChild`] for the first parent with a flat or inverted child
+    /// (`check_children`). O(edges + parents).
+    fn check_uniform_midpoints(&self, level: u8, tpl: &[Template], lab: &Labelled) -> Result<(), SubdivideError> {
         for &x in &lab.edge_darts {
             self.check_midpoint(DartId(x), level)?;
         }
         if N == 3 {
-            // And the children of every parent ([`SubdivideError::FlatChild`]), in parent order.
-            for darts in lab.darts.chunks_exact(24) {
-                let mut corners = [u32::MAX; 4];
-                let mut found = 0;
-                for &x in darts {
-                    let v = self.map.vertex_id(DartId(x)).0;
-                    if found < 4 && !corners[..found].contains(&v) {
-                        corners[found] = v;
-                        found += 1;
-                    }
-                }
+            // And the children of every parent ([`SubdivideError::FlatChild`]), in parent order;
+            // its darts are labelled in the order of the first template, as its corners.
+            let t0 = &tpl[0];
+            for darts in lab.darts.chunks_exact(t0.parents.len()) {
+                let corners = t0.corner_parent.map(|p| self.map.vertex_id(DartId(darts[p as usize])).0);
                 self.check_children(DartId(darts[0]), level, &corners)?;
             }
         }
@@ -828,7 +824,7 @@ impl LeveledMap<3> {
         self.check_positions_finite()?;
         let tpl = templates(3);
         let lab = self.label_parents(&tpl)?;
-        self.check_uniform_midpoints(level, &lab)?;
+        self.check_uniform_midpoints(level, &tpl, &lab)?;
         let parents = lab.template.len();
         let parent_mass: Vec<f64> = (0..parents)
             .map(|t| masses.mass.get(self.map.cell_id(3, DartId(lab.darts[t * 24])).index()).copied().unwrap_or(0.0))
@@ -907,7 +903,7 @@ impl LeveledMap<2> {
         self.uniform_level(level)?;
         let tpl = templates(2);
         let lab = self.label_parents(&tpl)?;
-        self.check_uniform_midpoints(level, &lab)?;
+        self.check_uniform_midpoints(level, &tpl, &lab)?;
         self.write_uniform(level, &tpl, &lab, false);
         self.after_uniform();
         Ok(lab.template.len())

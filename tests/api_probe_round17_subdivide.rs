@@ -243,7 +243,9 @@ fn catch_up_reaches_tets_of_several_levels() {
 /// The catch-up is all or nothing: tets T1 = (0,1,2,3) and T2 = (1,2,3,4) share a face; T2 is
 /// refined twice next to it, so the shared face is refined twice and T1 can no longer be split.
 /// A ball over T1 and a far tet F (both at μt = 0 < k − 1) is refused (`FaceRefinedTooFar`),
-/// and the map and the masses are what they were, even if F was split first.
+/// and the map and the masses are what they were, even if F was split first. Since round 29
+/// (finding 264) `refine_around` never refines a face twice (first part: its zone takes T1 at
+/// level 1, and the second ball then succeeds), so the stuck state is made by single operations.
 #[test]
 fn catch_up_refused_leaves_everything_unchanged() {
     let (map, _) = GMap::<3>::from_tets(9, &[[4, 1, 2, 3], [0, 1, 2, 3], [5, 6, 7, 8]]).unwrap();
@@ -262,7 +264,20 @@ fn catch_up_refused_leaves_everything_unchanged() {
     let mut masses = TetMasses::from_density(&m, 1.0).unwrap();
     let shared_face_centre = [1.0 / 3.0; 3];
     let near = [shared_face_centre[0] + 0.01, shared_face_centre[1] + 0.01, shared_face_centre[2] + 0.01];
-    m.refine_around(near, 0.0, 2, &mut masses).unwrap();
+    let (mut balanced, mut balanced_masses) = (m.clone(), masses.clone());
+    balanced.refine_around(near, 0.0, 2, &mut balanced_masses).unwrap();
+    balanced.check_faces_refinable().unwrap();
+    balanced.refine_around([-9.0, 0.2, 0.2], 11.5, 2, &mut balanced_masses).unwrap();
+    balanced.check_faces_refinable().unwrap();
+    // By hand: T2 at level 1, then its child on the shared face at level 2.
+    let t2 = m.map().darts().find(|&d| m.tet_vertices(d).unwrap() == [1, 2, 3, 4]).unwrap();
+    let children = m.subdivide_tet_with_mass(t2, 1, &mut masses).unwrap();
+    let on_face = children.iter().copied().find(|&c| {
+        let volume = m.map().orbit(c, topomech::AlphaMask::of(&[0, 1, 2]));
+        volume.iter().any(|&x| !m.map().is_free(3, x) && m.mu(m.map().alpha::<3>(x)).tet == 0)
+    });
+    m.subdivide_tet_with_mass(on_face.unwrap(), 2, &mut masses).unwrap();
+    assert!(m.check_faces_refinable().is_err());
     assert_eq!(m.max_level(), 2);
     let (version, darts, before) = (m.version(), m.map().dart_count(), masses.clone());
     let e = m.refine_around([-9.0, 0.2, 0.2], 11.5, 2, &mut masses).unwrap_err();

@@ -368,6 +368,10 @@ fn non_finite_and_out_of_range_numbers_are_refused_with_a_message() {
         (vec!["remove", liver, "--sphere", "0,0,0,-1"], "radius"),
         // A negative number reaches the command's own check (not clap's "unexpected argument").
         (vec!["tear", liver, "--threshold", "-1", "--steps", "1"], "threshold -1"),
+        // Finding 269: refused up front, also when no step would reach `tear_step`.
+        (vec!["tear", liver, "--threshold", "nan", "--steps", "0"], "threshold NaN"),
+        (vec!["tear", liver, "--threshold", "-5", "--steps", "0"], "threshold -5"),
+        (vec!["tear", liver, "--threshold", "inf", "--steps", "0"], "threshold inf"),
         (vec!["simulate", liver, "--steps", "1", "--dt", "-1"], "time step -1"),
         (vec!["simulate", liver, "--steps", "1", "--young", "-5"], "young = -5"),
         (vec!["refine", liver, "--around", "0,0,0", "--radius", "-1"], "radius must be"),

@@ -236,6 +236,9 @@ pub fn run_remove(args: RemoveArgs) -> Result<(), CliError> {
 /// # Errors
 /// As [`run`]; also a bad time step or a blow-up.
 pub fn run_tear(args: TearArgs) -> Result<(), CliError> {
+    // Before loading and stepping: `--steps 0` would otherwise never meet the check of
+    // `tear_step` (finding 269).
+    cut::check_threshold(args.threshold).map_err(other)?;
     let (mut body, mesh, built, load_us) = load_body(&args.common)?;
     let before = stats(&body, 0.0);
     // The rest positions of the vertices the tets use: an unreferenced point keeps a vertex

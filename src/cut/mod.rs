@@ -33,7 +33,7 @@ pub use dissociate::{dissociate_face, dissociate_face_id, face_dart, Dissociatio
 pub use incise::{incise_plane, tet_sides, Incision, Plane};
 pub use remove::{remove_volume, volume_dart, Removal};
 pub use sweep::{incise_sweep, sweep_faces, PolylineSweep};
-pub use tear::{fan_darts, principal_stress, tear_step, tear_vertex, Stress, Tear, TearStep};
+pub use tear::{check_threshold, fan_darts, principal_stress, tear_step, tear_vertex, Stress, Tear, TearStep};
 
 use crate::gmap::{DartError, SewError};
 use crate::mechanics::{BodyError, SimError, Vec3};

@@ -558,6 +558,26 @@ pub fn tear_vertex(body: &mut Body, v: CellId, direction: Vec3, hint: Option<Dar
     Ok(tear)
 }
 
+/// Refuses a tear threshold that is NaN, infinite or negative ([`CutError::BadThreshold`]: with
+/// NaN no stress would ever compare above it and tearing would silently never happen), as
+/// [`tear_step`] does before anything; a caller that steps before its first tear (the CLI's
+/// `tear`) checks it up front with this. O(1).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::cut::{check_threshold, CutError};
+/// assert!(check_threshold(2.5).is_ok() && check_threshold(0.0).is_ok());
+/// assert!(matches!(check_threshold(f64::NAN), Err(CutError::BadThreshold(_))));
+/// assert!(matches!(check_threshold(-1.0), Err(CutError::BadThreshold(_))));
+/// ```
+pub fn check_threshold(threshold: f64) -> Result<(), CutError> {
+    if threshold.is_finite() && threshold >= 0.0 {
+        return Ok(());
+    }
+    Err(CutError::BadThreshold(threshold))
+}
+
 /// One tearing pass inside a simulation loop: computes [`principal_stress`], tears the vertices
 /// whose stress exceeds `threshold`, strongest first, until `max_vertices` tears dissociated
 /// something (a vertex already touched by a tear of this pass is skipped; a vertex with no inner
@@ -602,9 +622,7 @@ pub fn tear_step(
     threshold: f64,
     max_vertices: usize,
 ) -> Result<TearStep, CutError> {
-    if !(threshold.is_finite() && threshold >= 0.0) {
-        return Err(CutError::BadThreshold(threshold));
-    }
+    check_threshold(threshold)?;
     let stress = principal_stress(body, sim)?;
     let mut order: Vec<usize> = (0..stress.len()).filter(|&v| stress[v].magnitude > threshold).collect();
     order.sort_by(|&a, &b| stress[b].magnitude.total_cmp(&stress[a].magnitude).then(a.cmp(&b)));

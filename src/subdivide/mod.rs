@@ -27,6 +27,7 @@
 //! checking them (lengths, level bounds, well-formed histories, every level's links closed and
 //! involutive, then [`LeveledMap::check_all`]). `store::save_leveled` / `load_leveled` use them.
 
+mod balance;
 mod conform;
 mod cut;
 mod cut_error;
@@ -288,6 +289,26 @@ pub enum SubdivideError {
         volume: u32,
         /// Its mass.
         mass: f64,
+    },
+    /// A live volume's mass is positive but too small for f64: its quarter (the least a vertex
+    /// of it can weigh) has no finite inverse, or, for a tet to split, the quarter of the eighth
+    /// each child takes (finding 268). Refused before any change.
+    #[error("volume {volume} has mass {mass:e}: too small for f64 (a quarter of it, or of a child's eighth when it is split, has no finite inverse)")]
+    MassTooSmall {
+        /// The volume id.
+        volume: u32,
+        /// Its mass.
+        mass: f64,
+    },
+    /// The face to split is sewn onto itself: the αj (j ≥ 2) of one of its darts is in the
+    /// same face (two sides glued into a cone, or the face folded by α3). A valid g-map, but a
+    /// 1→4 split of it is not supported (finding 270). Refused before any change.
+    #[error("the face of {dart} is sewn onto itself by α{alpha}: its 1→4 split is not supported")]
+    SelfGluedFace {
+        /// A dart of the face whose αj is in the face.
+        dart: DartId,
+        /// The index j.
+        alpha: usize,
     },
     /// A density for [`TetMasses::from_density`] that is not a finite number > 0.
     #[error("density {0} must be a finite number > 0")]

@@ -18,6 +18,7 @@
 //! one rounding. Vertex masses are derived, never stored: m_v = Σ_{tets t ∋ v} m_t / 4 (seed 000,
 //! §3.1), so Σ_v m_v = Σ_t m_t holds by construction.
 
+use super::balance::LevelSplit;
 use super::{LeveledMap, SubdivideError};
 use crate::gmap::{AlphaMask, CellId, DartId};
 use crate::mechanics::geom::{cross, dot, sub};
@@ -123,13 +124,23 @@ impl TetMasses {
         let map = m.map();
         let mut mass = vec![0.0; map.cell_id_bound(3)];
         for d in map.one_dart_per_cell(3) {
-            mass[map.cell_id(3, d).index()] = density_mass(density, m.corner_positions(m.tet_vertices(d)?)?);
+            let corners = m.corner_positions(m.tet_vertices(d)?)?;
+            let t = map.cell_id(3, d);
+            mass[t.index()] = density_mass(density, corners);
+            // A tet that is not flat weighs something: 0 here is ρ·V below f64 (finding 268).
+            if mass[t.index()] == 0.0 && !crate::mechanics::geom::is_flat(corners) {
+                return Err(SubdivideError::MassTooSmall { volume: t.0, mass: 0.0 });
+            }
         }
         let total = mass.iter().sum::<f64>();
         if !total.is_finite() {
             return Err(SubdivideError::MassOverflow { total });
         }
-        Ok(TetMasses { mass })
+        let masses = TetMasses { mass };
+        for d in map.one_dart_per_cell(3) {
+            masses.check_mass(map.cell_id(3, d))?;
+        }
+        Ok(masses)
     }
 
     /// Σ of the tet masses of the live volumes, summed with compensation (within about 2 ulp of
@@ -207,10 +218,25 @@ impl TetMasses {
 
     /// [`SubdivideError::BadMass`] unless the entry of volume t (which must exist) is finite
     /// and ≥ 0. O(1).
+    /// [`SubdivideError::MassTooSmall`] for a positive mass whose quarter (the least a vertex of
+    /// the tet can weigh) has no finite inverse: below about 8.9e-308, where f64 loses relative
+    /// precision and the mass laws could not hold (finding 268; a body refuses such masses too).
     fn check_mass(&self, t: CellId) -> Result<f64, SubdivideError> {
         match self.mass[t.index()] {
+            mass if mass > 0.0 && !(4.0 / mass).is_finite() => Err(SubdivideError::MassTooSmall { volume: t.0, mass }),
             mass if mass.is_finite() && mass >= 0.0 => Ok(mass),
             mass => Err(SubdivideError::BadMass { volume: t.0, mass }),
+        }
+    }
+
+    /// [`Self::check_mass`] for a tet about to be split 1→8: its children take about an eighth
+    /// each, so a positive mass below 64 / `f64::MAX` (about 3.6e-307) is
+    /// [`SubdivideError::MassTooSmall`] too (the children's quarters would have no finite
+    /// inverse, finding 268). O(1).
+    pub(super) fn check_split_mass(&self, t: CellId) -> Result<f64, SubdivideError> {
+        match self.check_mass(t)? {
+            mass if mass > 0.0 && !(64.0 / mass).is_finite() => Err(SubdivideError::MassTooSmall { volume: t.0, mass }),
+            mass => Ok(mass),
         }
     }
 
@@ -396,6 +422,38 @@ fn faces_distance(p: [f64; 3], t: [[f64; 3]; 4]) -> f64 {
     faces.iter().map(|&f| triangle_distance(p, f)).fold(f64::INFINITY, f64::min)
 }
 
+/// The splitter of [`LeveledMap::refine_around`] on maps with level skips
+/// ([`LeveledMap::refine_mixed`]): masses shared by rest volume, the bulk path where it applies.
+struct PlainSplit<'a> {
+    masses: &'a mut TetMasses,
+    bulk: bool,
+    center: [f64; 3],
+    radius: f64,
+}
+
+impl LevelSplit for PlainSplit<'_> {
+    type Error = SubdivideError;
+
+    fn split(&mut self, m: &mut LeveledMap<3>, d: DartId, level: u8) -> Result<(), SubdivideError> {
+        m.subdivide_tet_with_mass(d, level, self.masses).map(|_| ())
+    }
+
+    fn bulk(&mut self, m: &mut LeveledMap<3>, level: u8) -> Result<Option<usize>, SubdivideError> {
+        if !(self.bulk && m.bulk_applies(self.center, self.radius, level)) {
+            return Ok(None);
+        }
+        match m.refine_uniform(level, self.masses) {
+            Ok(r) => Ok(Some(r.subdivided_per_level[level as usize])),
+            Err(e @ SubdivideError::DartLimit { .. }) => Err(e),
+            Err(_) => Ok(None),
+        }
+    }
+
+    fn check_zone(&mut self, m: &LeveledMap<3>, level: u8, zone: &[DartId]) -> Result<(), SubdivideError> {
+        m.check_zone(level, zone, self.masses)
+    }
+}
+
 impl LeveledMap<3> {
     /// The four corner vertex ids of the tet of `d` at its own level μt, in increasing order (a
     /// tet outside a refined zone may carry inserted vertices of its neighbours on its sides in
@@ -532,7 +590,7 @@ impl LeveledMap<3> {
         // are the parent's and midpoints of its edges).
         self.tet_volume(d)?;
         masses.check_cover(self)?;
-        let parent = masses.check_mass(self.map.cell_id(3, d))?;
+        let parent = masses.check_split_mass(self.map.cell_id(3, d))?;
         let children = self.subdivide_tet(d, level)?;
         let volumes = self.volumes_of_children(&children)?;
         let total: f64 = volumes.iter().sum();
@@ -569,39 +627,39 @@ impl LeveledMap<3> {
         Ok(crate::mechanics::geom::volume_ratios(tets))
     }
 
-    /// Refines the zone of the ball B(center, radius) up to level `levels` (module docs): for
-    /// L = max(1, k)..=levels, every tet with μt = L − 1 meeting the ball is subdivided at level L,
-    /// its mass shared by [`Self::subdivide_tet_with_mass`]. When the ball holds every vertex and
+    /// Refines the zone of the ball B(center, radius) up to level `levels` (module docs), with
+    /// **zones balanced across faces** (finding 264, `super::balance`, SUBDIVISION.md): level by
+    /// level from max(1, k) (k the map's maximum level), the zone of level L is every tet with
+    /// μt < min(L, `levels`) within up to three face rings of a tet meeting the ball, and the tets
+    /// that must be split before one of them (read off the faces: a neighbour that would see a
+    /// face refined twice); the zone tets nothing blocks are split 1→8 at L (a tet below
+    /// μt = L − 1 by a level skip), their masses shared by [`Self::subdivide_tet_with_mass`], and
+    /// the others wait for the next level, if need be one past `levels` (then
+    /// `subdivided_per_level` has more entries). So no face is ever refined twice, and every tet
+    /// stays splittable ([`Self::check_faces_refinable`]). When the ball holds every vertex and
     /// every tet is at level L − 1, level L is done by the bulk [`Self::refine_uniform`] (same
     /// result, numbering aside); otherwise, or if it refuses, op by op
-    /// ([`Self::refine_around_per_op`]). Returns the count per level and the mass totals.
-    /// After `Ok`, every tet of the finest map that meets the ball has μt = `levels`. A tet at
-    /// μt < k − 1 meeting the ball (k the max level, k ≥ 2) cannot be reached one level at a
-    /// time (that would take an operation below level k, which the level order forbids): such
-    /// tets are first caught up by a level skip, split 1→8 at level k (their children at
-    /// μt = k; counted at level k), and the whole call is then all or nothing (the map and the
-    /// masses are copied first, O(darts) memory, and put back on any error).
-    /// O(Σ_L (volumes + refined · touched)); O(darts) per bulk level.
+    /// ([`Self::refine_around_per_op`]). On a map at level 0 each level is checked before its
+    /// first split and the levels done before a refusal stay; on a map above level 0 the call is
+    /// all or nothing (the map and the masses are copied first, O(darts) memory, and put back on
+    /// any error). Returns the count per level and the mass totals. After `Ok`, every tet of the
+    /// finest map that meets the ball has μt ≥ `levels`. O(Σ_L (darts + zone volumes ·
+    /// (neighbours + edge rings))); O(darts) per bulk level.
     ///
     /// Errors: [`SubdivideError::LevelTooHigh`] for `levels` above [`super::MAX_LEVEL`],
-    /// [`SubdivideError::BadBall`] for a non-finite centre or radius or a negative radius, those
-    /// of [`TetMasses::check`], before any change; in a catch-up, the dart limit and the refusals
-    /// of [`Self::subdivide_tet_with_mass`] (e.g. [`SubdivideError::FaceRefinedTooFar`] for a tet
-    /// whose face a finer neighbour refined twice — an earlier call that refined a zone two or
-    /// more levels past a face neighbour leaves that neighbour so, for good: no 2:1 balance
-    /// across faces yet, finding 264), the map and masses put back; at a level,
-    /// [`SubdivideError::DartLimit`] for a level whose darts (counted exactly before it starts)
-    /// would pass the dart limit, and the refusals of [`Self::subdivide_tet_with_mass`] for any
-    /// tet of its zone (e.g. [`SubdivideError::AlreadyAtLevel`] for an unsplit face that a finer
-    /// neighbour, split at a skipped level, brought to μf = L; [`SubdivideError::BelowPrecision`]
-    /// for an edge too short for its midpoint to be representable strictly between its ends:
-    /// about 52 − log2(|coordinates| / edge length) levels can be made), all checked on the whole
-    /// level before its first split, so an error leaves the map and the masses as the levels
-    /// before it left them. For a map made by the operations that is unchanged, except after a
-    /// [`SubdivideError::DartLimit`] or [`SubdivideError::BelowPrecision`] at a level after the
-    /// first (the levels before stay done): every other refusal comes at the first level the call
-    /// refines (after a level L, a tet at μt = L has only unsplit faces, with μf ≤ L, and finite
-    /// corners).
+    /// [`SubdivideError::LevelBelowMax`] below the map's level, [`SubdivideError::BadBall`] for a
+    /// non-finite centre or radius or a negative radius, those of [`TetMasses::check`], before
+    /// any change; on a level-0 map, at a level, [`SubdivideError::DartLimit`] for a level whose
+    /// darts (counted exactly before it starts) would pass the dart limit, and the refusals of
+    /// [`Self::subdivide_tet_with_mass`] for any tet of its zone
+    /// ([`SubdivideError::BelowPrecision`] for an edge too short for its midpoint to be
+    /// representable strictly between its ends: about 52 − log2(|coordinates| / edge length)
+    /// levels can be made; [`SubdivideError::FlatChild`]), all checked on the whole level before
+    /// its first split, so an error leaves the map and the masses as the levels before it left
+    /// them (unchanged, except after a [`SubdivideError::DartLimit`] or
+    /// [`SubdivideError::BelowPrecision`] at a level after the first); on a map above level 0,
+    /// the same refusals and [`SubdivideError::FaceRefinedTooFar`] for a tet whose face single
+    /// operations refined twice, with the map and the masses put back.
     ///
     /// ```
     /// use topomech::subdivide::{LeveledMap, TetMasses};
@@ -650,9 +708,9 @@ impl LeveledMap<3> {
     }
 
     /// [`Self::refine_around`] (`bulk`: a level may go through [`Self::refine_uniform`]) or
-    /// [`Self::refine_around_per_op`] (not `bulk`). With a catch-up (a ball meeting tets at
-    /// μt < k − 1), the whole call is all or nothing: the map and the masses are copied first
-    /// and put back on any error.
+    /// [`Self::refine_around_per_op`] (not `bulk`). On a map above level 0 by
+    /// [`Self::refine_mixed`], all or nothing: the map and the masses are copied first and put
+    /// back on any error.
     fn refine_zone(
         &mut self,
         center: [f64; 3],
@@ -664,113 +722,31 @@ impl LeveledMap<3> {
         self.check_op_level(levels)?;
         Self::check_ball(center, radius)?;
         masses.check(self)?;
-        let skipped = self.skipped_zone(center, radius)?;
-        if skipped.is_empty() {
-            return self.refine_levels(center, radius, levels, masses, bulk, None);
-        }
-        self.check_zone_darts(self.max_level, &skipped)?;
-        let saved = (self.clone(), masses.clone());
         let before = masses.total(self);
-        let result = self
-            .catch_up(&skipped, masses)
-            .and_then(|()| self.refine_levels(center, radius, levels, masses, bulk, Some((skipped.len(), before))));
-        if result.is_err() {
-            (*self, *masses) = saved;
+        if self.max_level == 0 {
+            // Levels done before a refusal stay (each level checked before its first split).
+            let per_level =
+                self.refine_mixed(center, radius, levels, &mut PlainSplit { masses, bulk, center, radius })?;
+            let after = masses.total(self);
+            return Ok(Refinement {
+                subdivided_per_level: per_level,
+                total_mass_before: before,
+                total_mass_after: after,
+            });
         }
-        result
-    }
-
-    /// The levels max(1, k)..=`levels` of [`Self::refine_zone`], after the catch-up (its count,
-    /// at level k, and the mass total before it) if there was one.
-    fn refine_levels(
-        &mut self,
-        center: [f64; 3],
-        radius: f64,
-        levels: u8,
-        masses: &mut TetMasses,
-        bulk: bool,
-        caught_up: Option<(usize, f64)>,
-    ) -> Result<Refinement, SubdivideError> {
-        // Mass totals: a bulk level reports them (Σ over every volume), so O(darts) sweeps are
-        // only made around per-op levels.
-        let (mut before, mut after) = (caught_up.map(|(_, m)| m), None);
-        let mut per_level = vec![0; levels as usize + 1];
-        per_level[self.max_level as usize] = caught_up.map_or(0, |(count, _)| count);
-        for level in self.max_level.max(1)..=levels {
-            if bulk && self.bulk_applies(center, radius, level) {
-                match self.refine_uniform(level, masses) {
-                    Ok(r) => {
-                        per_level[level as usize] += r.subdivided_per_level[level as usize];
-                        before.get_or_insert(r.total_mass_before);
-                        after = Some(r.total_mass_after);
-                        continue;
-                    }
-                    // Its count is exact (2ⁿ × the darts); the op-by-op level would make as
-                    // many darts and refuse too, with its own exact count.
-                    Err(e @ SubdivideError::DartLimit { .. }) => return Err(e),
-                    // Any other precondition: the op-by-op path decides.
-                    Err(_) => {}
-                }
+        let saved = (self.clone(), masses.clone());
+        let mut splitter = PlainSplit { masses, bulk, center, radius };
+        match self.refine_mixed(center, radius, levels, &mut splitter) {
+            Ok(per_level) => Ok(Refinement {
+                subdivided_per_level: per_level,
+                total_mass_before: before,
+                total_mass_after: masses.total(self),
+            }),
+            Err(e) => {
+                (*self, *masses) = saved;
+                Err(e)
             }
-            if before.is_none() {
-                before = Some(masses.total(self));
-            }
-            after = None;
-            per_level[level as usize] += self.refine_level_per_op(level, levels, center, radius, masses)?;
         }
-        Ok(Refinement {
-            subdivided_per_level: per_level,
-            total_mass_before: before.unwrap_or_else(|| masses.total(self)),
-            total_mass_after: after.unwrap_or_else(|| masses.total(self)),
-        })
-    }
-
-    /// Subdivides, op by op, every tet with μt = level − 1 meeting the ball (the last level being
-    /// `levels`). Returns the count. All or nothing: every refusal is made by
-    /// [`Self::check_level`] before the first split.
-    fn refine_level_per_op(
-        &mut self,
-        level: u8,
-        levels: u8,
-        center: [f64; 3],
-        radius: f64,
-        masses: &mut TetMasses,
-    ) -> Result<usize, SubdivideError> {
-        let zone = self.check_level(level, levels, center, radius, masses)?;
-        for &d in &zone {
-            self.subdivide_tet_with_mass(d, level, masses)?;
-        }
-        Ok(zone.len())
-    }
-
-    /// The zone of one op-by-op level of [`Self::refine_around`] (the tets at μt = level − 1 meeting
-    /// the ball), once everything that could refuse during the level, or at the start of the next
-    /// one short of [`SubdivideError::DartLimit`] and [`SubdivideError::BelowPrecision`], has been
-    /// checked on the map as it is: the zone itself ([`Self::zone_tets`]), the dart limit (the
-    /// darts after the level counted exactly, [`Self::check_zone_darts`]), every zone tet
-    /// ([`Self::check_zone`], with the precision of the midpoints it makes) and,
-    /// when `level` < `levels`, the corners of the tets already at μt = level before it (the
-    /// next level's zone looks at them; the tets the level makes have the corners of their
-    /// parents and finite midpoints). So the level is all or nothing, and an error at a later
-    /// level can only be the dart limit or the precision of its midpoints (which depend on the
-    /// midpoints the levels before made): the tets at μt = L after a level L have unsplit faces
-    /// with μf ≤ L only, which every zone check accepts (see [`Self::check_zone`]). O(darts +
-    /// Σ zone volumes).
-    pub(super) fn check_level(
-        &self,
-        level: u8,
-        levels: u8,
-        center: [f64; 3],
-        radius: f64,
-        masses: &TetMasses,
-    ) -> Result<Vec<DartId>, SubdivideError> {
-        let zone = self.zone_tets(level - 1, center, radius)?;
-        self.check_zone_darts(level, &zone)?;
-        self.check_zone(level, &zone, masses)?;
-        if level < levels {
-            self.zone_tets(level, center, radius)?;
-        }
-        Ok(zone)
     }
 
     /// The refusals [`Self::subdivide_tet_with_mass`] at `level` would make for the tets of `zone`
@@ -805,11 +781,11 @@ impl LeveledMap<3> {
     /// - N's corners are read at μt = level − 1 (`alpha_at`), which operations at `level` do not
     ///   change; no dart becomes free; N's volume id, mass and corner positions stay; the
     ///   midpoints created meanwhile get finite positions (midpoints of finite corners).
-    fn check_zone(&self, level: u8, zone: &[DartId], masses: &TetMasses) -> Result<(), SubdivideError> {
+    pub(super) fn check_zone(&self, level: u8, zone: &[DartId], masses: &TetMasses) -> Result<(), SubdivideError> {
         masses.check_cover(self)?;
         for &d in zone {
             self.tet_volume(d)?;
-            masses.check_mass(self.map.cell_id(3, d))?;
+            masses.check_split_mass(self.map.cell_id(3, d))?;
             self.check_zone_tet(d, level)?;
         }
         Ok(())
@@ -845,43 +821,10 @@ impl LeveledMap<3> {
         Ok(())
     }
 
-    /// One dart of every tet meeting the ball that the levels of a refinement cannot reach one
-    /// level at a time: with k the map's max level, the levels run from max(1, k) and level L
-    /// takes the tets at μt = L − 1, so a tet at μt < k − 1 needs a level skip (an operation at
-    /// level k). Empty for k ≤ 1. O(1), or O(darts) for k ≥ 2.
-    pub(super) fn skipped_zone(&self, center: [f64; 3], radius: f64) -> Result<Vec<DartId>, SubdivideError> {
-        let mut out = Vec::new();
-        if self.max_level < 2 {
-            return Ok(out);
-        }
-        for d in self.map.one_dart_per_cell(3) {
-            if self.mu[d.index()].tet < self.max_level - 1 && self.tet_in_ball(d, center, radius)? {
-                out.push(d);
-            }
-        }
-        Ok(out)
-    }
-
-    /// The catch-up of a refinement at max level k ≥ 2: every tet of `zone` (a
-    /// [`Self::skipped_zone`]) subdivided 1→8 at level k by a level skip (its children at
-    /// μt = k), its mass shared by [`Self::subdivide_tet_with_mass`]. Not all or nothing on its
-    /// own (a split may refuse for what an earlier split of the zone did to a face it shares,
-    /// a face then refined twice): [`Self::refine_zone`] keeps a copy. The dart limit is checked
-    /// again after the splits ([`SubdivideError::DartLimit`], the copy then put back): the count
-    /// before ([`Self::zone_darts_added`]) is exact for a zone of one level, but a zone mixing
-    /// levels can make it short (a coarse tet split first adds a face along an inner edge of its
-    /// split face that a finer zone tet then splits: 4 darts more for that edge). O(Σ zone volumes).
-    fn catch_up(&mut self, zone: &[DartId], masses: &mut TetMasses) -> Result<(), SubdivideError> {
-        let darts = self.map.dart_count();
-        for &d in zone {
-            self.subdivide_tet_with_mass(d, self.max_level, masses)?;
-        }
-        self.check_caught_up(darts, zone.len())
-    }
-
-    /// After a catch-up of `tets` zone tets that started at `darts` live darts:
-    /// [`SubdivideError::DartLimit`] if the map now passes its limit (the exact count before a
-    /// catch-up can be short for a zone mixing levels; the caller puts its copy back). O(1).
+    /// After a level of [`Self::refine_mixed`] that split `tets` tets, starting at `darts` live
+    /// darts: [`SubdivideError::DartLimit`] if the map now passes its limit (the exact count
+    /// before such a level can be short for a zone mixing levels; the caller puts its copy
+    /// back). O(1).
     pub(super) fn check_caught_up(&self, darts: usize, tets: usize) -> Result<(), SubdivideError> {
         let (estimate, limit) = (self.map.dart_count(), self.max_darts);
         if estimate > limit {
@@ -899,7 +842,7 @@ impl LeveledMap<3> {
     }
 
     /// Refuses splitting every tet of `zone` 1→8 at `level` (a level of `refine_around`, or a
-    /// catch-up) when the darts after it, counted exactly by [`Self::zone_darts_added`], exceed
+    /// level of [`Self::refine_mixed`]) when the darts after it, counted exactly by [`Self::zone_darts_added`], exceed
     /// the limit ([`SubdivideError::DartLimit`]). O(Σ zone volumes + rings of the edges it splits).
     pub(super) fn check_zone_darts(&self, level: u8, zone: &[DartId]) -> Result<(), SubdivideError> {
         let after = self.map.dart_count().saturating_add(self.zone_darts_added(zone));
@@ -920,8 +863,8 @@ impl LeveledMap<3> {
     /// splits: a face or edge is split once, by the first zone tet that has it (the others then
     /// see it split and reuse it), and the orbit of such an edge does not change before it is
     /// split (the splits meanwhile add faces only along edges between midpoints, which no unsplit
-    /// face of a zone tet has as a side: [`Self::check_zone`]). A catch-up zone mixing levels can
-    /// pass it by 4 darts per edge ([`Self::catch_up`] checks again). A tet some zone check
+    /// face of a zone tet has as a side: [`Self::check_zone`]). A zone mixing levels can
+    /// pass it by 4 darts per edge ([`Self::refine_mixed`] checks again). A tet some zone check
     /// refuses counts for the faces it passes (the level is refused anyway).
     /// O(Σ zone volumes + Σ_E |orbit(E)|).
     fn zone_darts_added(&self, zone: &[DartId]) -> usize {
@@ -943,7 +886,7 @@ impl LeveledMap<3> {
     /// sides)) and the edges those split (their sides without an inserted vertex, as (edge id, a
     /// dart)); the faces before the first one [`Self::check_tet_faces_visiting`] refuses.
     /// O(volume).
-    fn zone_tet_splits(&self, d: DartId, faces: &mut Vec<(u32, usize)>, edges: &mut Vec<(u32, DartId)>) {
+    pub(super) fn zone_tet_splits(&self, d: DartId, faces: &mut Vec<(u32, usize)>, edges: &mut Vec<(u32, DartId)>) {
         let Ok(corners) = self.tet_corners(d, self.mu[d.index()].tet) else { return };
         let _ = self.check_tet_faces_visiting(d, &corners, |sides, is_corner| {
             if !is_corner.iter().all(|&c| c) {
@@ -976,17 +919,6 @@ impl LeveledMap<3> {
     /// Whether every live dart has μt = `lt` (a quick filter before the bulk path). O(darts).
     fn all_tets_at(&self, lt: u8) -> bool {
         self.map.darts().all(|d| self.mu[d.index()].tet == lt)
-    }
-
-    /// One dart of every tet with μt = `lt` meeting the ball. O(darts).
-    pub(super) fn zone_tets(&self, lt: u8, center: [f64; 3], radius: f64) -> Result<Vec<DartId>, SubdivideError> {
-        let mut out = Vec::new();
-        for d in self.map.one_dart_per_cell(3) {
-            if self.mu[d.index()].tet == lt && self.tet_in_ball(d, center, radius)? {
-                out.push(d);
-            }
-        }
-        Ok(out)
     }
 
     /// The tets of the finest map as vertex quadruples (positive orientation: the exact sign of

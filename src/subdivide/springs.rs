@@ -64,6 +64,7 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
+use super::balance::LevelSplit;
 use super::{EdgeSplit, LeveledMap, Refinement, SubdivideError, TetMasses};
 use crate::gmap::{AlphaMask, DartId, GMap};
 use crate::mechanics::geom::{compensated_sum, is_flat, rest_length, CompensatedSum, Vec3};
@@ -1010,29 +1011,29 @@ impl LeveledMechanics {
         Ok(children)
     }
 
-    /// [`LeveledMap::refine_around`] through [`Self::subdivide_tet`]: level by level, every tet with
-    /// μt = L − 1 meeting the ball B(center, radius) is split 1→8 with its springs and masses (by the
-    /// bulk path for a level where the ball holds everything, with the same springs up to rounding).
-    /// The levels run from max(1, k), k the map's max level; after `Ok`, every tet of the finest
-    /// map that meets the ball has μt = `levels` (tets at μt < k − 1 in the ball are first caught
-    /// up by a level skip at level k, as by [`LeveledMap::refine_around`]; the call is then all or
-    /// nothing: map and coupling are copied first and put back on any error). Σ m u is kept
-    /// over the whole call, also when a level refuses after earlier ones were done (module docs;
-    /// the vertex masses before and after are recomputed over the whole map).
-    /// O(darts + Σ_L (volumes + refined · touched)).
+    /// [`LeveledMap::refine_around`] through [`Self::subdivide_tet`]: level by level, the tets of
+    /// each level's balanced zone (around the ball B(center, radius), widened by face rings so
+    /// that no face is refined twice, finding 264) are split 1→8 with their springs and masses
+    /// (by the bulk path for a level where the ball holds everything, with the same springs up
+    /// to rounding). The levels run from max(1, k), k the map's max level; after `Ok`, every tet
+    /// of the finest map that meets the ball has μt ≥ `levels` (= `levels` from a level-0 map;
+    /// on a map above level 0 the zones read the faces, a tet may wait one level, and the call is
+    /// all or nothing: map and coupling are copied first and put back on any error, as by
+    /// [`LeveledMap::refine_around`]). Σ m u is kept over the whole call, also when a level
+    /// refuses after earlier ones were done (module docs; the vertex masses before and after are
+    /// recomputed over the whole map). O(darts + Σ_L (darts + zone volumes · touched)).
     ///
     /// Errors: [`SubdivideError::LevelTooHigh`] for `levels` above the maximum,
-    /// [`SubdivideError::BadBall`], those of the coupling's sync check, before any change; in a
-    /// catch-up, the dart limit, [`CouplingError::SplitOverflow`] and the refusals of
-    /// [`Self::subdivide_tet`] (map and coupling put back); at a level, those of
-    /// [`LeveledMap::refine_around`] (the dart limit and the refusals of [`Self::subdivide_tet`] for
-    /// any tet of its zone) and [`CouplingError::SplitOverflow`] (the bound of
-    /// [`Self::subdivide_tet`] over the whole zone), all checked on the whole level before its
-    /// first split: an error leaves the map, the springs and the masses as the levels before it
-    /// left them (for a map made by the operations unchanged, except after a
+    /// [`SubdivideError::BadBall`], those of the coupling's sync check, before any change; on a
+    /// level-0 map, at a level, those of [`LeveledMap::refine_around`] (the dart limit and the
+    /// refusals of [`Self::subdivide_tet`] for any tet of its zone) and
+    /// [`CouplingError::SplitOverflow`] (the bound of [`Self::subdivide_tet`] over the whole
+    /// zone), all checked on the whole level before its first split: an error leaves the map,
+    /// the springs and the masses as the levels before it left them (unchanged, except after a
     /// [`SubdivideError::DartLimit`] or a [`CouplingError::SplitOverflow`] at a level after the
-    /// first; map and coupling in step either way). With `expensive-checks`, [`Self::check`] runs
-    /// once at the end (not after each tet).
+    /// first; map and coupling in step either way); on a map above level 0 the same, with map
+    /// and coupling put back. With `expensive-checks`, [`Self::check`] runs once at the end (not
+    /// after each tet).
     ///
     /// # Examples
     ///
@@ -1073,64 +1074,32 @@ impl LeveledMechanics {
         radius: f64,
         levels: u8,
     ) -> Result<Refinement, CouplingError> {
-        let skipped = m.skipped_zone(center, radius)?;
         let before = self.masses.total(m);
-        if skipped.is_empty() {
-            return self.refine_levels(m, center, radius, levels, (0, before));
+        if m.max_level() == 0 {
+            // Levels done before a refusal stay (each level checked before its first split).
+            let per_level = m.refine_mixed(center, radius, levels, &mut CoupledSplit { mech: self, center, radius })?;
+            self.expensive_check(m);
+            let after = self.masses.total(m);
+            return Ok(Refinement {
+                subdivided_per_level: per_level,
+                total_mass_before: before,
+                total_mass_after: after,
+            });
         }
-        m.check_zone_darts(m.max_level(), &skipped)?;
-        self.check_split_headroom(m, &skipped)?;
         let saved = (m.clone(), self.clone());
-        let result = self
-            .catch_up(m, &skipped)
-            .and_then(|()| self.refine_levels(m, center, radius, levels, (skipped.len(), before)));
-        if result.is_err() {
-            (*m, *self) = saved;
-        }
-        result
-    }
-
-    /// The levels max(1, k)..=`levels` of [`Self::refine_around`], after a catch-up of `caught_up`
-    /// = (tets split at level k, the mass total before the call).
-    fn refine_levels(
-        &mut self,
-        m: &mut LeveledMap<3>,
-        center: [f64; 3],
-        radius: f64,
-        levels: u8,
-        (caught_up, before): (usize, f64),
-    ) -> Result<Refinement, CouplingError> {
-        let mut per_level = vec![0; levels as usize + 1];
-        per_level[m.max_level() as usize] = caught_up;
-        for level in m.max_level().max(1)..=levels {
-            if let Some(count) = self.refine_level_in_bulk(m, center, radius, level)? {
-                per_level[level as usize] += count;
-                continue;
+        let mut splitter = CoupledSplit { mech: self, center, radius };
+        let result = m.refine_mixed(center, radius, levels, &mut splitter);
+        match result {
+            Ok(per_level) => {
+                self.expensive_check(m);
+                let after = self.masses.total(m);
+                Ok(Refinement { subdivided_per_level: per_level, total_mass_before: before, total_mass_after: after })
             }
-            // Every refusal of the level before its first split (map, springs and masses unchanged).
-            let zone = m.check_level(level, levels, center, radius, &self.masses)?;
-            self.check_split_headroom(m, &zone)?;
-            for d in zone {
-                self.split_followed(m, d, level)?;
-                per_level[level as usize] += 1;
+            Err(e) => {
+                (*m, *self) = saved;
+                Err(e)
             }
         }
-        self.expensive_check(m);
-        let after = self.masses.total(m);
-        Ok(Refinement { subdivided_per_level: per_level, total_mass_before: before, total_mass_after: after })
-    }
-
-    /// The catch-up of [`Self::refine_around`] on a map at max level k ≥ 2 (see
-    /// [`LeveledMap::refine_around`]): every tet of `zone` (the tets at μt < k − 1 meeting the
-    /// ball) split 1→8 at level k with its springs and masses. Not all or nothing on its own
-    /// (a split may refuse for what an earlier one did to a shared face): the caller keeps a
-    /// copy. O(Σ zone volumes · log E).
-    fn catch_up(&mut self, m: &mut LeveledMap<3>, zone: &[DartId]) -> Result<(), CouplingError> {
-        let darts = m.map().dart_count();
-        for &d in zone {
-            self.split_followed(m, d, m.max_level())?;
-        }
-        Ok(m.check_caught_up(darts, zone.len())?)
     }
 
     /// One level of [`Self::refine_around`] by the map's bulk path ([`LeveledMap::refine_uniform`])
@@ -1559,6 +1528,32 @@ pub(super) fn volume_vertices(m: &LeveledMap<3>, t: DartId) -> Vec<u32> {
     vs.sort_unstable();
     vs.dedup();
     vs
+}
+
+/// The splitter of [`LeveledMechanics::refine_around`] on maps with level skips
+/// ([`LeveledMap::refine_mixed`]): each split with its springs and masses
+/// ([`LeveledMechanics::split_followed`]), the bulk path where it applies.
+struct CoupledSplit<'a> {
+    mech: &'a mut LeveledMechanics,
+    center: [f64; 3],
+    radius: f64,
+}
+
+impl LevelSplit for CoupledSplit<'_> {
+    type Error = CouplingError;
+
+    fn split(&mut self, m: &mut LeveledMap<3>, d: DartId, level: u8) -> Result<(), CouplingError> {
+        self.mech.split_followed(m, d, level).map(|_| ())
+    }
+
+    fn bulk(&mut self, m: &mut LeveledMap<3>, level: u8) -> Result<Option<usize>, CouplingError> {
+        self.mech.refine_level_in_bulk(m, self.center, self.radius, level)
+    }
+
+    fn check_zone(&mut self, m: &LeveledMap<3>, level: u8, zone: &[DartId]) -> Result<(), CouplingError> {
+        m.check_zone(level, zone, &self.mech.masses)?;
+        self.mech.check_split_headroom(m, zone)
+    }
 }
 
 #[cfg(test)]

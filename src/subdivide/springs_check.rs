@@ -164,7 +164,7 @@ pub enum SpringLawError {
         expected: f64,
     },
     /// Σ m_t changed.
-    #[error("the tets weigh {after} in total, {before} when the coupling was built")]
+    #[error("the tets weigh {after:e} in total, {before:e} when the coupling was built")]
     TotalMass {
         /// Σ m_t at construction.
         before: f64,
@@ -172,7 +172,7 @@ pub enum SpringLawError {
         after: f64,
     },
     /// The lumped centre of mass (rest positions) is not the tets' (finding 218).
-    #[error("centre of mass, axis {axis}: {lumped} lumped on the vertices, {tets} from the tets")]
+    #[error("centre of mass, axis {axis}: {lumped:e} lumped on the vertices, {tets:e} from the tets")]
     CentreOfMass {
         /// 0, 1 or 2.
         axis: usize,
@@ -182,7 +182,7 @@ pub enum SpringLawError {
         tets: f64,
     },
     /// A vertex mass gathered around the vertex differs from the scatter.
-    #[error("vertex {vertex}: mass {scattered} scattered from the tets, {gathered} gathered around it")]
+    #[error("vertex {vertex}: mass {scattered:e} scattered from the tets, {gathered:e} gathered around it")]
     VertexMass {
         /// The vertex id.
         vertex: u32,

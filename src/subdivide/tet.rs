@@ -334,6 +334,7 @@ impl LeveledMap<3> {
         let (mut corner_children, mut centers) = (0usize, 0usize);
         for f in self.volume_faces(d) {
             let sides = self.triangle_sides(f).map_err(|_| SubdivideError::FaceRefinedTooFar { dart: f })?;
+            self.check_not_self_glued(f)?;
             let is_corner: Vec<bool> = sides.iter().map(|s| corners.contains(&self.map.vertex_id(s.start).0)).collect();
             match is_corner.iter().filter(|&&c| c).count() {
                 3 => unsplit.push(f),

@@ -203,6 +203,7 @@ impl<const N: usize> LeveledMap<N> {
         if let Some(s) = sides.iter().find(|s| self.map.is_free(0, s.start)) {
             return Err(SubdivideError::OpenEdge(s.start));
         }
+        self.check_not_self_glued(d)?;
         self.check_side_midpoints(&sides, level)?;
         self.begin(level);
         let mids: Vec<(DartId, DartId)> = sides.iter().map(|s| self.side_midpoint(s)).collect();
@@ -226,6 +227,23 @@ impl<const N: usize> LeveledMap<N> {
         }
         self.finish();
         Ok(children)
+    }
+
+    /// Refuses a face sewn onto itself ([`SubdivideError::SelfGluedFace`]): a dart x of the
+    /// face of `d` whose αj (j ≥ 2) is in the same face — two of its sides glued (a cone), or
+    /// the face folded onto itself by α3. The split walks each side once and would split a
+    /// glued side twice (then the flat law broke) or never end (finding 270). O(face²), the face
+    /// having a handful of darts.
+    pub(super) fn check_not_self_glued(&self, d: DartId) -> Result<(), SubdivideError> {
+        let face = self.map.orbit(d, AlphaMask::of(&[0, 1]));
+        for &x in &face {
+            for j in 2..=N {
+                if !self.map.is_free(j, x) && face.contains(&self.map.alpha_dyn(j, x)) {
+                    return Err(SubdivideError::SelfGluedFace { dart: x, alpha: j });
+                }
+            }
+        }
+        Ok(())
     }
 
     /// The three sides of the triangle face of `d`, from a corner. O(face).

@@ -827,8 +827,8 @@ impl LeveledMap<3> {
         self.check_uniform_midpoints(level, &tpl, &lab)?;
         let parents = lab.template.len();
         let parent_mass: Vec<f64> = (0..parents)
-            .map(|t| masses.mass.get(self.map.cell_id(3, DartId(lab.darts[t * 24])).index()).copied().unwrap_or(0.0))
-            .collect();
+            .map(|t| masses.check_split_mass(self.map.cell_id(3, DartId(lab.darts[t * 24]))))
+            .collect::<Result<_, _>>()?;
         let child = self.write_uniform(level, &tpl, &lab, true);
         masses.mass.resize(self.map.cell_id_bound(3).max(masses.mass.len()), 0.0);
         let (mut before, mut after) = (0.0, 0.0);

@@ -231,18 +231,35 @@ impl LeveledMap<3> {
         Ok(ready)
     }
 
-    /// The levels of a refinement from a map at maximum level k ≥ 2 (module docs, "Maps with
-    /// level skips"), from level k on: at each level L the zone of [`Self::balanced_zone`] (tets
-    /// with μt < min(L, `levels`), faces read exactly), of which the ready ones are split at L
-    /// (tets below μt = L − 1 by a level skip); until the zone is empty at a level ≥ `levels`.
-    /// Returns the tets split per level (index = level; longer than `levels` + 1 when a tet held
-    /// back at the last level was split at the next). Not all or nothing: the caller keeps a
+    /// The refusal for a level where no zone tet may be split, named by the zone tet of `d`: its
+    /// first blocker as [`SubdivideError::FaceRefinedTooFar`] (that tet's face would be refined
+    /// twice), else its unsplit face of μf ≥ `level` as [`SubdivideError::AlreadyAtLevel`].
+    /// O(volume · (neighbours + edge rings)).
+    fn stuck(&self, d: DartId, level: u8) -> Result<SubdivideError, SubdivideError> {
+        if let Some(&b) = self.blockers(d)?.first() {
+            return Ok(SubdivideError::FaceRefinedTooFar { dart: b });
+        }
+        let corners = self.tet_corners(d, self.mu[d.index()].tet)?;
+        let unsplit = self.check_tet_faces_visiting(d, &corners, |_, _| {})?;
+        let f = unsplit.into_iter().find(|f| self.mu[f.index()].face >= level).unwrap_or(d);
+        Ok(SubdivideError::AlreadyAtLevel { dart: f, dim: 2, cell_level: self.mu[f.index()].face, level })
+    }
+
+    /// The levels of a refinement (module docs, "Levels"), from level max(1, k), k the map's
+    /// maximum level: at each level L the zone of [`Self::balanced_zone`] (tets with
+    /// μt < min(L, `levels`)), of which the ready ones are checked ([`Self::check_zone_darts`],
+    /// the splitter's `check_zone`) and split at L (tets below μt = L − 1 by a level skip);
+    /// until the zone is empty at a level ≥ `levels`. Returns the tets split per level (index =
+    /// level; longer than `levels` + 1 when a tet held back at the last level was split at the
+    /// next). Each level is checked before its first split; a refusal keeps the levels before
+    /// (a caller that wants all or nothing keeps a
     /// copy. O(levels · darts + Σ zone volumes · neighbours).
     ///
     /// Errors: [`SubdivideError::LevelTooHigh`] past [`MAX_LEVEL`], the dart limit per level
-    /// ([`Self::check_zone_darts`]), the splitter's own, and a split's refusal. A level where no
-    /// zone tet is ready (a map with a face refined twice, not made by these calls) tries the
-    /// first zone tet, whose refusal names what is wrong.
+    /// ([`Self::check_zone_darts`]), the splitter's own, and a split's refusal; a level after
+    /// the first where no zone tet is ready ([`Self::stuck`]: not met — a blocker is strictly
+    /// larger than the tet it blocks, so the largest zone tet has none, and faces of the level
+    /// only come with its own splits — but refused rather than split past a blocker).
     pub(super) fn refine_mixed<S: LevelSplit>(
         &mut self,
         center: [f64; 3],
@@ -266,9 +283,9 @@ impl LeveledMap<3> {
                     continue;
                 }
             }
-            let mut ready = self.ready_at(&zone, level)?;
-            if ready.is_empty() && level > first {
-                ready.extend(zone.first());
+            let ready = self.ready_at(&zone, level)?;
+            if let (true, Some(&d), true) = (ready.is_empty(), zone.first(), level > first) {
+                return Err(self.stuck(d, level)?.into());
             }
             self.check_zone_darts(level, &ready)?;
             s.check_zone(self, level, &ready)?;

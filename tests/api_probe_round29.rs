@@ -1,5 +1,5 @@
-//! Round 29's probes: faces sewn onto themselves (findings 270), the α0-unsew of a
-//! high-valence edge (271), masses too small for f64 in the subdivision layer (268), and the
+//! Round 29's probes: faces sewn onto themselves (finding 270), the α0-unsew of a
+//! high-valence edge (271, open), masses too small for f64 in the subdivision layer (268), and the
 //! CLI's tear threshold (269, in `tests/cli.rs`).
 
 use topomech::mechanics::Material;
@@ -53,10 +53,9 @@ fn a_face_sewn_onto_itself_is_refused_not_split() {
     m.check_all().unwrap();
 }
 
-/// Finding 271: the α0-unsew of an edge of valence k looked up each of its O(k) endpoint ids in
-/// short lists, O(k²) (552 ms at k = 4 000). The lists now switch to hash indexes past 64
-/// endpoints; both paths must give the same cells: checked here against the traversal count on
-/// a fan of k tets around one edge, for k on both sides of the switch.
+/// Finding 271 (open: the α0-unsew of an edge of valence k is O(k²)): whatever mends its cost
+/// must keep the cells exact; checked here against the traversal count on a fan of k tets
+/// around one edge, small and large k.
 #[test]
 fn the_unsew_of_a_high_valence_edge_keeps_exact_cells() {
     for k in [3u32, 10, 40, 300] {

@@ -742,17 +742,16 @@ impl<const N: usize> GMap<N> {
         let classes = links.classes(dim);
         anchors.clear();
         complete.clear();
-        let mut index = IdIndex::for_endpoints(2 * pairs.len());
         for (k, z) in pairs.iter().flat_map(|&(x, y)| [x, y]).enumerate() {
             if classes.has_earlier_member(k) {
                 continue;
             }
             let id = self.cell_id(dim, z).0;
-            if index.is_complete(complete, id) {
+            if complete.contains(&id) {
                 continue;
             }
-            let Some(slot) = index.anchor_slot(anchors, id) else {
-                index.push_anchor(anchors, (id, k));
+            let Some(slot) = anchors.iter().position(|a| a.0 == id) else {
+                anchors.push((id, k));
                 continue;
             };
             let a = anchors[slot].1;
@@ -790,7 +789,7 @@ impl<const N: usize> GMap<N> {
                 }
             };
             let (new, is_z_side) = new;
-            index.push_complete(complete, new);
+            complete.push(new);
             let (dart_kept, dart_new) = if is_z_side { (anchor, z) } else { (z, anchor) };
             anchors[slot].1 = if is_z_side { a } else { k };
             changes.push(CellChange::Split { dim, kept: CellId(id), new: CellId(new), dart_kept, dart_new });
@@ -799,52 +798,6 @@ impl<const N: usize> GMap<N> {
 }
 
 type SplitScratch = (Vec<(u32, usize)>, Vec<u32>);
-
-/// The lookups of [`GMap::split_cells`] in its (id, anchor) and complete-id lists: scans of the
-/// short lists for the usual handful of endpoints (12 per dimension for an inner face), hash
-/// indexes past [`IdIndex::SCAN`] endpoints. An unsew around an edge of valence k has O(k)
-/// endpoints per dimension, each with its own face and volume id, so the scans made the α0-unsew
-/// of such an edge O(k²) (finding 271: 552 ms at k = 4 000). O(1) per lookup either way.
-struct IdIndex {
-    hashed: Option<(std::collections::HashMap<u32, usize>, std::collections::HashSet<u32>)>,
-}
-
-impl IdIndex {
-    /// Endpoint counts up to this are scanned.
-    const SCAN: usize = 64;
-
-    fn for_endpoints(endpoints: usize) -> Self {
-        IdIndex { hashed: (endpoints > Self::SCAN).then(Default::default) }
-    }
-
-    fn is_complete(&self, complete: &[u32], id: u32) -> bool {
-        match &self.hashed {
-            Some((_, done)) => done.contains(&id),
-            None => complete.contains(&id),
-        }
-    }
-
-    fn anchor_slot(&self, anchors: &[(u32, usize)], id: u32) -> Option<usize> {
-        match &self.hashed {
-            Some((slots, _)) => slots.get(&id).copied(),
-            None => anchors.iter().position(|a| a.0 == id),
-        }
-    }
-
-    fn push_anchor(&mut self, anchors: &mut Vec<(u32, usize)>, anchor: (u32, usize)) {
-        if let Some((slots, _)) = &mut self.hashed {
-            slots.insert(anchor.0, anchors.len());
-        }
-        anchors.push(anchor);
-    }
-
-    fn push_complete(&mut self, complete: &mut Vec<u32>, id: u32) {
-        if let Some((_, done)) = &mut self.hashed {
-            done.insert(id);
-        }
-        complete.push(id);
-    }
-}
 
 thread_local! {
     /// The (id, anchor) and complete-id lists of [`GMap::split_cells`], reused across unsews.

@@ -1,6 +1,6 @@
 //! Round 29's probes: faces sewn onto themselves (finding 270), the α0-unsew of a
-//! high-valence edge (271, open), masses too small for f64 in the subdivision layer (268), and the
-//! CLI's tear threshold (269, in `tests/cli.rs`).
+//! high-valence edge (271, fixed in the next session), masses too small for f64 in the
+//! subdivision layer (268), and the CLI's tear threshold (269, in `tests/cli.rs`).
 
 use topomech::mechanics::Material;
 use topomech::subdivide::{LeveledMap, LeveledMechanics, SubdivideError, TetMasses};
@@ -53,9 +53,10 @@ fn a_face_sewn_onto_itself_is_refused_not_split() {
     m.check_all().unwrap();
 }
 
-/// Finding 271 (open: the α0-unsew of an edge of valence k is O(k²)): whatever mends its cost
-/// must keep the cells exact; checked here against the traversal count on a fan of k tets
-/// around one edge, small and large k.
+/// Finding 271 (the α0-unsew of an edge of valence k was O(k²); linear now, guarded by the unit
+/// test `a_high_valence_edge_unsews_in_linear_walks`): the fix must keep the cells exact;
+/// checked here against the traversal count on a fan of k tets around one edge, small and
+/// large k.
 #[test]
 fn the_unsew_of_a_high_valence_edge_keeps_exact_cells() {
     for k in [3u32, 10, 40, 300] {

@@ -742,16 +742,18 @@ impl<const N: usize> GMap<N> {
         let classes = links.classes(dim);
         anchors.clear();
         complete.clear();
-        for (k, z) in pairs.iter().flat_map(|&(x, y)| [x, y]).enumerate() {
+        let count = if quick { Self::split_endpoints(i, dim, pairs.len()) } else { 2 * pairs.len() };
+        let mut index = IdIndex::for_endpoints(count);
+        for (k, z) in pairs.iter().flat_map(|&(x, y)| [x, y]).take(count).enumerate() {
             if classes.has_earlier_member(k) {
                 continue;
             }
             let id = self.cell_id(dim, z).0;
-            if complete.contains(&id) {
+            if index.is_complete(complete, id) {
                 continue;
             }
-            let Some(slot) = anchors.iter().position(|a| a.0 == id) else {
-                anchors.push((id, k));
+            let Some(slot) = index.anchor_slot(anchors, id) else {
+                index.push_anchor(anchors, (id, k));
                 continue;
             };
             let a = anchors[slot].1;
@@ -789,7 +791,7 @@ impl<const N: usize> GMap<N> {
                 }
             };
             let (new, is_z_side) = new;
-            complete.push(new);
+            index.push_complete(complete, new);
             let (dart_kept, dart_new) = if is_z_side { (anchor, z) } else { (z, anchor) };
             anchors[slot].1 = if is_z_side { a } else { k };
             changes.push(CellChange::Split { dim, kept: CellId(id), new: CellId(new), dart_kept, dart_new });
@@ -797,7 +799,78 @@ impl<const N: usize> GMap<N> {
     }
 }
 
+impl<const N: usize> GMap<N> {
+    /// How many endpoints of the `pairs` unlinked by an αi-unsew [`GMap::split_cells`] has to
+    /// look at for the dim-cells: the first pair's two when |dim − i| = 1, else all.
+    ///
+    /// The law: the pairs are (x, αi x) for x over the orbit ⟨C⟩(d) of the generators C that
+    /// commute with αi (|j − i| ≥ 2). When |dim − i| = 1, C holds no α_dim, so C ⊆ the dim-cell's
+    /// generators minus αi: after the unsew every x is still in one dim-cell with x0 (a word w
+    /// of C, x = w x0), and every αi x = w αi x0 (the αs of C commute with αi) with αi x0. So
+    /// the cell of the pairs falls into at most the two pieces of the first pair's ends, and
+    /// every later endpoint would be skipped as complete or found joined to its anchor: no
+    /// change. This keeps the α0-unsew of an edge of valence k in a 3-map (2k pairs, each edge
+    /// piece the whole fan of one end) at O(k) instead of one O(k) fan walk per endpoint
+    /// (finding 271). Used on `quick` unsews only, so that the exact path still looks at every
+    /// endpoint (unit tests `quick_proofs_change_no_outcome`, `fan_unsews_change_no_outcome`).
+    /// O(1).
+    fn split_endpoints(i: usize, dim: usize, pairs: usize) -> usize {
+        if dim.abs_diff(i) == 1 {
+            2.min(2 * pairs)
+        } else {
+            2 * pairs
+        }
+    }
+}
+
 type SplitScratch = (Vec<(u32, usize)>, Vec<u32>);
+
+/// The lookups of [`GMap::split_cells`] in its (id, anchor) and complete-id lists: scans of the
+/// short lists for the usual handful of endpoints (12 per dimension for an inner face), hash
+/// indexes past [`IdIndex::SCAN`] endpoints. An α0-unsew around an edge of valence k in a 3-map
+/// has 4k endpoints for faces and for volumes, with k face ids and k volume ids, so scans would
+/// make it O(k²) (finding 271, with the fan walks of [`GMap::split_endpoints`]). O(1) per lookup
+/// either way (expected, for the hash indexes).
+struct IdIndex {
+    hashed: Option<(std::collections::HashMap<u32, usize>, std::collections::HashSet<u32>)>,
+}
+
+impl IdIndex {
+    /// Endpoint counts up to this are scanned.
+    const SCAN: usize = 64;
+
+    fn for_endpoints(endpoints: usize) -> Self {
+        IdIndex { hashed: (endpoints > Self::SCAN).then(Default::default) }
+    }
+
+    fn is_complete(&self, complete: &[u32], id: u32) -> bool {
+        match &self.hashed {
+            Some((_, done)) => done.contains(&id),
+            None => complete.contains(&id),
+        }
+    }
+
+    fn anchor_slot(&self, anchors: &[(u32, usize)], id: u32) -> Option<usize> {
+        match &self.hashed {
+            Some((slots, _)) => slots.get(&id).copied(),
+            None => anchors.iter().position(|a| a.0 == id),
+        }
+    }
+
+    fn push_anchor(&mut self, anchors: &mut Vec<(u32, usize)>, anchor: (u32, usize)) {
+        if let Some((slots, _)) = &mut self.hashed {
+            slots.insert(anchor.0, anchors.len());
+        }
+        anchors.push(anchor);
+    }
+
+    fn push_complete(&mut self, complete: &mut Vec<u32>, id: u32) {
+        if let Some((_, done)) = &mut self.hashed {
+            done.insert(id);
+        }
+        complete.push(id);
+    }
+}
 
 thread_local! {
     /// The (id, anchor) and complete-id lists of [`GMap::split_cells`], reused across unsews.
@@ -916,6 +989,8 @@ impl CornerCell {
     /// Appends the corner ⟨αh, αl⟩ of `c` to `darts`, stamping each with `own`.
     fn enter<const N: usize>(&self, map: &GMap<N>, c: DartId, stamps: &mut Stamps, own: u32, darts: &mut Vec<DartId>) {
         map.for_each_dihedral(c, self.h, self.l, |x| {
+            #[cfg(test)]
+            tests::CORNER_DARTS.set(tests::CORNER_DARTS.get() + 1);
             stamps.mark(x.0, own);
             darts.push(x);
         });
@@ -1572,6 +1647,69 @@ mod tests {
         pub(super) static CELL_WALKS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
         /// Darts [`RingCell::split_side`] looked up (one per step of either path walk).
         pub(super) static RING_STEPS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+        /// Darts [`CornerCell::split_side`] entered (corner by corner, both sides).
+        pub(super) static CORNER_DARTS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+    }
+
+    /// The darts of a fan of k tets around the edge (0, 1) (closed around it, or open: the
+    /// edge on the boundary), and a dart of vertex 0 on that edge.
+    fn fan(k: u32, closed: bool) -> (GMap<3>, DartId) {
+        let tets: Vec<[u32; 4]> = (0..k).map(|t| [0, 1, 2 + t, 2 + (t + 1) % (k + u32::from(!closed))]).collect();
+        let (map, _) = GMap::<3>::from_tets(k as usize + 3, &tets).unwrap();
+        let d = map.darts().find(|&d| map.vertex_id(d).0 == 0 && map.vertex_id(map.alpha::<0>(d)).0 == 1).unwrap();
+        (map, d)
+    }
+
+    /// Finding 271: the α0-unsew of an edge of valence k walked the whole fan (2k darts) once
+    /// per endpoint of its 2k pairs for the edge pieces, and scanned lists of k face and volume
+    /// ids per endpoint: O(k²). The darts its walks enter (corners and ring steps, all
+    /// dimensions) now grow linearly with k: at most 80 per tet of the fan (70 now), and doubling k at
+    /// most doubles them (+5 %). Before, the edge walks alone were 8k² darts.
+    #[test]
+    fn a_high_valence_edge_unsews_in_linear_walks() {
+        let mut per_k = Vec::new();
+        for k in [100u32, 200, 400, 800] {
+            for closed in [true, false] {
+                let (mut map, d) = fan(k, closed);
+                let (corners, steps) = (CORNER_DARTS.get(), RING_STEPS.get());
+                let changes = map.unsew_dyn(0, d).unwrap();
+                let walked = CORNER_DARTS.get() - corners + RING_STEPS.get() - steps;
+                assert_eq!(changes.splits(1).count(), 1, "k = {k}: the edge splits in two");
+                assert!(walked <= 80 * k as usize, "k = {k}, closed {closed}: {walked} darts walked");
+                per_k.push(walked);
+            }
+        }
+        for w in per_k.windows(4).step_by(2) {
+            assert!(w[2] * 100 <= w[0] * 210 && w[3] * 100 <= w[1] * 210, "not linear: {per_k:?}");
+        }
+    }
+
+    /// The shortcut of [`GMap::split_endpoints`] (only the first pair's endpoints for the
+    /// dimensions next to i) gives the exact path's outcome where the quick proofs do not
+    /// reach: fans of more than 16 pairs, open and closed, every unsew of a random order.
+    #[test]
+    fn fan_unsews_change_no_outcome() {
+        for (k, closed) in [(9, true), (12, false), (20, true), (3, true)] {
+            let (start, _) = fan(k, closed);
+            for i in 0..=3 {
+                let (mut fast, mut slow) = (start.clone(), start.clone());
+                let mut darts: Vec<DartId> = start.darts().collect();
+                let mut rng = SplitMix64(u64::from(k) * 7 + i as u64);
+                for t in (1..darts.len()).rev() {
+                    darts.swap(t, rng.below(t + 1));
+                }
+                for d in darts {
+                    let j = if rng.below(2) == 0 { 0 } else { i };
+                    if fast.is_free(j, d) {
+                        continue;
+                    }
+                    let (a, b) = (fast.unsew_with(j, d, true).unwrap(), slow.unsew_with(j, d, false).unwrap());
+                    assert_eq!(a, b, "k = {k}: alpha{j} unsew of {d}");
+                }
+                assert!(same_state(&fast, &slow), "k = {k}, alpha{i}: the maps differ");
+                assert_eq!(fast.count_cells(), fast.count_cells_by_traversal());
+            }
+        }
     }
 
     /// The quick proofs do their job: an α3-unsew of an inner face that splits nothing (every

@@ -27,6 +27,14 @@
 
 use super::{LeveledMap, SubdivideError, MAX_LEVEL};
 use crate::gmap::{AlphaMask, DartId};
+use rustc_hash::FxHashMap;
+use std::collections::hash_map::Entry;
+
+/// Per edge id, the darts around the edge whose tets see it as an inner side of a split face
+/// ([`LeveledMap::sees_inside`]): the edge part of [`LeveledMap::blockers`], found once per edge
+/// and level (the map does not change between a level's zone and its ready tets), so that the k
+/// tets around an edge of valence k cost O(k) there, not O(k²) (finding 248).
+type EdgeSeers = FxHashMap<u32, Vec<DartId>>;
 
 /// The most face rings a level's zone is widened by (module docs). `levels − L` rings at level
 /// L (enough by a monotonicity argument) made a deep call (60 levels around a point) refine the
@@ -96,6 +104,7 @@ impl LeveledMap<3> {
         (level, levels, below): (u8, u8, u8),
         center: [f64; 3],
         radius: f64,
+        seers: &mut EdgeSeers,
     ) -> Result<Vec<DartId>, SubdivideError> {
         let tets = self.map.one_dart_per_cell(3);
         let ring = self.rings(&tets, center, radius, levels.saturating_sub(level).min(RING_CAP))?;
@@ -109,7 +118,7 @@ impl LeveledMap<3> {
             }
         }
         while let Some(t) = stack.pop() {
-            for n in self.blockers(t)? {
+            for n in self.blockers(t, seers)? {
                 let id = self.map.cell_id(3, n).index();
                 if !in_zone[id] {
                     in_zone[id] = true;
@@ -158,15 +167,19 @@ impl LeveledMap<3> {
     }
 
     /// One dart of each tet whose faces a split of the tet of `t` would refine twice: a face
-    /// neighbour that sees the shared face as a child of its own ([`Self::sees_split`]), and a
-    /// tet around an edge the split would split (a side without a flat vertex of one of its
-    /// unsplit faces) that sees that edge as an inner side of one of its split faces (a side of
-    /// a child face, between two of its corners that are not corners of the tet).
-    /// Read off the faces, whatever the levels say. O(volume · (neighbours + edge rings)).
-    fn blockers(&self, t: DartId) -> Result<Vec<DartId>, SubdivideError> {
+    /// neighbour that sees the shared face as a child of its own ([`Self::sees_split`]) where
+    /// the tet of `t` sees it whole (the split would refine it), and a tet around an edge the
+    /// split would split (a side without a flat vertex of one of its unsplit faces) that sees
+    /// that edge as an inner side of one of its split faces (a side of a child face, between two
+    /// of its corners that are not corners of the tet). A face both tets see as a child (a face
+    /// split 1→4 on its own) blocks neither: the split of either keeps its children (finding
+    /// 272). Read off the faces, whatever the levels say. O(volume · (neighbours + edge rings)).
+    fn blockers(&self, t: DartId, seers: &mut EdgeSeers) -> Result<Vec<DartId>, SubdivideError> {
         let mut out = Vec::new();
-        for (n, _) in self.face_neighbours(t) {
-            if self.sees_split(n)? {
+        let volume = self.map.orbit(t, AlphaMask::cell(3, 3));
+        for x in volume.into_iter().filter(|&x| !self.map.is_free(3, x)) {
+            let n = self.map.alpha_dyn(3, x);
+            if self.sees_split(n)? && !self.sees_split(x)? {
                 out.push(n);
             }
         }
@@ -174,11 +187,23 @@ impl LeveledMap<3> {
         self.zone_tet_splits(t, &mut faces, &mut edges);
         let own = self.map.cell_id(3, t);
         for (_, x) in edges {
-            let ends = [self.map.vertex_id(x).0, self.map.vertex_id(self.map.alpha_dyn(0, x)).0];
-            for y in self.map.orbit(x, AlphaMask::of(&[2, 3])) {
-                if self.map.cell_id(3, y) != own && self.sees_inside(y, ends)? {
-                    out.push(y);
-                }
+            let around = match seers.entry(self.map.cell_id(1, x).0) {
+                Entry::Occupied(known) => known.into_mut(),
+                Entry::Vacant(slot) => slot.insert(self.edge_seers(x)?),
+            };
+            out.extend(around.iter().filter(|&&y| self.map.cell_id(3, y) != own));
+        }
+        Ok(out)
+    }
+
+    /// The darts y around the edge of `x` (its ⟨α2, α3⟩ orbit, in orbit order) whose tets see
+    /// the edge as an inner side of a split face ([`Self::sees_inside`]). O(edge ring · volume).
+    fn edge_seers(&self, x: DartId) -> Result<Vec<DartId>, SubdivideError> {
+        let ends = [self.map.vertex_id(x).0, self.map.vertex_id(self.map.alpha_dyn(0, x)).0];
+        let mut out = Vec::new();
+        for y in self.map.orbit(x, AlphaMask::of(&[2, 3])) {
+            if self.sees_inside(y, ends)? {
+                out.push(y);
             }
         }
         Ok(out)
@@ -215,7 +240,7 @@ impl LeveledMap<3> {
     /// unsplit face with μf ≥ `level`. A face refined twice is
     /// refused ([`SubdivideError::FaceRefinedTooFar`], from [`Self::check_tet_faces_visiting`]).
     /// O(Σ zone volumes · neighbours).
-    fn ready_at(&self, zone: &[DartId], level: u8) -> Result<Vec<DartId>, SubdivideError> {
+    fn ready_at(&self, zone: &[DartId], level: u8, seers: &mut EdgeSeers) -> Result<Vec<DartId>, SubdivideError> {
         let mut ready = Vec::new();
         for &d in zone {
             let corners = self.tet_corners(d, self.mu[d.index()].tet)?;
@@ -223,7 +248,7 @@ impl LeveledMap<3> {
             if unsplit.iter().any(|f| self.mu[f.index()].face >= level) {
                 continue;
             }
-            let blocked = !self.blockers(d)?.is_empty();
+            let blocked = !self.blockers(d, seers)?.is_empty();
             if !blocked {
                 ready.push(d);
             }
@@ -235,8 +260,8 @@ impl LeveledMap<3> {
     /// first blocker as [`SubdivideError::FaceRefinedTooFar`] (that tet's face would be refined
     /// twice), else its unsplit face of μf ≥ `level` as [`SubdivideError::AlreadyAtLevel`].
     /// O(volume · (neighbours + edge rings)).
-    fn stuck(&self, d: DartId, level: u8) -> Result<SubdivideError, SubdivideError> {
-        if let Some(&b) = self.blockers(d)?.first() {
+    fn stuck(&self, d: DartId, level: u8, seers: &mut EdgeSeers) -> Result<SubdivideError, SubdivideError> {
+        if let Some(&b) = self.blockers(d, seers)?.first() {
             return Ok(SubdivideError::FaceRefinedTooFar { dart: b });
         }
         let corners = self.tet_corners(d, self.mu[d.index()].tet)?;
@@ -259,7 +284,8 @@ impl LeveledMap<3> {
     /// ([`Self::check_zone_darts`]), the splitter's own, and a split's refusal; a level after
     /// the first where no zone tet is ready ([`Self::stuck`]: not met — a blocker is strictly
     /// larger than the tet it blocks, so the largest zone tet has none, and faces of the level
-    /// only come with its own splits — but refused rather than split past a blocker).
+    /// only come with its own splits — but refused rather than split past a blocker; round 30
+    /// met it through a wrong blocker, finding 272).
     pub(super) fn refine_mixed<S: LevelSplit>(
         &mut self,
         center: [f64; 3],
@@ -270,7 +296,8 @@ impl LeveledMap<3> {
         let first = self.max_level.max(1);
         let mut per_level = vec![0; levels as usize + 1];
         for level in first..=MAX_LEVEL {
-            let zone = self.balanced_zone((level, levels, level.min(levels)), center, radius)?;
+            let mut seers = EdgeSeers::default();
+            let zone = self.balanced_zone((level, levels, level.min(levels)), center, radius, &mut seers)?;
             if zone.is_empty() && level >= levels {
                 return Ok(per_level);
             }
@@ -283,9 +310,9 @@ impl LeveledMap<3> {
                     continue;
                 }
             }
-            let ready = self.ready_at(&zone, level)?;
+            let ready = self.ready_at(&zone, level, &mut seers)?;
             if let (true, Some(&d), true) = (ready.is_empty(), zone.first(), level > first) {
-                return Err(self.stuck(d, level)?.into());
+                return Err(self.stuck(d, level, &mut seers)?.into());
             }
             self.check_zone_darts(level, &ready)?;
             s.check_zone(self, level, &ready)?;

@@ -272,20 +272,28 @@ fn apply_3d(m: &mut LeveledMap<3>, mech: &mut LeveledMechanics, op: Op) -> Appli
 
 /// `refine_around` with the mass, zone and spring laws checked. Tets created by hand-ordered ops
 /// may not be refinable by a ball (`FaceRefinedTooFar` after a face was split twice): that is a
-/// refusal.
+/// refusal, but only on a map that fails [`LeveledMap::check_faces_refinable`]; a map that
+/// passes it is refused no tet for its faces and passes it afterwards (finding 272).
 fn around(m: &mut LeveledMap<3>, mech: &mut LeveledMechanics, center: [u8; 2], radius: u8) -> Applied {
     let c = [f64::from(center[0]) / 255.0, f64::from(center[1]) / 255.0, 0.5];
     let r = f64::from(radius) / 255.0;
     let levels = level_of(m, true);
     let (before, mech_before) = (m.clone(), mech.clone());
     let expected = masses_total(m)?;
+    let refinable = m.check_faces_refinable().is_ok();
     if let Err(e) = mech.refine_around(m, c, r, levels) {
         // refine_around keeps the ops done before a refusal; the fuzz checks want all or nothing.
         (*m, *mech) = (before, mech_before);
         return match e {
+            CouplingError::Subdivide(e @ SubdivideError::FaceRefinedTooFar { .. }) if refinable => {
+                Err(format!("refused a map whose faces are refinable: {e}"))
+            }
             CouplingError::Subdivide(e) => Ok(Err(e)),
             e => Err(format!("spring coupling: {e}")),
         };
+    }
+    if refinable {
+        m.check_faces_refinable().map_err(|e| format!("refinable before, not after: {e}"))?;
     }
     let total = mech.masses.total(m);
     if (total - expected).abs() > 1e-12 * expected.max(1.0) {

@@ -72,10 +72,15 @@ pub(super) struct Scratch {
 #[derive(Clone, Debug, Default)]
 pub(super) struct OpLog {
     level: u8,
+    /// Whether the running operation only adds darts to vertices and creates vertices, never
+    /// separating or joining the darts of existing ones ([`LeveledMap::begin_growth`]).
+    grows_vertices: bool,
     /// Pre-existing darts whose links changed, in first-touch order.
     touched: Vec<DartId>,
     /// (N + 1) cell ids per touched dart, as they were before the operation.
     old_ids: Vec<u32>,
+    /// Per touched dart, the bit set of the generators αj whose link it changed.
+    changed: Vec<u8>,
     /// Darts created by the operation.
     created: Vec<DartId>,
     /// Inserted vertices: (a dart at the new vertex, darts at the two end vertices).
@@ -125,8 +130,21 @@ impl<const N: usize> LeveledMap<N> {
         debug_assert!(self.check_op_level(level).is_ok());
         debug_assert!(self.op.touched.is_empty() && self.op.created.is_empty());
         self.op.level = level;
+        self.op.grows_vertices = false;
         self.op.scratch.touched.clear();
         self.op.scratch.created.clear();
+    }
+
+    /// [`Self::begin`] for a split (of an edge, a triangle or a tet's inner faces): such an
+    /// operation inserts darts into vertices and creates new vertices, but never separates the
+    /// darts of a vertex nor joins two vertices (the split keeps every old vertex a point of the
+    /// mesh with the same neighbourhood, refined). So [`Self::finish`] gives the vertex ids of
+    /// the created darts only ([`Self::label_grown_vertices`]), and an operation at a vertex of
+    /// valence V no longer walks it (finding 248). The law is checked after every operation in
+    /// debug builds on the darts touched, and by the full `validate()` under `expensive-checks`.
+    pub(super) fn begin_growth(&mut self, level: u8) {
+        self.begin(level);
+        self.op.grows_vertices = true;
     }
 
     /// Records that `d` is about to change (its old cell ids and, once per level and αj, the old
@@ -143,10 +161,13 @@ impl<const N: usize> LeveledMap<N> {
             }
             at[d.index()] = self.op.touched.len() as u32;
             self.op.touched.push(d);
+            self.op.changed.push(0);
             for dim in 0..=N {
                 self.op.old_ids.push(self.map.cell_id(dim, d).0);
             }
         }
+        let at = self.op.scratch.touched_at[d.index()] as usize;
+        self.op.changed[at] |= 1 << j;
         if !self.history.of(d.index()).any(|c| c.level == level && c.j as usize == j) {
             let old = self.map.alpha_dyn(j, d).0;
             self.history.push(d.index(), LinkChange { level, j: j as u8, old });
@@ -214,7 +235,11 @@ impl<const N: usize> LeveledMap<N> {
         // Before the relabelling, a pre-existing dart still carries the id its edge had.
         let old_edges: Vec<u32> = midpoints.iter().map(|&(_, a, _)| self.map.cell_id(1, a).0).collect();
         for dim in 0..=N {
-            self.relabel_dim(dim);
+            if dim == 0 && self.op.grows_vertices {
+                self.label_grown_vertices();
+            } else {
+                self.relabel_dim(dim);
+            }
         }
         for ((m, a, b), edge) in midpoints.into_iter().zip(old_edges) {
             let (pa, pb) = (self.position(a), self.position(b));
@@ -242,6 +267,7 @@ impl<const N: usize> LeveledMap<N> {
         }
         self.op.touched.clear();
         self.op.old_ids.clear();
+        self.op.changed.clear();
         self.op.created.clear();
         #[cfg(feature = "expensive-checks")]
         if let Err(e) = self.map.validate() {
@@ -249,26 +275,45 @@ impl<const N: usize> LeveledMap<N> {
         }
     }
 
-    /// Re-derives the dim-cell ids of every cell that contains a touched or created dart. An
+    /// Re-derives the dim-cell ids of every cell that may have changed: the cells of the created
+    /// darts and of the touched darts that changed a link of the cell's own generators. An
     /// orbit keeps an id one of its darts had before the operation when it can (untouched darts
     /// first, in breadth-first orbit order, then the old ids of touched darts in the same order),
     /// otherwise gets a fresh one; old ids no orbit kept are released in increasing order.
-    /// O(touched cells); the visited and claimed sets are epoch stamps ([`EpochSet`]).
+    ///
+    /// A touched dart whose changed links are all outside the cell's generators starts no walk
+    /// (finding 248): if no dart of its orbit changed such a link or was created, the orbit's
+    /// links are the old ones, so it is the old cell, whole, and keeps its id (the relabelling
+    /// would give it that id too: its untouched darts carry it, or all its old ids are it, and no
+    /// other orbit had it). So the corners of an operation at a vertex of valence V, whose
+    /// α1, α2, α3 links no split changes, cost nothing here instead of O(V).
+    /// O(changed cells); the visited and claimed sets are epoch stamps ([`EpochSet`]).
     fn relabel_dim(&mut self, dim: usize) {
         let mut s = std::mem::take(&mut self.op.scratch);
         s.seen.clear();
         s.claimed.clear();
         let nt = self.op.touched.len();
+        let mask = AlphaMask::cell(N, dim);
+        let in_cell = (0..=N).filter(|&j| mask.contains(j)).fold(0u8, |bits, j| bits | 1 << j);
         for k in 0..nt + self.op.created.len() {
             let start = if k < nt { self.op.touched[k] } else { self.op.created[k - nt] };
-            if s.seen.contains(start.0) {
+            if s.seen.contains(start.0) || (k < nt && self.op.changed[k] & in_cell == 0) {
                 continue;
             }
             self.walk_orbit(start, AlphaMask::cell(N, dim), &mut s.seen, &mut s.orbit);
+            #[cfg(test)]
+            tests::RELABELLED.set(tests::RELABELLED.get() + s.orbit.len());
             let id = self.kept_id(dim, &s).unwrap_or_else(|| self.map.alloc_cell_id(dim));
             s.claimed.insert(id);
             for &x in &s.orbit {
                 self.map.set_cell_raw(dim, x, id);
+            }
+        }
+        for &d in &self.op.touched {
+            if !s.seen.contains(d.0) {
+                let id = self.map.cell_id(dim, d).0;
+                debug_assert_eq!(id, self.op.old_ids[s.touched_at[d.index()] as usize * (N + 1) + dim]);
+                s.claimed.insert(id); // an unchanged cell, not walked: its id stays
             }
         }
         s.pool.clear();
@@ -278,6 +323,45 @@ impl<const N: usize> LeveledMap<N> {
         for &id in &s.pool {
             if !s.claimed.contains(id) {
                 self.map.release_cell_id(dim, id);
+            }
+        }
+        self.op.scratch = s;
+    }
+
+    /// The vertex ids after an operation opened by [`Self::begin_growth`]: each vertex of
+    /// created darts takes the id of the pre-existing darts it holds (one id: the operation
+    /// joins no vertices), or a fresh one if it holds none (a new vertex), in the order of the
+    /// created darts — the ids [`Self::relabel_dim`] gives, without walking the pre-existing
+    /// darts. O(created darts · n).
+    fn label_grown_vertices(&mut self) {
+        let mut s = std::mem::take(&mut self.op.scratch);
+        s.seen.clear();
+        for k in 0..self.op.created.len() {
+            let start = self.op.created[k];
+            if !s.seen.insert(start.0) {
+                continue;
+            }
+            s.orbit.clear();
+            s.orbit.push(start);
+            let (mut head, mut id) = (0, None);
+            while head < s.orbit.len() {
+                let row = self.map.alpha_row(s.orbit[head].0);
+                head += 1;
+                for &y in &row[1..=N] {
+                    if !s.created.contains(y) {
+                        let old = self.map.cell_id(0, DartId(y)).0;
+                        debug_assert!(id.is_none_or(|i| i == old), "subdivide bug: a split joined two vertices");
+                        id = Some(old);
+                    } else if s.seen.insert(y) {
+                        s.orbit.push(DartId(y));
+                    }
+                }
+            }
+            let id = id.unwrap_or_else(|| self.map.alloc_cell_id(0));
+            #[cfg(test)]
+            tests::RELABELLED.set(tests::RELABELLED.get() + s.orbit.len());
+            for &x in &s.orbit {
+                self.map.set_cell_raw(0, x, id);
             }
         }
         self.op.scratch = s;
@@ -330,6 +414,61 @@ impl<const N: usize> LeveledMap<N> {
 #[cfg(test)]
 mod tests {
     use super::EpochSet;
+    use crate::subdivide::LeveledMap;
+    use crate::GMap;
+
+    thread_local! {
+        /// Darts walked by the relabellings of this thread's operations, all dimensions.
+        pub(super) static RELABELLED: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+    }
+
+    /// The cone from the centre of the cube [-1, 1]³ over its surface (each side an n × n grid,
+    /// two triangles per square): 12 n² tets at the centre vertex 0, whose edges have valence
+    /// at most 6.
+    fn star(n: u32) -> LeveledMap<3> {
+        let mut points = vec![[0.0; 3]];
+        let mut ids = std::collections::HashMap::new();
+        let mut tets = Vec::new();
+        for (axis, side) in (0..3).flat_map(|a| [(a, -1.0), (a, 1.0)]) {
+            let mut id = |a: u32, b: u32| {
+                let mut p = [side; 3];
+                p[(axis + 1) % 3] = -1.0 + 2.0 * f64::from(a) / f64::from(n);
+                p[(axis + 2) % 3] = -1.0 + 2.0 * f64::from(b) / f64::from(n);
+                *ids.entry(p.map(f64::to_bits)).or_insert_with(|| {
+                    points.push(p);
+                    points.len() as u32 - 1
+                })
+            };
+            for (i, j) in (0..n).flat_map(|i| (0..n).map(move |j| (i, j))) {
+                let q = [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)];
+                tets.extend([[0, q[0], q[1], q[2]], [0, q[0], q[2], q[3]]]);
+            }
+        }
+        let (map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
+        LeveledMap::new(map, points)
+    }
+
+    /// Finding 248: splitting an edge at a vertex of valence V relabelled that vertex's whole
+    /// orbit (6 darts per tet around it), and refining the tets around it was O(V²). Now the
+    /// darts the relabellings walk do not grow with V: the same spoke split at the centre of
+    /// 192 and of 3 072 tets walks the same number of darts (the edge ring, its faces and
+    /// volumes, the new vertex), and the ids are exact (`validate` after each).
+    #[test]
+    fn a_split_at_a_high_valence_vertex_walks_no_more_for_more_tets() {
+        let mut walked = Vec::new();
+        for n in [4, 16] {
+            let mut m = star(n);
+            let d = m.map().darts().find(|&d| m.map().vertex_id(d).0 == 0).unwrap();
+            let before = RELABELLED.get();
+            m.split_edge(d, 1).unwrap();
+            walked.push(RELABELLED.get() - before);
+            m.map().validate().unwrap();
+            assert_eq!(m.map().count_cells(), m.map().count_cells_by_traversal());
+            assert_eq!(m.map().count_cells().0[3], 12 * n as usize * n as usize);
+        }
+        assert!(walked[0] < 6 * 192, "{walked:?}");
+        assert_eq!(walked[0], walked[1], "the relabelling grows with the valence: {walked:?}");
+    }
 
     #[test]
     fn epoch_set_clear_empties_and_insert_reports_absence() {

@@ -656,8 +656,9 @@ impl LeveledMap<3> {
     /// representable strictly between its ends: about 52 − log2(|coordinates| / edge length)
     /// levels can be made; [`SubdivideError::FlatChild`]), all checked on the whole level before
     /// its first split, so an error leaves the map and the masses as the levels before it left
-    /// them (unchanged, except after a [`SubdivideError::DartLimit`] or
-    /// [`SubdivideError::BelowPrecision`] at a level after the first); on a map above level 0,
+    /// them: unchanged when it comes at the first level, the earlier levels done when it comes
+    /// later (a split mass check, [`SubdivideError::MassTooSmall`], can pass at one level and
+    /// fail on the children at the next: finding 273); on a map above level 0,
     /// the same refusals and [`SubdivideError::FaceRefinedTooFar`] for a tet whose face single
     /// operations refined twice, with the map and the masses put back.
     ///

@@ -1029,9 +1029,9 @@ impl LeveledMechanics {
     /// refusals of [`Self::subdivide_tet`] for any tet of its zone) and
     /// [`CouplingError::SplitOverflow`] (the bound of [`Self::subdivide_tet`] over the whole
     /// zone), all checked on the whole level before its first split: an error leaves the map,
-    /// the springs and the masses as the levels before it left them (unchanged, except after a
-    /// [`SubdivideError::DartLimit`] or a [`CouplingError::SplitOverflow`] at a level after the
-    /// first; map and coupling in step either way); on a map above level 0 the same, with map
+    /// the springs and the masses as the levels before it left them (unchanged when it comes at
+    /// the first level, the earlier levels done when it comes later, whatever the refusal; map
+    /// and coupling in step either way); on a map above level 0 the same, with map
     /// and coupling put back. With `expensive-checks`, [`Self::check`] runs once at the end (not
     /// after each tet).
     ///

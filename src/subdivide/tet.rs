@@ -238,7 +238,7 @@ impl LeveledMap<3> {
         for f in unsplit {
             self.subdivide_triangle(f, level)?;
         }
-        self.begin(level);
+        self.begin_growth(level);
         let children = self.insert_inner_faces(d, &corners);
         for &c in &children {
             self.set_tet_levels(c, level);

@@ -43,8 +43,8 @@ impl<const N: usize> LeveledMap<N> {
     /// `subdividedge`). Every dart x of the edge gets a new dart x' with α0^level(x) = x'; the
     /// new darts are α1-linked pairwise at the new vertex and αj-linked (j ≥ 2) like their
     /// partners. All darts of the two halves take μa = level. Returns α0(d) afterwards.
-    /// O(edge · (n + log edge) + V): each dart's new partner is found in the orbit sorted once; V,
-    /// the darts of the vertices it touches, is the relabelling at the end of the operation.
+    /// O(edge · (n + log edge)): each dart's new partner is found in the orbit sorted once; the
+    /// relabelling at the end walks the edge's cells, not its end vertices (finding 248).
     ///
     /// Errors: [`SubdivideError::NoSuchDart`], [`SubdivideError::OpenEdge`],
     /// [`SubdivideError::AlreadyAtLevel`] (μa(d) ≥ level), [`SubdivideError::NonFinitePosition`] (an end of an edge to
@@ -71,7 +71,7 @@ impl<const N: usize> LeveledMap<N> {
         self.check_op_level(level)?;
         self.check_edge(d, level)?;
         self.check_midpoint(d, level)?;
-        self.begin(level);
+        self.begin_growth(level);
         let m = self.split_edge_raw(d);
         self.finish();
         Ok(m)
@@ -205,7 +205,7 @@ impl<const N: usize> LeveledMap<N> {
         }
         self.check_not_self_glued(d)?;
         self.check_side_midpoints(&sides, level)?;
-        self.begin(level);
+        self.begin_growth(level);
         let mids: Vec<(DartId, DartId)> = sides.iter().map(|s| self.side_midpoint(s)).collect();
         let (m_in, m_out): (Vec<DartId>, Vec<DartId>) = mids.into_iter().unzip();
         self.insert_edge_2d(m_in[0], m_out[2]);

@@ -542,8 +542,8 @@ impl LeveledMap<3> {
             self.walk_orbit(x, AlphaMask::cell(3, 2), &mut s.seen, &mut faces);
             for &y in &faces {
                 self.mu[y.index()].face = self.mu[y.index()].face.max(level);
-                if s.seen2.contains(y.0) {
-                    continue;
+                if s.seen2.contains(y.0) || self.mu[y.index()].edge >= level {
+                    continue; // μa is one value per edge: nothing to raise (finding 248)
                 }
                 self.walk_orbit(y, AlphaMask::cell(3, 1), &mut s.seen2, &mut edges);
                 for &z in &edges {

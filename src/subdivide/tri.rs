@@ -343,8 +343,8 @@ impl<const N: usize> LeveledMap<N> {
         self.walk_orbit(c, AlphaMask::cell(N, 2), &mut s.seen, &mut face);
         for &x in &face {
             self.mu[x.index()].face = level;
-            if s.seen2.contains(x.0) {
-                continue;
+            if s.seen2.contains(x.0) || self.mu[x.index()].edge == level {
+                continue; // μa is one value per edge and at most the level: already set (finding 248)
             }
             self.walk_orbit(x, AlphaMask::cell(N, 1), &mut s.seen2, &mut edge);
             for &y in &edge {

@@ -144,7 +144,8 @@ impl LeveledMap<3> {
         for r in 1..=depth.min(MAX_LEVEL) {
             let mut next = Vec::new();
             for &t in &frontier {
-                for (n, id) in self.face_neighbours(t) {
+                for (_, n) in self.face_neighbours(t) {
+                    let id = self.map.cell_id(3, n).index();
                     if ring[id] == u8::MAX {
                         ring[id] = r;
                         next.push(n);
@@ -156,14 +157,11 @@ impl LeveledMap<3> {
         Ok(ring)
     }
 
-    /// One dart `n` of the tet across each sewn face dart of the tet of `t`, with its volume id
-    /// (a neighbour comes once per dart pair of the faces they share). O(volume).
-    fn face_neighbours(&self, t: DartId) -> impl Iterator<Item = (DartId, usize)> + '_ {
+    /// Each sewn face dart x of the tet of `t` with the dart n = α3(x) of the tet across (a
+    /// neighbour comes once per dart pair of the faces they share). O(volume).
+    fn face_neighbours(&self, t: DartId) -> impl Iterator<Item = (DartId, DartId)> + '_ {
         let volume = self.map.orbit(t, AlphaMask::cell(3, 3));
-        volume.into_iter().filter(|&x| !self.map.is_free(3, x)).map(|x| {
-            let n = self.map.alpha_dyn(3, x);
-            (n, self.map.cell_id(3, n).index())
-        })
+        volume.into_iter().filter(|&x| !self.map.is_free(3, x)).map(|x| (x, self.map.alpha_dyn(3, x)))
     }
 
     /// One dart of each tet whose faces a split of the tet of `t` would refine twice: a face
@@ -176,9 +174,7 @@ impl LeveledMap<3> {
     /// 272). Read off the faces, whatever the levels say. O(volume · (neighbours + edge rings)).
     fn blockers(&self, t: DartId, seers: &mut EdgeSeers) -> Result<Vec<DartId>, SubdivideError> {
         let mut out = Vec::new();
-        let volume = self.map.orbit(t, AlphaMask::cell(3, 3));
-        for x in volume.into_iter().filter(|&x| !self.map.is_free(3, x)) {
-            let n = self.map.alpha_dyn(3, x);
+        for (x, n) in self.face_neighbours(t) {
             if self.sees_split(n)? && !self.sees_split(x)? {
                 out.push(n);
             }

@@ -79,7 +79,8 @@ pub(super) struct OpLog {
     touched: Vec<DartId>,
     /// (N + 1) cell ids per touched dart, as they were before the operation.
     old_ids: Vec<u32>,
-    /// Per touched dart, the bit set of the generators αj whose link it changed.
+    /// Per touched dart, the bit set of the generators αj whose link it changed (bit j, as in
+    /// [`AlphaMask`]).
     changed: Vec<u8>,
     /// Darts created by the operation.
     created: Vec<DartId>,
@@ -294,13 +295,12 @@ impl<const N: usize> LeveledMap<N> {
         s.claimed.clear();
         let nt = self.op.touched.len();
         let mask = AlphaMask::cell(N, dim);
-        let in_cell = (0..=N).filter(|&j| mask.contains(j)).fold(0u8, |bits, j| bits | 1 << j);
         for k in 0..nt + self.op.created.len() {
             let start = if k < nt { self.op.touched[k] } else { self.op.created[k - nt] };
-            if s.seen.contains(start.0) || (k < nt && self.op.changed[k] & in_cell == 0) {
+            if s.seen.contains(start.0) || (k < nt && self.op.changed[k] & mask.0 == 0) {
                 continue;
             }
-            self.walk_orbit(start, AlphaMask::cell(N, dim), &mut s.seen, &mut s.orbit);
+            self.walk_orbit(start, mask, &mut s.seen, &mut s.orbit);
             let id = self.kept_id(dim, &s).unwrap_or_else(|| self.map.alloc_cell_id(dim));
             s.claimed.insert(id);
             for &x in &s.orbit {

@@ -387,6 +387,9 @@ pub trait CellRules<const N: usize> {
     /// The `split.dim`-cell `split.kept` (containing `split.dart_kept`) was split: the darts of
     /// the other side, `split.dart_new` among them, now form the cell `split.new`; when the
     /// kernel reported them, `split.new_side` lists every one of them (no need to walk it).
+    /// The rules run after the whole operation, on the map as it leaves it: a cell cut into
+    /// three pieces comes as two splits of the same `kept`, and in each `dart_kept` lies in
+    /// `kept` and `dart_new` in `new` in that final map.
     fn on_split(&mut self, map: &GMap<N>, split: &Split<'_>);
 
     /// The `dim`-cell `absorbed` was merged into `kept`, which now holds the darts of both.

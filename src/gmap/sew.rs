@@ -127,7 +127,10 @@ pub enum CellChange {
         absorbed: CellId,
     },
     /// One `dim`-cell became two: the darts of one side (`dart_new` among them) now carry the
-    /// fresh id `new`; the other side (`dart_kept` among them) keeps `kept`.
+    /// fresh id `new`; the other side (`dart_kept` among them) keeps `kept`. A cell cut into
+    /// three or more pieces by one operation is reported as one split per extra piece, each
+    /// with its own `new`, `kept` staying with one piece; in every entry `dart_kept` and
+    /// `dart_new` carry `kept` and `new` in the map as the operation leaves it (finding 276).
     Split {
         /// Dimension of the cells.
         dim: usize,
@@ -795,6 +798,38 @@ impl<const N: usize> GMap<N> {
             let (dart_kept, dart_new) = if is_z_side { (anchor, z) } else { (z, anchor) };
             anchors[slot].1 = if is_z_side { a } else { k };
             changes.push(CellChange::Split { dim, kept: CellId(id), new: CellId(new), dart_kept, dart_new });
+        }
+        // One fresh id per split: the last `complete.len()` changes are this call's splits.
+        if complete.len() >= 2 {
+            let first = changes.len() - complete.len();
+            self.keep_darts_in_kept(dim, pairs, anchors, &index, &mut changes[first..]);
+        }
+    }
+
+    /// A cell cut into three or more pieces by one unsew is split once per extra piece, and a
+    /// later split can carry an earlier one's `dart_kept` away to its new piece (finding 276).
+    /// Points each `dart_kept` of `made` (one dimension's splits of one call of
+    /// [`Self::split_cells`]) that no longer carries its `kept` at the endpoint its anchor slot
+    /// ends with, which keeps the id. The new pieces are complete and never split again in
+    /// that call, so every `dart_new` stays in its `new`. Apart, not inlined: the splits of a
+    /// face dissociation rarely come two to a dimension, and the loop of `split_cells` keeps
+    /// its code. O(splits).
+    #[inline(never)]
+    fn keep_darts_in_kept(
+        &self,
+        dim: usize,
+        pairs: &[(DartId, DartId)],
+        anchors: &[(u32, usize)],
+        index: &IdIndex,
+        made: &mut [CellChange],
+    ) {
+        for change in made {
+            if let CellChange::Split { kept, dart_kept, .. } = change {
+                if self.cell_id(dim, *dart_kept) != *kept {
+                    let slot = index.anchor_slot(anchors, kept.0).expect("a split id has an anchor");
+                    *dart_kept = endpoint(pairs, anchors[slot].1);
+                }
+            }
         }
     }
 }

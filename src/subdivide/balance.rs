@@ -20,7 +20,9 @@
 //! - the zone tets without blockers and without an unsplit face made at level L (next to a
 //!   level skip: such a face cannot be split at L) are split at L; the others wait a level;
 //! - the call ends at the first level ≥ `levels` with an empty zone (a tet held back at the
-//!   last requested level is split at the next one, its children one level past `levels`).
+//!   last requested level is split at the first later level where nothing blocks it, by a
+//!   level skip: a chain of blockers can hold it back several levels, so its children can end
+//!   several levels past `levels`, with the size of level `levels`; finding 275).
 //!
 //! The rings anticipate (the neighbours of the tets of the next level are split a level before,
 //! so few tets wait); the blockers make it exact.

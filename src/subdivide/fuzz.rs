@@ -303,7 +303,7 @@ fn around(m: &mut LeveledMap<3>, mech: &mut LeveledMechanics, center: [u8; 2], r
         let corners = m.tet_vertices(d).map_err(|e| e.to_string())?.map(|v| m.points()[v as usize]);
         // SUBDIVISION.md's law, from any state since finding 125 (such tets are caught up by a
         // level skip since round 18; since round 29 a tet that had to wait for a coarser
-        // neighbour may end one level past `levels`).
+        // neighbour may end past `levels`, several levels past after a chain of blockers).
         if tet_distance(c, corners) <= r && levels >= 1 && m.mu(d).tet < levels {
             return Err(format!("the tet of {d} meets the ball but stayed at level {}", m.mu(d).tet));
         }

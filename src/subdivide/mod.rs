@@ -395,6 +395,28 @@ pub enum SubdivideError {
         /// (0,1), (0,2), (0,3), (1,2), (1,3), (2,3).
         child: [u8; 4],
     },
+    /// A 1→4 split of a triangle of a 2-G-map past the precision of the `f64` coordinates: the
+    /// triangle is valid but so nearly collinear at its scale that, with its side midpoints
+    /// placed (rounded, or the inserted vertices already there), a child would be collinear or
+    /// oriented against it, in the projection onto the coordinate plane where the parent's
+    /// normal is largest (the 2D analogue of [`SubdivideError::FlatChild`]). Checked by a float
+    /// filter and else exact orientation; an exactly collinear triangle is not refused. Refused
+    /// before any change; not checked on a map without points.
+    #[error(
+        "splitting the triangle of {dart} (corners {corners:?}) 1->4 at level {level} is past the precision of \
+         f64: with its side midpoints placed, the child of corner and midpoint labels {child:?} would be \
+         collinear or inverted (the triangle is nearly collinear at the scale of its coordinates)"
+    )]
+    FlatTriangleChild {
+        /// The level refused.
+        level: u8,
+        /// A dart of the triangle.
+        dart: DartId,
+        /// Its corner vertex ids (labels 0..2), in the order of its sides.
+        corners: [u32; 3],
+        /// The child's labels: corners 0..2, midpoint of side k = (k, k + 1 mod 3) = 3 + k.
+        child: [u8; 3],
+    },
 }
 
 /// Violations of the level laws found by [`LeveledMap::check_levels`] and [`LeveledMap::check_all`].

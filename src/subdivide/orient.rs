@@ -11,11 +11,18 @@
 //! corner children and the 4 children around each of the 3 diagonals, each compared with the
 //! parent's; a parent that is exactly flat has no orientation to keep and is accepted, as
 //! before.
+//!
+//! The same holds for the 1→4 split of a triangle in a 2-G-map (the four children have the
+//! parent's orientation for exact midpoints): there the orientation is that of the projection
+//! onto a coordinate plane, the one where the parent's normal is largest, so a planar mesh in any
+//! plane z = c is checked by its plain 2D orientation, and a surface triangle in 3D by its
+//! dominant projection.
 
 use super::tet::{child_tets, mid_label};
 use super::{LeveledMap, SubdivideError};
-use crate::exact::orient3d;
+use crate::exact::{det_sign, orient3d};
 use crate::gmap::DartId;
+use std::cmp::Ordering;
 
 type Vec3 = [f64; 3];
 
@@ -86,7 +93,113 @@ pub(super) fn children_keep_orientation(p: [Vec3; 4]) -> Result<(), [u8; 4]> {
     Ok(())
 }
 
+/// The four children of the 1→4 split of a triangle: labels 0..2 its corners, 3 + k the midpoint
+/// of its side k = (k, k + 1 mod 3). Each is listed so that, for exact midpoints, it has the
+/// parent's orientation: the three corner children are the parent halved towards a corner, the
+/// central one the parent halved and turned by a half-turn.
+pub(super) const TRIANGLE_CHILDREN: [[u8; 3]; 4] = [[0, 3, 5], [3, 1, 4], [5, 4, 2], [3, 4, 5]];
+
+/// The exact sign of the `k`-th component of (b − a) × (c − a): the orientation of the triangle
+/// projected onto the coordinate plane orthogonal to axis `k` (0 when it is collinear there or a
+/// coordinate is not finite). It is det[b − a, c − a, e_k] ([`crate::exact`]). O(1).
+fn orient_on_axis(a: Vec3, b: Vec3, c: Vec3, k: usize) -> i8 {
+    let mut e = [0.0; 3];
+    e[k] = 1.0;
+    match det_sign([&[(false, b), (true, a)], &[(false, c), (true, a)], &[(false, e)]]) {
+        Some(Ordering::Greater) => 1,
+        Some(Ordering::Less) => -1,
+        _ => 0,
+    }
+}
+
+/// Whether the float filter settles the triangle case: |n_k| (the parent's normal on the axis of
+/// the check, twice its projected area) exceeds, with a factor of 4 to spare, 4 × the largest
+/// change rounded midpoints can make to a child's n_k (each child corner moved by at most
+/// δ = ε·max|x| + the smallest normal per coordinate, edges at most L: ≤ 6δ(L + 4δ)) plus the
+/// float error of n_k itself (≤ 8εL²), plus an allowance for products lost to underflow.
+/// Infinite or NaN terms fail it (the exact test decides). O(1).
+fn triangle_clearly_kept(p: [Vec3; 3], nk: f64) -> bool {
+    let eps = f64::EPSILON;
+    let m = p.iter().flatten().fold(0.0f64, |a, c| a.max(c.abs()));
+    let delta = eps * m + f64::MIN_POSITIVE;
+    let mut l2 = 0.0f64;
+    for x in 0..3 {
+        let y = (x + 1) % 3;
+        l2 = l2.max((0..3).map(|k| (p[x][k] - p[y][k]).powi(2)).sum());
+    }
+    let child_change = 6.0 * delta * (l2.sqrt() + 4.0 * delta);
+    let bound = 4.0 * (4.0 * child_change + 8.0 * eps * l2) + 1e-290;
+    nk.abs() > bound
+}
+
+/// `Err(child)` with the labels ([`TRIANGLE_CHILDREN`]) of the first child of the 1→4 split of
+/// the triangle with corners `p` that is collinear or oriented against the parent in the
+/// projection onto the coordinate plane where the parent's float normal is largest (if the
+/// parent's projection there is exactly collinear, the next largest where it is not); `Ok` when
+/// every child keeps the parent's orientation there, or the parent is exactly collinear (no
+/// orientation to keep). `mids[k]` is the position of side k's midpoint (side k = (k, k + 1
+/// mod 3)), `None` for the rounded midpoint of its ends (`crate::mesh::midpoint`, where the
+/// split puts a new vertex). With rounded midpoints a float filter decides ordinary triangles;
+/// other midpoints are always checked exactly. O(1): a float filter, then at most 7 exact
+/// orientations.
+pub(super) fn triangle_children_keep_orientation(p: [Vec3; 3], mids: [Option<Vec3>; 3]) -> Result<(), [u8; 3]> {
+    let u: Vec3 = std::array::from_fn(|k| p[1][k] - p[0][k]);
+    let v: Vec3 = std::array::from_fn(|k| p[2][k] - p[0][k]);
+    let n = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]].map(f64::abs);
+    let top = if n[0] >= n[1] && n[0] >= n[2] {
+        0
+    } else if n[1] >= n[2] {
+        1
+    } else {
+        2
+    };
+    let rounded_mid = |k: usize| crate::mesh::midpoint(p[k], p[(k + 1) % 3]);
+    let rounded = mids.iter().enumerate().all(|(k, m)| m.is_none_or(|q| q == rounded_mid(k)));
+    if rounded && triangle_clearly_kept(p, n[top]) {
+        return Ok(());
+    }
+    let mut axes = [0usize, 1, 2];
+    axes.sort_by(|&x, &y| n[y].total_cmp(&n[x]));
+    let found = axes.iter().find_map(|&k| {
+        let s = orient_on_axis(p[0], p[1], p[2], k);
+        (s != 0).then_some((k, s))
+    });
+    let Some((k, parent)) = found else { return Ok(()) };
+    let placed: [Vec3; 3] = std::array::from_fn(|k| mids[k].unwrap_or_else(|| rounded_mid(k)));
+    let points = [p[0], p[1], p[2], placed[0], placed[1], placed[2]];
+    for t in TRIANGLE_CHILDREN {
+        let [a, b, c] = t.map(|l| points[l as usize]);
+        if orient_on_axis(a, b, c, k) != parent {
+            return Err(t);
+        }
+    }
+    Ok(())
+}
+
 impl<const N: usize> LeveledMap<N> {
+    /// [`SubdivideError::FlatTriangleChild`] when a child of the 1→4 split of the triangle of
+    /// `d` (corner vertex ids `corners`, in the order of its sides) would be collinear or
+    /// inverted with its midpoints placed: `mids[k]` is the position of side k's inserted vertex
+    /// when it has one (`None`: the rounded midpoint the split will insert)
+    /// ([`triangle_children_keep_orientation`]). Nothing is checked on a map without the
+    /// corners' positions. O(1).
+    pub(super) fn check_triangle_children(
+        &self,
+        d: DartId,
+        level: u8,
+        corners: [u32; 3],
+        mids: [Option<Vec3>; 3],
+    ) -> Result<(), SubdivideError> {
+        let p = corners.map(|v| self.points.get(v as usize).copied());
+        let [Some(a), Some(b), Some(c)] = p else { return Ok(()) };
+        triangle_children_keep_orientation([a, b, c], mids).map_err(|child| SubdivideError::FlatTriangleChild {
+            level,
+            dart: d,
+            corners,
+            child,
+        })
+    }
+
     /// [`SubdivideError::FlatChild`] when a child of the 1→8 split of the tet of `d` (corner
     /// vertex ids `corners`) would be flat or inverted once its midpoints are rounded
     /// ([`super::orient::children_keep_orientation`]). Nothing is checked on a map without the
@@ -123,6 +236,53 @@ mod tests {
     fn an_exactly_flat_tet_has_no_orientation_to_keep() {
         let flat = [[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]];
         assert_eq!(children_keep_orientation(flat), Ok(()));
+    }
+
+    /// The listed children have the parent's orientation for exact midpoints, on every axis and
+    /// for both orientations of the parent.
+    #[test]
+    fn every_child_of_a_reference_triangle_keeps_its_orientation() {
+        for k in 0..3 {
+            let lift = |x: f64, y: f64| -> Vec3 {
+                let mut q = [5.0; 3];
+                q[(k + 1) % 3] = x;
+                q[(k + 2) % 3] = y;
+                q
+            };
+            for p in
+                [[lift(0.0, 0.0), lift(4.0, 0.0), lift(0.0, 4.0)], [lift(0.0, 0.0), lift(0.0, 4.0), lift(4.0, 0.0)]]
+            {
+                let mids = [0, 1, 2].map(|s| crate::mesh::midpoint(p[s], p[(s + 1) % 3]));
+                let parent = orient_on_axis(p[0], p[1], p[2], k);
+                assert_ne!(parent, 0);
+                let points = [p[0], p[1], p[2], mids[0], mids[1], mids[2]];
+                for t in TRIANGLE_CHILDREN {
+                    let [a, b, c] = t.map(|l| points[l as usize]);
+                    assert_eq!(orient_on_axis(a, b, c, k), parent, "child {t:?} on axis {k}");
+                }
+                assert_eq!(triangle_children_keep_orientation(p, [None; 3]), Ok(()));
+                assert_eq!(triangle_children_keep_orientation(p, mids.map(Some)), Ok(()));
+                assert!(triangle_clearly_kept(p, (4.0 * 4.0) * parent as f64));
+            }
+        }
+    }
+
+    #[test]
+    fn a_thin_triangle_is_decided_exactly_and_a_collinear_one_is_kept() {
+        let ulp = f64::EPSILON;
+        // Corners within an ulp of the line y = 1 across 2 units: the filter cannot tell.
+        let thin = [[1.0, 1.0, 0.0], [3.0, 1.0, 0.0], [2.0, 1.0 + ulp, 0.0]];
+        let n = (thin[1][0] - thin[0][0]) * (thin[2][1] - thin[0][1]);
+        assert!(!triangle_clearly_kept(thin, n));
+        // The midpoint of sides 1 and 2 round onto y = 1 (1 + ulp/2 is not an f64 above 1):
+        // the corner child at corner 2 keeps its height, the others go flat.
+        assert!(triangle_children_keep_orientation(thin, [None; 3]).is_err());
+        let line = [[0.0; 3], [1.0, 1.0, 1.0], [2.0, 2.0, 2.0]];
+        assert_eq!(triangle_children_keep_orientation(line, [None; 3]), Ok(()));
+        // A midpoint moved off its place is checked exactly, filter or not.
+        let big = [[0.0; 3], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]];
+        assert_eq!(triangle_children_keep_orientation(big, [None; 3]), Ok(()));
+        assert_eq!(triangle_children_keep_orientation(big, [Some([-1.0, 0.0, 0.0]), None, None]), Err([0, 3, 5]));
     }
 
     #[test]

@@ -634,8 +634,10 @@ impl LeveledMap<3> {
     /// that must be split before one of them (read off the faces: a neighbour that would see a
     /// face refined twice); the zone tets nothing blocks are split 1→8 at L (a tet below
     /// μt = L − 1 by a level skip), their masses shared by [`Self::subdivide_tet_with_mass`], and
-    /// the others wait for the next level, if need be one past `levels` (then
-    /// `subdivided_per_level` has more entries). So no face is ever refined twice, and every tet
+    /// the others wait for a later level, if need be past `levels` (then
+    /// `subdivided_per_level` has more entries): a chain of blockers can hold a tet back for
+    /// several levels (finding 275), and a tet held back is split by a level skip, so its children
+    /// have the size of the level it waited at and a μt that can be several levels past `levels`. So no face is ever refined twice, and every tet
     /// stays splittable ([`Self::check_faces_refinable`]). When the ball holds every vertex and
     /// every tet is at level L − 1, level L is done by the bulk [`Self::refine_uniform`] (same
     /// result, numbering aside); otherwise, or if it refuses, op by op

@@ -1017,7 +1017,7 @@ impl LeveledMechanics {
     /// (by the bulk path for a level where the ball holds everything, with the same springs up
     /// to rounding). The levels run from max(1, k), k the map's max level; after `Ok`, every tet
     /// of the finest map that meets the ball has μt ≥ `levels` (a tet that had to wait for a
-    /// blocker is split a level later, if need be past `levels`; on a map above level 0 the call
+    /// blocker is split at a later level, if need be past `levels`; on a map above level 0 the call
     /// is all or nothing: map and coupling are copied first and put back on any error, as by
     /// [`LeveledMap::refine_around`]). Σ m u is kept over the whole call, also when a level
     /// refuses after earlier ones were done (module docs; the vertex masses before and after are

@@ -119,6 +119,18 @@ impl<const N: usize> LeveledMap<N> {
         Ok(())
     }
 
+    /// [`SubdivideError::FlatTriangleChild`] for the 1→4 split of the triangle of `d` with sides
+    /// `sides`: corners at the sides' starts, a side's midpoint at its oldest inserted vertex
+    /// (the one the split keeps) or, without one, the rounded midpoint it will insert. O(sides).
+    fn check_split_triangle(&self, d: DartId, level: u8, sides: &[Side]) -> Result<(), SubdivideError> {
+        let corners: [u32; 3] = std::array::from_fn(|k| self.map.vertex_id(sides[k].start).0);
+        let mids = std::array::from_fn(|k| {
+            let oldest = sides[k].flats.iter().min_by_key(|(a, _)| self.dart_level[a.index()]);
+            oldest.and_then(|&(a, _)| self.points.get(self.map.vertex_id(a).0 as usize).copied())
+        });
+        self.check_triangle_children(d, level, corners, mids)
+    }
+
     /// The topology of [`Self::split_edge`] inside a running operation. The edge must be closed.
     pub(super) fn split_edge_raw(&mut self, d: DartId) -> DartId {
         let level = self.op_level();
@@ -171,8 +183,10 @@ impl<const N: usize> LeveledMap<N> {
     /// [`SubdivideError::AlreadyAtLevel`] (μf(d) ≥ level), [`SubdivideError::NotATriangle`],
     /// [`SubdivideError::OpenEdge`], [`SubdivideError::NonFinitePosition`] (an end of an edge to
     /// split at a NaN or infinite position), [`SubdivideError::BelowPrecision`] (a side to split whose
-    /// midpoint f64 cannot hold strictly between its ends), the level-order errors. The map is
-    /// unchanged on error.
+    /// midpoint f64 cannot hold strictly between its ends), in a 2-G-map
+    /// [`SubdivideError::FlatTriangleChild`] (a triangle so nearly collinear at its scale that,
+    /// its midpoints placed, a child would be collinear or inverted; `orient.rs`), the
+    /// level-order errors. The map is unchanged on error.
     ///
     /// # Examples
     ///
@@ -205,6 +219,9 @@ impl<const N: usize> LeveledMap<N> {
         }
         self.check_not_self_glued(d)?;
         self.check_side_midpoints(&sides, level)?;
+        if N == 2 {
+            self.check_split_triangle(d, level, &sides)?;
+        }
         self.begin_growth(level);
         let mids: Vec<(DartId, DartId)> = sides.iter().map(|s| self.side_midpoint(s)).collect();
         let (m_in, m_out): (Vec<DartId>, Vec<DartId>) = mids.into_iter().unzip();

@@ -570,9 +570,10 @@ impl<const N: usize> LeveledMap<N> {
     }
 
     /// [`SubdivideError::BelowPrecision`] for the first parent edge (in rank order) whose
-    /// midpoint f64 cannot hold strictly between its ends (`check_midpoint`); in 3D then
-    /// [`SubdivideError::FlatChild`] for the first parent with a flat or inverted child
-    /// (`check_children`). O(edges + parents).
+    /// midpoint f64 cannot hold strictly between its ends (`check_midpoint`); then
+    /// [`SubdivideError::FlatChild`] (3D) or [`SubdivideError::FlatTriangleChild`] (2D) for the
+    /// first parent with a flat or inverted child (`check_children`, `check_triangle_children`).
+    /// O(edges + parents).
     fn check_uniform_midpoints(&self, level: u8, tpl: &[Template], lab: &Labelled) -> Result<(), SubdivideError> {
         for &x in &lab.edge_darts {
             self.check_midpoint(DartId(x), level)?;
@@ -584,6 +585,15 @@ impl<const N: usize> LeveledMap<N> {
             for darts in lab.darts.chunks_exact(t0.parents.len()) {
                 let corners = t0.corner_parent.map(|p| self.map.vertex_id(DartId(darts[p as usize])).0);
                 self.check_children(DartId(darts[0]), level, &corners)?;
+            }
+        } else {
+            // 2D: the children of every triangle ([`SubdivideError::FlatTriangleChild`]); a
+            // uniform map has no inserted vertex, so every midpoint is the rounded one.
+            let t0 = &tpl[0];
+            for darts in lab.darts.chunks_exact(t0.parents.len()) {
+                let corners: [u32; 3] =
+                    std::array::from_fn(|c| self.map.vertex_id(DartId(darts[t0.corner_parent[c] as usize])).0);
+                self.check_triangle_children(DartId(darts[0]), level, corners, [None; 3])?;
             }
         }
         Ok(())
@@ -884,7 +894,8 @@ impl LeveledMap<2> {
     /// (here: a face that is not a triangle of 6 darts with three distinct corner vertices);
     /// [`SubdivideError::NonFinitePosition`] (an end of an edge to
     /// split at a NaN or infinite position), [`SubdivideError::BelowPrecision`] (an edge whose midpoint f64 cannot hold strictly
-    /// between its ends; with points only).
+    /// between its ends; with points only), [`SubdivideError::FlatTriangleChild`] (a triangle
+    /// so nearly collinear that a child would be collinear or inverted; with points only).
     ///
     /// # Examples
     ///

@@ -281,3 +281,57 @@ fn a_chain_of_blockers_can_hold_a_tet_back_several_levels() {
     // Two levels past: what SUBDIVISION.md reports for this sequence (update both together).
     assert!(deepest_overshoot >= 2, "tets held back past `levels`: {deepest_overshoot} levels");
 }
+
+/// What a 2D 1→4 split of the triangle `p` answers: accepted, refused for a child (its labels),
+/// or refused for another reason.
+fn split_outcome(p: [[f64; 3]; 3]) -> String {
+    let (map, _) = GMap::<2>::from_triangles(3, &[[0, 1, 2]]).unwrap();
+    let mut m = LeveledMap::new(map, p.to_vec());
+    let d = m.map().darts().next().unwrap();
+    match m.subdivide_triangle(d, 1) {
+        Ok(_) => "split".into(),
+        Err(SubdivideError::FlatTriangleChild { child, .. }) => format!("refused for {child:?}"),
+        Err(SubdivideError::BelowPrecision { .. }) => "below precision".into(),
+        Err(e) => panic!("unexpected {e}"),
+    }
+}
+
+/// Finding 277: the check took its projection from the float normal, which overflows (NaN) for
+/// edges past about 1e154 and underflows (0) below about 1e-154; it then checked an arbitrary
+/// plane (the first axis), accepting splits whose children were inverted in the dominant one,
+/// so the answer depended on the scale. Scaling by a power of two is exact (corners, midpoints
+/// and every orientation scale with it) as long as everything stays normal: the answer must be
+/// the same at every scale. Thin and general triangles on a plane whose dominant projection is
+/// not the first axis, at scales 2⁻⁹⁰⁰ to 2¹⁰⁰⁰.
+#[test]
+fn the_children_check_answers_the_same_at_every_scale() {
+    let mut state = 0x7777_1234_u64;
+    let mut refused = 0;
+    for round in 0..400 {
+        let flat = if round % 2 == 0 {
+            thin_triangle(&mut state, [0, 1], 1.0)
+        } else {
+            let mut r = || 1.0 + rng_common::next_unit(&mut state);
+            [[r(), r(), 1.0], [r(), r(), 1.0], [r(), r(), 1.0]]
+        };
+        // Normal ∝ (−2, −3, 1): the dominant projection is onto the zx plane (axis 1).
+        let p = flat.map(|q| [q[0], q[1], 1.0 + 2.0 * (q[0] - 1.0) + 3.0 * (q[1] - 1.0)]);
+        let at_one = split_outcome(p);
+        refused += at_one.starts_with("refused") as usize;
+        for s in [-900, -500, -100, 100, 500, 900, 1000] {
+            let scaled = p.map(|q| q.map(|x| x * 2f64.powi(s)));
+            assert_eq!(split_outcome(scaled), at_one, "{p:?} scaled by 2^{s}");
+        }
+    }
+    assert!(refused > 0, "thin triangles refused at scale 1");
+    // The probe's case: a triangle at 1e271 (its plain normal NaN), accepted there and refused
+    // at 2⁻⁶⁰⁰ of that scale before; three of its children are inverted in the dominant plane.
+    let p = [
+        [1.0307711606538196e271, 1.2171719376801812e271, 1.181016250216777e271],
+        [1.0415737989055892e271, 1.2332546634633508e271, 1.1627729967832536e271],
+        [1.0315900280463959e271, 1.218391049106543e271, 1.1796333653119e271],
+    ];
+    for s in [0, -600, -1000] {
+        assert_eq!(split_outcome(p.map(|q| q.map(|x| x * 2f64.powi(s)))), "refused for [3, 1, 4]", "at 2^{s}");
+    }
+}

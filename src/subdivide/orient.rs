@@ -132,10 +132,24 @@ fn triangle_clearly_kept(p: [Vec3; 3], nk: f64) -> bool {
     nk.abs() > bound
 }
 
+/// 2⁻⁹⁰⁰: the largest component of a plain float normal must reach it to name the axis of the
+/// check; far above the subnormals, the products' underflow (at most 2⁻¹⁰⁷⁴ each) cannot move
+/// the order of the components that matter.
+const PLAIN_NORMAL_MIN: f64 = 1.1830521861667747e-271; // 2⁻⁹⁰⁰
+
+/// |(b − a) × (c − a)| component by component, in floats, for the corners `p` as they are. O(1).
+fn normal_magnitudes(p: [Vec3; 3]) -> [f64; 3] {
+    let u: Vec3 = std::array::from_fn(|k| p[1][k] - p[0][k]);
+    let v: Vec3 = std::array::from_fn(|k| p[2][k] - p[0][k]);
+    [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]].map(f64::abs)
+}
+
 /// `Err(child)` with the labels ([`TRIANGLE_CHILDREN`]) of the first child of the 1→4 split of
 /// the triangle with corners `p` that is collinear or oriented against the parent in the
 /// projection onto the coordinate plane where the parent's float normal is largest (if the
-/// parent's projection there is exactly collinear, the next largest where it is not); `Ok` when
+/// parent's projection there is exactly collinear, the next largest where it is not; a normal
+/// that overflows or underflows in plain floats is taken on the corners rescaled by a power of
+/// two, finding 277); `Ok` when
 /// every child keeps the parent's orientation there, or the parent is exactly collinear (no
 /// orientation to keep). `mids[k]` is the position of side k's midpoint (side k = (k, k + 1
 /// mod 3)), `None` for the rounded midpoint of its ends (`crate::mesh::midpoint`, where the
@@ -143,9 +157,16 @@ fn triangle_clearly_kept(p: [Vec3; 3], nk: f64) -> bool {
 /// other midpoints are always checked exactly. O(1): a float filter, then at most 7 exact
 /// orientations.
 pub(super) fn triangle_children_keep_orientation(p: [Vec3; 3], mids: [Option<Vec3>; 3]) -> Result<(), [u8; 3]> {
-    let u: Vec3 = std::array::from_fn(|k| p[1][k] - p[0][k]);
-    let v: Vec3 = std::array::from_fn(|k| p[2][k] - p[0][k]);
-    let n = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]].map(f64::abs);
+    let mut n = normal_magnitudes(p);
+    // A plain normal that overflowed (∞, NaN) or fell near the subnormals (0 for a triangle
+    // far from collinear) names no axis: it is taken again on the corners translated and
+    // scaled by a power of two (finding 277), and then only the exact signs decide.
+    let plain = n.iter().all(|c| c.is_finite()) && n.iter().any(|&c| c >= PLAIN_NORMAL_MIN);
+    if !plain {
+        let mut fitted = p;
+        crate::mesh::fit_for_products(&mut fitted);
+        n = normal_magnitudes(fitted);
+    }
     let top = if n[0] >= n[1] && n[0] >= n[2] {
         0
     } else if n[1] >= n[2] {
@@ -155,7 +176,7 @@ pub(super) fn triangle_children_keep_orientation(p: [Vec3; 3], mids: [Option<Vec
     };
     let rounded_mid = |k: usize| crate::mesh::midpoint(p[k], p[(k + 1) % 3]);
     let rounded = mids.iter().enumerate().all(|(k, m)| m.is_none_or(|q| q == rounded_mid(k)));
-    if rounded && triangle_clearly_kept(p, n[top]) {
+    if plain && rounded && triangle_clearly_kept(p, n[top]) {
         return Ok(());
     }
     let mut axes = [0usize, 1, 2];

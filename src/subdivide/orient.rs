@@ -149,9 +149,8 @@ fn normal_magnitudes(p: [Vec3; 3]) -> [f64; 3] {
 /// projection onto the coordinate plane where the parent's float normal is largest (if the
 /// parent's projection there is exactly collinear, the next largest where it is not; a normal
 /// that overflows or underflows in plain floats is taken on the corners rescaled by a power of
-/// two, finding 277); `Ok` when
-/// every child keeps the parent's orientation there, or the parent is exactly collinear (no
-/// orientation to keep). `mids[k]` is the position of side k's midpoint (side k = (k, k + 1
+/// two, finding 277); `Ok` when every child keeps the parent's orientation there, or the parent
+/// is exactly collinear (no orientation to keep). `mids[k]` is the position of side k's midpoint (side k = (k, k + 1
 /// mod 3)), `None` for the rounded midpoint of its ends (`crate::mesh::midpoint`, where the
 /// split puts a new vertex). With rounded midpoints a float filter decides ordinary triangles;
 /// other midpoints are always checked exactly. O(1): a float filter, then at most 7 exact

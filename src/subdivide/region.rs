@@ -636,10 +636,11 @@ impl LeveledMap<3> {
     /// μt = L − 1 by a level skip), their masses shared by [`Self::subdivide_tet_with_mass`], and
     /// the others wait for a later level, if need be past `levels` (then
     /// `subdivided_per_level` has more entries): a chain of blockers can hold a tet back for
-    /// several levels (finding 275), and a tet held back is split by a level skip, so its children
-    /// have the size of the level it waited at and a μt that can be several levels past `levels`. So no face is ever refined twice, and every tet
-    /// stays splittable ([`Self::check_faces_refinable`]). When the ball holds every vertex and
-    /// every tet is at level L − 1, level L is done by the bulk [`Self::refine_uniform`] (same
+    /// several levels (finding 275), and a tet held back is split by a level skip, so its
+    /// children have the size of the level it waited at and a μt that can be several levels past
+    /// `levels`. So no face is ever refined twice, and every tet stays splittable
+    /// ([`Self::check_faces_refinable`]). When the ball holds every vertex and every tet is at
+    /// level L − 1, level L is done by the bulk [`Self::refine_uniform`] (same
     /// result, numbering aside); otherwise, or if it refuses, op by op
     /// ([`Self::refine_around_per_op`]). On a map at level 0 each level is checked before its
     /// first split and the levels done before a refusal stay; on a map above level 0 the call is

@@ -125,8 +125,8 @@ impl<const N: usize> LeveledMap<N> {
     fn check_split_triangle(&self, d: DartId, level: u8, sides: &[Side]) -> Result<(), SubdivideError> {
         let corners: [u32; 3] = std::array::from_fn(|k| self.map.vertex_id(sides[k].start).0);
         let mids = std::array::from_fn(|k| {
-            let oldest = sides[k].flats.iter().min_by_key(|(a, _)| self.dart_level[a.index()]);
-            oldest.and_then(|&(a, _)| self.points.get(self.map.vertex_id(a).0 as usize).copied())
+            let kept = self.kept_midpoint(&sides[k]);
+            kept.and_then(|(a, _)| self.points.get(self.map.vertex_id(a).0 as usize).copied())
         });
         self.check_triangle_children(d, level, corners, mids)
     }
@@ -291,11 +291,17 @@ impl<const N: usize> LeveledMap<N> {
         Ok(sides)
     }
 
+    /// The inserted vertex of a side that a 1→4 split keeps as its midpoint: the oldest (lowest
+    /// dart level), as its two darts (incoming half, outgoing half); `None` on an unsplit side.
+    /// O(side).
+    fn kept_midpoint(&self, side: &Side) -> Option<(DartId, DartId)> {
+        side.flats.iter().min_by_key(|(a, _)| self.dart_level[a.index()]).copied()
+    }
+
     /// The two darts of the face at the midpoint of a side (incoming half, outgoing half),
     /// splitting the side now if nobody split it before.
     fn side_midpoint(&mut self, side: &Side) -> (DartId, DartId) {
-        let oldest = side.flats.iter().min_by_key(|(a, _)| self.dart_level[a.index()]).copied();
-        match oldest {
+        match self.kept_midpoint(side) {
             Some(pair) => pair,
             None => {
                 let m = self.split_edge_raw(side.start);

@@ -157,6 +157,33 @@ pub(crate) fn plane_sign(xs: &[Vec3], p: Vec3, n: Vec3) -> Option<Ordering> {
     Some(acc.sign())
 }
 
+/// Whether the centroid of `xs` lies in the closed ball B(`centre`, `r`), exactly: the sign of
+/// |Σ xᵢ − N c|² − N² r² (N = |xs|, the centroid's distance times N, squared), every product of
+/// the expansion added without rounding. `false` when an input is not finite or `xs` is empty
+/// (or past 2^26 points, where N² would round). Not filtered: O(N² · 3) products of a few hundred integer operations
+/// each (finding 283: the rounded centroid and distance dropped faces exactly on the sphere and
+/// moved with a translation).
+pub(crate) fn centroid_in_ball(xs: &[Vec3], centre: Vec3, r: f64) -> bool {
+    let finite = |v: &Vec3| v.iter().all(|c| c.is_finite());
+    let n = xs.len() as f64;
+    if xs.is_empty() || n > 67_108_864.0 || !finite(&centre) || !r.is_finite() || !xs.iter().all(finite) {
+        return false;
+    }
+    let mut acc = Accumulator::new();
+    for k in 0..3 {
+        // (Σ xᵢ − N c)² = Σᵢ Σⱼ xᵢ xⱼ − 2N c Σᵢ xᵢ + N² c².
+        for a in xs {
+            for b in xs {
+                acc.add(false, &[a[k], b[k]]);
+            }
+            acc.add(true, &[2.0 * n, centre[k], a[k]]);
+        }
+        acc.add(false, &[n * n, centre[k], centre[k]]);
+    }
+    acc.add(true, &[n * n, r, r]);
+    acc.sign() != Ordering::Greater
+}
+
 /// One entry-wise term of a determinant column: the vector, negated when the flag is set.
 pub(crate) type Term = (bool, Vec3);
 

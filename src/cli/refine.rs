@@ -74,9 +74,11 @@ pub struct RefineJson {
     pub volumes: usize,
     /// Darts of the finest map.
     pub darts: usize,
-    /// Volumes of the extracted level i, i = 0..=L (L = `--levels`; always L + 1 entries, as
-    /// `subdivided_per_level`): a level at which nothing was refined (an empty zone) repeats the
-    /// count of the level before it, since G_i = G_{i−1} then.
+    /// Volumes of the extracted level i, i = 0..=M with M = max(L, the finest level made), L =
+    /// `--levels` (as many entries as `subdivided_per_level`): at least L + 1 entries, more when a
+    /// tet held back by a coarser neighbour was split past level L (findings 275, 285); a level at which
+    /// nothing was refined (an empty zone) repeats the count of the level before it, since
+    /// G_i = G_{i−1} then.
     pub tets_per_level: Vec<usize>,
     /// Tets subdivided at each level (index 0 is 0).
     pub subdivided_per_level: Vec<usize>,

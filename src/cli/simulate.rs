@@ -315,9 +315,10 @@ pub(crate) fn file_vertex(tags: &[u64], file_point: &[u32], points: usize, slot:
     }
 }
 
-/// The CLI's message for a failed step: a blow-up is stated in the steps the user counts (step
-/// `step` of `steps`, 1-based as the progress bar and the frames count them) and at the vertex
-/// `name_vertex` gives for its slot; other errors go through as they are. O(1).
+/// The CLI's message for a failed step: a blow-up or a failed implicit solve is stated in the
+/// steps the user counts (step `step` of `steps`, 1-based as the progress bar and the frames count
+/// them), a blow-up at the vertex `name_vertex` gives for its slot; other errors go through as
+/// they are. O(1).
 pub(crate) fn step_error(
     e: topomech::mechanics::SimError,
     step: u64,
@@ -329,6 +330,11 @@ pub(crate) fn step_error(
         SimError::Step(StepError::BlowUp { slot, reason, .. }) => other(format!(
             "simulation blew up in step {step} of {steps} (counted from 1, as the progress bar does), at {}: {reason}",
             name_vertex(slot)
+        )),
+        // The library counts steps from 0; the run from 1 (finding 280).
+        SimError::Step(StepError::SolverFailed { iterations, residual, .. }) => other(format!(
+            "implicit step {step} of {steps} (counted from 1, as the progress bar does): conjugate gradient stopped \
+             after {iterations} iterations at relative residual {residual:e}"
         )),
         e => other(e),
     }

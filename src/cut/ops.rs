@@ -507,106 +507,130 @@ impl Harness {
     pub fn apply(&mut self, op: Op) -> Result<(), String> {
         let mut touched = TouchedCells::default();
         match op {
-            Op::Dissociate(k) => {
-                let glued = self.oracle.glued();
-                if glued.is_empty() {
-                    return Ok(());
-                }
-                let (key, [(t, f), _]) = glued[k % glued.len()];
-                let d = DartId((24 * t + 6 * f) as u32);
-                let dis = super::dissociate_face(&mut self.body, d).map_err(|e| e.to_string())?;
-                self.oracle.cut.insert(key);
-                touched.extend(&dis.touched);
-            }
-            Op::DissociateBoundary(k) => {
-                let live: Vec<(usize, usize)> = (0..self.oracle.tets.len())
-                    .filter(|&t| self.oracle.alive[t])
-                    .flat_map(|t| (0..4).map(move |f| (t, f)))
-                    .filter(|&(t, f)| {
-                        let key = self.oracle.triple(t, f);
-                        !self.oracle.glued().iter().any(|(k, _)| *k == key)
-                    })
-                    .collect();
-                if live.is_empty() {
-                    return Ok(());
-                }
-                let (t, f) = live[k % live.len()];
-                let before = (self.body.version(), self.body.map().count_cells());
-                match super::dissociate_face(&mut self.body, DartId((24 * t + 6 * f) as u32)) {
-                    Err(CutError::BoundaryFace { .. }) => {}
-                    other => return Err(format!("boundary face ({t}, {f}): expected BoundaryFace, got {other:?}")),
-                }
-                if before != (self.body.version(), self.body.map().count_cells()) {
-                    return Err("a refused dissociation changed the body".into());
-                }
-            }
-            Op::Remove(k) => {
-                let live: Vec<usize> = (0..self.oracle.tets.len()).filter(|&t| self.oracle.alive[t]).collect();
-                if live.len() <= 1 {
-                    return Ok(());
-                }
-                let t = live[k % live.len()];
-                let r = super::remove_volume(&mut self.body, CellId(t as u32)).map_err(|e| e.to_string())?;
-                self.oracle.alive[t] = false;
-                self.removed_mass += r.removed_mass;
-                self.removed_stiffness += r.removed_stiffness;
-                touched.extend(&r.touched);
-            }
-            Op::RemoveAgain(k) => {
-                let dead: Vec<usize> = (0..self.oracle.tets.len()).filter(|&t| !self.oracle.alive[t]).collect();
-                if dead.is_empty() {
-                    return Ok(());
-                }
-                let t = dead[k % dead.len()];
-                let version = self.body.version();
-                match super::remove_volume(&mut self.body, CellId(t as u32)) {
-                    Err(CutError::NoSuchVolume(v)) if v == CellId(t as u32) => {}
-                    other => return Err(format!("removing tet {t} again: got {other:?}")),
-                }
-                if version != self.body.version() {
-                    return Err("a refused removal changed the body".into());
-                }
-            }
-            Op::Incise(k, n) => {
-                let live: Vec<usize> = (0..self.oracle.tets.len()).filter(|&t| self.oracle.alive[t]).collect();
-                // Off the centroid: a centroid exactly on the plane is decided by rounding.
-                let c = self.oracle.centroid(live[k % live.len()]);
-                let point = [c[0] + 0.0137 * n[0], c[1] + 0.0137 * n[1], c[2] + 0.0137 * n[2]];
-                let plane = Plane { point, normal: n };
-                let inc = super::incise_plane(&mut self.body, &plane).map_err(|e| e.to_string())?;
-                let mut expected = 0;
-                for (key, [(a, _), (b, _)]) in self.oracle.glued() {
-                    if self.oracle.positive(a, &plane) != self.oracle.positive(b, &plane) {
-                        self.oracle.cut.insert(key);
-                        expected += 1;
-                    }
-                }
-                if inc.cut_faces() != expected {
-                    return Err(format!("incision cut {} faces, oracle expects {expected}", inc.cut_faces()));
-                }
-                touched.extend(&inc.touched);
-            }
-            Op::Tear(k, n) => {
-                let live: Vec<usize> = (0..self.oracle.tets.len()).filter(|&t| self.oracle.alive[t]).collect();
-                let t = live[k % live.len()];
-                let d = DartId((24 * t + (k / 7) % 24) as u32);
-                let v = self.body.map().vertex_id(d);
-                let tear = super::tear_vertex(&mut self.body, v, n, Some(d)).map_err(|e| e.to_string())?;
-                for dis in &tear.dissociations {
-                    let x = dis.dart.index();
-                    let key = self.oracle.triple(x / 24, (x % 24) / 6);
-                    if !self.oracle.cut.insert(key) {
-                        return Err(format!("tear dissociated face {key:?} twice"));
-                    }
-                }
-                touched.extend(&tear.touched);
-            }
+            Op::Dissociate(k) => self.apply_dissociate(k, &mut touched)?,
+            Op::DissociateBoundary(k) => self.apply_dissociate_boundary(k)?,
+            Op::Remove(k) => self.apply_remove(k, &mut touched)?,
+            Op::RemoveAgain(k) => self.apply_remove_again(k)?,
+            Op::Incise(k, n) => self.apply_incise(k, n, &mut touched)?,
+            Op::Tear(k, n) => self.apply_tear(k, n, &mut touched)?,
         }
         // The operations' own lists must always be taken incrementally: a rebuild here would
         // make the "incremental ≡ fresh" law of `check` hold trivially.
         if !self.projection.update(&self.body, &touched) {
             return Err(format!("{op:?}: the operation's touched cells were not taken incrementally"));
         }
+        Ok(())
+    }
+
+    /// [`Op::Dissociate`]: the k-th glued face (mod their number).
+    fn apply_dissociate(&mut self, k: usize, touched: &mut TouchedCells) -> Result<(), String> {
+        let glued = self.oracle.glued();
+        if glued.is_empty() {
+            return Ok(());
+        }
+        let (key, [(t, f), _]) = glued[k % glued.len()];
+        let d = DartId((24 * t + 6 * f) as u32);
+        let dis = super::dissociate_face(&mut self.body, d).map_err(|e| e.to_string())?;
+        self.oracle.cut.insert(key);
+        touched.extend(&dis.touched);
+        Ok(())
+    }
+
+    /// [`Op::DissociateBoundary`]: the k-th boundary face must be refused, the body unchanged.
+    fn apply_dissociate_boundary(&mut self, k: usize) -> Result<(), String> {
+        let live: Vec<(usize, usize)> = (0..self.oracle.tets.len())
+            .filter(|&t| self.oracle.alive[t])
+            .flat_map(|t| (0..4).map(move |f| (t, f)))
+            .filter(|&(t, f)| {
+                let key = self.oracle.triple(t, f);
+                !self.oracle.glued().iter().any(|(k, _)| *k == key)
+            })
+            .collect();
+        if live.is_empty() {
+            return Ok(());
+        }
+        let (t, f) = live[k % live.len()];
+        let before = (self.body.version(), self.body.map().count_cells());
+        match super::dissociate_face(&mut self.body, DartId((24 * t + 6 * f) as u32)) {
+            Err(CutError::BoundaryFace { .. }) => {}
+            other => return Err(format!("boundary face ({t}, {f}): expected BoundaryFace, got {other:?}")),
+        }
+        if before != (self.body.version(), self.body.map().count_cells()) {
+            return Err("a refused dissociation changed the body".into());
+        }
+        Ok(())
+    }
+
+    /// [`Op::Remove`]: the k-th live tet (none when one is left).
+    fn apply_remove(&mut self, k: usize, touched: &mut TouchedCells) -> Result<(), String> {
+        let live: Vec<usize> = (0..self.oracle.tets.len()).filter(|&t| self.oracle.alive[t]).collect();
+        if live.len() <= 1 {
+            return Ok(());
+        }
+        let t = live[k % live.len()];
+        let r = super::remove_volume(&mut self.body, CellId(t as u32)).map_err(|e| e.to_string())?;
+        self.oracle.alive[t] = false;
+        self.removed_mass += r.removed_mass;
+        self.removed_stiffness += r.removed_stiffness;
+        touched.extend(&r.touched);
+        Ok(())
+    }
+
+    /// [`Op::RemoveAgain`]: the k-th removed tet must be refused, the body unchanged.
+    fn apply_remove_again(&mut self, k: usize) -> Result<(), String> {
+        let dead: Vec<usize> = (0..self.oracle.tets.len()).filter(|&t| !self.oracle.alive[t]).collect();
+        if dead.is_empty() {
+            return Ok(());
+        }
+        let t = dead[k % dead.len()];
+        let version = self.body.version();
+        match super::remove_volume(&mut self.body, CellId(t as u32)) {
+            Err(CutError::NoSuchVolume(v)) if v == CellId(t as u32) => {}
+            other => return Err(format!("removing tet {t} again: got {other:?}")),
+        }
+        if version != self.body.version() {
+            return Err("a refused removal changed the body".into());
+        }
+        Ok(())
+    }
+
+    /// [`Op::Incise`]: a plane of normal n near the k-th live tet's centroid; cuts what the oracle expects.
+    fn apply_incise(&mut self, k: usize, n: Vec3, touched: &mut TouchedCells) -> Result<(), String> {
+        let live: Vec<usize> = (0..self.oracle.tets.len()).filter(|&t| self.oracle.alive[t]).collect();
+        // Off the centroid: a centroid exactly on the plane is decided by rounding.
+        let c = self.oracle.centroid(live[k % live.len()]);
+        let point = [c[0] + 0.0137 * n[0], c[1] + 0.0137 * n[1], c[2] + 0.0137 * n[2]];
+        let plane = Plane { point, normal: n };
+        let inc = super::incise_plane(&mut self.body, &plane).map_err(|e| e.to_string())?;
+        let mut expected = 0;
+        for (key, [(a, _), (b, _)]) in self.oracle.glued() {
+            if self.oracle.positive(a, &plane) != self.oracle.positive(b, &plane) {
+                self.oracle.cut.insert(key);
+                expected += 1;
+            }
+        }
+        if inc.cut_faces() != expected {
+            return Err(format!("incision cut {} faces, oracle expects {expected}", inc.cut_faces()));
+        }
+        touched.extend(&inc.touched);
+        Ok(())
+    }
+
+    /// [`Op::Tear`]: a tear at a vertex of the k-th live tet, each face dissociated once.
+    fn apply_tear(&mut self, k: usize, n: Vec3, touched: &mut TouchedCells) -> Result<(), String> {
+        let live: Vec<usize> = (0..self.oracle.tets.len()).filter(|&t| self.oracle.alive[t]).collect();
+        let t = live[k % live.len()];
+        let d = DartId((24 * t + (k / 7) % 24) as u32);
+        let v = self.body.map().vertex_id(d);
+        let tear = super::tear_vertex(&mut self.body, v, n, Some(d)).map_err(|e| e.to_string())?;
+        for dis in &tear.dissociations {
+            let x = dis.dart.index();
+            let key = self.oracle.triple(x / 24, (x % 24) / 6);
+            if !self.oracle.cut.insert(key) {
+                return Err(format!("tear dissociated face {key:?} twice"));
+            }
+        }
+        touched.extend(&tear.touched);
         Ok(())
     }
 

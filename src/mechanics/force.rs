@@ -1046,7 +1046,9 @@ impl SpringSystem {
     }
 
     /// [`SpringSystem::acceleration`] of slot i given the sum `s` of its spring forces (as the
-    /// gather or [`SpringSystem::spring_sums4`] computes it). O(1).
+    /// gather or [`SpringSystem::spring_sums4`] computes it): f / m on a free slot, exactly 0 on a
+    /// fixed one (`inv_mass` 0) whatever its force — an overflowed or NaN force on a pinned
+    /// vertex would otherwise make ∞ · 0 = NaN (finding 279). O(1).
     #[inline(always)]
     pub(crate) fn acceleration_of_sum(&self, i: usize, s: Vec3, vi: Vec3) -> Vec3 {
         let (m, g, w) = (self.mass[i], self.viscosity[i], self.inv_mass[i]);
@@ -1055,7 +1057,10 @@ impl SpringSystem {
             s[1] + m * self.gravity[1] - g * vi[1],
             s[2] + m * self.gravity[2] - g * vi[2],
         ];
-        [f[0] * w, f[1] * w, f[2] * w]
+        let a = [f[0] * w, f[1] * w, f[2] * w];
+        // A select, not a branch: the same code on every slot.
+        let free = w != 0.0;
+        [if free { a[0] } else { 0.0 }, if free { a[1] } else { 0.0 }, if free { a[2] } else { 0.0 }]
     }
 
     /// `out[i] = value(i)` for every slot, split across threads when asked and large.

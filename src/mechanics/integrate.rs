@@ -257,7 +257,7 @@ pub enum StepError {
     /// The conjugate gradient of the implicit step did not reach its tolerance.
     #[error("implicit step {step}: conjugate gradient stopped after {iterations} iterations at relative residual {residual:e}")]
     SolverFailed {
-        /// The step.
+        /// Index of the step whose solve failed (0-based, as [`StepError::BlowUp`]'s).
         step: u64,
         /// Iterations made.
         iterations: usize,
@@ -447,6 +447,38 @@ struct CgBuffers {
     /// allocating).
     wide_y: Vec<[Wide; 3]>,
     wide_b: Vec<[Wide; 3]>,
+}
+
+impl CgBuffers {
+    /// One CG update with step length `alpha` (when `advance`: Δv += α p, r −= α q; else the
+    /// residual as it is), then the preconditioned residual z = P r into `q`. Returns (rᵀz,
+    /// ‖z‖∞, ‖Δv‖∞). O(slots).
+    fn step_residual(&mut self, alpha: f64, advance: bool) -> (f64, f64, f64) {
+        let (mut rz, mut zm, mut dm) = (0.0, 0.0, 0.0);
+        for i in 0..self.r.len() {
+            if advance {
+                self.dv[i] = madd(self.dv[i], alpha, self.p[i]);
+                self.r[i] = madd(self.r[i], -alpha, self.q[i]);
+            }
+            let z = times(self.pre[i], self.r[i]);
+            rz += dot(self.r[i], z);
+            zm = max_abs(zm, z);
+            dm = max_abs(dm, self.dv[i]);
+            self.q[i] = z;
+        }
+        (rz, zm, dm)
+    }
+}
+
+/// The binade of max |(P b)ᵢ| to a factor 2, from the exponents of P and b alone (no product
+/// formed: either may be far outside 1); `None` when every P b coordinate is 0. O(slots).
+fn preconditioned_binade(b: &[Vec3], pre: &[Vec3]) -> Option<i32> {
+    b.iter()
+        .zip(pre)
+        .flat_map(|(r, p)| (0..3).map(move |j| (r[j], p[j])))
+        .filter(|&(r, p)| r != 0.0 && p != 0.0)
+        .map(|(r, p)| exponent(r.abs()) + exponent(p))
+        .max()
 }
 
 impl Stepper {
@@ -1235,14 +1267,16 @@ impl Stepper {
         let (par, tol) = (self.config.parallel, self.config.cg_tolerance);
         let cg = &mut self.cg;
         cg.dv.iter_mut().for_each(|d| *d = [0.0; 3]);
+        // `f64::max` skips NaN: the NaN test comes before the zero test (finding 278: a b whose
+        // every nonzero entry was NaN had b_max = 0 and was "solved" with Δv = 0).
         let b_max = cg.r.iter().flatten().fold(0.0f64, |m, c| m.max(c.abs()));
-        if b_max == 0.0 {
-            return Ok(0);
-        }
         if !b_max.is_finite() || cg.r.iter().flatten().any(|c| c.is_nan()) {
             // b overflowed or holds NaN: there is no finite right-hand side to solve for.
             let residual = dot_all(&cg.r, &cg.r).sqrt();
             return Err(StepError::SolverFailed { step: self.step, iterations: 0, residual });
+        }
+        if b_max == 0.0 {
+            return Ok(0);
         }
         let op_exp = operator_exponent(sys, &cg.coef, h);
         scale_operator(sys, h, op_exp, &mut cg.coef, &mut cg.diag);
@@ -1250,24 +1284,12 @@ impl Stepper {
         // r = 2^-β b with 2^β the binade of max |(P b)ᵢ| (to a factor 2), so that the
         // preconditioned residual z — Δv's units — starts near 1: estimated from exponents, no
         // product of P and b formed (either may be far outside 1).
-        let shift =
-            cg.r.iter()
-                .zip(&cg.pre)
-                .flat_map(|(r, p)| (0..3).map(move |j| (r[j], p[j])))
-                .filter(|&(r, p)| r != 0.0 && p != 0.0)
-                .map(|(r, p)| exponent(r.abs()) + exponent(p))
-                .max()
-                .unwrap_or(exponent(b_max));
+        let shift = preconditioned_binade(&cg.r, &cg.pre).unwrap_or(exponent(b_max));
         scale_all(&mut cg.r, -shift);
         let b_exp = pre_scaled.unwrap_or(0) + shift;
         // z₀ = P b, p₀ = z₀.
-        let (mut rz, mut z_max) = (0.0, 0.0);
-        for i in 0..cg.r.len() {
-            let z = times(cg.pre[i], cg.r[i]);
-            rz += dot(cg.r[i], z);
-            z_max = max_abs(z_max, z);
-            cg.p[i] = z;
-        }
+        let (mut rz, mut z_max, _) = cg.step_residual(0.0, false);
+        cg.p.copy_from_slice(&cg.q);
         let z_b = z_max;
         let mut dv_max = 0.0;
         let solved = |cg: &mut CgBuffers, it: usize| {
@@ -1286,17 +1308,7 @@ impl Stepper {
                 let residual = z_max / max_of(z_b, dv_max);
                 return Err(StepError::SolverFailed { step: self.step, iterations: it, residual });
             }
-            let alpha = rz / pq;
-            let (mut rz_new, mut zm, mut dm) = (0.0, 0.0, 0.0);
-            for i in 0..cg.p.len() {
-                cg.dv[i] = madd(cg.dv[i], alpha, cg.p[i]);
-                cg.r[i] = madd(cg.r[i], -alpha, cg.q[i]);
-                let z = times(cg.pre[i], cg.r[i]);
-                rz_new += dot(cg.r[i], z);
-                zm = max_abs(zm, z);
-                dm = max_abs(dm, cg.dv[i]);
-                cg.q[i] = z;
-            }
+            let (rz_new, zm, dm) = cg.step_residual(rz / pq, true);
             let beta = rz_new / rz;
             (rz, z_max, dv_max) = (rz_new, zm, dm);
             for i in 0..cg.p.len() {

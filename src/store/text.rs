@@ -353,6 +353,42 @@ fn decode_header(lines: &mut Lines<'_>) -> Result<(u32, usize), StoreError> {
 fn decode_map(lines: &mut Lines<'_>) -> Result<(u32, RawMap), StoreError> {
     let (version, dim) = decode_header(lines)?;
     let n1 = dim + 1;
+    let (capacity, live_count, dead) = decode_dart_counts(lines)?;
+    // The arrays hold every slot, live or dead: they are allocated only when the free-darts line
+    // after the dart lines lists as many slots as the counts leave dead, so that their size is
+    // bounded by what the file holds (a lying count with no such line allocates nothing; the
+    // dart lines are then read only for their errors, which come first as always).
+    let listed = free_darts_line_ahead(lines, live_count, dead);
+    let cap = if listed { capacity as usize } else { 0 };
+    let mut alpha: Vec<u32> = (0..cap as u32).flat_map(|d| std::iter::repeat_n(d, n1)).collect();
+    let mut cell = vec![UNSET; cap * n1];
+    let mut prev: Option<u32> = None;
+    for _ in 0..live_count {
+        let line = decode_dart_line(lines, n1, capacity, prev)?;
+        prev = Some(line.dart);
+        if listed {
+            let row = line.dart as usize * n1..(line.dart as usize + 1) * n1;
+            alpha[row.clone()].copy_from_slice(&line.alpha[..n1]);
+            cell[row].copy_from_slice(&line.cell[..n1]);
+        }
+    }
+    let (no, f) = lines.next("free-darts", "\"free-darts COUNT IDS…\"")?;
+    let free_darts = id_list(&f, 1, no, "free-darts")?;
+    if free_darts.len() as u64 != dead {
+        let what = "free dart slots (capacity − live)";
+        return Err(StoreError::BadCount { at: Where::Line(no), what, count: free_darts.len() as u64, limit: dead });
+    }
+    // The look-ahead saw this very line: keyword, count = dead, and that many ids.
+    debug_assert!(listed, "the free-darts line was accepted but not seen ahead");
+    let ids = (0..n1).map(|i| decode_cell_ids(lines, i)).collect::<Result<Vec<_>, _>>()?;
+    let raw = RawMap { dimension: dim, capacity, alpha, cell, free_darts, ids };
+    structure::check(&raw, Where::Line(no))?;
+    Ok((version, raw))
+}
+
+/// The `darts CAPACITY LIVE` line: (capacity, live darts, dead slots), each bounded by what the
+/// rest of the file can hold.
+fn decode_dart_counts(lines: &mut Lines<'_>) -> Result<(u32, u64, u64), StoreError> {
     let (no, h) = lines.next("darts", "\"darts CAPACITY LIVE\"")?;
     arity(&h, 3, no, "darts")?;
     let capacity = int32(h[1], no, "capacity")?;
@@ -367,75 +403,73 @@ fn decode_map(lines: &mut Lines<'_>) -> Result<(u32, RawMap), StoreError> {
     if capacity == UNSET || dead > limit {
         return Err(StoreError::BadCount { at: Where::Line(no), what: "dead dart slots", count: dead, limit });
     }
-    // The arrays hold every slot, live or dead: they are allocated only when the free-darts line
-    // after the dart lines lists as many slots as the counts leave dead, so that their size is
-    // bounded by what the file holds (a lying count with no such line allocates nothing; the
-    // dart lines are then read only for their errors, which come first as always).
-    let listed = {
-        let mut ahead = *lines;
-        (0..live_count).all(|_| ahead.next_line().is_some())
-            && ahead.next_line().is_some_and(|(_, line)| {
-                let mut tokens = tokens(line);
-                tokens.next() == Some("free-darts")
-                    && tokens.next().is_some_and(|count| unsigned(count) == Some(dead))
-                    && tokens.count() as u64 == dead
-            })
-    };
-    let cap = if listed { capacity as usize } else { 0 };
-    let mut alpha: Vec<u32> = (0..cap as u32).flat_map(|d| std::iter::repeat_n(d, n1)).collect();
-    let mut cell = vec![UNSET; cap * n1];
-    let mut prev: Option<u32> = None;
-    for _ in 0..live_count {
-        let (no, t) = lines.next("", "a dart line")?;
-        arity(&t, 2 * n1 + 2, no, "dart line")?;
-        let d = int(t[0], no, "dart id")?;
-        if d >= u64::from(capacity) {
-            return Err(StoreError::DartOutOfRange { at: Where::Line(no), dart: d, capacity: capacity.into() });
-        }
-        let d = d as u32;
-        if prev.is_some_and(|p| d <= p) {
-            return Err(StoreError::Inconsistent {
-                at: Where::Line(no),
-                message: format!("dart {d} is not after dart {} (ids must increase)", prev.unwrap_or(0)),
-            });
-        }
-        prev = Some(d);
-        if t[n1 + 1] != "|" {
-            return Err(syntax(no, format!("expected \"|\" between links and cell ids, found {:?}", t[n1 + 1])));
-        }
-        for i in 0..n1 {
-            let a = int(t[1 + i], no, "alpha link")?;
-            if a >= u64::from(capacity) {
-                return Err(StoreError::DartOutOfRange { at: Where::Line(no), dart: a, capacity: capacity.into() });
-            }
-            let c = int32(t[n1 + 2 + i], no, "cell id")?;
-            if listed {
-                alpha[d as usize * n1 + i] = a as u32;
-                cell[d as usize * n1 + i] = c;
-            }
-        }
+    Ok((capacity, live_count, dead))
+}
+
+/// Whether the line after the next `live_count` lines is a free-darts line listing `dead` ids
+/// (a look-ahead: `lines` is not advanced).
+fn free_darts_line_ahead(lines: &Lines<'_>, live_count: u64, dead: u64) -> bool {
+    let mut ahead = *lines;
+    (0..live_count).all(|_| ahead.next_line().is_some())
+        && ahead.next_line().is_some_and(|(_, line)| {
+            let mut tokens = tokens(line);
+            tokens.next() == Some("free-darts")
+                && tokens.next().is_some_and(|count| unsigned(count) == Some(dead))
+                && tokens.count() as u64 == dead
+        })
+}
+
+/// One dart line as read: `DART A0 … An | C0 … Cn` (first n + 1 entries of each row used).
+struct DartLine {
+    dart: u32,
+    alpha: [u32; MAX_DIMENSION + 1],
+    cell: [u32; MAX_DIMENSION + 1],
+}
+
+/// The next dart line, its dart after `prev` and every id below `capacity`.
+fn decode_dart_line(
+    lines: &mut Lines<'_>,
+    n1: usize,
+    capacity: u32,
+    prev: Option<u32>,
+) -> Result<DartLine, StoreError> {
+    let (no, t) = lines.next("", "a dart line")?;
+    arity(&t, 2 * n1 + 2, no, "dart line")?;
+    let d = int(t[0], no, "dart id")?;
+    if d >= u64::from(capacity) {
+        return Err(StoreError::DartOutOfRange { at: Where::Line(no), dart: d, capacity: capacity.into() });
     }
-    let (no, f) = lines.next("free-darts", "\"free-darts COUNT IDS…\"")?;
-    let free_darts = id_list(&f, 1, no, "free-darts")?;
-    if free_darts.len() as u64 != dead {
-        let what = "free dart slots (capacity − live)";
-        return Err(StoreError::BadCount { at: Where::Line(no), what, count: free_darts.len() as u64, limit: dead });
+    let dart = d as u32;
+    if prev.is_some_and(|p| dart <= p) {
+        return Err(StoreError::Inconsistent {
+            at: Where::Line(no),
+            message: format!("dart {dart} is not after dart {} (ids must increase)", prev.unwrap_or(0)),
+        });
     }
-    // The look-ahead saw this very line: keyword, count = dead, and that many ids.
-    debug_assert!(listed, "the free-darts line was accepted but not seen ahead");
-    let mut ids = Vec::with_capacity(n1);
+    if t[n1 + 1] != "|" {
+        return Err(syntax(no, format!("expected \"|\" between links and cell ids, found {:?}", t[n1 + 1])));
+    }
+    let mut line = DartLine { dart, alpha: [0; MAX_DIMENSION + 1], cell: [0; MAX_DIMENSION + 1] };
     for i in 0..n1 {
-        let (no, c) = lines.next("cell-ids", "\"cell-ids DIM NEXT COUNT IDS…\"")?;
-        if c.len() < 3 || int(c[1], no, "cell dimension")? != i as u64 {
-            return Err(syntax(no, format!("expected \"cell-ids {i} NEXT COUNT IDS…\"")));
+        let a = int(t[1 + i], no, "alpha link")?;
+        if a >= u64::from(capacity) {
+            return Err(StoreError::DartOutOfRange { at: Where::Line(no), dart: a, capacity: capacity.into() });
         }
-        let next = int32(c[2], no, "next cell id")?;
-        let free = id_list(&c, 3, no, "cell-ids")?;
-        ids.push(IdAllocRecord { next, free });
+        line.alpha[i] = a as u32;
+        line.cell[i] = int32(t[n1 + 2 + i], no, "cell id")?;
     }
-    let raw = RawMap { dimension: dim, capacity, alpha, cell, free_darts, ids };
-    structure::check(&raw, Where::Line(no))?;
-    Ok((version, raw))
+    Ok(line)
+}
+
+/// The `cell-ids DIM NEXT COUNT IDS…` line of dimension i.
+fn decode_cell_ids(lines: &mut Lines<'_>, i: usize) -> Result<IdAllocRecord, StoreError> {
+    let (no, c) = lines.next("cell-ids", "\"cell-ids DIM NEXT COUNT IDS…\"")?;
+    if c.len() < 3 || int(c[1], no, "cell dimension")? != i as u64 {
+        return Err(syntax(no, format!("expected \"cell-ids {i} NEXT COUNT IDS…\"")));
+    }
+    let next = int32(c[2], no, "next cell id")?;
+    let free = id_list(&c, 3, no, "cell-ids")?;
+    Ok(IdAllocRecord { next, free })
 }
 
 /// `COUNT IDS…` starting at token `start`.

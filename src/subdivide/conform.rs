@@ -14,13 +14,15 @@
 //! - A volume of 24 darts is a plain tet (4 triangular faces, no inserted vertex): it is output as
 //!   it is.
 //! - Any other volume is a coarse tet whose sides carry inserted vertices. Each of its face
-//!   polygons is triangulated ([`triangulate_polygon`]) and every boundary triangle is coned to a
+//!   polygons is triangulated (from its structure: a triangle at its own level μf whose sides
+//!   carry the vertices inserted later, below) and every boundary triangle is coned to a
 //!   new vertex (a *Steiner point*) at the centroid of the tet's four corners. The tet is convex
 //!   and the centroid is strictly inside, so every cone tet has a positive volume, and the cones
 //!   tile the tet exactly.
 //! - A face polygon is shared by the two volumes on its sides (it is one face cell of the finest
 //!   map); it is triangulated **once** (cached by face id, from its vertex cycle in a canonical
-//!   order: smallest vertex id first, towards its smaller neighbour) and both sides use the same
+//!   order: the vertex of smallest position first, towards its smaller neighbour, so that the
+//!   result does not depend on the vertex numbering) and both sides use the same
 //!   triangles, so neighbouring tets meet along identical triangles: the mesh is conforming. A
 //!   plain tet's face is a triangle, triangulated as itself, so the plain tets match too.
 //!
@@ -28,6 +30,16 @@
 //! its split edges, without new vertices). It adds one vertex per closed tet, but it is valid for
 //! every pattern the adaptive refinement produces — faces refined several times, any number of
 //! inserted vertices on a side — because it relies only on convexity.
+//!
+//! # Triangulating a face polygon
+//! A face of the finest map is, at its own level μf, a triangle; the vertices on its sides were
+//! inserted later by finer neighbours (edge splits). Walking the face with α0 and α1 of level μf
+//! ([`LeveledMap::alpha_at`]) gives its three corners; the other vertices of its cycle lie on the
+//! side between the corners they sit between. Three of its vertices are collinear exactly when one
+//! side holds all three, so the ears are chosen from this structure, with no geometric tolerance
+//! (finding 281: the geometric turn test, [`triangulate_polygon`], refused faces with a corner
+//! angle below about 1e-9 rad). The geometric test remains the fallback for a face whose walk at
+//! its level is not a triangle (none is known).
 //!
 //! # Cut faces: the closure expresses the map's topology or refuses
 //! The output is a tet list keyed by vertex ids, and [`crate::GMap::from_tets`] glues two tets
@@ -154,9 +166,17 @@ fn convex(a: [f64; 3], b: [f64; 3], c: [f64; 3], n: WideVec) -> bool {
 ///
 /// Ear clipping: repeatedly cut off the first strictly convex corner (with respect to the
 /// polygon's Newell normal) whose removal leaves a polygon that still has a strictly convex
-/// corner (so the rest never degenerates into a segment). Returns k − 2 triangles, each with the
-/// orientation of the cycle, or `None` when the polygon has zero area, fewer than 3 vertices, or
-/// a reflex corner (not of the kind the refinement makes). O(k³).
+/// corner (so the rest never degenerates into a segment). A corner is strictly convex when the
+/// sine of its turn exceeds a relative tolerance of 1e-9 (so that inserted midpoints, collinear
+/// up to rounding, are never cut off as ears). Returns k − 2 triangles, each with the
+/// orientation of the cycle, or `None` when the polygon has fewer than 3 vertices or zero area,
+/// or when no such ear is left — in particular for a triangle with every corner angle below about
+/// 1e-9 rad (a face with a positive but tiny angle). Meant for polygons convex up to collinear
+/// vertices: a simple polygon with a reflex corner may still be triangulated correctly (ears at
+/// convex corners only), but no ear is checked against the other vertices, so a polygon that is
+/// not convex can get triangles outside it, and a self-intersecting cycle an arbitrary answer.
+/// The closure ([`LeveledMap::conforming_tets`]) triangulates from the face's structure instead.
+/// O(k³).
 ///
 /// ```
 /// use topomech::subdivide::triangulate_polygon;
@@ -210,17 +230,70 @@ pub fn triangulate_polygon(cycle: &[u32], points: &[[f64; 3]]) -> Option<Vec<[u3
     Some(out)
 }
 
-/// The cycle rotated to start at its smallest vertex id and turned towards the smaller of that
-/// vertex's two neighbours, so that a face gets the same triangulation whichever side and dart it
-/// is read from. O(k).
-fn canonical_cycle(mut cycle: Vec<u32>) -> Vec<u32> {
-    if let Some(i) = cycle.iter().enumerate().min_by_key(|&(_, &v)| v).map(|(i, _)| i) {
+/// The cycle rotated to start at the vertex of smallest position (lexicographic order of the
+/// coordinates, `f64::total_cmp`; equal positions, as on the two sides of a cut, by vertex id) and
+/// turned towards the smaller of that vertex's two neighbours in the same order, so that a face
+/// gets the same triangulation whichever side and dart it is read from, and the same
+/// triangulation of the same geometry whatever the vertex numbering (finding 282: the start was
+/// the smallest vertex id, and renumbering the mesh changed the closure). O(k).
+fn canonical_cycle(mut cycle: Vec<u32>, points: &[[f64; 3]]) -> Vec<u32> {
+    let key = |v: u32| (points.get(v as usize).copied().unwrap_or([f64::NAN; 3]), v);
+    let less = |a: u32, b: u32| {
+        let ((pa, a), (pb, b)) = (key(a), key(b));
+        let by_position = (0..3).map(|k| pa[k].total_cmp(&pb[k])).find(|o| o.is_ne());
+        by_position.unwrap_or(a.cmp(&b)).is_lt()
+    };
+    let first = (0..cycle.len()).reduce(|best, i| if less(cycle[i], cycle[best]) { i } else { best });
+    if let Some(i) = first {
         cycle.rotate_left(i);
     }
-    if cycle.len() > 2 && cycle[cycle.len() - 1] < cycle[1] {
+    if cycle.len() > 2 && less(cycle[cycle.len() - 1], cycle[1]) {
         cycle[1..].reverse();
     }
     cycle
+}
+
+/// Triangulates a face polygon that is a triangle with vertices inserted on its sides, from its
+/// structure alone: `corners` are the triangle's three corners (in `cycle`); the vertices between
+/// two consecutive corners lie on the side they span. Three vertices are collinear exactly when
+/// they lie on one side, so an ear (prev, v, next) is cut when no side holds all three and the
+/// rest does not lie on one side; the polygon is convex, so every such ear lies inside it. No
+/// geometric test, so no tolerance: a triangle with corner angles far below any float tolerance
+/// is triangulated like any other (finding 281: the turn test's relative tolerance 1e-9 refused
+/// faces with an angle below about 1e-9 rad). Ears are cut in cycle order from the start of the
+/// (canonical) cycle. `None` when the corners are not three distinct vertices of the cycle.
+/// O(k²).
+fn triangulate_by_sides(cycle: &[u32], corners: &[u32]) -> Option<Vec<[u32; 3]>> {
+    let at: Vec<usize> = cycle.iter().enumerate().filter(|(_, v)| corners.contains(v)).map(|(i, _)| i).collect();
+    if corners.len() != 3 || at.len() != 3 || cycle.len() < 3 {
+        return None;
+    }
+    // Side j runs from the corner at[j] to at[j + 1] (cyclically); a corner lies on two sides.
+    let mut poly: Vec<(u32, u8)> = Vec::with_capacity(cycle.len());
+    for (i, &v) in cycle.iter().enumerate() {
+        let side = |i: usize| (0..3).rev().find(|&j| at[j] <= i).unwrap_or(2);
+        let j = side(i);
+        let mask = if at.contains(&i) { (1u8 << j) | (1u8 << ((j + 2) % 3)) } else { 1u8 << j };
+        poly.push((v, mask));
+    }
+    let on_one_side = |p: &[(u32, u8)]| p.iter().fold(7u8, |m, &(_, s)| m & s) != 0;
+    let mut out = Vec::with_capacity(cycle.len() - 2);
+    while poly.len() > 3 {
+        let k = poly.len();
+        let ear = (0..k).find(|&i| {
+            let (prev, next) = (poly[(i + k - 1) % k], poly[(i + 1) % k]);
+            let mut rest = poly.clone();
+            rest.remove(i);
+            !on_one_side(&[prev, poly[i], next]) && !on_one_side(&rest)
+        })?;
+        out.push([poly[(ear + k - 1) % k].0, poly[ear].0, poly[(ear + 1) % k].0]);
+        poly.remove(ear);
+    }
+    if on_one_side(&poly) {
+        return None;
+    }
+    out.push([poly[0].0, poly[1].0, poly[2].0]);
+    Some(out)
 }
 
 /// How the finest map glues the face of an output tet: what [`GMap::from_tets`] must find on
@@ -300,8 +373,9 @@ impl LeveledMap<3> {
     /// Errors (the first met, volume by volume): [`SubdivideError::OpenEdge`] if a face is not
     /// closed, [`SubdivideError::CutNotExpressible`] above, the errors of
     /// [`Self::tet_vertices`] for a closed volume that is not a tet at its level,
-    /// [`SubdivideError::DegenerateFace`] if a face polygon cannot be triangulated (zero area,
-    /// reflex corner) or a cone tet would have a non-positive volume;
+    /// [`SubdivideError::DegenerateFace`] if a face polygon cannot be triangulated (it is not a
+    /// triangle with vertices on its sides, and the geometric fallback finds no ear) or a cone
+    /// tet would have a non-positive volume;
     /// [`SubdivideError::NoPosition`] first if a live vertex has no position (it was read as the
     /// origin, and the error then blamed a degenerate face), then
     /// [`SubdivideError::NonFinitePosition`] for the smallest live vertex whose position is NaN or
@@ -378,8 +452,12 @@ impl LeveledMap<3> {
                 let tris = match face_tris.entry(id) {
                     Entry::Occupied(e) => e.into_mut(),
                     Entry::Vacant(e) => {
-                        let cycle = canonical_cycle(self.face_cycle(f)?);
-                        e.insert(triangulate_polygon(&cycle, &out.points).ok_or(SubdivideError::DegenerateFace(f))?)
+                        let cycle = canonical_cycle(self.face_cycle(f)?, &out.points);
+                        let tris = match self.face_corners(f) {
+                            Some(corners) => triangulate_by_sides(&cycle, &corners),
+                            None => triangulate_polygon(&cycle, &out.points),
+                        };
+                        e.insert(tris.ok_or(SubdivideError::DegenerateFace(f))?)
                     }
                 };
                 let glue = self.side_glue(f);
@@ -478,6 +556,26 @@ impl LeveledMap<3> {
                 return Err(SubdivideError::OpenEdge(f));
             }
         }
+    }
+
+    /// The corners of the face of `f`: the vertices of its cycle at its own level μf (walked with
+    /// α0 and α1 of that level from a dart that exists there), where the vertices its neighbours
+    /// inserted on its sides later are not yet. `None` when that walk does not close on three
+    /// vertices (not a triangle at its level). O(face · history).
+    fn face_corners(&self, f: DartId) -> Option<Vec<u32>> {
+        let level = self.mu(f).face;
+        let side = self.map.orbit(f, AlphaMask::of(&[0, 1]));
+        let start = side.iter().copied().find(|&x| self.dart_level(x) <= level)?;
+        let mut corners = Vec::with_capacity(3);
+        let mut x = start;
+        loop {
+            corners.push(self.map.vertex_id(x).0);
+            x = self.alpha_at(level, 1, self.alpha_at(level, 0, x));
+            if x == start || corners.len() > 3 {
+                break;
+            }
+        }
+        (corners.len() == 3).then_some(corners)
     }
 
     /// `t` ordered for a positive signed volume over `points`, by the exact orientation sign of

@@ -16,10 +16,11 @@ impl LeveledMap<3> {
     /// glued; G_i for i ≥ `level` has it cut. Returns the number of darts unlinked on the side of
     /// d. O(face + touched cells).
     ///
-    /// Errors: [`SubdivideError::NoSuchDart`], the level-order errors
-    /// ([`SubdivideError::LevelBelowMax`], [`SubdivideError::LevelTooHigh`]),
-    /// [`SubdivideError::FaceNotSewn`] (some dart of the face is α3-free). The map is unchanged on
-    /// error.
+    /// Errors: the level-order errors ([`SubdivideError::LevelTooHigh`],
+    /// [`SubdivideError::LevelBelowMax`]), [`SubdivideError::NoPosition`] (points are given but
+    /// not for some live vertex; a map without points is accepted), then
+    /// [`SubdivideError::NoSuchDart`] and [`SubdivideError::FaceNotSewn`] (some dart of the face
+    /// is α3-free). The map is unchanged on error.
     ///
     /// ```
     /// use topomech::gmap::{DartId, GMap};

@@ -14,8 +14,11 @@
 //! # The measure
 //! For each dissociated face: the distances |(x − p) · n| / |n| of its three vertices x (current
 //! positions) to the plane (p, n). Over the faces *measured* — every cut face, or with a zone
-//! B(c, r) only those whose centroid lies in the ball — the error is the maximum vertex distance
-//! and the mean over faces of the mean vertex distance. With no face measured both are NaN.
+//! B(c, r) only those whose centroid lies in the closed ball, decided exactly on the positions
+//! as given (a centroid on the sphere is in; the same faces for a copy scaled by a power of two
+//! or translated without rounding) — the error is the maximum
+//! vertex distance and the mean over faces of the mean vertex distance. With no face measured
+//! both are NaN.
 
 use crate::cut::{incise_plane, CutError, Dissociation, Incision, Plane};
 use crate::gmap::AlphaMask;
@@ -104,11 +107,10 @@ pub fn measure_cut(
         ids.sort_unstable();
         ids.dedup();
         let pts: Vec<[f64; 3]> = ids.iter().map(|&v| mech.position[v]).collect();
-        let c = crate::mesh::centroid(&pts); // divided first: no overflow for huge coordinates
         if let Some((centre, r)) = zone {
-            // Scaled distance: (Σ dₖ²) and r² overflow to ∞ ≤ ∞ for far zones (finding 80).
-            let inside = crate::mesh::distance(c, centre) <= r; // false for a NaN distance
-            if !inside {
+            // Exact at every scale (finding 283; finding 80: no overflow for far zones); a
+            // non-finite position is outside.
+            if !crate::exact::centroid_in_ball(&pts, centre, r) {
                 continue;
             }
         }

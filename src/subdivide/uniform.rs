@@ -153,107 +153,131 @@ fn flag_alpha(n: usize, set: &[u8], t: [u8; 3], j: usize) -> [u8; 3] {
     out
 }
 
+/// The label of the midpoint of corners x and y: n + 1 + the index of the pair in `pr`.
+fn midpoint_label(n: usize, pr: &[(u8, u8)], x: u8, y: u8) -> u8 {
+    let i = pr.iter().position(|&p| p == (x.min(y), x.max(y))).expect("a corner pair");
+    n as u8 + 1 + i as u8
+}
+
+/// The index in `parents` of the parent flag whose first n labels are those of `t`.
+fn parent_index(n: usize, parents: &[[u8; 3]], t: [u8; 3]) -> u8 {
+    parents.iter().position(|&p| p[..n] == t[..n]).expect("a parent flag") as u8
+}
+
+/// `act[p][j]`: the parent index of αj(p) for j < n.
+fn parent_action(n: usize, corners: &[u8], parents: &[[u8; 3]]) -> Vec<[u8; 3]> {
+    let act_of = |p: [u8; 3]| {
+        let mut a = [0u8; 3];
+        for (j, slot) in a.iter_mut().enumerate().take(n) {
+            *slot = parent_index(n, parents, flag_alpha(n, corners, p, j));
+        }
+        a
+    };
+    parents.iter().map(|&p| act_of(p)).collect()
+}
+
+/// The child flags of the fixed slots of parent dart p = (a, b, c) (the table of the module
+/// docs): the slots on the parent's facets, plus the centre slot of a triangle.
+fn fixed_slots(n: usize, children: &[[u8; 4]], pr: &[(u8, u8)], p: [u8; 3]) -> Vec<(u8, [u8; 3])> {
+    let mid = |x: u8, y: u8| midpoint_label(n, pr, x, y);
+    let (a, b) = (p[0], p[1]);
+    let other = |used: &[u8]| (0..=n as u8).find(|x| !used.contains(x)).expect("n + 1 corners");
+    if n == 2 {
+        let c = other(&[a, b]);
+        return vec![
+            (a, [a, mid(a, b), 0]),
+            (a, [mid(a, b), a, 0]),
+            (a, [mid(a, b), mid(a, c), 0]),
+            (3, [mid(a, b), mid(a, c), 0]),
+        ];
+    }
+    let (c, d) = (p[2], other(&p));
+    let holder = |face: &[u8], not: Option<u8>| -> u8 {
+        let found = (0..children.len() as u8)
+            .find(|&k| Some(k) != not && face.iter().all(|l| children[k as usize][..=n].contains(l)));
+        found.expect("a child holds the face")
+    };
+    let centre = [mid(a, b), mid(a, c), mid(b, c)];
+    let cut = [mid(a, b), mid(a, c), mid(a, d)];
+    // The corner child of a is child a.
+    vec![
+        (a, [a, mid(a, b), mid(a, c)]),
+        (a, [mid(a, b), a, mid(a, c)]),
+        (a, [mid(a, b), mid(a, c), a]),
+        (holder(&centre, None), centre),
+        (a, cut),
+        (holder(&cut, Some(a)), cut),
+    ]
+}
+
+/// The child flag of every slot (p · per + k): the fixed slots of each parent dart, then the
+/// other child flags in order, one per remaining slot (a bijection).
+fn slot_flags(n: usize, children: &[[u8; 4]], parents: &[[u8; 3]], pr: &[(u8, u8)]) -> Vec<(u8, [u8; 3])> {
+    let per = if n == 3 { 8 } else { 4 };
+    let mut flags: Vec<(u8, [u8; 3])> = Vec::new();
+    for (c, set) in children.iter().enumerate() {
+        flags.extend(tuples(n, &set[..=n]).into_iter().map(|t| (c as u8, t)));
+    }
+    let mut slot_flag: Vec<Option<(u8, [u8; 3])>> = vec![None; parents.len() * per];
+    for (pi, &p) in parents.iter().enumerate() {
+        for (k, f) in fixed_slots(n, children, pr, p).into_iter().enumerate() {
+            slot_flag[pi * per + k] = Some(f);
+        }
+    }
+    let mut rest = flags.iter().copied().filter(|f| !slot_flag.contains(&Some(*f))).collect::<Vec<_>>().into_iter();
+    for s in slot_flag.iter_mut().filter(|s| s.is_none()) {
+        *s = rest.next();
+    }
+    let slot_flag: Vec<(u8, [u8; 3])> = slot_flag.into_iter().map(|f| f.expect("a bijection")).collect();
+    assert_eq!(slot_flag.len(), flags.len(), "template bug: slot count");
+    slot_flag
+}
+
+/// Per slot: the slot of its αj for j < n (inside its child), and of its αn (the same flag in the
+/// other child holding its facet) or [`BORDER`] when no other child holds it.
+fn child_links(n: usize, children: &[[u8; 4]], slot_flag: &[(u8, [u8; 3])]) -> Vec<[u8; 4]> {
+    let slot_of = |f: (u8, [u8; 3])| slot_flag.iter().position(|&g| g == f).expect("template bug: a flag") as u8;
+    let link_of = |(c, t): (u8, [u8; 3])| {
+        let set = &children[c as usize][..=n];
+        let mut l = [BORDER; 4];
+        for (j, slot) in l.iter_mut().enumerate().take(n) {
+            *slot = slot_of((c, flag_alpha(n, set, t, j)));
+        }
+        let other =
+            children.iter().enumerate().position(|(o, s)| o as u8 != c && t[..n].iter().all(|x| s[..=n].contains(x)));
+        l[n] = other.map_or(BORDER, |o| slot_of((o as u8, t)));
+        l
+    };
+    slot_flag.iter().map(|&f| link_of(f)).collect()
+}
+
 impl Template {
     /// The template of an n-simplex (n ∈ {2, 3}) whose children are `children`.
     fn new(n: usize, children: Vec<[u8; 4]>) -> Self {
         let corners: Vec<u8> = (0..=n as u8).collect();
         let pr = pairs(n);
-        let mid = |x: u8, y: u8| n as u8 + 1 + pr.iter().position(|&p| p == (x.min(y), x.max(y))).expect("pair") as u8;
         let parents = tuples(n, &corners);
-        let index_of = |t: [u8; 3]| parents.iter().position(|&p| p[..n] == t[..n]).expect("a parent flag") as u8;
-        let act: Vec<[u8; 3]> = parents
-            .iter()
-            .map(|&p| {
-                let mut a = [0u8; 3];
-                for (j, slot) in a.iter_mut().enumerate().take(n) {
-                    *slot = index_of(flag_alpha(n, &corners, p, j));
-                }
-                a
-            })
-            .collect();
+        let act = parent_action(n, &corners, &parents);
         let tree = Self::spanning_tree(n, &act);
-        // Child darts: (child, tuple).
-        let mut flags: Vec<(u8, [u8; 3])> = Vec::new();
-        for (c, set) in children.iter().enumerate() {
-            flags.extend(tuples(n, &set[..=n]).into_iter().map(|t| (c as u8, t)));
-        }
-        let holder = |face: &[u8], not: Option<u8>| -> u8 {
-            let found = children
-                .iter()
-                .enumerate()
-                .position(|(c, set)| Some(c as u8) != not && face.iter().all(|l| set[..=n].contains(l)));
-            found.expect("a child holds the face") as u8
-        };
-        let per = if n == 3 { 8 } else { 4 };
-        let mut slot_flag: Vec<Option<(u8, [u8; 3])>> = vec![None; parents.len() * per];
-        for (pi, &p) in parents.iter().enumerate() {
-            let (a, b) = (p[0], p[1]);
-            let c = if n == 3 { p[2] } else { corners.iter().copied().find(|&x| x != a && x != b).expect("3") };
-            let ca = a; // the corner child of a is child a
-            let fixed: Vec<(u8, [u8; 3])> = if n == 2 {
-                vec![
-                    (ca, [a, mid(a, b), 0]),
-                    (ca, [mid(a, b), a, 0]),
-                    (ca, [mid(a, b), mid(a, c), 0]),
-                    (3, [mid(a, b), mid(a, c), 0]),
-                ]
-            } else {
-                let d = corners.iter().copied().find(|x| !p.contains(x)).expect("4 corners");
-                let centre = [mid(a, b), mid(a, c), mid(b, c)];
-                let cut = [mid(a, b), mid(a, c), mid(a, d)];
-                vec![
-                    (ca, [a, mid(a, b), mid(a, c)]),
-                    (ca, [mid(a, b), a, mid(a, c)]),
-                    (ca, [mid(a, b), mid(a, c), a]),
-                    (holder(&centre, None), centre),
-                    (ca, cut),
-                    (holder(&cut, Some(ca)), cut),
-                ]
-            };
-            for (k, f) in fixed.into_iter().enumerate() {
-                slot_flag[pi * per + k] = Some(f);
-            }
-        }
-        let rest: Vec<(u8, [u8; 3])> = flags.iter().copied().filter(|f| !slot_flag.contains(&Some(*f))).collect();
-        let mut rest = rest.into_iter();
-        for s in slot_flag.iter_mut().filter(|s| s.is_none()) {
-            *s = rest.next();
-        }
-        let slot_flag: Vec<(u8, [u8; 3])> = slot_flag.into_iter().map(|f| f.expect("a bijection")).collect();
-        assert_eq!(slot_flag.len(), flags.len(), "template bug: slot count");
-        let slot_of = |f: (u8, [u8; 3])| slot_flag.iter().position(|&g| g == f).expect("template bug: a flag") as u8;
-        let link: Vec<[u8; 4]> = slot_flag
+        let slot_flag = slot_flags(n, &children, &parents, &pr);
+        let link = child_links(n, &children, &slot_flag);
+        let pair_parent = pr
             .iter()
-            .map(|&(c, t)| {
-                let set = &children[c as usize][..=n];
-                let mut l = [BORDER; 4];
-                for (j, slot) in l.iter_mut().enumerate().take(n) {
-                    *slot = slot_of((c, flag_alpha(n, set, t, j)));
-                }
-                let other = children
-                    .iter()
-                    .enumerate()
-                    .position(|(o, s)| o as u8 != c && t[..n].iter().all(|x| s[..=n].contains(x)));
-                l[n] = other.map_or(BORDER, |o| slot_of((o as u8, t)));
-                l
+            .map(|&(x, y)| {
+                let z = corners.iter().copied().find(|&z| z != x && z != y).expect("n ≥ 2");
+                parent_index(n, &parents, [x, y, z])
             })
             .collect();
         let mut template = Template {
             n,
-            per,
+            per: if n == 3 { 8 } else { 4 },
             act,
             tree,
             link,
             cell: vec![[0; 4]; slot_flag.len()],
             rules: vec![Vec::new(); n + 1],
             inner: [0; 4],
-            pair_parent: pr
-                .iter()
-                .map(|&(x, y)| {
-                    let z = corners.iter().copied().find(|&z| z != x && z != y).expect("n ≥ 2");
-                    index_of([x, y, z])
-                })
-                .collect(),
+            pair_parent,
             child_cell: Vec::new(),
             pairs: pr.clone(),
             flat_cell: Vec::new(),

@@ -1,7 +1,9 @@
-//! Round 32's probes of the simulation layer. Finding 278: the implicit step "solved" a
-//! right-hand side whose every nonzero entry was NaN (Δv = 0, `Ok`). Finding 279: a pinned slot
-//! whose force overflowed got the acceleration ∞ · 0 = NaN in the explicit schemes. Finding 280:
-//! the CLI named a failed implicit solve by the library's 0-based step.
+//! Round 32's probes. Finding 278: the implicit step "solved" a right-hand side whose every
+//! nonzero entry was NaN (Δv = 0, `Ok`). Finding 279 (documented): a pinned slot whose force
+//! overflows is a blow-up in the explicit schemes. Finding 280: the CLI named a failed implicit
+//! solve by the library's 0-based step. Findings 281–283: the conforming closure refused faces
+//! with tiny corner angles and depended on the vertex numbering; `measure_cut` dropped faces
+//! whose centroid lies exactly on the zone's sphere.
 
 use topomech::generate::kuhn_cube;
 use topomech::mechanics::{Body, Integrator, Material, Simulation, SpringSystem, StepConfig, StepError, Stepper};
@@ -38,8 +40,10 @@ fn an_implicit_step_with_a_nan_right_hand_side_fails_as_the_explicit_ones_blow_u
         match (integrator, r) {
             (Integrator::Implicit, Err(StepError::SolverFailed { step: 0, iterations: 0, .. })) => {}
             (Integrator::Implicit, other) => panic!("implicit: expected SolverFailed at step 0, got {other:?}"),
-            (_, Err(StepError::BlowUp { step: 0, slot: 1, .. })) => {}
-            (_, other) => panic!("{integrator:?}: expected a blow-up of slot 1, got {other:?}"),
+            // The first slot whose state is not finite: fixed slot 0, whose force overflowed
+            // too (finding 279).
+            (_, Err(StepError::BlowUp { step: 0, slot: 0, .. })) => {}
+            (_, other) => panic!("{integrator:?}: expected a blow-up at step 0, got {other:?}"),
         }
     }
 }
@@ -57,10 +61,12 @@ fn an_implicit_free_fall_at_a_step_past_the_range_of_f64_is_refused() {
 }
 
 #[test]
-fn a_pinned_slot_keeps_its_velocity_whatever_its_force() {
+fn an_overflowing_force_on_a_pinned_slot_is_a_blow_up_named_at_that_slot() {
     // Slots 0 and 1 fixed and moving apart through a spring of damping 1e300 (its force
     // overflows, on fixed slots only); slot 2 free, at rest, joined to slot 0 by a spring without
-    // stiffness or damping (so that no scheme's stage positions pull it).
+    // stiffness or damping. The documented behaviour (finding 279): the explicit schemes report
+    // a blow-up at the first fixed slot whose force is not finite; the implicit one leaves fixed
+    // slots out of its solve and moves them at their velocity.
     let sys = SpringSystem::new(
         vec![[0, 1], [0, 2]],
         vec![1.0, 1.0],
@@ -78,13 +84,17 @@ fn a_pinned_slot_keeps_its_velocity_whatever_its_force() {
         let mut v = v0.clone();
         let dt = 1e-3;
         let mut st = Stepper::new(StepConfig::new(integrator, dt), &sys, &x, &v).unwrap();
-        st.step(&sys, &mut x, &mut v).unwrap_or_else(|e| panic!("{integrator:?}: {e}"));
-        assert_eq!(&v[..2], &v0[..2], "{integrator:?}: the fixed slots keep their velocity");
-        // At constant velocity (to rounding: RK4 sums its four equal stage velocities).
-        let close = |a: [f64; 3], b: [f64; 3]| (0..3).all(|j| (a[j] - b[j]).abs() <= 1e-12 * b[j].abs().max(1.0));
-        assert!(close(x[0], [-1e10 * dt, 0.0, 0.0]), "{integrator:?}: {:?}", x[0]);
-        assert!(close(x[1], [1.0 + 1e10 * dt, 0.0, 0.0]), "{integrator:?}: {:?}", x[1]);
-        assert_eq!((x[2], v[2]), ([0.0, 1.0, 0.0], [0.0; 3]), "{integrator:?}: the free slot feels nothing");
+        match (integrator, st.step(&sys, &mut x, &mut v)) {
+            (Integrator::Implicit, Ok(())) => {
+                assert_eq!(&v[..2], &v0[..2]);
+                assert_eq!((x[2], v[2]), ([0.0, 1.0, 0.0], [0.0; 3]), "the free slot feels nothing");
+            }
+            (Integrator::Implicit, Err(e)) => panic!("implicit: {e}"),
+            (_, Err(StepError::BlowUp { step: 0, slot: 0, reason })) => {
+                assert!(reason.contains("non-finite"), "{integrator:?}: {reason}")
+            }
+            (_, other) => panic!("{integrator:?}: expected a blow-up at fixed slot 0, got {other:?}"),
+        }
     }
 }
 

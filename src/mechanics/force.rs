@@ -57,7 +57,8 @@ pub const PARALLEL_CHUNK: usize = 4096;
 /// Vertices are *slots* `0..slots()`: positions and velocities are passed in as slices of that
 /// length. A slot with `inv_mass == 0` (fixed: pinned, dead or massless) has no acceleration: it
 /// keeps its velocity, so it stays put at velocity 0 and moves at constant velocity otherwise (a
-/// driven pin, in every scheme of [`crate::mechanics::Stepper`]); its kinetic energy counts
+/// driven pin, in every scheme of [`crate::mechanics::Stepper`]; a force on it that is not
+/// finite is a blow-up in the explicit schemes, docs/MECHANICS.md); its kinetic energy counts
 /// nowhere ([`SpringSystem::kinetic_energy`], the runaway test). Equality compares
 /// the arrays and, per slot, the incident lists in order (not where they sit in memory).
 ///
@@ -1046,9 +1047,7 @@ impl SpringSystem {
     }
 
     /// [`SpringSystem::acceleration`] of slot i given the sum `s` of its spring forces (as the
-    /// gather or [`SpringSystem::spring_sums4`] computes it): f / m on a free slot, exactly 0 on a
-    /// fixed one (`inv_mass` 0) whatever its force — an overflowed or NaN force on a pinned
-    /// vertex would otherwise make ∞ · 0 = NaN (finding 279). O(1).
+    /// gather or [`SpringSystem::spring_sums4`] computes it). O(1).
     #[inline(always)]
     pub(crate) fn acceleration_of_sum(&self, i: usize, s: Vec3, vi: Vec3) -> Vec3 {
         let (m, g, w) = (self.mass[i], self.viscosity[i], self.inv_mass[i]);
@@ -1057,10 +1056,7 @@ impl SpringSystem {
             s[1] + m * self.gravity[1] - g * vi[1],
             s[2] + m * self.gravity[2] - g * vi[2],
         ];
-        let a = [f[0] * w, f[1] * w, f[2] * w];
-        // A select, not a branch: the same code on every slot.
-        let free = w != 0.0;
-        [if free { a[0] } else { 0.0 }, if free { a[1] } else { 0.0 }, if free { a[2] } else { 0.0 }]
+        [f[0] * w, f[1] * w, f[2] * w]
     }
 
     /// `out[i] = value(i)` for every slot, split across threads when asked and large.

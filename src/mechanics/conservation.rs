@@ -397,7 +397,11 @@ fn scatter_one(map: &GMap<3>, mech: &Mechanics, darts: &[DartId], exp: &mut Expe
         let x = darts.iter().copied().find(|&x| map.cell_id(1, x) == e).expect("edge of this volume");
         let (a, b) = (mech.rest_position[map.vertex_id(x)], mech.rest_position[map.vertex_id(map.alpha::<0>(x))]);
         let length = super::geom::rest_length(a, b);
-        exp.edge_stiffness[e.index()] += stiffness_contribution(young, volume, length);
+        // Law 2 reads the edge's stored rest length, as every rule that recomputes a stiffness
+        // does; the stored length is checked against the rest positions on its own (finding 287:
+        // a length stored within the tolerance of the distance, read from a file, made the next
+        // recomputed stiffness fail a law measured on the distance).
+        exp.edge_stiffness[e.index()] += stiffness_contribution(young, volume, mech.edge_rest_length(e));
         exp.edge_dart[e.index()] = Some(x);
         exp.edge_length[e.index()] = length;
     }

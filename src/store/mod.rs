@@ -137,7 +137,12 @@ pub enum Where {
     /// 0-based byte offset in the binary form.
     Byte(usize),
     /// A [`Document`] built or changed in memory, not read from a file (its fields are public):
-    /// [`encode`], the `into_*` conversions and [`check_all_laws`] check it as the decoders do.
+    /// [`encode`], the `into_*` conversions and [`check_all_laws`] check its structure and laws
+    /// as the decoders do, with two differences of scope (finding 288): only [`encode`] refuses
+    /// what the file forms cannot write (a non-finite level point: `into_leveled` and
+    /// `check_all_laws` accept it, as `LeveledMap::from_parts` does), and `into_map` builds the
+    /// map alone, ignoring any mechanics or levels the document carries (`check_all_laws` and
+    /// `encode` refuse mechanics on a map that is not a 3-G-map).
     Document,
 }
 

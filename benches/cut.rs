@@ -102,8 +102,7 @@ fn fixture(name: &str, points: &[Vec3], tets: &[[u32; 4]]) -> Fixture {
 
 fn small() -> Option<Fixture> {
     let mesh =
-        topomech::io::read_mesh(Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes/liver_547.msh")))
-            .ok()?;
+        topomech::io::read_mesh(Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/data/liver_547_v22.msh"))).ok()?;
     Some(fixture_of("liver_547", &mesh))
 }
 

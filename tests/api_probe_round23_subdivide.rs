@@ -268,7 +268,7 @@ fn f211_diagonal_is_order_independent_for_random_near_tie_tets() {
 // 214: distance 0 on the tet; radius-0 balls.
 
 fn liver() -> topomech::mesh::TetMesh {
-    topomech::io::read_mesh(Path::new("/work/shared/meshes/liver_547.msh")).unwrap()
+    topomech::io::read_mesh(Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/data/liver_547_v22.msh"))).unwrap()
 }
 
 /// Whether ½(a + b) is the exact midpoint (the sum of each coordinate exact).

@@ -33,11 +33,9 @@ proptest! {
 
     #[test]
     fn cut_sequences_on_liver_547(bytes in scenario_bytes()) {
-        let path = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes/liver_547.msh"));
-        if !path.exists() {
-            eprintln!("liver_547.msh absent: skipped");
-            return Ok(());
-        }
+        // The built-in copy (byte-identical to ../shared/meshes/liver_547_v22.msh): never skipped
+        // (finding 293: the shared file is absent from a checkout elsewhere).
+        let path = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/data/liver_547_v22.msh"));
         let mesh = topomech::io::read_mesh(path).unwrap();
         let ops = decode(&bytes).ops;
         run(Harness::new(mesh.points, mesh.tets).unwrap(), &ops[..ops.len().min(4)])?;

@@ -7,11 +7,9 @@ use std::process::Command;
 
 #[test]
 fn plane_cut_of_liver_547_json() {
-    let mesh = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes/liver_547.msh");
-    if !std::path::Path::new(mesh).exists() {
-        eprintln!("{mesh} absent: skipped");
-        return;
-    }
+    // The built-in copy of the mesh (byte-identical to ../shared/meshes/liver_547_v22.msh; the
+    // MSH 4.1 file gives the same JSON): never skipped (finding 293).
+    let mesh = concat!(env!("CARGO_MANIFEST_DIR"), "/data/liver_547_v22.msh");
     let out = Command::new(env!("CARGO_BIN_EXE_topomech"))
         .args(["cut", mesh, "--plane", "0,0,0,1,0.3,0.2", "--json"])
         .output()

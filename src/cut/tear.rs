@@ -22,7 +22,7 @@ use std::cmp::Ordering;
 use crate::mechanics::geom::{self, cross, dot, sub};
 use crate::mechanics::model::{closed_triangle_vertices, triangle_vertices};
 use crate::mechanics::{Body, SimError, Simulation, TouchedCells, Vec3};
-use crate::{AlphaMask, CellId, DartId, GMap};
+use crate::{CellId, DartId, GMap};
 
 use super::{dissociate_face, CutError, Dissociation};
 use crate::exact::{det_sign, Term};
@@ -192,45 +192,7 @@ fn largest_eigenpair(m: &[[f64; 3]; 3]) -> Stress {
     for _ in 0..JACOBI_SWEEPS {
         let mut rotated = false;
         for (p, q) in [(0, 1), (0, 2), (1, 2)] {
-            let apq = a[p][q];
-            if apq == 0.0 {
-                continue;
-            }
-            // Negligible against both diagonal entries: dropping it moves the eigenvalues by
-            // less than 1e-2 ulp of them (Numerical Recipes' `jacobi` test).
-            let g = 100.0 * apq.abs();
-            if a[p][p].abs() + g == a[p][p].abs() && a[q][q].abs() + g == a[q][q].abs() {
-                a[p][q] = 0.0;
-                a[q][p] = 0.0;
-                continue;
-            }
-            rotated = true;
-            // The rotation that zeroes a[p][q] (Golub & Van Loan, sym.schur2), the smaller angle:
-            // t = tan φ = sign(θ) / (|θ| + √(θ² + 1)), θ = (a_qq − a_pp) / (2 a_pq). θ may be
-            // infinite (a tiny a_pq): t = 0, no change; θ² overflowing gives t = 0 too.
-            let theta = (a[q][q] - a[p][p]) / (2.0 * apq);
-            let t = if theta.abs() > 1e150 {
-                0.5 / theta
-            } else {
-                theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt())
-            };
-            let c = 1.0 / (t * t + 1.0).sqrt();
-            let s = t * c;
-            a[p][p] -= t * apq;
-            a[q][q] += t * apq;
-            a[p][q] = 0.0;
-            a[q][p] = 0.0;
-            let r = 3 - p - q;
-            let (arp, arq) = (a[r][p], a[r][q]);
-            a[r][p] = c * arp - s * arq;
-            a[p][r] = a[r][p];
-            a[r][q] = s * arp + c * arq;
-            a[q][r] = a[r][q];
-            for row in &mut v {
-                let (vp, vq) = (row[p], row[q]);
-                row[p] = c * vp - s * vq;
-                row[q] = s * vp + c * vq;
-            }
+            rotated |= jacobi_rotate(&mut a, &mut v, p, q);
         }
         if !rotated {
             break;
@@ -243,6 +205,47 @@ fn largest_eigenpair(m: &[[f64; 3]; 3]) -> Stress {
     let n = dot(x, x).sqrt().copysign(x[big]);
     x = [x[0] / n, x[1] / n, x[2] / n];
     Stress { magnitude: a[k][k], direction: x }
+}
+
+/// One Jacobi rotation of the symmetric `a` in the (p, q) plane that zeroes a[p][q], applied to
+/// the eigenvector columns `v` too; returns whether it rotated. An a[p][q] of 0, or negligible
+/// against both diagonal entries (dropping it moves the eigenvalues by less than 1e-2 ulp of
+/// them, Numerical Recipes' `jacobi` test), is set to 0 with no rotation. O(1).
+fn jacobi_rotate(a: &mut [[f64; 3]; 3], v: &mut [[f64; 3]; 3], p: usize, q: usize) -> bool {
+    let apq = a[p][q];
+    if apq == 0.0 {
+        return false;
+    }
+    let g = 100.0 * apq.abs();
+    if a[p][p].abs() + g == a[p][p].abs() && a[q][q].abs() + g == a[q][q].abs() {
+        a[p][q] = 0.0;
+        a[q][p] = 0.0;
+        return false;
+    }
+    // The rotation that zeroes a[p][q] (Golub & Van Loan, sym.schur2), the smaller angle:
+    // t = tan φ = sign(θ) / (|θ| + √(θ² + 1)), θ = (a_qq − a_pp) / (2 a_pq). θ may be
+    // infinite (a tiny a_pq): t = 0, no change; θ² overflowing gives t = 0 too.
+    let theta = (a[q][q] - a[p][p]) / (2.0 * apq);
+    let t =
+        if theta.abs() > 1e150 { 0.5 / theta } else { theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt()) };
+    let c = 1.0 / (t * t + 1.0).sqrt();
+    let s = t * c;
+    a[p][p] -= t * apq;
+    a[q][q] += t * apq;
+    a[p][q] = 0.0;
+    a[q][p] = 0.0;
+    let r = 3 - p - q;
+    let (arp, arq) = (a[r][p], a[r][q]);
+    a[r][p] = c * arp - s * arq;
+    a[p][r] = a[r][p];
+    a[r][q] = s * arp + c * arq;
+    a[q][r] = a[r][q];
+    for row in v.iter_mut() {
+        let (vp, vq) = (row[p], row[q]);
+        row[p] = c * vp - s * vq;
+        row[q] = s * vp + c * vq;
+    }
+    true
 }
 
 /// Sweeps of [`largest_eigenpair`] at most. Jacobi converges quadratically: 3×3 matrices need
@@ -377,11 +380,24 @@ fn face_vertices_at(body: &Body, x: DartId) -> Option<[CellId; 3]> {
 /// that of scoring every inner dart (unit test). Which of the two tets at the face the fan starts
 /// from is [`start_side`]'s choice. The vertex orbit is walked once, corner by corner, with no
 /// list. O(vertex orbit).
+///
+/// # Errors
+/// [`CutError::NonFinitePosition`] for the smallest vertex id of the star (the vertex and the
+/// other end of every edge at it: the corners of every face and tet around it, boundary faces
+/// included) whose position is NaN or infinite (finding 289: a NaN on a boundary face only was
+/// read by [`start_side`] as a tie).
 fn start_face(body: &Body, start: DartId, direction: Vec3) -> Result<Option<DartId>, CutError> {
-    let map = body.map();
+    let (map, pos) = (body.map(), body.attrs().position());
     let mut best: Option<(DartId, f64)> = None;
-    let mut bad: Option<DartId> = None;
+    let mut bad: Option<CellId> = None;
+    let mut note = |w: CellId| {
+        if !pos[w].iter().all(|c| c.is_finite()) && bad.is_none_or(|b| w < b) {
+            bad = Some(w);
+        }
+    };
+    note(map.vertex_id(start));
     map.for_each_corner(start, |_, x| {
+        note(map.vertex_id(map.alpha_local(0, x)));
         // α1 is computed for tets as built (`alpha_local`): only α3(x) reads a row here.
         if x > map.alpha_local(1, x) {
             return;
@@ -392,8 +408,8 @@ fn start_face(body: &Body, start: DartId, direction: Vec3) -> Result<Option<Dart
         }
         let score = dot(face_normal_at(body, x), direction).abs();
         if !score.is_finite() {
-            // A NaN normal would win every comparison (`total_cmp`): refused below.
-            bad = bad.or(Some(x));
+            // A NaN normal would win every comparison (`total_cmp`); its corners are refused
+            // above, and a face of finite corners whose normal overflowed is not a candidate.
             return;
         }
         let better = |(d, s): (DartId, f64)| match score.total_cmp(&s) {
@@ -404,8 +420,8 @@ fn start_face(body: &Body, start: DartId, direction: Vec3) -> Result<Option<Dart
             best = Some((x, score));
         }
     });
-    match bad.and_then(|x| nonfinite_corner(body, x)) {
-        Some(e) => Err(e),
+    match bad {
+        Some(vertex) => Err(CutError::NonFinitePosition { vertex, position: pos[vertex] }),
         None => Ok(best.map(|(d, _)| d)),
     }
 }
@@ -478,19 +494,6 @@ fn start_side(body: &Body, x: DartId, direction: Vec3) -> DartId {
     }
 }
 
-/// [`CutError::NonFinitePosition`] for a vertex of the face of `x` (its darts' vertex ids)
-/// whose position is NaN or infinite, if there is one. O(face).
-fn nonfinite_corner(body: &Body, x: DartId) -> Option<CutError> {
-    let (map, pos) = (body.map(), body.attrs().position());
-    let vertex = map
-        .orbit(x, AlphaMask::of(&[0, 1]))
-        .into_iter()
-        .map(|d| map.vertex_id(d))
-        .filter(|&v| !pos[v].iter().all(|c| c.is_finite()))
-        .min()?;
-    Some(CutError::NonFinitePosition { vertex, position: pos[vertex] })
-}
-
 /// Tears vertex `v` along `direction`: among the inner faces around v, the one whose normal is
 /// closest to ±`direction` starts the fan ([`fan_darts`]), walked from the tet at that face on
 /// the side `direction` points into (module docs: the start face's ties and the side are decided
@@ -505,8 +508,9 @@ fn nonfinite_corner(body: &Body, x: DartId) -> Option<CutError> {
 /// # Errors
 /// [`CutError::NoSuchVertex`] (no live dart carries `v`; body unchanged);
 /// [`CutError::BadDirection`] for a non-finite or zero direction;
-/// [`CutError::NonFinitePosition`] for a NaN or infinite position on a face around `v` (body
-/// unchanged); [`CutError::Body`] is a bug. A vertex with no inner face is left as is (an empty
+/// [`CutError::NonFinitePosition`] for a NaN or infinite position on a face around `v`, boundary
+/// faces included (the smallest such vertex id; body unchanged, also when v has no inner face);
+/// [`CutError::Body`] is a bug. A vertex with no inner face is left as is (an empty
 /// fan).
 ///
 /// # Examples

@@ -235,6 +235,7 @@ impl LeveledMap<3> {
         }
         self.check_split_midpoints(&unsplit, level)?;
         self.check_children(d, level, &corners)?;
+        let version = self.version;
         for f in unsplit {
             self.subdivide_triangle(f, level)?;
         }
@@ -244,6 +245,8 @@ impl LeveledMap<3> {
             self.set_tet_levels(c, level);
         }
         self.finish();
+        // One operation, one version (finding 294): the face splits above counted themselves.
+        self.version = version + 1;
         Ok(children)
     }
 

@@ -210,10 +210,20 @@ fn fixed_slots(n: usize, children: &[[u8; 4]], pr: &[(u8, u8)], p: [u8; 3]) -> V
     ]
 }
 
+/// Child darts per parent dart of an n-simplex split 1 → 2ⁿ (n ∈ {2, 3}): each of the 2ⁿ children
+/// is an n-simplex with as many darts as its parent, (n + 1)!.
+fn children_per_dart(n: usize) -> usize {
+    if n == 3 {
+        8
+    } else {
+        4
+    }
+}
+
 /// The child flag of every slot (p · per + k): the fixed slots of each parent dart, then the
 /// other child flags in order, one per remaining slot (a bijection).
 fn slot_flags(n: usize, children: &[[u8; 4]], parents: &[[u8; 3]], pr: &[(u8, u8)]) -> Vec<(u8, [u8; 3])> {
-    let per = if n == 3 { 8 } else { 4 };
+    let per = children_per_dart(n);
     let mut flags: Vec<(u8, [u8; 3])> = Vec::new();
     for (c, set) in children.iter().enumerate() {
         flags.extend(tuples(n, &set[..=n]).into_iter().map(|t| (c as u8, t)));
@@ -270,7 +280,7 @@ impl Template {
             .collect();
         let mut template = Template {
             n,
-            per: if n == 3 { 8 } else { 4 },
+            per: children_per_dart(n),
             act,
             tree,
             link,

@@ -388,6 +388,9 @@ fn non_finite_and_out_of_range_numbers_are_refused_with_a_message() {
         (vec!["simulate", liver, "--steps", "1", "--gravity", "nan,0,0"], "not finite"),
         (vec!["simulate", liver, "--steps", "1", "--pin-below", "z=nan"], "not finite"),
         (vec!["tear", liver, "--threshold", "1", "--steps", "1", "--pin-z", "nan"], "not finite"),
+        // Finding 310: exited 1 from the simulation ("gravity … must be finite").
+        (vec!["tear", liver, "--threshold", "1", "--steps", "1", "--gravity-z", "nan"], "not finite"),
+        (vec!["tear", liver, "--threshold", "1", "--steps", "1", "--gravity-z", "-inf"], "not finite"),
         (vec!["remove", liver, "--sphere", "nan,0,0,1"], "not finite"),
         (vec!["cut", liver, "--plane", "0,0,0,inf,0,0"], "not finite"),
         (vec!["simulate", liver, "--steps", "-3"], "invalid value '-3' for '--steps"),

@@ -35,6 +35,11 @@ pub const FORMAT: &str = "topomech-conformance";
 pub const VERSION: u32 = 1;
 /// Default relative tolerance of every floating-point comparison (stored in each vector).
 pub const TOLERANCE: f64 = 1e-9;
+
+/// The largest initial vertex count for which [`generate`] writes the per-cell fields
+/// [`Expect::vertex_masses`] and [`Expect::edge_stiffnesses`] (larger vectors stay small files:
+/// their totals only).
+pub const DETAIL_MAX_VERTICES: usize = 200;
 /// The largest [`Vector::tolerance`] a vector may ask for: 0 ≤ tolerance ≤ 10⁻³. A relative
 /// tolerance of 1 or more accepts every value of the same sign (|a − b| ≤ max(|a|, |b|)), so a
 /// loose bound would make the float fields vacuous; 10⁻³ still absorbs any rounding difference
@@ -215,7 +220,7 @@ pub enum ConformanceError {
         /// Its centroid's distance from the plane.
         distance: f64,
         /// The required margin: [`PLANE_MARGIN`] × the diagonal of the bounding box of the points
-        /// the tets use.
+        /// the input tets use (removed ones included).
         margin: f64,
     },
 }
@@ -393,8 +398,16 @@ impl Vector {
             .chain(self.steps.iter().enumerate().map(|(k, s)| (Some(k), &s.expect)));
         for (step, e) in expects {
             let scalars = [("total_mass", None, e.total_mass), ("total_stiffness", None, e.total_stiffness)];
-            let masses = e.component_masses.iter().enumerate().map(|(i, &m)| ("component_masses", Some(i), m));
-            if let Some((field, index, value)) = scalars.into_iter().chain(masses).find(|(_, _, x)| !x.is_finite()) {
+            fn list<'a>(
+                field: &'static str,
+                x: Option<&'a [f64]>,
+            ) -> impl Iterator<Item = (&'static str, Option<usize>, f64)> + 'a {
+                x.unwrap_or_default().iter().enumerate().map(move |(i, &m)| (field, Some(i), m))
+            }
+            let lists = list("component_masses", Some(&e.component_masses))
+                .chain(list("vertex_masses", e.vertex_masses.as_deref()))
+                .chain(list("edge_stiffnesses", e.edge_stiffnesses.as_deref()));
+            if let Some((field, index, value)) = scalars.into_iter().chain(lists).find(|(_, _, x)| !x.is_finite()) {
                 return Err(ConformanceError::NotFinite { vector: self.name.clone(), step, field, index, value });
             }
         }

@@ -256,4 +256,16 @@ pub struct Expect {
     pub total_stiffness: f64,
     /// The mass of each component, ascending.
     pub component_masses: Vec<f64>,
+    /// The mass of every vertex (Σ m_t/4 over the live tets of its class of corners), ascending:
+    /// how a split vertex shares its mass (m = m1 + m2), which the totals above cannot see.
+    /// Written for vectors of at most [`DETAIL_MAX_VERTICES`](super::DETAIL_MAX_VERTICES)
+    /// initial vertices; absent otherwise and in vectors written before 2026-12-07 (a replay
+    /// then skips it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vertex_masses: Option<Vec<f64>>,
+    /// The stiffness of every edge (Σ over the live tets of its class of tet edges of
+    /// E·V_t/L_e²), ascending: how a split edge shares its stiffness (Kirchhoff: k = k1 + k2).
+    /// Present exactly when [`Expect::vertex_masses`] is.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub edge_stiffnesses: Option<Vec<f64>>,
 }

@@ -10,6 +10,9 @@
 //! | `kuhn2_tear_center` | Kuhn cube k = 2, generated | tearing the centre vertex, then a removal |
 //! | `jittered_cube_shared_sequence` | jittered Kuhn cube k = 2, inline | a seeded sequence of the shared cut generator (`cut::ops`) |
 //! | `liver_short_sequence` | `data/liver_547_v22.msh` | a short fixed sequence of the shared generator on the built-in liver |
+//! | `pinch_edge_glued_dissociate` | 3 tets, inline | two glued tets and a third touching them along an edge only; a dissociation that splits vertices and edges |
+//! | `pinch_edge_remove` | 2 tets sharing an edge only, inline | a pinched edge in the input (two edges, four vertices); a removal |
+//! | `pinch_vertex_remove` | 2 tets sharing a point only, inline | a pinched point in the input (two vertices); a removal |
 
 use crate::cut::ops::{self as shared, jittered_cube, Oracle};
 use crate::generate::{kuhn_cube, SplitMix64};
@@ -27,7 +30,7 @@ use super::ConformanceError;
 /// use topomech::conformance::standard::recipes;
 ///
 /// let names: Vec<String> = recipes().into_iter().map(|r| r.name).collect();
-/// assert_eq!(names.len(), 8);
+/// assert_eq!(names.len(), 11);
 /// assert!(names.windows(2).all(|w| w[0] < w[1])); // file-name order
 /// assert!(names.iter().any(|n| n == "single_tet_remove"));
 /// ```
@@ -39,6 +42,9 @@ pub fn recipes() -> Vec<Recipe> {
         kuhn2_incise_planes(),
         kuhn2_tear_center(),
         liver_short_sequence(),
+        pinch_edge_glued_dissociate(),
+        pinch_edge_remove(),
+        pinch_vertex_remove(),
         single_tet_remove(),
         two_tets_dissociate(),
     ]
@@ -57,7 +63,7 @@ pub fn recipes() -> Vec<Recipe> {
 ///
 /// let root = Path::new(env!("CARGO_MANIFEST_DIR"));
 /// let vectors = generate_all(root).unwrap();
-/// assert_eq!(vectors.len(), 8);
+/// assert_eq!(vectors.len(), 11);
 /// assert!(vectors.iter().all(|v| replay_in(v, root).is_ok()));
 /// ```
 pub fn generate_all(root: &std::path::Path) -> Result<Vec<Vector>, ConformanceError> {
@@ -83,6 +89,62 @@ fn dissociate(oracle: &Oracle, mut face: [u32; 3]) -> Op {
     face.sort_unstable();
     let [(a, _), (b, _)] = oracle.inner[&face];
     Op::Dissociate { tets: [a.min(b) as u32, a.max(b) as u32], face }
+}
+
+/// Two tets glued on a face and a third touching them along an edge only (finding 299: no vector
+/// had a point the input shares only through an edge or a vertex).
+fn pinch_edge_glued_dissociate() -> Recipe {
+    let points = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, -1.0],
+        [0.0, -1.0, 0.3],
+        [0.0, -0.5, -1.0],
+    ];
+    recipe(
+        "pinch_edge_glued_dissociate",
+        "Tets 0 and 1 glued on the face {0,1,2}; tet 2 touches them along the edge {0,1} only, so in the \
+         input points 0 and 1 are two vertices each and {0,1} two edges (9 vertices, 15 edges, 2 \
+         components). Step 0 dissociates {0,1,2}: its three vertices and three edges split (3 components); \
+         vertex_masses and edge_stiffnesses show each side keeping its own tets' shares.",
+        inline((points, vec![[0, 1, 2, 3], [0, 1, 2, 4], [0, 1, 5, 6]])),
+        Ops::Listed(vec![Op::Dissociate { tets: [0, 1], face: [0, 1, 2] }]),
+    )
+}
+
+/// Two tets sharing the edge {0, 1} only (finding 299).
+fn pinch_edge_remove() -> Recipe {
+    let points =
+        vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0], [0.0, 0.0, -1.0]];
+    recipe(
+        "pinch_edge_remove",
+        "Two tets sharing only the edge {0,1} in the input: points 0 and 1 are two vertices each and the \
+         edge two edges (8 vertices, 12 edges, 8 faces, 2 components). Step 0 removes tet 0: one tet left.",
+        inline((points, vec![[0, 1, 2, 3], [0, 1, 4, 5]])),
+        Ops::Listed(vec![Op::Remove { tet: 0 }]),
+    )
+}
+
+/// Two tets sharing the point 0 only (finding 299).
+fn pinch_vertex_remove() -> Recipe {
+    let points = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [-1.0, 0.0, 0.0],
+        [0.0, -1.0, 0.0],
+        [0.0, 0.0, -1.0],
+    ];
+    recipe(
+        "pinch_vertex_remove",
+        "Two tets sharing only the point 0 in the input: it is two vertices (8 vertices, 12 edges, 8 faces, \
+         2 components). Step 0 removes tet 1: one tet left.",
+        inline((points, vec![[0, 1, 2, 3], [0, 4, 5, 6]])),
+        Ops::Listed(vec![Op::Remove { tet: 1 }]),
+    )
 }
 
 fn single_tet_remove() -> Recipe {
@@ -163,7 +225,7 @@ fn kuhn2_tear_center() -> Recipe {
         "Kuhn cube [0,2]^3 given by its generator (mesh kind kuhn_cube). Step 0 tears the centre point 13 = \
          (1,1,1) along (0.2, 0.3, 1): the fan of faces around it that starts with the face whose normal is \
          closest to the direction is dissociated; the faces are listed in expect.dissociated, so another \
-         engine can replay the tear as those dissociations (here they also cut a piece off: 2 components). \
+         engine can replay the tear as those dissociations (the body stays in one piece: 1 component). \
          Step 1 removes tet 0; step 2 tears point 13 as seen from tet 0, which must be refused (removed_tet).",
         MeshSpec::KuhnCube { k: 2 },
         Ops::Listed(vec![

@@ -35,7 +35,7 @@ impl Plane {
     /// O(1).
     ///
     /// The sign is that of the exact real number (x − point) · normal formed from the `f64`
-    /// inputs, never of a rounded one (`src/cut/exact.rs`: a float evaluation with
+    /// inputs, never of a rounded one (`src/exact.rs`: a float evaluation with
     /// a forward error bound decides unless the value is within that bound of zero, then an
     /// exact fixed-point sum of the products decides). So the tie rule holds exactly: a point
     /// exactly on the plane is *not* positive, i.e. it is on the negative side, and a point one

@@ -158,8 +158,8 @@ pub enum ConservationError {
         tets: f64,
     },
     /// A sew would merge two vertices that are apart at rest: the merged vertex has one rest
-    /// position, so the rest lengths (law 3) of the edges of one side would be wrong. Raised
-    /// before the sew ([`crate::embedding::CellRules::check_sew`]), which is then refused.
+    /// position, so the rest lengths of the edges of one side would be wrong (the rest-length
+    /// law). Raised before the sew ([`crate::embedding::CellRules::check_sew`]), which is then refused.
     #[error("sewing {dart} to {other} would merge vertex {} with vertex {}, {distance} apart at rest (only faces that coincide at rest can be sewn)", .vertex.0, .other_vertex.0)]
     SewApart {
         /// A dart of the sew.

@@ -1,0 +1,46 @@
+//! Round 35's probes (a claims audit of the docs; an engine written from the conformance spec
+//! alone). Finding 303: `fan_darts` kept the faces it had seen in a list scanned per face, so a
+//! fan around a vertex of valence K cost O(K²) (713 ms at K = 64 000), not the documented O(fan).
+
+use std::collections::BTreeSet;
+
+use topomech::cut::fan_darts;
+use topomech::GMap;
+
+/// Vertex 0 at the centre of a ring of `k` points with an apex above and one below: 2k tets
+/// around it.
+fn double_cone(k: usize) -> GMap<3> {
+    let mut points = vec![[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
+    for i in 0..k {
+        let a = i as f64 * std::f64::consts::TAU / k as f64;
+        points.push([a.cos(), a.sin(), 0.0]);
+    }
+    let mut tets = Vec::new();
+    for i in 0..k {
+        let (a, b) = (3 + i as u32, 3 + ((i + 1) % k) as u32);
+        tets.push([0, a, b, 1]);
+        tets.push([0, b, a, 2]);
+    }
+    GMap::<3>::from_tets(points.len(), &tets).unwrap().0
+}
+
+/// The fan lists each face once, all at the vertex, on small and large rings alike: the long
+/// fans go past the short list to the hash set of seen faces (finding 303) and must list the
+/// same faces as a set built here from the walk's own darts. The longest fan from a dart at the
+/// centre has k faces here, more than the 64 a list holds before the switch for k ≥ 200.
+#[test]
+fn f303_long_fans_list_each_face_once() {
+    for k in [5, 20, 40, 200, 1000] {
+        let map = double_cone(k);
+        let mut longest = 0;
+        for d in map.darts().filter(|&d| map.vertex_id(d).0 == 0).take(24) {
+            let fan = fan_darts(&map, d);
+            let faces: BTreeSet<u32> = fan.iter().map(|&e| map.cell_id(2, e).0).collect();
+            assert_eq!(faces.len(), fan.len(), "k {k}: a face listed twice");
+            assert!(fan.iter().all(|&e| map.vertex_id(e).0 == 0));
+            assert_eq!(fan[0], d);
+            longest = longest.max(fan.len());
+        }
+        assert_eq!(longest, k, "k {k}: longest fan");
+    }
+}

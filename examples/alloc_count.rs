@@ -41,7 +41,7 @@ unsafe impl GlobalAlloc for Counting {
 static GLOBAL: Counting = Counting;
 
 fn main() {
-    let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes/liver_547.msh"));
+    let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/data/liver_547_v22.msh"));
     let mesh = topomech::io::read_mesh(path).expect("liver_547.msh");
     let (z, _) = mesh.spatially_ordered();
     let (mut body, _) = Body::from_tets(&z.points, &z.tets, Material::default()).expect("mesh");

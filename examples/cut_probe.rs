@@ -58,8 +58,8 @@ impl Probe {
 
 fn main() {
     let passes: usize = std::env::args().nth(1).and_then(|a| a.parse().ok()).unwrap_or(20);
-    let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes/liver_547.msh"));
-    let mesh = topomech::io::read_mesh(path).expect("liver_547.msh");
+    let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/data/liver_547_v22.msh"));
+    let mesh = topomech::io::read_mesh(path).expect("data/liver_547_v22.msh");
     let (z, _) = mesh.spatially_ordered();
     let (body, _) = Body::from_tets(&z.points, &z.tets, Material::default()).expect("mesh");
     let projection = Projection::build(&body, G).unwrap();

@@ -94,7 +94,7 @@ fn main() {
         Some(i) if i + 1 < args.len() => args.drain(i..i + 2).nth(1).map(std::path::PathBuf::from),
         _ => None,
     };
-    let path = path.unwrap_or_else(|| concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes/liver_547.msh").into());
+    let path = path.unwrap_or_else(|| concat!(env!("CARGO_MANIFEST_DIR"), "/data/liver_547_v22.msh").into());
     let passes: usize = args.get(1).and_then(|a| a.parse().ok()).unwrap_or(2);
     let which = args.get(2).cloned().unwrap_or_default();
     let mesh = topomech::io::read_mesh(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));

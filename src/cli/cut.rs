@@ -99,7 +99,7 @@ pub struct TearArgs {
     /// a value below the whole body (pinning no vertex) is refused.
     #[arg(long, allow_hyphen_values = true, value_parser = parse_finite)]
     pub pin_z: Option<f64>,
-    /// Gravity along z (negative pulls down); large values stretch the body. Finite (finding 310).
+    /// Gravity along z (negative pulls down); large values stretch the body. Must be finite.
     #[arg(long, default_value_t = -200.0, allow_hyphen_values = true, value_parser = parse_finite)]
     pub gravity_z: f64,
     /// Vertices torn per step at most (at least 1: 0 would never tear).

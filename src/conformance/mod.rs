@@ -148,7 +148,7 @@ pub enum ConformanceError {
         step: Option<usize>,
         /// The field of [`Expect`].
         field: &'static str,
-        /// The element, for `component_masses`.
+        /// The element, for the lists (`component_masses`, `vertex_masses`, `edge_stiffnesses`).
         index: Option<usize>,
         /// The value found.
         value: f64,
@@ -332,13 +332,15 @@ impl Vector {
     /// order: `format` is [`FORMAT`], `version` is [`VERSION`], `name` is 1 to [`MAX_NAME_LEN`]
     /// characters of `A–Z a–z 0–9 _ - .` (it is printed in reports and is a file stem), the
     /// tolerance is in 0 ..= [`MAX_TOLERANCE`], the material constants are finite and ≥ 0, and
-    /// every expected float (`total_mass`, `total_stiffness`, `component_masses`, initial state
-    /// and every step) is finite. O(size).
+    /// every expected float (`total_mass`, `total_stiffness`, `component_masses`, `vertex_masses`,
+    /// `edge_stiffnesses`, initial state and every step) is finite, and the two per-cell lists
+    /// are ascending with no negative entry. O(size).
     ///
     /// # Errors
     /// The first that fails: [`ConformanceError::Format`], [`ConformanceError::Version`] (origin
     /// `<memory>`), [`ConformanceError::BadName`], [`ConformanceError::Invalid`],
-    /// [`ConformanceError::NotFinite`] (step and field).
+    /// [`ConformanceError::NotFinite`] (step, field and element), [`ConformanceError::Invalid`]
+    /// for a per-cell list out of order.
     ///
     /// # Examples
     ///
@@ -409,6 +411,19 @@ impl Vector {
                 .chain(list("edge_stiffnesses", e.edge_stiffnesses.as_deref()));
             if let Some((field, index, value)) = scalars.into_iter().chain(lists).find(|(_, _, x)| !x.is_finite()) {
                 return Err(ConformanceError::NotFinite { vector: self.name.clone(), step, field, index, value });
+            }
+            // The per-cell lists are sorted values of masses and stiffnesses: a list out of
+            // order or with a negative entry is a defect of the vector, not a mismatch of the
+            // engine (finding 313).
+            for (field, list) in [("vertex_masses", &e.vertex_masses), ("edge_stiffnesses", &e.edge_stiffnesses)] {
+                let list = list.as_deref().unwrap_or_default();
+                if let Some(i) = (0..list.len()).find(|&i| list[i] < 0.0 || (i > 0 && list[i] < list[i - 1])) {
+                    let at = step.map_or("the initial state".to_string(), |k| format!("step {k}"));
+                    return Err(invalid(format!(
+                        "{at}: {field}[{i}] = {:?} breaks the list's order (ascending, every entry ≥ 0)",
+                        list[i]
+                    )));
+                }
             }
         }
         Ok(())

@@ -265,7 +265,8 @@ pub struct Expect {
     pub vertex_masses: Option<Vec<f64>>,
     /// The stiffness of every edge (Σ over the live tets of its class of tet edges of
     /// E·V_t/L_e²), ascending: how a split edge shares its stiffness (Kirchhoff: k = k1 + k2).
-    /// Present exactly when [`Expect::vertex_masses`] is.
+    /// [`generate`](super::generate) writes it exactly when it writes [`Expect::vertex_masses`];
+    /// a replay compares each one that is present.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub edge_stiffnesses: Option<Vec<f64>>,
 }

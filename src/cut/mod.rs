@@ -105,7 +105,8 @@ pub enum CutError {
     /// (the sides of an incision, the face normals of a tear): nothing is cut.
     #[error("vertex {} has the non-finite position {position:?}: its tets have no side to be cut on", .vertex.0)]
     NonFinitePosition {
-        /// The smallest such vertex id (for a tear: one on the face that needed it).
+        /// The smallest such vertex id (for a tear: of the star of the torn vertex, itself and
+        /// the other end of every edge at it).
         vertex: CellId,
         /// Its position.
         position: [f64; 3],

@@ -44,3 +44,29 @@ fn f303_long_fans_list_each_face_once() {
         assert_eq!(longest, k, "k {k}: longest fan");
     }
 }
+
+/// Mutation sample 50's survivor: `check_fields` must refuse a non-finite entry of the per-cell
+/// lists (findings 298, 313), naming the step, the field and the entry, as it does for the
+/// component masses; a NaN is never reported as a list out of order.
+#[test]
+fn a_non_finite_per_cell_entry_is_refused_naming_its_entry() {
+    use topomech::conformance::{replay_in, standard::generate_all, ConformanceError};
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let v = generate_all(root).unwrap().into_iter().find(|v| v.name == "kuhn2_incise_planes").unwrap();
+    for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+        for field in ["vertex_masses", "edge_stiffnesses"] {
+            let mut w = v.clone();
+            let list = match field {
+                "vertex_masses" => w.steps[1].expect.vertex_masses.as_mut(),
+                _ => w.steps[1].expect.edge_stiffnesses.as_mut(),
+            };
+            let list = list.unwrap();
+            let i = list.len() / 2;
+            list[i] = bad;
+            let e = replay_in(&w, root).unwrap_err();
+            assert!(matches!(e, ConformanceError::NotFinite { .. }), "{field} {bad}: {e}");
+            assert_eq!((e.step(), e.field()), (Some(1), Some(field)), "{e}");
+            assert!(e.to_string().contains(&format!("{field}[{i}]")), "{e}");
+        }
+    }
+}

@@ -187,6 +187,32 @@ pub fn decode(bytes: &[u8]) -> Vec<KernelOp> {
     ops
 }
 
+/// The decoder's law, shared by the unit tests, the proptest and the Kani harness: at most one
+/// operation per input byte and at most [`MAX_OPS`], and [`encode`] inverts [`decode`]. Returns
+/// the decoded operations. O(len).
+///
+/// # Errors
+/// Which part of the law failed, with the input's length.
+///
+/// # Examples
+///
+/// ```
+/// use topomech::ops::{check_decode, MAX_OPS};
+///
+/// assert_eq!(check_decode(&[0u8; 10_000]).unwrap().len(), MAX_OPS);
+/// assert!(check_decode(&[]).unwrap().is_empty());
+/// ```
+pub fn check_decode(bytes: &[u8]) -> Result<Vec<KernelOp>, String> {
+    let ops = decode(bytes);
+    if ops.len() > bytes.len().min(MAX_OPS) {
+        return Err(format!("{} bytes decoded into {} operations (at most {MAX_OPS})", bytes.len(), ops.len()));
+    }
+    if decode(&encode(&ops)) != ops {
+        return Err(format!("encode does not invert decode on {} bytes", bytes.len()));
+    }
+    Ok(ops)
+}
+
 /// The bytes that [`decode`] turns back into `ops` (dart numbers are kept modulo 2^16, which is
 /// all decode can produce). O(len).
 ///
@@ -885,15 +911,50 @@ pub fn check_map_laws<const N: usize>(map: &GMap<N>) -> Result<(), String> {
             map.component_labels().1
         ));
     }
-    if let Some(colour) = map.orientation() {
-        let bad = map.darts().find(|&d| {
-            (0..=N).any(|i| map.alpha_dyn(i, d) != d && colour[map.alpha_dyn(i, d).index()] == colour[d.index()])
-        });
-        if let Some(d) = bad {
-            return Err(format!("orientation() colours {d:?} like one of its neighbours"));
+    match map.orientation() {
+        Some(colour) => {
+            let bad = map.darts().find(|&d| {
+                (0..=N).any(|i| map.alpha_dyn(i, d) != d && colour[map.alpha_dyn(i, d).index()] == colour[d.index()])
+            });
+            if let Some(d) = bad {
+                return Err(format!("orientation() colours {d:?} like one of its neighbours"));
+            }
         }
+        None if two_colourable(map) => {
+            return Err("orientation() is None but the darts have a proper 2-colouring".to_string());
+        }
+        None => {}
     }
     check_cell_ids_exact(map)
+}
+
+/// Whether the darts can be 2-coloured so that every αi link (not a fixed point) joins two
+/// colours: the orientability test, written again here (a breadth-first search) so that a wrong
+/// `None` from [`GMap::orientation`] is caught. O(darts · n).
+fn two_colourable<const N: usize>(map: &GMap<N>) -> bool {
+    let mut colour = vec![None; map.capacity()];
+    let mut queue = std::collections::VecDeque::new();
+    for root in map.darts() {
+        if colour[root.index()].is_some() {
+            continue;
+        }
+        colour[root.index()] = Some(false);
+        queue.push_back(root);
+        while let Some(x) = queue.pop_front() {
+            let c = colour[x.index()] == Some(true);
+            for y in (0..=N).map(|i| map.alpha_dyn(i, x)).filter(|&y| y != x) {
+                match colour[y.index()] {
+                    None => {
+                        colour[y.index()] = Some(!c);
+                        queue.push_back(y);
+                    }
+                    Some(same) if same == c => return false,
+                    Some(_) => {}
+                }
+            }
+        }
+    }
+    true
 }
 
 /// Cell ids equal a from-scratch labelling by orbits: for every dimension, two darts share an id
@@ -917,7 +978,8 @@ pub fn check_cell_ids_exact<const N: usize>(map: &GMap<N>) -> Result<(), String>
         let label = orbit_labels(map, dim);
         let cells = label.iter().filter(|&&l| l != u32::MAX).max().map_or(0, |&m| m as usize + 1);
         let mut id_of_orbit = vec![None; cells];
-        let mut orbit_of_id = std::collections::HashMap::new();
+        // A BTreeMap, not a HashMap: deterministic, and no random state under Kani.
+        let mut orbit_of_id = std::collections::BTreeMap::new();
         for d in map.darts() {
             let (l, id) = (label[d.index()] as usize, map.cell_id(dim, d));
             if !map.is_live_cell(dim, id) {
@@ -1284,7 +1346,7 @@ mod tests {
     fn decode_is_total_and_bounded() {
         assert!(decode(&[]).is_empty());
         assert_eq!(decode(&[3]), vec![KernelOp::Sew { i: 0, a: 0, b: 0 }]);
-        assert_eq!(decode(&[0u8; 10_000]).len(), MAX_OPS);
+        assert_eq!(check_decode(&[0u8; 10_000]).unwrap().len(), MAX_OPS);
     }
 
     #[test]

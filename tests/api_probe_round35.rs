@@ -2,27 +2,12 @@
 //! alone). Finding 303: `fan_darts` kept the faces it had seen in a list scanned per face, so a
 //! fan around a vertex of valence K cost O(K²) (713 ms at K = 64 000), not the documented O(fan).
 
+mod fan_common;
+use fan_common::double_cone;
+
 use std::collections::BTreeSet;
 
 use topomech::cut::fan_darts;
-use topomech::GMap;
-
-/// Vertex 0 at the centre of a ring of `k` points with an apex above and one below: 2k tets
-/// around it.
-fn double_cone(k: usize) -> GMap<3> {
-    let mut points = vec![[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
-    for i in 0..k {
-        let a = i as f64 * std::f64::consts::TAU / k as f64;
-        points.push([a.cos(), a.sin(), 0.0]);
-    }
-    let mut tets = Vec::new();
-    for i in 0..k {
-        let (a, b) = (3 + i as u32, 3 + ((i + 1) % k) as u32);
-        tets.push([0, a, b, 1]);
-        tets.push([0, b, a, 2]);
-    }
-    GMap::<3>::from_tets(points.len(), &tets).unwrap().0
-}
 
 /// The fan lists each face once, all at the vertex, on small and large rings alike: the long
 /// fans go past the short list to the hash set of seen faces (finding 303) and must list the

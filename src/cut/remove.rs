@@ -76,7 +76,8 @@ pub fn volume_dart(body: &Body, t: CellId) -> Option<DartId> {
 ///
 /// # Errors
 /// [`CutError::NoSuchVolume`] (never existed or already removed), [`CutError::NotATet`] — body
-/// unchanged; [`CutError::Body`], [`CutError::Kernel`], [`CutError::Dart`] are bugs.
+/// unchanged; [`CutError::Body`], [`CutError::Kernel`], [`CutError::Dart`] are bugs, and so is
+/// the attributes' check failing after the deletion (`expensive-checks` only).
 ///
 /// # Examples
 ///
@@ -120,6 +121,14 @@ pub fn remove_volume(body: &mut Body, t: CellId) -> Result<Removal, CutError> {
         touched.edges.push((map.cell_id(1, x), None));
     }
     delete_isolated(body, &darts)?;
+    // The deletion bypasses the rules, so the embedding layer's check after each operation does
+    // not run for it: under `expensive-checks`, the attributes' laws on what is left (finding 327).
+    #[cfg(feature = "expensive-checks")]
+    {
+        use crate::embedding::CellRules;
+        let check = |source| crate::embedding::EmbedError::Check { op: "remove_volume", dart: d, source };
+        body.attrs().check(body.map()).map_err(check)?;
+    }
     touched.cover(body, from);
     Ok(Removal { volume: t, removed_mass, removed_stiffness, dissociations, touched })
 }

@@ -23,6 +23,7 @@ mod cells;
 mod cells_tets;
 mod cmap;
 mod dart;
+mod handle;
 mod iso;
 mod mark;
 mod mask;
@@ -34,6 +35,7 @@ mod validate_tets;
 pub use cells::{CellCounts, MapSummary};
 pub use cmap::CombinatorialMap;
 pub use dart::{CellId, DartId};
+pub use handle::{CellHandle, StaleCell};
 pub use mark::{DartSet, Mark};
 pub use mask::AlphaMask;
 pub use orbit::release_thread_caches;
@@ -44,11 +46,15 @@ pub(crate) use orbit::{join_with_smaller, with_stamps};
 
 use dart::NONE;
 
-/// Allocator of the ids of one cell dimension: dense ids, a free list, and a count of live ids.
+/// Allocator of the ids of one cell dimension: dense ids, a free list, and a count of live ids;
+/// with, per id, how many times it was released (its generation, for [`CellHandle`]).
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub(crate) struct IdAlloc {
     pub(crate) next: u32,
     pub(crate) free: Vec<u32>,
+    /// `released[id]`: how many times `id` was released (wrapping); ids past the end: 0. Grown by
+    /// a release only, so a map that never released an id holds none of it.
+    pub(crate) released: Vec<u32>,
 }
 
 impl IdAlloc {
@@ -65,6 +71,16 @@ impl IdAlloc {
     fn release(&mut self, id: u32) {
         debug_assert!(id < self.next, "releasing an id never allocated");
         self.free.push(id);
+        let k = id as usize;
+        if k >= self.released.len() {
+            self.released.resize(k + 1, 0);
+        }
+        self.released[k] = self.released[k].wrapping_add(1);
+    }
+
+    /// How many times `id` was released (wrapping). O(1).
+    pub(crate) fn generation(&self, id: u32) -> u32 {
+        self.released.get(id as usize).copied().unwrap_or(0)
     }
 
     /// Number of live ids. O(1).
@@ -685,8 +701,10 @@ impl<const N: usize> GMap<N> {
     }
 
     /// Sets the id allocator of dimension i to "ids 0..next are used but those in `free`".
+    /// The release counts ([`CellHandle`] generations) stay: the bulk refinement appends ids.
     pub(crate) fn set_id_alloc_raw(&mut self, i: usize, next: u32, free: Vec<u32>) {
-        self.ids[i] = IdAlloc { next, free };
+        let released = std::mem::take(&mut self.ids[i].released);
+        self.ids[i] = IdAlloc { next, free, released };
     }
 
     /// The id allocator of dimension i as (next, free list): for the file format (`crate::store`).

@@ -9,8 +9,11 @@
 //! split and a ball becomes the bulk uniform refinement one level up, `refine_uniform`, or, where
 //! that is refused as `NotUniform` (the map checked unchanged), a triangle split), bit 7 of a
 //! whether the level goes up by one; bytes b, c pick the dart
-//! (any live dart, `(b·256 + c) mod darts`) or, for a ball, its centre and radius. Levels stay
-//! ≤ [`MAX_FUZZ_LEVEL`]; the map stops growing at [`MAX_DARTS`] darts.
+//! (any live dart, `(b·256 + c) mod darts`) or, for a ball, its centre and radius. The level an
+//! op asks for is at most [`MAX_FUZZ_LEVEL`]; a refinement around a ball splits a tet its zone held
+//! back by a level skip past the level asked for (`refine_around`, finding 275), so the map's
+//! maximum level can pass it (4 in the committed corpus; finding 328). The map stops growing at
+//! [`MAX_DARTS`] darts: the ops after that are not applied.
 //!
 //! # Laws checked after every op (a failure is a bug in topomech)
 //! - accepted op: [`LeveledMap::check_all`] (finest map valid, μt ≤ μf ≤ μa, every level a valid
@@ -18,8 +21,9 @@
 //!   that of the input; a refinement around a ball keeps Σ tet mass and leaves every tet meeting
 //!   the ball at the top level;
 //! - refused op: only the documented refusals (`AlreadyAtLevel`, `NotATriangle`,
-//!   `NotATetrahedron`, `FaceRefinedTooFar`, `OpenEdge`, `NotUniform`), and the map is unchanged
-//!   (same darts, isomorphic, same maximum level).
+//!   `NotATetrahedron`, `FaceRefinedTooFar`, `OpenEdge`, `NotUniform`), each true of the map it
+//!   refused (the cell already at the level has that level, and so on: finding 325), and the map
+//!   is unchanged (same darts, isomorphic, same maximum level).
 //! - 3D: every op goes through a [`LeveledMechanics`] (springs and masses follow the map); after an
 //!   accepted op its laws hold ([`LeveledMechanics::check`]), after a refused one it is unchanged.
 
@@ -393,6 +397,7 @@ pub fn check_refused<const N: usize>(
     if !documented {
         return Err("not a documented refusal for a live dart at a valid level".into());
     }
+    refusal_holds(before, e)?;
     let same = before.map().dart_count() == after.map().dart_count()
         && before.max_level() == after.max_level()
         && before.map().is_isomorphic(after.map());
@@ -400,4 +405,51 @@ pub fn check_refused<const N: usize>(
         return Err("the map changed".into());
     }
     after.check_all().map_err(|e| e.to_string())
+}
+
+/// What a refusal states about the map it refused, checked on that map (`before`): the dart it
+/// names is live, a cell refused as already at the level has that level there (μa, μf or μt
+/// by its dimension) and it is at least the level asked for, a face or volume refused for its
+/// corners does not have 3 or 4, an open edge's dart is free for some αj with j < n. A refusal
+/// that only names a documented variant is not enough: an operation that refused valid work
+/// with such a variant passed every subdivision test (finding 325). O(1).
+fn refusal_holds<const N: usize>(before: &LeveledMap<N>, e: &SubdivideError) -> Result<(), String> {
+    let live = |d: DartId| {
+        if before.map().contains(d) {
+            Ok(())
+        } else {
+            Err(format!("{e}: {d} is not a live dart of the refused map"))
+        }
+    };
+    match *e {
+        SubdivideError::AlreadyAtLevel { dart, dim, cell_level, level } => {
+            live(dart)?;
+            let mu = before.mu(dart);
+            let own = match dim {
+                1 => mu.edge,
+                2 => mu.face,
+                3 => mu.tet,
+                _ => return Err(format!("{e}: no level for dimension {dim}")),
+            };
+            if own != cell_level || cell_level < level {
+                return Err(format!("{e}: the cell's level is {own}, asked for {level}"));
+            }
+        }
+        SubdivideError::NotATriangle { dart, corners } | SubdivideError::NotATetrahedron { dart, corners } => {
+            live(dart)?;
+            let expected = if matches!(e, SubdivideError::NotATriangle { .. }) { 3 } else { 4 };
+            if corners == expected {
+                return Err(format!("{e}: refused with {corners} corners"));
+            }
+        }
+        SubdivideError::OpenEdge(d) => {
+            live(d)?;
+            if !(0..N).any(|j| before.map().is_free(j, d)) {
+                return Err(format!("{e}: {d} is not free for any αj, j < {N}"));
+            }
+        }
+        SubdivideError::FaceRefinedTooFar { dart } | SubdivideError::NotUniform { dart, .. } => live(dart)?,
+        _ => {}
+    }
+    Ok(())
 }

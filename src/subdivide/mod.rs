@@ -53,6 +53,16 @@ pub use springs_check::SpringLawError;
 
 use crate::gmap::{DartId, GMap, InvariantViolation};
 
+/// Levels above 0 up to which every operation checks every level's map under
+/// `expensive-checks` (`LeveledMap::check_after_op`; deeper maps check the levels the operation
+/// touches and the top one).
+pub const FULLY_CHECKED_LEVELS: u8 = 4;
+
+/// Darts up to which every operation checks the level maps under `expensive-checks`
+/// (`LeveledMap::check_after_op`; larger maps check the finest map and the μ order per
+/// operation, and every law at the end of a refinement around a ball or a uniform level).
+pub const FULLY_CHECKED_DARTS: usize = 50_000;
+
 /// The largest level an operation may use.
 pub const MAX_LEVEL: u8 = 250;
 
@@ -1001,6 +1011,38 @@ impl<const N: usize> LeveledMap<N> {
             }
         }
         Ok(())
+    }
+
+    /// The check after every operation under `expensive-checks` (finding 327): the finest map and
+    /// [`Self::check_levels`] (μ order, levels constant on their cells) always, O(darts); on maps
+    /// of at most [`FULLY_CHECKED_DARTS`] darts also the level maps and the flat law, as
+    /// [`Self::check_all`] does — every level while the map has at most
+    /// [`FULLY_CHECKED_LEVELS`] levels above 0, past that the operation's level, the one below
+    /// and the top one. Bounded so that the quadratic cost of a check after each of the
+    /// thousands of operations of a large refinement stays that of `validate()` alone; a
+    /// refinement around a ball and a uniform level end with [`Self::check_all`] at any size.
+    #[cfg(feature = "expensive-checks")]
+    pub(crate) fn check_after_op(&self, level: u8) -> Result<(), LevelError> {
+        self.map.validate().map_err(LevelError::InvalidMap)?;
+        self.check_levels()?;
+        if self.map.dart_count() > FULLY_CHECKED_DARTS {
+            return Ok(());
+        }
+        let levels: Vec<u8> = if self.max_level <= FULLY_CHECKED_LEVELS {
+            (0..=self.max_level).collect()
+        } else {
+            let mut top = vec![level.saturating_sub(1), level.min(self.max_level), self.max_level];
+            top.dedup();
+            top
+        };
+        for i in levels {
+            let view = self.level(i)?;
+            view.map.validate().map_err(|source| LevelError::InvalidLevel { level: i, source })?;
+        }
+        match self.flat_errors(1).into_iter().next() {
+            Some(e) => Err(e),
+            None => Ok(()),
+        }
     }
 
     /// Every law: the finest map valid, [`Self::check_levels`], every level 0..=k extracted

@@ -270,9 +270,12 @@ impl<const N: usize> LeveledMap<N> {
         self.op.old_ids.clear();
         self.op.changed.clear();
         self.op.created.clear();
+        // The leveled map's laws (`check_after_op`: the finest map, the μ order, the flat law and
+        // every level's map, or the touched ones past a few levels), not the finest map alone
+        // (finding 327).
         #[cfg(feature = "expensive-checks")]
-        if let Err(e) = self.map.validate() {
-            panic!("topomech bug: subdivision broke the map: {e}");
+        if let Err(e) = self.check_after_op(self.op.level) {
+            panic!("topomech bug: subdivision broke the leveled map: {e}");
         }
     }
 

@@ -723,6 +723,25 @@ impl LeveledMap<3> {
         masses: &mut TetMasses,
         bulk: bool,
     ) -> Result<Refinement, SubdivideError> {
+        let result = self.refine_zone_checked(center, radius, levels, masses, bulk);
+        // Every law of the leveled map once the zone is done, at any size (its single
+        // operations check what `check_after_op` affords: finding 327).
+        #[cfg(feature = "expensive-checks")]
+        if let Err(e) = self.check_all() {
+            panic!("topomech bug: a refinement around a ball broke the leveled map: {e}");
+        }
+        result
+    }
+
+    /// [`Self::refine_zone`] before its final check.
+    fn refine_zone_checked(
+        &mut self,
+        center: [f64; 3],
+        radius: f64,
+        levels: u8,
+        masses: &mut TetMasses,
+        bulk: bool,
+    ) -> Result<Refinement, SubdivideError> {
         self.check_op_level(levels)?;
         Self::check_ball(center, radius)?;
         masses.check(self)?;

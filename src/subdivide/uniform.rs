@@ -956,10 +956,15 @@ impl LeveledMap<2> {
 }
 
 impl<const N: usize> LeveledMap<N> {
-    /// The checks after a bulk refinement: the whole map in debug builds and under
-    /// `expensive-checks` (a failure is a bug of this module).
+    /// The checks after a bulk refinement: the whole map in debug builds, and every law of the
+    /// leveled map (`check_all`: levels, μ order, flat vertices) under `expensive-checks`
+    /// (finding 327). A failure is a bug of this module.
     fn after_uniform(&self) {
-        #[cfg(any(debug_assertions, feature = "expensive-checks"))]
+        #[cfg(feature = "expensive-checks")]
+        if let Err(e) = self.check_all() {
+            panic!("topomech bug: uniform refinement broke the leveled map: {e}");
+        }
+        #[cfg(all(debug_assertions, not(feature = "expensive-checks")))]
         if let Err(e) = self.map.validate() {
             panic!("topomech bug: uniform refinement broke the map: {e}");
         }

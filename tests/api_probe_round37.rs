@@ -204,3 +204,20 @@ fn the_cutting_docs_handle_example_runs() {
     let text = std::fs::read_to_string(root().join("docs/CUTTING.md")).unwrap();
     assert!(text.contains("let grasp = body.map().cell_handle(0, CellId(13)).unwrap();"));
 }
+
+/// Finding 333: the 2D bulk path reports a face that is not a triangle as `NotATetrahedron`
+/// (its volumes are faces), so the refusal check expects N + 1 corners: a 2D refusal naming 3
+/// corners (a proper triangle refused) is a false refusal, one naming 2 is not.
+#[test]
+fn f333_a_2d_refusal_of_a_proper_triangle_is_flagged() {
+    use topomech::generate::grid_triangles;
+    use topomech::subdivide::fuzz::check_refused;
+    use topomech::subdivide::{LeveledMap, SubdivideError};
+    let (points, triangles) = grid_triangles(2);
+    let map = GMap::<2>::from_triangles(points.len(), &triangles).unwrap().0;
+    let m = LeveledMap::new(map, points);
+    let dart = m.map().darts().next().unwrap();
+    let refusal = |corners| SubdivideError::NotATetrahedron { dart, corners };
+    assert!(check_refused(&m, &m, &refusal(3)).is_err());
+    assert!(check_refused(&m, &m, &refusal(2)).is_ok());
+}

@@ -20,7 +20,9 @@ use super::{CellId, GMap};
 /// cell. Release counts wrap
 /// after 2³² releases of one id. They are the map's history, not its state: the file formats
 /// (`crate::store`) do not keep them (a loaded map starts at 0), and a handle belongs to the map
-/// it was taken from (and its clones, until they diverge).
+/// it was taken from (and its clones, until they diverge). A handle carries no identity of its
+/// map: resolved on a map loaded from a file or on a clone that diverged, it is checked against
+/// that map's counts and may resolve to another cell (finding 332; not done: a map stamp).
 ///
 /// # Examples
 ///

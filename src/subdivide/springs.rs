@@ -1062,6 +1062,12 @@ impl LeveledMechanics {
         let masses = self.vertex_masses_raw(m);
         let result = self.refine_in_step(m, center, radius, levels);
         self.conserve_momentum_whole(m, &masses);
+        // Every law of the leveled map at the end, at any size, as `LeveledMap::refine_around`
+        // (its single splits check what `check_after_op` affords; finding 331).
+        #[cfg(feature = "expensive-checks")]
+        if let Err(e) = m.check_all() {
+            panic!("topomech bug: a coupled refinement around a ball broke the leveled map: {e}");
+        }
         result
     }
 

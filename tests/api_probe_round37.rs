@@ -156,7 +156,11 @@ fn check_handles(ops: &[(bool, u16)], takes: &[(u8, u16)]) -> [usize; 3] {
             let expected = if !map.is_live_cell(dim, id) {
                 Err(StaleCell::Released { dim, id })
             } else if now != at {
-                Err(StaleCell::Reused { dim, id, then: h.generation(), now: h.generation() + (now - at) })
+                // The generation now is the one a fresh handle reads; it differs from the
+                // handle's because a release happened since (finding 332: stamps, not counts).
+                let fresh = map.cell_handle(dim, id).unwrap().generation();
+                assert_ne!(fresh, h.generation(), "after op {k}: released since but same generation");
+                Err(StaleCell::Reused { dim, id, then: h.generation(), now: fresh })
             } else {
                 Ok(id)
             };

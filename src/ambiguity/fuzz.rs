@@ -27,7 +27,9 @@
 //! and after it); 5. the level law of [`crate::ambiguity::mixed`] holds (G_i is the finest map as
 //! it was when level i ended); 6. when the tet list shows none of the symptoms (no hanging edge,
 //! no inexpressible or lost cut, no pinched point or non-manifold edge, as many points as g-map
-//! vertices), the map it means is the g-map, through the tet ↔ volume pairing.
+//! vertices), the map it means is the g-map, through the tet ↔ volume pairing; 7. the vertex
+//! masses lumped from density 1 keep the input's first moment Σ_v m_v x_v = ∫ x dV (finding
+//! 335: a cut through a hanging midpoint lumped its copy as a corner).
 
 use crate::ambiguity::campaign::run_cuts;
 use crate::ambiguity::construct::glued_faces;
@@ -134,6 +136,9 @@ pub enum FuzzFailure {
     /// Invariant 6 (mixed mode).
     #[error("the tet list shows no symptom yet means another map than the g-map")]
     CleanButDifferent,
+    /// Invariant 7 (mixed mode).
+    #[error("the lumped vertex masses moved the first moment of the input")]
+    FirstMoment,
     /// A step that cannot fail on these meshes failed.
     #[error("unexpected error: {0}")]
     Unexpected(String),
@@ -246,7 +251,7 @@ pub fn check_bytes(bytes: &[u8]) -> Result<FuzzReport, FuzzFailure> {
     })
 }
 
-/// The mixed mode: invariants 1', 5 and 6 of the [module docs](self).
+/// The mixed mode: invariants 1', 4', 5, 6 and 7 of the [module docs](self).
 fn check_mixed(selector: u8, rest: &[u8]) -> Result<FuzzReport, FuzzFailure> {
     let (points, tets) = mesh(selector);
     let ops = decode_ops(rest);
@@ -256,6 +261,9 @@ fn check_mixed(selector: u8, rest: &[u8]) -> Result<FuzzReport, FuzzFailure> {
     }
     if !run.level_law {
         return Err(FuzzFailure::LevelLaw);
+    }
+    if !run.first_moment_kept {
+        return Err(FuzzFailure::FirstMoment);
     }
     if run.skeleton_violations > 0 {
         return Err(FuzzFailure::Skeleton);

@@ -214,6 +214,10 @@ pub struct MixedRun {
     pub level_law: bool,
     /// Whether the leveled map passes `check_all` (expected).
     pub gmap_valid: bool,
+    /// Whether the vertex masses lumped from density 1 ([`crate::subdivide::TetMasses`]) keep
+    /// the input's first moment, Σ_v m_v x_v = ∫ x dV (expected: cuts move nothing and a split's
+    /// children fill their parent; finding 335).
+    pub first_moment_kept: bool,
 }
 
 impl MixedRun {
@@ -271,6 +275,7 @@ impl MixedRun {
             levels: Vec::new(),
             level_law: true,
             gmap_valid: true,
+            first_moment_kept: true,
         }
     }
 }
@@ -334,6 +339,7 @@ pub fn run_ops(points: &[[f64; 3]], tets: &[[u32; 4]], ops: &[Op]) -> Result<Mix
         }
     }
     run.gmap_valid = s.lm.check_all().is_ok();
+    run.first_moment_kept = first_moment_kept(&s.lm, points, tets);
     if !level_ends.is_empty() {
         // The input again (built, not kept: no copy is alive during the first pass).
         let (map, _) = GMap::<3>::from_tets(points.len(), tets)?;
@@ -419,6 +425,30 @@ fn check_volumes(points: &[[f64; 3]], tets: &[[u32; 4]]) -> Result<(), MixedErro
         }
     }
     Ok(())
+}
+
+/// Whether Σ_v m_v x_v of the vertex masses lumped from density 1 equals ∫ x dV = Σ_t V_t c_t
+/// over the input's tets (V_t its volume, c_t its centroid), to 1e-9 of Σ_t V_t max|x|: the
+/// leveled map's volumes fill the input's and its hanging vertices lump along their corners
+/// (docs/SUBDIVISION.md). O(darts + splits).
+fn first_moment_kept(lm: &LeveledMap<3>, points: &[[f64; 3]], tets: &[[u32; 4]]) -> bool {
+    let lumped = match crate::subdivide::TetMasses::from_density(lm, 1.0).and_then(|m| m.vertex_masses(lm)) {
+        Ok(lumped) => lumped,
+        Err(_) => return false,
+    };
+    let (mut got, mut want, mut scale) = ([0.0; 3], [0.0; 3], 0.0);
+    for (v, &m) in lumped.iter().enumerate() {
+        if lm.map().is_live_cell(0, crate::CellId(v as u32)) {
+            (0..3).for_each(|k| got[k] += m * lm.points()[v][k]);
+        }
+    }
+    for t in tets {
+        let p = t.map(|v| points[v as usize]);
+        let volume = crate::mesh::signed_volume(p[0], p[1], p[2], p[3]).abs();
+        (0..3).for_each(|k| want[k] += volume * p.iter().map(|x| x[k]).sum::<f64>() / 4.0);
+        scale += volume * p.iter().flatten().fold(0.0f64, |a, x| a.max(x.abs()));
+    }
+    (0..3).all(|k| (got[k] - want[k]).abs() <= 1e-9 * scale.max(f64::MIN_POSITIVE))
 }
 
 /// One dart per glued face of the finest map, in dart order. O(darts).

@@ -580,12 +580,6 @@ fn fingerprint(changes: &CellChanges) -> u64 {
     h
 }
 
-/// A number no earlier call returned in this process (1, 2, 3, …). O(1).
-pub(crate) fn next_identity() -> u64 {
-    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
-    NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
-}
-
 /// A clone is another body: same map, attributes and version, its own [`Embedded::identity`]
 /// (so what was built for the original does not run on the copy unnoticed).
 impl<const N: usize, E: Clone> Clone for Embedded<N, E> {
@@ -594,7 +588,7 @@ impl<const N: usize, E: Clone> Clone for Embedded<N, E> {
             map: self.map.clone(),
             attrs: self.attrs.clone(),
             version: self.version,
-            identity: next_identity(),
+            identity: crate::gmap::next_unique(),
             source: Some((self.identity, self.version)),
         }
     }
@@ -662,7 +656,7 @@ impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
         if let Err(error) = attrs.check(&map) {
             return Err(Box::new(RefusedParts { error, map, attrs }));
         }
-        Ok(Embedded { map, attrs, version: 0, identity: next_identity(), source: None })
+        Ok(Embedded { map, attrs, version: 0, identity: crate::gmap::next_unique(), source: None })
     }
 
     /// [`Embedded::new`] without the check, for parts this crate has just built or checked
@@ -670,7 +664,7 @@ impl<const N: usize, E: CellRules<N>> Embedded<N, E> {
     /// [`CellRules::grow_to`]).
     pub(crate) fn from_checked_parts(map: GMap<N>, mut attrs: E) -> Self {
         attrs.grow_to(&map);
-        Embedded { map, attrs, version: 0, identity: next_identity(), source: None }
+        Embedded { map, attrs, version: 0, identity: crate::gmap::next_unique(), source: None }
     }
 
     /// The map (read-only). O(1).

@@ -2,27 +2,29 @@
 
 use super::{CellId, GMap};
 
-/// A cell id with the generation it had when the handle was taken.
+/// A cell id with the generation it had when the handle was taken, and the map it was taken on.
 ///
 /// Cell ids are dense and a released id is reused by a later operation (module docs of
 /// [`crate::gmap`], docs/ARCHITECTURE.md §3), so a bare [`CellId`] kept across a cut, a removal
-/// or a sew silently names another cell once its id comes back. A [`CellHandle`] is the triple
-/// (i, id, g) where g is the number of times `id` had been released in dimension i when the
-/// handle was taken (its *generation*; the map counts releases per id). The law:
+/// or a sew silently names another cell once its id comes back. A [`CellHandle`] is the tuple
+/// (i, id, g, o) where g is the id's *generation* when the handle was taken — the stamp of its
+/// last release in dimension i, 0 if none — and o the identity of the map. Stamps and identities
+/// come from one process-wide counter: no two releases share a stamp, in any map, and every map
+/// made (empty, built from a mesh, loaded from a file, extracted as a level) gets a new identity
+/// that its clones keep. The law:
 ///
-/// > `resolve(h)` is `Ok(id)` exactly when `id` is a live i-cell now and has not been released
-/// > since `h` was taken (its release count is still g).
+/// > `resolve(h)` on a map of identity o is `Ok(id)` exactly when `id` is a live i-cell now
+/// > and its last release is still the one it had when `h` was taken (none, or the same event).
 ///
 /// A cell that keeps its id through an operation keeps its handles: the side of a split that
 /// keeps the id ([`CellChange::Split`](super::CellChange::Split)'s `kept`), the surviving cell
 /// of a merge (`kept`). The absorbed cell of a merge, and every cell whose darts were deleted,
 /// had their ids released: their handles are stale for good, even after the id is given to a new
-/// cell. Release counts wrap
-/// after 2³² releases of one id. They are the map's history, not its state: the file formats
-/// (`crate::store`) do not keep them (a loaded map starts at 0), and a handle belongs to the map
-/// it was taken from (and its clones, until they diverge). A handle carries no identity of its
-/// map: resolved on a map loaded from a file or on a clone that diverged, it is checked against
-/// that map's counts and may resolve to another cell (finding 332; not done: a map stamp).
+/// cell. On a clone, a handle taken before the clone resolves in both until the id is released in
+/// one of them; one taken after a release that the other map did not make is stale there, since
+/// that map's id names another cell (finding 332). The stamps are the map's history, not its
+/// state: the file formats (`crate::store`) do not keep them, and a loaded map is another map
+/// (handles taken before the save are refused with [`StaleCell::OtherMap`]).
 ///
 /// # Examples
 ///
@@ -51,7 +53,8 @@ use super::{CellId, GMap};
 pub struct CellHandle {
     dim: u8,
     id: CellId,
-    generation: u32,
+    generation: u64,
+    origin: u64,
 }
 
 impl CellHandle {
@@ -65,8 +68,9 @@ impl CellHandle {
         self.id
     }
 
-    /// How many times the id had been released when the handle was taken.
-    pub fn generation(&self) -> u32 {
+    /// The id's generation when the handle was taken: the stamp of its last release, 0 if it had
+    /// never been released. Only equality is meaningful (stamps grow with time in the process).
+    pub fn generation(&self) -> u64 {
         self.generation
     }
 }
@@ -82,19 +86,29 @@ pub enum StaleCell {
         /// The id.
         id: CellId,
     },
-    /// The id is live but was released since the handle was taken: it names another cell.
+    /// The id is live but its last release is not the one it had when the handle was taken
+    /// (released since, or on a clone, released by another history): it names another cell.
     #[error(
-        "{dim}-cell {id} no longer exists: its id now names another cell (released {now} times, {then} when the handle was taken)"
+        "{dim}-cell {id} no longer exists: its id now names another cell (generation {now}, {then} when the handle was taken)"
     )]
     Reused {
         /// The dimension.
         dim: usize,
         /// The id.
         id: CellId,
-        /// The id's release count when the handle was taken.
-        then: u32,
-        /// Its release count now.
-        now: u32,
+        /// The id's generation when the handle was taken ([`CellHandle::generation`]).
+        then: u64,
+        /// Its generation now.
+        now: u64,
+    },
+    /// The handle was taken on another map (not this one or a clone of it): a map built apart,
+    /// loaded from a file, or extracted as a level.
+    #[error("the handle on {dim}-cell {id} was taken on another map")]
+    OtherMap {
+        /// The dimension.
+        dim: usize,
+        /// The id.
+        id: CellId,
     },
     /// No such dimension, or an id that was never allocated.
     #[error("no {dim}-cell {id} in this map")]
@@ -131,22 +145,25 @@ impl<const N: usize> GMap<N> {
                 if ids.free.contains(&id.0) {
                     return Err(StaleCell::Released { dim: i, id });
                 }
-                Ok(CellHandle { dim: i as u8, id, generation: ids.generation(id.0) })
+                Ok(CellHandle { dim: i as u8, id, generation: ids.generation(id.0), origin: self.origin })
             }
             _ => Err(StaleCell::NoSuchCell { dim: i, id }),
         }
     }
 
     /// The id of the cell `h` was taken for, if that cell still holds it: `Ok(id)` exactly when
-    /// the id is live and was not released since ([`CellHandle`]).
-    /// O(free ids of the handle's dimension).
+    /// `h` was taken on this map or a clone of it, the id is live and its generation is the
+    /// handle's ([`CellHandle`]). O(free ids of the handle's dimension).
     ///
     /// # Errors
-    /// [`StaleCell::Released`] when the id is free, [`StaleCell::Reused`] when it is live but
-    /// was released since (it names another cell now), [`StaleCell::NoSuchCell`] for a handle of
-    /// another map that names no id here.
+    /// [`StaleCell::OtherMap`] for a handle taken on another map, [`StaleCell::Released`] when
+    /// the id is free, [`StaleCell::Reused`] when it is live but was released since (it names
+    /// another cell now).
     pub fn resolve(&self, h: CellHandle) -> Result<CellId, StaleCell> {
         let (dim, id) = (h.dim(), h.id);
+        if h.origin != self.origin {
+            return Err(StaleCell::OtherMap { dim, id });
+        }
         let Some(ids) = self.ids.get(dim).filter(|ids| id.0 < ids.next) else {
             return Err(StaleCell::NoSuchCell { dim, id });
         };

@@ -44,17 +44,26 @@ pub use validate::{InvariantViolation, Law};
 
 pub(crate) use orbit::{join_with_smaller, with_stamps};
 
+/// A number no earlier call returned in this process (1, 2, 3, …): the identities of maps, bodies
+/// and leveled-map states and the release stamps of cell ids all come from this one counter.
+/// O(1).
+pub(crate) fn next_unique() -> u64 {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+    NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+}
+
 use dart::NONE;
 
 /// Allocator of the ids of one cell dimension: dense ids, a free list, and a count of live ids;
-/// with, per id, how many times it was released (its generation, for [`CellHandle`]).
+/// with, per id, the stamp of its last release (its generation, for [`CellHandle`]).
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub(crate) struct IdAlloc {
     pub(crate) next: u32,
     pub(crate) free: Vec<u32>,
-    /// `released[id]`: how many times `id` was released (wrapping); ids past the end: 0. Grown by
-    /// a release only, so a map that never released an id holds none of it.
-    pub(crate) released: Vec<u32>,
+    /// `released[id]`: the [`next_unique`] number drawn when `id` was last released, 0 if never;
+    /// ids past the end: 0. Grown by a release only, so a map that never released an id holds
+    /// none of it. No two releases share a stamp, in any map of the process (finding 332).
+    pub(crate) released: Vec<u64>,
 }
 
 impl IdAlloc {
@@ -75,11 +84,11 @@ impl IdAlloc {
         if k >= self.released.len() {
             self.released.resize(k + 1, 0);
         }
-        self.released[k] = self.released[k].wrapping_add(1);
+        self.released[k] = next_unique();
     }
 
-    /// How many times `id` was released (wrapping). O(1).
-    pub(crate) fn generation(&self, id: u32) -> u32 {
+    /// The stamp of the last release of `id`, 0 if it was never released. O(1).
+    pub(crate) fn generation(&self, id: u32) -> u64 {
         self.released.get(id as usize).copied().unwrap_or(0)
     }
 
@@ -159,6 +168,9 @@ pub struct GMap<const N: usize> {
     /// change an αi link with i < n or add a dart. A conservative flag (false proves nothing); it
     /// lets the mechanics skip the per-face closure check. See [`GMap::tets_as_built`].
     tets_as_built: bool,
+    /// The map's identity for [`CellHandle`]s: a [`next_unique`] number drawn when the map was
+    /// made (empty, built or loaded), kept by its clones (finding 332).
+    origin: u64,
 }
 
 impl<const N: usize> Default for GMap<N> {
@@ -195,6 +207,7 @@ impl<const N: usize> GMap<N> {
             ids: vec![IdAlloc::default(); N + 1],
             mark_pool: Vec::new(),
             tets_as_built: false,
+            origin: next_unique(),
         }
     }
 
@@ -701,7 +714,7 @@ impl<const N: usize> GMap<N> {
     }
 
     /// Sets the id allocator of dimension i to "ids 0..next are used but those in `free`".
-    /// The release counts ([`CellHandle`] generations) stay: the bulk refinement appends ids.
+    /// The release stamps ([`CellHandle`] generations) stay: the bulk refinement appends ids.
     pub(crate) fn set_id_alloc_raw(&mut self, i: usize, next: u32, free: Vec<u32>) {
         let released = std::mem::take(&mut self.ids[i].released);
         self.ids[i] = IdAlloc { next, free, released };

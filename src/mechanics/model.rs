@@ -280,13 +280,13 @@ pub(crate) struct Instance {
 impl Instance {
     /// A number no other instance has. O(1).
     pub(crate) fn fresh() -> Self {
-        Instance { id: crate::embedding::next_identity(), from: 0 }
+        Instance { id: crate::gmap::next_unique(), from: 0 }
     }
 }
 
 impl Clone for Instance {
     fn clone(&self) -> Self {
-        Instance { id: crate::embedding::next_identity(), from: self.id }
+        Instance { id: crate::gmap::next_unique(), from: self.id }
     }
 }
 
@@ -727,7 +727,7 @@ impl Mechanics {
     /// assert_eq!(body.attrs().position().len(), 8);
     /// ```
     pub fn position_mut(&mut self) -> CellSliceMut<'_, Vec3> {
-        self.position_epoch = crate::embedding::next_identity();
+        self.position_epoch = crate::gmap::next_unique();
         CellSliceMut::new(&mut self.position)
     }
 
@@ -761,7 +761,7 @@ impl Mechanics {
     /// assert!((body.kinetic_energy() - 0.5).abs() < 1e-12); // ½ · 1 kg · (1 m/s)²
     /// ```
     pub fn velocity_mut(&mut self) -> CellSliceMut<'_, Vec3> {
-        self.velocity_epoch = crate::embedding::next_identity();
+        self.velocity_epoch = crate::gmap::next_unique();
         CellSliceMut::new(&mut self.velocity)
     }
 
@@ -817,7 +817,7 @@ impl Mechanics {
     /// assert_eq!(body.attrs().pinned().as_slice().iter().filter(|&&p| p).count(), 1);
     /// ```
     pub fn pinned_mut(&mut self) -> CellSliceMut<'_, bool> {
-        self.pins_epoch = crate::embedding::next_identity();
+        self.pins_epoch = crate::gmap::next_unique();
         CellSliceMut::new(&mut self.pinned)
     }
 
@@ -1151,7 +1151,7 @@ impl Mechanics {
     /// assert_eq!(body.attrs().pinned().as_slice().iter().filter(|&&p| p).count(), 4);
     /// ```
     pub fn pin_where(&mut self, mut pin: impl FnMut(CellId, Vec3) -> bool) {
-        self.pins_epoch = crate::embedding::next_identity();
+        self.pins_epoch = crate::gmap::next_unique();
         for (i, (p, r)) in self.pinned.as_mut_slice().iter_mut().zip(self.rest_position.as_slice()).enumerate() {
             *p = pin(CellId(i as u32), *r);
         }

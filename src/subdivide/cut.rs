@@ -41,16 +41,24 @@ impl LeveledMap<3> {
         if let Some(&x) = side.iter().find(|&&x| self.map.is_free(3, x)) {
             return Err(SubdivideError::FaceNotSewn(x));
         }
-        let positions: Vec<(DartId, [f64; 3])> =
-            side.iter().flat_map(|&x| [x, self.map.alpha::<3>(x)]).map(|x| (x, self.position(x))).collect();
+        // (dart, its vertex id, its position) on both sides, before the cut.
+        let before: Vec<(DartId, u32, [f64; 3])> = side
+            .iter()
+            .flat_map(|&x| [x, self.map.alpha::<3>(x)])
+            .map(|x| (x, self.map.vertex_id(x).0, self.position(x)))
+            .collect();
         self.begin(level);
         for &x in &side {
             self.unlink(3, x);
         }
         self.finish();
-        if !self.points.is_empty() {
-            for (x, p) in positions {
-                let v = self.map.vertex_id(x).index();
+        for (x, old, p) in before {
+            let v = self.map.vertex_id(x).0;
+            if v != old {
+                self.set_vertex_origin(v, old);
+            }
+            if !self.points.is_empty() {
+                let v = v as usize;
                 if self.points.len() <= v {
                     self.points.resize(v + 1, [0.0; 3]);
                 }

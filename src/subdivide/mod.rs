@@ -570,6 +570,10 @@ pub struct LeveledMap<const N: usize> {
     splits: Vec<[u32; 3]>,
     /// The edge cells of every inserted vertex, parallel to `splits` (see [`LeveledMap::edge_split_log`]).
     edge_splits: Vec<EdgeSplit>,
+    /// `origins[v]`: the vertex a cut ([`LeveledMap::unsew_face`]) split v from, followed to one
+    /// that no cut made; v itself past the end or for a vertex no cut made
+    /// ([`LeveledMap::vertex_origin`]).
+    origins: Vec<u32>,
     op: ops::OpLog,
     /// The dart limit of the refinements ([`LeveledMap::set_max_darts`]).
     max_darts: usize,
@@ -577,12 +581,6 @@ pub struct LeveledMap<const N: usize> {
     version: u64,
     /// A process-wide unique stamp of the map's present state ([`LeveledMap::stamp`]).
     stamp: u64,
-}
-
-/// The next state stamp of a [`LeveledMap`]: unique in the process (a counter). O(1).
-pub(crate) fn next_stamp() -> u64 {
-    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
-    NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
 }
 
 impl<const N: usize> LeveledMap<N> {
@@ -622,10 +620,11 @@ impl<const N: usize> LeveledMap<N> {
             points,
             splits: Vec::new(),
             edge_splits: Vec::new(),
+            origins: Vec::new(),
             op: ops::OpLog::default(),
             max_darts: DEFAULT_MAX_DARTS,
             version: 0,
-            stamp: next_stamp(),
+            stamp: crate::gmap::next_unique(),
         }
     }
 
@@ -643,7 +642,7 @@ impl<const N: usize> LeveledMap<N> {
     /// [`LeveledMap::stamp`]. O(1).
     pub(crate) fn bump_version(&mut self) {
         self.version += 1;
-        self.stamp = next_stamp();
+        self.stamp = crate::gmap::next_unique();
     }
 
     /// Number of operations that changed the map since [`LeveledMap::new`] (or
@@ -842,6 +841,43 @@ impl<const N: usize> LeveledMap<N> {
     /// ```
     pub fn split_log(&self) -> &[[u32; 3]] {
         &self.splits
+    }
+
+    /// The vertex a cut split `v` from: the id of the vertex v was a side of before every
+    /// [`Self::unsew_face`] since this map was created or loaded (v itself if no cut made it).
+    /// A copy lies where its origin lies and stands for it in [`Self::split_log`]: a volume's
+    /// vertices have distinct origins (a cut splits a vertex between volumes, never inside one),
+    /// and a cut vertex hangs on a volume exactly when its origin did (round 38: the lumped
+    /// masses treated a cut copy of a midpoint as a corner). Not saved by
+    /// [`LeveledMap::to_parts`]. O(1).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use topomech::subdivide::LeveledMap;
+    /// # use topomech::GMap;
+    /// let (map, _) = GMap::<3>::from_tets(5, &[[0, 1, 2, 3], [1, 2, 3, 4]]).unwrap();
+    /// let mut m = LeveledMap::new(map, vec![]);
+    /// let glued = m.map().darts().find(|&d| !m.map().is_free(3, d)).unwrap();
+    /// m.unsew_face(glued, 1).unwrap(); // vertices 1, 2, 3 split: three new ids
+    /// let origins: Vec<u32> = (0..8).map(|v| m.vertex_origin(v)).collect();
+    /// assert_eq!(origins[..5], [0, 1, 2, 3, 4]);
+    /// assert_eq!({ let mut o = origins[5..].to_vec(); o.sort(); o }, [1, 2, 3]);
+    /// ```
+    pub fn vertex_origin(&self, v: u32) -> u32 {
+        self.origins.get(v as usize).copied().unwrap_or(v)
+    }
+
+    /// Records that the vertex `copy` was split from `from` by a cut ([`Self::vertex_origin`]).
+    /// O(1) amortized.
+    pub(crate) fn set_vertex_origin(&mut self, copy: u32, from: u32) {
+        let origin = self.vertex_origin(from);
+        let k = copy as usize;
+        if self.origins.len() <= k {
+            let start = self.origins.len() as u32;
+            self.origins.extend(start..=copy);
+        }
+        self.origins[k] = origin;
     }
 
     /// The edge cells of every entry of [`Self::split_log`] (same order, same length): which edge
@@ -1043,6 +1079,19 @@ impl<const N: usize> LeveledMap<N> {
             Some(e) => Err(e),
             None => Ok(()),
         }
+    }
+
+    /// Under `expensive-checks`, [`Self::check_all`] at the end of a whole operation (a
+    /// refinement around a ball, coupled or not, a uniform level), at any size: its single
+    /// operations check only what [`Self::check_after_op`] affords (findings 327, 331). A failure
+    /// is a bug of this module and panics naming `op`. Without the feature, nothing.
+    pub(crate) fn expensive_check_all(&self, op: &str) {
+        #[cfg(feature = "expensive-checks")]
+        if let Err(e) = self.check_all() {
+            panic!("topomech bug: {op} broke the leveled map: {e}");
+        }
+        #[cfg(not(feature = "expensive-checks"))]
+        let _ = op;
     }
 
     /// Every law: the finest map valid, [`Self::check_levels`], every level 0..=k extracted

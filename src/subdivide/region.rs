@@ -279,8 +279,7 @@ impl TetMasses {
         let parents = super::springs::split_parents(m);
         let mut out = vec![0.0; map.cell_id_bound(0)];
         for t in map.one_dart_per_cell(3) {
-            let vertices = super::springs::volume_vertices(m, t);
-            for (v, share) in super::springs::volume_mass_shares(&vertices, self.of(map.cell_id(3, t)), &parents) {
+            for (v, share) in super::springs::volume_shares_by_id(m, t, self.of(map.cell_id(3, t)), &parents) {
                 out[v as usize] += share;
             }
         }
@@ -684,7 +683,9 @@ impl LeveledMap<3> {
         levels: u8,
         masses: &mut TetMasses,
     ) -> Result<Refinement, SubdivideError> {
-        self.refine_zone(center, radius, levels, masses, true)
+        let result = self.refine_zone(center, radius, levels, masses, true);
+        self.expensive_check_all("a refinement around a ball");
+        result
     }
 
     /// [`Self::refine_around`] op by op only ([`Self::subdivide_tet_with_mass`] on every tet of
@@ -708,7 +709,9 @@ impl LeveledMap<3> {
         levels: u8,
         masses: &mut TetMasses,
     ) -> Result<Refinement, SubdivideError> {
-        self.refine_zone(center, radius, levels, masses, false)
+        let result = self.refine_zone(center, radius, levels, masses, false);
+        self.expensive_check_all("a refinement around a ball");
+        result
     }
 
     /// [`Self::refine_around`] (`bulk`: a level may go through [`Self::refine_uniform`]) or
@@ -716,25 +719,6 @@ impl LeveledMap<3> {
     /// [`Self::refine_mixed`], all or nothing: the map and the masses are copied first and put
     /// back on any error.
     fn refine_zone(
-        &mut self,
-        center: [f64; 3],
-        radius: f64,
-        levels: u8,
-        masses: &mut TetMasses,
-        bulk: bool,
-    ) -> Result<Refinement, SubdivideError> {
-        let result = self.refine_zone_checked(center, radius, levels, masses, bulk);
-        // Every law of the leveled map once the zone is done, at any size (its single
-        // operations check what `check_after_op` affords: finding 327).
-        #[cfg(feature = "expensive-checks")]
-        if let Err(e) = self.check_all() {
-            panic!("topomech bug: a refinement around a ball broke the leveled map: {e}");
-        }
-        result
-    }
-
-    /// [`Self::refine_zone`] before its final check.
-    fn refine_zone_checked(
         &mut self,
         center: [f64; 3],
         radius: f64,

@@ -1062,12 +1062,8 @@ impl LeveledMechanics {
         let masses = self.vertex_masses_raw(m);
         let result = self.refine_in_step(m, center, radius, levels);
         self.conserve_momentum_whole(m, &masses);
-        // Every law of the leveled map at the end, at any size, as `LeveledMap::refine_around`
-        // (its single splits check what `check_after_op` affords; finding 331).
-        #[cfg(feature = "expensive-checks")]
-        if let Err(e) = m.check_all() {
-            panic!("topomech bug: a coupled refinement around a ball broke the leveled map: {e}");
-        }
+        // As `LeveledMap::refine_around` (finding 331).
+        m.expensive_check_all("a coupled refinement around a ball");
         result
     }
 
@@ -1194,7 +1190,7 @@ impl LeveledMechanics {
         self.position.resize(n, [0.0; 3]);
         self.velocity.resize(n, [0.0; 3]);
         self.parents.resize(n.max(self.parents.len()), None);
-        self.parents[v as usize] = Some((index, [a, b]));
+        self.parents[v as usize] = Some((index, [m.vertex_origin(a), m.vertex_origin(b)]));
         let mean = |x: &[Vec3]| crate::mesh::midpoint(x[a as usize], x[b as usize]);
         let (x, u) = (mean(&self.position), mean(&self.velocity));
         self.position[v as usize] = x;
@@ -1259,7 +1255,7 @@ impl LeveledMechanics {
     /// coupling's split parents). O(volume + n log n).
     fn volume_shares(&self, m: &LeveledMap<3>, t: DartId) -> Vec<(u32, f64)> {
         let mass = self.masses.mass.get(m.map().cell_id(3, t).index()).copied().unwrap_or(0.0);
-        volume_mass_shares(&volume_vertices(m, t), mass, &self.parents)
+        volume_shares_by_id(m, t, mass, &self.parents)
     }
 
     /// The finest level as a flat [`SpringSystem`] with slots = vertex ids (so [`Self::position`] and
@@ -1470,12 +1466,13 @@ fn distinct_volumes(m: &LeveledMap<3>, darts: impl IntoIterator<Item = DartId>) 
 }
 
 /// For every vertex id, the split that inserted it: (its index in [`LeveledMap::split_log`], the
-/// ends of the split edge); `None` for a vertex of level 0. O(vertices + splits).
+/// [origins](LeveledMap::vertex_origin) of the ends of the split edge); `None` for a vertex of
+/// level 0 and for a cut's copy (look its origin up). O(vertices + splits).
 pub(super) fn split_parents(m: &LeveledMap<3>) -> Vec<Option<(usize, [u32; 2])>> {
     let mut out = vec![None; m.map().cell_id_bound(0)];
     for (i, &[mid, a, b]) in m.split_log().iter().enumerate() {
         if let Some(slot) = out.get_mut(mid as usize) {
-            *slot = Some((i, [a, b]));
+            *slot = Some((i, [m.vertex_origin(a), m.vertex_origin(b)]));
         }
     }
     out
@@ -1527,13 +1524,42 @@ pub(super) fn volume_mass_shares(
     vertices.iter().zip(share.iter().zip(&owed)).map(|(&v, (&s, &debt))| (v, s - debt)).collect()
 }
 
-/// The distinct vertex ids of the volume of `t` in the finest map. O(volume).
-pub(super) fn volume_vertices(m: &LeveledMap<3>, t: DartId) -> Vec<u32> {
-    let mut vs: Vec<u32> =
-        m.map().orbit(t, AlphaMask::of(&[0, 1, 2])).iter().map(|&x| m.map().vertex_id(x).0).collect();
+/// The distinct vertices of the volume of `t` in the finest map, as their
+/// [origins](LeveledMap::vertex_origin) (sorted: the keys of [`split_parents`]) and their ids
+/// (parallel). Distinct ids have distinct origins in one volume. O(volume).
+pub(super) fn volume_vertices(m: &LeveledMap<3>, t: DartId) -> (Vec<u32>, Vec<u32>) {
+    let mut vs: Vec<(u32, u32)> = m
+        .map()
+        .orbit(t, AlphaMask::of(&[0, 1, 2]))
+        .iter()
+        .map(|&x| m.map().vertex_id(x).0)
+        .map(|v| (m.vertex_origin(v), v))
+        .collect();
     vs.sort_unstable();
     vs.dedup();
-    vs
+    vs.into_iter().unzip()
+}
+
+/// [`volume_mass_shares`] of the volume of `t` by vertex id (sorted), its vertices looked up in
+/// `parents` by their origins. O(volume + n log n).
+pub(super) fn volume_shares_by_id(
+    m: &LeveledMap<3>,
+    t: DartId,
+    mass: f64,
+    parents: &[Option<(usize, [u32; 2])>],
+) -> Vec<(u32, f64)> {
+    let (origins, ids) = volume_vertices(m, t);
+    let mut out: Vec<(u32, f64)> =
+        volume_mass_shares(&origins, mass, parents).into_iter().zip(ids).map(|((_, w), v)| (v, w)).collect();
+    out.sort_unstable_by_key(|&(v, _)| v);
+    out
+}
+
+/// The corners of the volume of `t` (its vertices that do not hang on it, [`is_hanging`] by
+/// origin), as vertex ids. O(volume + n log n).
+pub(super) fn volume_corners(m: &LeveledMap<3>, t: DartId, parents: &[Option<(usize, [u32; 2])>]) -> Vec<u32> {
+    let (origins, ids) = volume_vertices(m, t);
+    origins.iter().zip(ids).filter(|&(&o, _)| !is_hanging(&origins, parents, o)).map(|(_, v)| v).collect()
 }
 
 /// The splitter of [`LeveledMechanics::refine_around`] on maps with level skips

@@ -34,7 +34,7 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
-use super::springs::{is_hanging, split_parents, tet_edges, volume_mass_shares, volume_vertices, EdgeKey, Tet0};
+use super::springs::{split_parents, tet_edges, volume_corners, volume_shares_by_id, EdgeKey, Tet0};
 use super::{LeveledMap, LeveledMechanics};
 use crate::gmap::AlphaMask;
 use crate::mechanics::geom::rest_length;
@@ -212,15 +212,19 @@ fn within_rounding(stored: f64, measured: f64, [a, b]: [[f64; 3]; 2], levels: u3
 }
 
 /// The split depth of every vertex id: 0 for a vertex of level 0, 1 + the deeper end's depth
-/// for a midpoint (the split log lists ends before their midpoints). O(vertices + splits).
+/// for a midpoint (the split log lists ends before their midpoints), a cut's copy that of its
+/// [origin](LeveledMap::vertex_origin). O(vertices + splits).
 fn split_depths(m: &LeveledMap<3>) -> Vec<u32> {
     let mut depth = vec![0u32; m.map().cell_id_bound(0)];
     for &[mid, a, b] in m.split_log() {
-        let below = |v: u32| depth.get(v as usize).copied().unwrap_or(0);
+        let below = |v: u32| depth.get(m.vertex_origin(v) as usize).copied().unwrap_or(0);
         let d = 1 + below(a).max(below(b));
         if let Some(slot) = depth.get_mut(mid as usize) {
             *slot = d;
         }
+    }
+    for v in 0..depth.len() {
+        depth[v] = depth.get(m.vertex_origin(v as u32) as usize).copied().unwrap_or(0);
     }
     depth
 }
@@ -425,7 +429,7 @@ impl LeveledMechanics {
         for t in map.one_dart_per_cell(3) {
             let id = map.cell_id(3, t);
             let mass = self.masses.mass.get(id.index()).copied().unwrap_or(0.0);
-            out[id.index()] = volume_mass_shares(&volume_vertices(m, t), mass, parents);
+            out[id.index()] = volume_shares_by_id(m, t, mass, parents);
         }
         out
     }
@@ -456,8 +460,7 @@ impl LeveledMechanics {
         }
         let mut tets = [0.0; 3];
         for t in map.one_dart_per_cell(3) {
-            let vertices = volume_vertices(m, t);
-            let corners: Vec<u32> = vertices.iter().copied().filter(|&v| !is_hanging(&vertices, parents, v)).collect();
+            let corners = volume_corners(m, t, parents);
             let mass = self.masses.mass.get(map.cell_id(3, t).index()).copied().unwrap_or(0.0) / tets_total;
             for (axis, sum) in tets.iter_mut().enumerate() {
                 let mean =

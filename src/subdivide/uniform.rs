@@ -960,10 +960,7 @@ impl<const N: usize> LeveledMap<N> {
     /// leveled map (`check_all`: levels, μ order, flat vertices) under `expensive-checks`
     /// (finding 327). A failure is a bug of this module.
     fn after_uniform(&self) {
-        #[cfg(feature = "expensive-checks")]
-        if let Err(e) = self.check_all() {
-            panic!("topomech bug: uniform refinement broke the leveled map: {e}");
-        }
+        self.expensive_check_all("uniform refinement");
         #[cfg(all(debug_assertions, not(feature = "expensive-checks")))]
         if let Err(e) = self.map.validate() {
             panic!("topomech bug: uniform refinement broke the map: {e}");

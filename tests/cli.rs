@@ -667,6 +667,7 @@ fn ambiguity_subdivide_reports_the_mixed_campaign_and_rejects_a_bad_probability(
     assert_eq!(k["k"], 2);
     assert_eq!(k["level_law_broken"], 0);
     assert_eq!(k["gmap_invalid"], 0);
+    assert_eq!(k["first_moment_moved"], 0);
     let ops = k["cuts"].as_u64().unwrap() + k["subdivisions"].as_u64().unwrap() + k["refused"].as_u64().unwrap();
     assert_eq!(ops, 6, "3 sequences of 2 ops on a cube with glued faces left");
     let bad = run(&["ambiguity", "kuhn:1", "--subdivide", "1.5"]);

@@ -709,6 +709,9 @@ pub struct MixedStats {
     pub level_law_broken: usize,
     /// Sequences where the leveled map failed `check_all` (expected 0).
     pub gmap_invalid: usize,
+    /// Sequences whose lumped vertex masses moved the input's first moment (expected 0;
+    /// [`MixedRun::first_moment_kept`]).
+    pub first_moment_moved: usize,
 }
 
 impl MixedStats {
@@ -734,6 +737,7 @@ impl MixedStats {
         self.levels_ambiguous += r.levels.iter().filter(|c| c.ambiguous()).count();
         self.level_law_broken += usize::from(!r.level_law);
         self.gmap_invalid += usize::from(!r.gmap_valid);
+        self.first_moment_moved += usize::from(!r.first_moment_kept);
     }
 }
 
@@ -814,7 +818,7 @@ mod tests {
         let mut rng = SplitMix64(3);
         let (stats, _) = campaign_mixed(&p, &t, 4, 0.0, 10, &mut rng).expect("runs");
         assert_eq!(stats.subdivisions + stats.refused, 0);
-        assert_eq!(stats.level_law_broken + stats.gmap_invalid, 0);
+        assert_eq!(stats.level_law_broken + stats.gmap_invalid + stats.first_moment_moved, 0);
         assert_eq!(stats.cuts, 40);
         assert_eq!(stats.skeleton_violations, 0);
         assert!(stats.skeleton_pairs > 0, "a Kuhn cube has faces whose cut splits nothing: {stats:?}");
@@ -917,6 +921,7 @@ mod tests {
         assert_eq!(stats.sequences, 6);
         assert_eq!(stats.level_law_broken, 0, "{stats:?}");
         assert_eq!(stats.gmap_invalid, 0, "{stats:?}");
+        assert_eq!(stats.first_moment_moved, 0, "{stats:?}");
         assert!(stats.subdivisions > 0 && stats.ambiguous > 0, "{stats:?}");
         assert!(!firsts.is_empty());
     }

@@ -389,11 +389,12 @@ fn write_mixed(out: &mut dyn Write, m: &SubdivideJson) -> std::io::Result<()> {
             s.levels_compared,
             s.levels_ambiguous
         )?;
-        if s.level_law_broken + s.gmap_invalid + s.graph_undecided + s.skeleton_violations > 0 {
+        let broken = s.level_law_broken + s.gmap_invalid + s.first_moment_moved;
+        if broken + s.graph_undecided + s.skeleton_violations > 0 {
             writeln!(
                 out,
-                "       level law broken {}, g-map invalid {}, graph pairs undecided {}, skeleton violations {}",
-                s.level_law_broken, s.gmap_invalid, s.graph_undecided, s.skeleton_violations
+                "       level law broken {}, g-map invalid {}, first moment moved {}, graph pairs undecided {}, skeleton violations {}",
+                s.level_law_broken, s.gmap_invalid, s.first_moment_moved, s.graph_undecided, s.skeleton_violations
             )?;
         }
     }

@@ -1537,6 +1537,7 @@ pub(super) fn volume_vertices(m: &LeveledMap<3>, t: DartId) -> (Vec<u32>, Vec<u3
         .collect();
     vs.sort_unstable();
     vs.dedup();
+    debug_assert!(vs.windows(2).all(|w| w[0].0 != w[1].0), "topomech bug: two vertices of one volume share an origin");
     vs.into_iter().unzip()
 }
 

@@ -113,6 +113,15 @@ impl Laws {
         Laws { proj: Projection::build(body, G).unwrap(), initial: body.total_tet_mass(), removed: 0.0 }
     }
 
+    /// Removes volume `t`, counts its removed mass and checks every law after it. Returns the
+    /// removed mass.
+    fn remove(&mut self, body: &mut Body, t: CellId, what: &str) -> f64 {
+        let r = remove_volume(body, t).unwrap_or_else(|e| panic!("{what}: {e}"));
+        self.removed += r.removed_mass;
+        self.after(body, &r.touched, what);
+        r.removed_mass
+    }
+
     fn after(&mut self, body: &Body, touched: &TouchedCells, what: &str) {
         body.map().validate().unwrap_or_else(|e| panic!("{what}: invalid map: {e}"));
         check_conservation(body.map(), body.attrs()).unwrap_or_else(|e| panic!("{what}: conservation: {e}"));
@@ -270,10 +279,8 @@ fn refine_around_then_every_cut_keeps_every_law() {
     let mut gone = Vec::new();
     for t in volumes_near(&body, c).into_iter().take(3) {
         let m_t = body.attrs().tet_mass(t);
-        let r = remove_volume(&mut body, t).unwrap();
-        assert!(close(r.removed_mass, m_t, 1e-15), "removed {} ≠ tet mass {m_t}", r.removed_mass);
-        laws.removed += r.removed_mass;
-        laws.after(&body, &r.touched, "remove");
+        let removed = laws.remove(&mut body, t, "remove");
+        assert!(close(removed, m_t, 1e-15), "removed {removed} ≠ tet mass {m_t}");
         gone.push(t);
     }
     refused(&mut body, "removed tet", |b| remove_volume(b, gone[0]), |e| matches!(e, CutError::NoSuchVolume(_)));
@@ -357,9 +364,7 @@ fn uniform_and_coupled_refinements_then_cuts() {
     let r = incise_plane(&mut body, &Plane { point: [1.0, 1.0, 1.1], normal: [0.0, 0.0, 1.0] }).unwrap();
     laws.after(&body, &r.touched, "uniform: incise");
     for t in volumes_near(&body, [1.0; 3]).into_iter().take(4) {
-        let r = remove_volume(&mut body, t).unwrap();
-        laws.removed += r.removed_mass;
-        laws.after(&body, &r.touched, "uniform: remove");
+        laws.remove(&mut body, t, "uniform: remove");
     }
 
     // Coupled.
@@ -494,9 +499,7 @@ fn cut_then_refine_keeps_mass_and_laws() {
         }
     }
     let t = volumes_near(&body, [0.5, 0.5, 0.5])[0];
-    let r = remove_volume(&mut body, t).unwrap();
-    laws.removed += r.removed_mass;
-    laws.after(&body, &r.touched, "remove");
+    laws.remove(&mut body, t, "remove");
     let v = inner_vertices_near(&body, [2.0, 2.0, 2.0])[0];
     let r = tear_vertex(&mut body, v, [1.0, 0.0, 0.0], None).unwrap();
     laws.after(&body, &r.touched, "tear");
@@ -604,9 +607,7 @@ fn cut_refine_cut_round_trip() {
     laws.after(&body2, &r.touched, "incise again");
     assert_eq!(components(&body2).len(), 4);
     for t in volumes_near(&body2, [1.0; 3]).into_iter().take(6) {
-        let r = remove_volume(&mut body2, t).unwrap();
-        laws.removed += r.removed_mass;
-        laws.after(&body2, &r.touched, "remove after refine");
+        laws.remove(&mut body2, t, "remove after refine");
     }
 }
 
@@ -976,9 +977,7 @@ fn the_closure_of_a_leveled_through_cut_is_a_body_that_cuts_again() {
     let r = incise_plane(&mut body, &Plane { point: [1.0, 1.0, 1.0], normal: [1.0, 0.0, 0.0] }).unwrap();
     laws.after(&body, &r.touched, "incise the closure");
     for t in volumes_near(&body, [1.0; 3]).into_iter().take(5) {
-        let r = remove_volume(&mut body, t).unwrap();
-        laws.removed += r.removed_mass;
-        laws.after(&body, &r.touched, "remove from the closure");
+        laws.remove(&mut body, t, "remove from the closure");
     }
 }
 

@@ -200,9 +200,12 @@ fn every_truncation_is_an_error_never_a_panic() {
 fn unknown_versions_sections_and_flags_are_refused_clearly() {
     let doc = Document::from_leveled(&small());
     let text = String::from_utf8(store::encode(&doc, Format::Text).unwrap()).unwrap();
+    let e = store::decode(text.replacen("topomech-gmap 2 2", "topomech-gmap 4 2", 1).as_bytes()).unwrap_err();
+    assert!(matches!(e, StoreError::UnsupportedVersion { found: 4, .. }), "{e}");
+    assert!(e.to_string().contains("line 1") && e.to_string().contains("versions 1 to 3"), "{e}");
+    // A version-2 levels section under a version-3 header: the origin count is missing.
     let e = store::decode(text.replacen("topomech-gmap 2 2", "topomech-gmap 3 2", 1).as_bytes()).unwrap_err();
-    assert!(matches!(e, StoreError::UnsupportedVersion { found: 3, .. }), "{e}");
-    assert!(e.to_string().contains("line 1") && e.to_string().contains("versions 1 to 2"), "{e}");
+    assert!(e.to_string().contains("levels"), "{e}");
     // A levels section in a version-1 file.
     let e = store::decode(text.replacen("topomech-gmap 2 2", "topomech-gmap 1 2", 1).as_bytes()).unwrap_err();
     assert!(matches!(e, StoreError::Inconsistent { .. }) && e.to_string().contains("version 2"), "{e}");
@@ -219,8 +222,10 @@ fn unknown_versions_sections_and_flags_are_refused_clearly() {
         reseal(&mut b);
         store::decode(&b).unwrap_err()
     };
-    let e = edit(8, 3);
-    assert!(matches!(e, StoreError::UnsupportedVersion { found: 3, .. }) && e.to_string().contains("byte 8"), "{e}");
+    let e = edit(8, 4);
+    assert!(matches!(e, StoreError::UnsupportedVersion { found: 4, .. }) && e.to_string().contains("byte 8"), "{e}");
+    // A version-2 levels section under a version-3 header: the origin count is missing.
+    assert!(matches!(edit(8, 3), StoreError::Truncated { .. }), "{}", edit(8, 3));
     let e = edit(8, 1);
     assert!(matches!(e, StoreError::Inconsistent { .. }) && e.to_string().contains("version 2"), "{e}");
     let e = edit(16, 2 | 4);

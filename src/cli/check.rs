@@ -104,7 +104,7 @@ fn json_report(
 
 /// Stable law names: involution, quasi_manifold, cell_id_constant, cell_id_unique, body_state,
 /// conservation, and for levels: level_record, mu_order, mu_constant, level_closed, level_valid,
-/// flat_flag (and structure, which a decoded file never has).
+/// flat_flag, own_level, split_log, vertex_origin (and structure, which a decoded file never has).
 fn law_name(f: &Finding) -> &'static str {
     match f {
         Finding::Map(v) => map_law_name(v),
@@ -115,6 +115,11 @@ fn law_name(f: &Finding) -> &'static str {
             LevelError::NotClosed { .. } => "level_closed",
             LevelError::InvalidLevel { .. } | LevelError::InvalidMap(_) => "level_valid",
             LevelError::FlatFlag { .. } => "flat_flag",
+            LevelError::SplitLog { .. } => "split_log",
+            LevelError::NotAtOwnLevel { .. } => "own_level",
+            LevelError::OriginNotRoot { .. }
+            | LevelError::OriginElsewhere { .. }
+            | LevelError::OriginTwiceInCell { .. } => "vertex_origin",
         },
         Finding::Level(_) => "level_record",
         Finding::LevelMap { .. } => "level_valid",
@@ -164,13 +169,22 @@ fn level_darts(e: &LevelPartsError) -> Vec<u32> {
         LevelPartsError::Law(
             LevelError::MuOrder { dart, .. }
             | LevelError::AboveMaxLevel { dart, .. }
-            | LevelError::FlatFlag { dart, .. },
+            | LevelError::FlatFlag { dart, .. }
+            | LevelError::OriginTwiceInCell { dart, .. },
         ) => vec![dart.0],
+        LevelPartsError::Law(LevelError::NotAtOwnLevel { dart, escape, .. }) => {
+            std::iter::once(dart.0).chain(escape.map(|y| y.0)).collect()
+        }
         LevelPartsError::Law(LevelError::MuNotConstant { dart, other, .. }) => vec![dart.0, other.0],
         LevelPartsError::Law(LevelError::NotClosed { dart, image, .. }) => vec![dart.0, image.0],
         LevelPartsError::Law(LevelError::InvalidLevel { source: v, .. } | LevelError::InvalidMap(v)) => {
             violation_darts(v)
         }
-        LevelPartsError::WrongLength { .. } | LevelPartsError::MaxLevelTooHigh(_) => Vec::new(),
+        LevelPartsError::WrongLength { .. }
+        | LevelPartsError::MaxLevelTooHigh(_)
+        | LevelPartsError::BadOrigin { .. }
+        | LevelPartsError::Law(
+            LevelError::SplitLog { .. } | LevelError::OriginNotRoot { .. } | LevelError::OriginElsewhere { .. },
+        ) => Vec::new(),
     }
 }

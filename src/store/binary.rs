@@ -2,7 +2,8 @@
 
 use super::raw::{IdAllocRecord, RawMap, RawMechanics, VertexRecord, UNSET};
 use super::{
-    structure, Document, StoreError, Where, BINARY_MAGIC, LEVELS_VERSION, MAX_DIMENSION, MIN_VERSION, VERSION,
+    structure, Document, StoreError, Where, BINARY_MAGIC, LEVELS_VERSION, MAX_DIMENSION, MIN_VERSION, ORIGINS_VERSION,
+    VERSION,
 };
 use crate::subdivide::{DartLevels, HistoryEntry, LevelParts, Mu};
 
@@ -37,7 +38,7 @@ pub(super) fn encode(doc: &Document) -> Vec<u8> {
         encode_mechanics(&mut p, mech);
     }
     if let Some(levels) = &doc.levels {
-        encode_levels(&mut p, levels, &m.live());
+        encode_levels(&mut p, levels, &m.live(), doc.version());
     }
     let mut out = Vec::with_capacity(HEADER + p.len() + 8);
     out.extend_from_slice(&BINARY_MAGIC);
@@ -76,8 +77,8 @@ fn encode_mechanics(p: &mut Vec<u8>, m: &RawMechanics) {
 }
 
 /// u8 max level; per live dart (increasing id): u8 level, μa, μf, μt, flat, u32 h, h × (u8 level,
-/// u8 j, u32 old); u32 np, np × 3 f64.
-fn encode_levels(p: &mut Vec<u8>, l: &LevelParts, live: &[bool]) {
+/// u8 j, u32 old); u32 np, np × 3 f64; from version 3 on, u32 no, no × (u32 copy, u32 origin).
+fn encode_levels(p: &mut Vec<u8>, l: &LevelParts, live: &[bool], version: u32) {
     p.push(l.max_level);
     for rec in l.darts.iter().enumerate().filter(|&(d, _)| live[d]).map(|(_, r)| r) {
         p.extend_from_slice(&[rec.level, rec.mu.edge, rec.mu.face, rec.mu.tet, u8::from(rec.flat)]);
@@ -89,6 +90,10 @@ fn encode_levels(p: &mut Vec<u8>, l: &LevelParts, live: &[bool]) {
     }
     p.extend_from_slice(&(l.points.len() as u32).to_le_bytes());
     l.points.iter().flatten().for_each(|x| p.extend_from_slice(&x.to_bits().to_le_bytes()));
+    if version >= ORIGINS_VERSION {
+        p.extend_from_slice(&(l.origins.len() as u32).to_le_bytes());
+        l.origins.iter().flatten().for_each(|x| p.extend_from_slice(&x.to_le_bytes()));
+    }
 }
 
 /// A bounds-checked little-endian reader that knows its absolute offset.
@@ -209,7 +214,7 @@ pub(super) fn decode(bytes: &[u8]) -> Result<Document, StoreError> {
     let mut r = Reader { bytes: &bytes[..end], pos: HEADER };
     let map = decode_map(&mut r, dim)?;
     let mechanics = if flags & FLAG_MECHANICS != 0 { Some(decode_mechanics(&mut r)?) } else { None };
-    let levels = if flags & FLAG_LEVELS != 0 { Some(decode_levels(&mut r, &map)?) } else { None };
+    let levels = if flags & FLAG_LEVELS != 0 { Some(decode_levels(&mut r, &map, version)?) } else { None };
     if r.pos != end {
         return Err(StoreError::TrailingData { at: Where::Byte(r.pos) });
     }
@@ -278,8 +283,9 @@ fn decode_mechanics(r: &mut Reader<'_>) -> Result<RawMechanics, StoreError> {
     Ok(m)
 }
 
-/// The levels section (structure only: flags 0|1, j ≤ n, old < capacity, finite points).
-fn decode_levels(r: &mut Reader<'_>, map: &RawMap) -> Result<LevelParts, StoreError> {
+/// The levels section (structure only: flags 0|1, j ≤ n, old < capacity, finite points; the
+/// origin pairs of version 3 are judged by the level laws).
+fn decode_levels(r: &mut Reader<'_>, map: &RawMap, version: u32) -> Result<LevelParts, StoreError> {
     let max_level = r.u8("the max level")?;
     let alive = map.live();
     let mut darts = vec![DartLevels::default(); map.capacity as usize];
@@ -309,5 +315,13 @@ fn decode_levels(r: &mut Reader<'_>, map: &RawMap) -> Result<LevelParts, StoreEr
     for k in 0..np {
         points.push([r.f64("point", k)?, r.f64("point", k)?, r.f64("point", k)?]);
     }
-    Ok(LevelParts { max_level, darts, points })
+    let mut origins = Vec::new();
+    if version >= ORIGINS_VERSION {
+        let no = r.count("origin pairs", 8)?;
+        origins.reserve_exact(no);
+        for _ in 0..no {
+            origins.push([r.u32("a copied vertex")?, r.u32("an origin")?]);
+        }
+    }
+    Ok(LevelParts { max_level, darts, points, origins })
 }

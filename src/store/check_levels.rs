@@ -1,7 +1,8 @@
 //! The level laws of a document's levels part, every violation listed (what `topomech check`
 //! prints for a leveled map): malformed records, μt ≤ μf ≤ μa at every dart, μ constant on the
 //! cells of the finest map, every level G_0 … G_k closed, an involution at every dart and a
-//! valid G-map, and every dart's flat flag the one its level and link history determine.
+//! valid G-map, every dart's flat flag the one its level and link history determine, and the
+//! laws of the vertices' past (origins of cut copies, the split log the history witnesses).
 
 use crate::gmap::InvariantViolation;
 use crate::subdivide::{record_errors, LevelError, LevelParts, LevelPartsError, LeveledMap};
@@ -100,6 +101,10 @@ fn every_level<const N: usize>(m: LeveledMap<N>, out: &mut Collector) -> bool {
     let flats = m.flat_errors(usize::MAX);
     broken |= !flats.is_empty();
     flats.into_iter().for_each(|e| out.push(Finding::Level(LevelPartsError::Law(e))));
+    // Top cells at their own level, then the vertices' past (origins, the split log).
+    let past: Vec<LevelError> = m.own_level_errors(usize::MAX).into_iter().chain(m.past_errors(usize::MAX)).collect();
+    broken |= !past.is_empty();
+    past.into_iter().for_each(|e| out.push(Finding::Level(LevelPartsError::Law(e))));
     broken
 }
 

@@ -61,11 +61,14 @@ use crate::{GMap, InvariantViolation};
 
 /// The newest version of both forms: this library reads versions [`MIN_VERSION`]`..=VERSION`.
 /// It writes version 2 for a document with a levels part and version 1 otherwise.
-pub const VERSION: u32 = 2;
+pub const VERSION: u32 = 3;
 /// The oldest version this library reads (and writes for documents without levels).
 pub const MIN_VERSION: u32 = 1;
 /// The first version that may hold a levels part.
 pub const LEVELS_VERSION: u32 = 2;
+/// The first version that holds the origins of a leveled map's cut copies
+/// ([`LevelParts::origins`]); written only for a levels part that has some.
+pub const ORIGINS_VERSION: u32 = 3;
 /// First token of the text form.
 pub const TEXT_MAGIC: &str = "topomech-gmap";
 /// First 8 bytes of the binary form (the CR LF catches text-mode transfers).
@@ -376,7 +379,8 @@ impl Document {
         Document { map: RawMap::from_map(m.map()), mechanics: None, levels: Some(parts) }
     }
 
-    /// The version a document is written with: [`LEVELS_VERSION`] with a levels part,
+    /// The version a document is written with, the lowest that holds it: [`ORIGINS_VERSION`]
+    /// with a levels part that has origins, [`LEVELS_VERSION`] with another levels part,
     /// [`MIN_VERSION`] without. O(1).
     ///
     /// # Examples
@@ -392,10 +396,10 @@ impl Document {
     /// assert_eq!(Document::from_leveled(&m).version(), store::LEVELS_VERSION);
     /// ```
     pub fn version(&self) -> u32 {
-        if self.levels.is_some() {
-            LEVELS_VERSION
-        } else {
-            MIN_VERSION
+        match &self.levels {
+            Some(l) if !l.origins.is_empty() => ORIGINS_VERSION,
+            Some(_) => LEVELS_VERSION,
+            None => MIN_VERSION,
         }
     }
 

@@ -3,7 +3,10 @@
 use std::fmt::Write as _;
 
 use super::raw::{IdAllocRecord, RawMap, RawMechanics, VertexRecord, UNSET};
-use super::{structure, Document, StoreError, Where, LEVELS_VERSION, MAX_DIMENSION, MIN_VERSION, TEXT_MAGIC, VERSION};
+use super::{
+    structure, Document, StoreError, Where, LEVELS_VERSION, MAX_DIMENSION, MIN_VERSION, ORIGINS_VERSION, TEXT_MAGIC,
+    VERSION,
+};
 use crate::subdivide::{DartLevels, HistoryEntry, LevelParts, Mu};
 
 /// Writes the document. Floats use Rust's shortest round-trip notation (`{:?}`). O(size).
@@ -35,7 +38,7 @@ pub(super) fn encode(doc: &Document) -> String {
         encode_mechanics(&mut s, mech);
     }
     if let Some(levels) = &doc.levels {
-        encode_levels(&mut s, levels, &live);
+        encode_levels(&mut s, levels, &live, doc.version());
     }
     s.push_str("end\n");
     s
@@ -85,10 +88,15 @@ fn encode_mechanics(s: &mut String, m: &RawMechanics) {
     }
 }
 
-/// `levels K LIVE NP`, one `l` line per live dart (increasing id), one `p` line per point.
-fn encode_levels(s: &mut String, l: &LevelParts, live: &[bool]) {
+/// `levels K LIVE NP` (version 3: `levels K LIVE NP NO`), one `l` line per live dart
+/// (increasing id), one `p` line per point, (version 3) one `o COPY ORIGIN` line per origin pair.
+fn encode_levels(s: &mut String, l: &LevelParts, live: &[bool], version: u32) {
     let live_count = live.iter().filter(|&&x| x).count();
-    let _ = writeln!(s, "levels {} {live_count} {}", l.max_level, l.points.len());
+    let _ = write!(s, "levels {} {live_count} {}", l.max_level, l.points.len());
+    if version >= ORIGINS_VERSION {
+        let _ = write!(s, " {}", l.origins.len());
+    }
+    s.push('\n');
     for (d, rec) in l.darts.iter().enumerate().filter(|&(d, _)| live[d]) {
         let Mu { edge, face, tet } = rec.mu;
         let _ = write!(s, "l {d} {} {edge} {face} {tet} {} {}", rec.level, u8::from(rec.flat), rec.history.len());
@@ -101,6 +109,11 @@ fn encode_levels(s: &mut String, l: &LevelParts, live: &[bool]) {
         let _ = write!(s, "p {k}");
         floats(s, p);
         s.push('\n');
+    }
+    if version >= ORIGINS_VERSION {
+        l.origins.iter().for_each(|[copy, origin]| {
+            let _ = writeln!(s, "o {copy} {origin}");
+        });
     }
 }
 
@@ -316,7 +329,7 @@ pub(super) fn decode(bytes: &[u8]) -> Result<Document, StoreError> {
             let message = format!("a levels section needs format version {LEVELS_VERSION}, the header says {version}");
             return Err(StoreError::Inconsistent { at: Where::Line(no), message });
         }
-        Some(&"levels") => Some(decode_levels(&mut lines, no, &head, &map)?),
+        Some(&"levels") => Some(decode_levels(&mut lines, no, &head, &map, version)?),
         _ => {
             lines.back();
             None
@@ -557,10 +570,18 @@ fn int8(tok: &str, line: usize, what: &str) -> Result<u8, StoreError> {
     u8::try_from(v).map_err(|_| syntax(line, format!("{what}: {v} does not fit in 8 bits")))
 }
 
-/// `levels K LIVE NP` (already read as `head`), then the `l` and `p` lines. Structure only:
-/// one `l` line per live dart in increasing id order, j ≤ n, old < capacity, finite points.
-fn decode_levels(lines: &mut Lines<'_>, no: usize, head: &[&str], map: &RawMap) -> Result<LevelParts, StoreError> {
-    arity(head, 4, no, "levels")?;
+/// `levels K LIVE NP` (version 3: `levels K LIVE NP NO`, already read as `head`), then the `l`,
+/// `p` and (version 3) `o` lines. Structure only: one `l` line per live dart in increasing id
+/// order, j ≤ n, old < capacity, finite points (the origin pairs are judged by the level laws).
+fn decode_levels(
+    lines: &mut Lines<'_>,
+    no: usize,
+    head: &[&str],
+    map: &RawMap,
+    version: u32,
+) -> Result<LevelParts, StoreError> {
+    let with_origins = version >= ORIGINS_VERSION;
+    arity(head, if with_origins { 5 } else { 4 }, no, "levels")?;
     let max_level = int8(head[1], no, "max level")?;
     let live: Vec<u32> = {
         let alive = map.live();
@@ -587,7 +608,20 @@ fn decode_levels(lines: &mut Lines<'_>, no: usize, head: &[&str], map: &RawMap) 
         let xs = floats_of(&t[2..], no, "point", k)?;
         points.push([xs[0], xs[1], xs[2]]);
     }
-    Ok(LevelParts { max_level, darts, points })
+    let mut origins = Vec::new();
+    if with_origins {
+        let count = int(head[4], no, "origin pairs")?;
+        if count > lines.remaining() as u64 {
+            let limit = lines.remaining() as u64;
+            return Err(StoreError::BadCount { at: Where::Line(no), what: "origin pairs", count, limit });
+        }
+        for k in 0..count {
+            let (no, t) = lines.next("o", &format!("origin pair {k} \"o COPY ORIGIN\""))?;
+            arity(&t, 3, no, "o")?;
+            origins.push([int32(t[1], no, "copied vertex")?, int32(t[2], no, "origin")?]);
+        }
+    }
+    Ok(LevelParts { max_level, darts, points, origins })
 }
 
 /// `l D LEVEL MUA MUF MUT FLAT H (LEVEL J OLD){H}` for live dart `d`.

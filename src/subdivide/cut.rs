@@ -41,30 +41,19 @@ impl LeveledMap<3> {
         if let Some(&x) = side.iter().find(|&&x| self.map.is_free(3, x)) {
             return Err(SubdivideError::FaceNotSewn(x));
         }
-        // (dart, its vertex id, its position) on both sides, before the cut.
+        // (dart, its vertex id, its position) on both sides, before the cut: `finish` records
+        // the copies among them before it checks the laws.
         let before: Vec<(DartId, u32, [f64; 3])> = side
             .iter()
             .flat_map(|&x| [x, self.map.alpha::<3>(x)])
             .map(|x| (x, self.map.vertex_id(x).0, self.position(x)))
             .collect();
         self.begin(level);
+        self.op.cut_darts = before;
         for &x in &side {
             self.unlink(3, x);
         }
         self.finish();
-        for (x, old, p) in before {
-            let v = self.map.vertex_id(x).0;
-            if v != old {
-                self.set_vertex_origin(v, old);
-            }
-            if !self.points.is_empty() {
-                let v = v as usize;
-                if self.points.len() <= v {
-                    self.points.resize(v + 1, [0.0; 3]);
-                }
-                self.points[v] = p;
-            }
-        }
         Ok(side.len())
     }
 }

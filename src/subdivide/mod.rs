@@ -36,6 +36,8 @@ pub mod fuzz;
 mod history;
 mod ops;
 mod orient;
+mod origins;
+mod own_level;
 mod parts;
 mod region;
 mod springs;
@@ -515,6 +517,60 @@ pub enum LevelError {
         /// The flag stored for it.
         flat: bool,
     },
+    /// The split log disagrees with the link history on an inserted vertex (module `origins`:
+    /// the history witnesses each edge split; ids are [origins](LeveledMap::vertex_origin)):
+    /// the log has no entry, a second entry, or other ends for it, or two witnesses disagree.
+    #[error("split log: vertex {vertex} has the ends {logged:?} in the log but {witnessed:?} in the link history")]
+    SplitLog {
+        /// The inserted vertex (an origin).
+        vertex: u32,
+        /// Its ends in the log (increasing), if it has an entry.
+        logged: Option<[u32; 2]>,
+        /// Its ends as the history witnesses them (increasing), if it does.
+        witnessed: Option<[u32; 2]>,
+    },
+    /// A cut's copy has an origin that is itself a copy.
+    #[error("vertex {vertex} has the origin {origin}, which is a copy of {origin_of_origin}")]
+    OriginNotRoot {
+        /// The copy.
+        vertex: u32,
+        /// Its origin.
+        origin: u32,
+        /// The origin's own origin.
+        origin_of_origin: u32,
+    },
+    /// A cut's copy does not lie at the point of its origin.
+    #[error("vertex {vertex} does not lie at the point of its origin {origin}")]
+    OriginElsewhere {
+        /// The copy.
+        vertex: u32,
+        /// Its origin.
+        origin: u32,
+    },
+    /// A top cell (a volume in 3D, a face in 2D) is not a cell of the level its μ names
+    /// (module `own_level`): it has no dart of that level (`escape` = `None`), or its orbit at
+    /// that level reaches `escape`, a dart of another cell (the cell is part of a coarser one
+    /// there).
+    #[error("the top cell of {dart} is no cell of its level {level} ({})", .escape.map_or("it has no dart of that level".to_string(), |y| format!("at that level it reaches {y} of another cell")))]
+    NotAtOwnLevel {
+        /// A dart of the cell.
+        dart: DartId,
+        /// Its resolution level (μt, μf in 2D).
+        level: u8,
+        /// A dart of another cell its orbit at that level reaches, if any.
+        escape: Option<DartId>,
+    },
+    /// An n-cell (a volume in 3D) has two vertices with one origin: a cut never splits a vertex
+    /// inside a cell.
+    #[error("the top cell of {dart} has the vertices {} and {} of one origin {origin}", .vertices[0], .vertices[1])]
+    OriginTwiceInCell {
+        /// A dart of the cell.
+        dart: DartId,
+        /// The shared origin.
+        origin: u32,
+        /// The two vertices (increasing).
+        vertices: [u32; 2],
+    },
 }
 
 /// An extracted level G_i together with the ids its darts have in the leveled map.
@@ -675,6 +731,9 @@ impl<const N: usize> LeveledMap<N> {
     /// counted exactly before it starts, see [`SubdivideError::DartLimit`]) exceeds it is refused
     /// with [`SubdivideError::DartLimit`] before it changes anything.
     /// Default [`DEFAULT_MAX_DARTS`]. Single operations (`subdivide_tet`, …) are not limited.
+    /// A limit of the running process, not a record of the map: not saved by
+    /// [`Self::to_parts`] or the store, so a loaded map has the default until it is set again
+    /// (finding 337).
     /// O(1).
     ///
     /// # Examples
@@ -820,10 +879,13 @@ impl<const N: usize> LeveledMap<N> {
         &self.points
     }
 
-    /// Every vertex inserted on an edge since this map was created or loaded, in insertion order, as
-    /// `[new vertex id, end vertex id, end vertex id]` (the ends of the edge it split; vertex ids
-    /// never change, so the entries stay valid). [`LeveledMechanics`] follows the map with it.
-    /// Not saved by [`LeveledMap::to_parts`]. O(1).
+    /// Every vertex inserted on an edge, in insertion order, as `[new vertex id, end vertex id,
+    /// end vertex id]` (the ends of the edge it split; a cut may give a vertex copies, which
+    /// [`Self::vertex_origin`] maps back). [`LeveledMechanics`] follows the map with it, and the
+    /// lumped masses find hanging vertices through it. Not saved by [`LeveledMap::to_parts`]: the
+    /// link history holds it, and [`LeveledMap::from_parts`] rebuilds it
+    /// ([`Self::rebuild_split_log`]: ids as origins, ends increasing, in (level, vertex) order;
+    /// finding 336: a loaded map had an empty log, and lumped every midpoint as a corner). O(1).
     ///
     /// # Examples
     ///
@@ -848,8 +910,9 @@ impl<const N: usize> LeveledMap<N> {
     /// A copy lies where its origin lies and stands for it in [`Self::split_log`]: a volume's
     /// vertices have distinct origins (a cut splits a vertex between volumes, never inside one),
     /// and a cut vertex hangs on a volume exactly when its origin did (round 38: the lumped
-    /// masses treated a cut copy of a midpoint as a corner). Not saved by
-    /// [`LeveledMap::to_parts`]. O(1).
+    /// masses treated a cut copy of a midpoint as a corner). Saved by [`LeveledMap::to_parts`]
+    /// (as [`LevelParts::origins`]; finding 336: it was not, and a loaded map lumped cut
+    /// copies as corners). O(1).
     ///
     /// # Examples
     ///
@@ -882,7 +945,9 @@ impl<const N: usize> LeveledMap<N> {
 
     /// The edge cells of every entry of [`Self::split_log`] (same order, same length): which edge
     /// cell was split and which edge cells its halves are ([`EdgeSplit`]). Not saved by
-    /// [`LeveledMap::to_parts`]. O(1).
+    /// [`LeveledMap::to_parts`]: a loaded map starts an empty one (its [`Self::split_log`] is
+    /// rebuilt from the link history, but not the edge cells; a coupling, the only reader,
+    /// starts from level 0). O(1).
     ///
     /// # Examples
     ///
@@ -1075,7 +1140,7 @@ impl<const N: usize> LeveledMap<N> {
             let view = self.level(i)?;
             view.map.validate().map_err(|source| LevelError::InvalidLevel { level: i, source })?;
         }
-        match self.flat_errors(1).into_iter().next() {
+        match self.flat_errors(1).into_iter().chain(self.own_level_errors(1)).chain(self.past_errors(1)).next() {
             Some(e) => Err(e),
             None => Ok(()),
         }
@@ -1100,7 +1165,13 @@ impl<const N: usize> LeveledMap<N> {
     /// iff L ≥ 1, e = α1(d) ≠ d has level L, neither d nor e has an α1 history entry, and
     /// x = α0^L(d), y = α0^L(e) have the history entries (L, α0, y) and (L, α0, x) (its vertex
     /// was inserted on one edge at level L and no face split has made it a corner since;
-    /// [`LevelError::FlatFlag`]).
+    /// [`LevelError::FlatFlag`]); every top cell a cell of the level its μ names
+    /// ([`LevelError::NotAtOwnLevel`], module `own_level`); then the laws of the vertices' past
+    /// (module `origins`): origins
+    /// are roots lying at their copies' points, no top cell meets one origin twice
+    /// ([`LevelError::OriginNotRoot`], [`LevelError::OriginElsewhere`],
+    /// [`LevelError::OriginTwiceInCell`]), and the split log is what the link history witnesses
+    /// ([`LevelError::SplitLog`]).
     /// O(k · capacity · n²).
     ///
     /// # Examples
@@ -1124,9 +1195,19 @@ impl<const N: usize> LeveledMap<N> {
             view.map.validate().map_err(|source| LevelError::InvalidLevel { level: i, source })?;
         }
         // Every level is closed now, so the flat law reads live darts only.
-        match self.flat_errors(1).into_iter().next() {
+        match self.flat_errors(1).into_iter().chain(self.own_level_errors(1)).chain(self.past_errors(1)).next() {
             Some(e) => Err(e),
             None => Ok(()),
         }
+    }
+
+    /// The laws of the vertices' past (module `origins`): the first violation of the origin
+    /// laws, then of the split-log law, up to `limit`. O(darts · log + history entries).
+    pub(crate) fn past_errors(&self, limit: usize) -> Vec<LevelError> {
+        let mut out = self.origin_errors(limit);
+        if out.len() < limit {
+            out.extend(self.split_log_errors(limit - out.len()));
+        }
+        out
     }
 }

@@ -86,6 +86,9 @@ pub(super) struct OpLog {
     created: Vec<DartId>,
     /// Inserted vertices: (a dart at the new vertex, darts at the two end vertices).
     midpoints: Vec<(DartId, DartId, DartId)>,
+    /// Darts a cut may move to a new vertex: (dart, its vertex id and position before the
+    /// operation). A dart whose id changed records a copy of the old vertex (its origin).
+    pub(super) cut_darts: Vec<(DartId, u32, [f64; 3])>,
     /// Reusable sets and buffers.
     pub(super) scratch: Scratch,
 }
@@ -224,6 +227,22 @@ impl<const N: usize> LeveledMap<N> {
         self.op.midpoints.push((m, a, b));
     }
 
+    /// After a cut's relabelling: if the vertex of `x` is no longer `old`, it is a copy of `old`
+    /// ([`Self::vertex_origin`]) placed at `p`, the position `old` had. O(1) amortized.
+    fn note_copy(&mut self, x: DartId, old: u32, p: [f64; 3]) {
+        let v = self.map.vertex_id(x).0;
+        if v != old {
+            self.set_vertex_origin(v, old);
+        }
+        if !self.points.is_empty() {
+            let v = v as usize;
+            if self.points.len() <= v {
+                self.points.resize(v + 1, [0.0; 3]);
+            }
+            self.points[v] = p;
+        }
+    }
+
     /// The level of the running operation.
     pub(super) fn op_level(&self) -> u8 {
         self.op.level
@@ -255,6 +274,9 @@ impl<const N: usize> LeveledMap<N> {
                 }
                 self.points[v] = crate::mesh::midpoint(pa, pb);
             }
+        }
+        for (x, old, p) in std::mem::take(&mut self.op.cut_darts) {
+            self.note_copy(x, old, p);
         }
         self.max_level = self.max_level.max(self.op.level);
         self.bump_version();

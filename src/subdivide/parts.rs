@@ -87,6 +87,9 @@ pub struct LevelParts {
     pub darts: Vec<DartLevels>,
     /// Vertex positions keyed by vertex id (may be empty).
     pub points: Vec<[f64; 3]>,
+    /// The vertices a cut made, as (copy, [origin](LeveledMap::vertex_origin)) with copy ≠
+    /// origin, copies strictly increasing (empty when no cut split a vertex).
+    pub origins: Vec<[u32; 2]>,
 }
 
 /// Why [`LeveledMap::from_parts`] refused its input.
@@ -150,6 +153,17 @@ pub enum LevelPartsError {
         /// What is wrong.
         reason: &'static str,
     },
+    /// An origin pair is malformed: a vertex id at or past the map's vertex id bound, a copy
+    /// named as its own origin, or copies not strictly increasing.
+    #[error("origin pair {index} (vertex {}, origin {}) {reason}", .pair[0], .pair[1])]
+    BadOrigin {
+        /// Index of the pair in [`LevelParts::origins`].
+        index: usize,
+        /// The pair (copy, origin).
+        pair: [u32; 2],
+        /// What is wrong.
+        reason: &'static str,
+    },
     /// The records are well formed but a level law is broken.
     #[error("level law: {0}")]
     Law(#[from] LevelError),
@@ -197,8 +211,28 @@ pub fn record_errors<const N: usize>(map: &GMap<N>, parts: &LevelParts, limit: u
             }
         }
     }
+    for (index, &pair) in parts.origins.iter().enumerate() {
+        let before = index.checked_sub(1).map(|k| parts.origins[k][0]);
+        if let Some(reason) = origin_problem(pair, before, map.cell_id_bound(0)) {
+            out.push(LevelPartsError::BadOrigin { index, pair, reason });
+        }
+    }
     out.truncate(limit);
     out
+}
+
+/// What is wrong with the origin pair `[copy, origin]` after a pair of copy `before`, with
+/// `vertices` the map's vertex id bound, if anything. O(1).
+fn origin_problem([copy, origin]: [u32; 2], before: Option<u32>, vertices: usize) -> Option<&'static str> {
+    if copy as usize >= vertices || origin as usize >= vertices {
+        Some("names a vertex id past the map's vertex ids")
+    } else if copy == origin {
+        Some("names a vertex as its own origin")
+    } else if before.is_some_and(|b| b >= copy) {
+        Some("does not come after the previous copy")
+    } else {
+        None
+    }
 }
 
 /// What is wrong with `entry` after the entries `before` of the same dart, if anything.
@@ -224,8 +258,10 @@ fn history_problem<const N: usize>(
 }
 
 impl<const N: usize> LeveledMap<N> {
-    /// Copies the dart levels, μ, flat flags, histories, max level and points. O(capacity +
-    /// history entries + points).
+    /// Copies the dart levels, μ, flat flags, histories, max level, points and the origins of
+    /// the vertices a cut made ([`LeveledMap::vertex_origin`]). The split log is not copied: the
+    /// histories hold it ([`LeveledMap::rebuild_split_log`]). O(capacity + history entries +
+    /// points + vertices).
     ///
     /// ```
     /// use topomech::subdivide::LeveledMap;
@@ -247,7 +283,7 @@ impl<const N: usize> LeveledMap<N> {
                 history: self.history.of(k).map(|c| HistoryEntry { level: c.level, j: c.j, old: c.old }).collect(),
             })
             .collect();
-        LevelParts { max_level: self.max_level, darts, points: self.points.clone() }
+        LevelParts { max_level: self.max_level, darts, points: self.points.clone(), origins: self.origin_pairs() }
     }
 
     /// Rebuilds a leveled map from its finest map and its records. Records of dead dart slots are
@@ -255,11 +291,12 @@ impl<const N: usize> LeveledMap<N> {
     ///
     /// # Errors
     /// The first of [`record_errors`] ([`LevelPartsError::WrongLength`], `MaxLevelTooHigh`,
-    /// `DartLevelAboveMax`, `MuAboveMax`, `BadHistory`), then [`LevelPartsError::Law`] with the first level law
+    /// `DartLevelAboveMax`, `MuAboveMax`, `BadHistory`, `BadOrigin`), then [`LevelPartsError::Law`] with the first level law
     /// broken: a level not closed or not an involution at some dart, then (from
     /// [`Self::check_all`]) the finest map invalid, μ order or constancy, a level not a valid
     /// G-map, a flat flag other than the one the levels and history determine
-    /// ([`LevelError::FlatFlag`]).
+    /// ([`LevelError::FlatFlag`]), an origin law broken or a history that is no split log
+    /// ([`LevelError::SplitLog`]). [`LevelPartsError::BadOrigin`] comes with the record errors.
     ///
     /// # Examples
     ///
@@ -333,6 +370,14 @@ impl<const N: usize> LeveledMap<N> {
                 m.history.push(k, LinkChange { level: e.level, j: e.j, old: e.old });
             }
         }
+        // As given (not followed to a root as a cut records them): the laws judge them.
+        if let Some(&[last, _]) = parts.origins.iter().max_by_key(|p| p[0]) {
+            m.origins = (0..=last).collect();
+        }
+        for [copy, origin] in parts.origins {
+            m.origins[copy as usize] = origin;
+        }
+        m.splits = m.rebuild_split_log();
         m
     }
 }

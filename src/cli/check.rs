@@ -116,7 +116,7 @@ fn law_name(f: &Finding) -> &'static str {
             LevelError::InvalidLevel { .. } | LevelError::InvalidMap(_) => "level_valid",
             LevelError::FlatFlag { .. } => "flat_flag",
             LevelError::SplitLog { .. } => "split_log",
-            LevelError::NotAtOwnLevel { .. } => "own_level",
+            LevelError::NotAtOwnLevel { .. } | LevelError::AboveOwnLevel { .. } => "own_level",
             LevelError::OriginNotRoot { .. }
             | LevelError::OriginElsewhere { .. }
             | LevelError::OriginTwiceInCell { .. } => "vertex_origin",
@@ -170,7 +170,8 @@ fn level_darts(e: &LevelPartsError) -> Vec<u32> {
             LevelError::MuOrder { dart, .. }
             | LevelError::AboveMaxLevel { dart, .. }
             | LevelError::FlatFlag { dart, .. }
-            | LevelError::OriginTwiceInCell { dart, .. },
+            | LevelError::OriginTwiceInCell { dart, .. }
+            | LevelError::AboveOwnLevel { dart, .. },
         ) => vec![dart.0],
         LevelPartsError::Law(LevelError::NotAtOwnLevel { dart, escape, .. }) => {
             std::iter::once(dart.0).chain(escape.map(|y| y.0)).collect()

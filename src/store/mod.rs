@@ -28,9 +28,10 @@
 //! ```
 //!
 //! A leveled map ([`crate::subdivide::LeveledMap`]) adds an optional *levels* part
-//! ([`LevelParts`]: max level, per-dart level, μ, flat flag and link history, vertex positions);
-//! a file holding it is version 2 ([`save_leveled`] / [`load_leveled`]). Files without it are
-//! still written and read as version 1, byte for byte as before.
+//! ([`LevelParts`]: max level, per-dart level, μ, flat flag and link history, vertex positions,
+//! and the origins of the vertices a cut made inside it); a file holding it is version 2, or 3
+//! when it has origins ([`save_leveled`] / [`load_leveled`]). Files without it are still written
+//! and read as version 1, byte for byte as before.
 //!
 //! Writes are atomic: [`save_document`] (through [`write_atomically`]) writes a temporary file in
 //! the target's directory, flushes and fsyncs it, then renames it into place, so a crash or an
@@ -60,7 +61,7 @@ use crate::subdivide::{LevelPartsError, LeveledMap};
 use crate::{GMap, InvariantViolation};
 
 /// The newest version of both forms: this library reads versions [`MIN_VERSION`]`..=VERSION`.
-/// It writes version 2 for a document with a levels part and version 1 otherwise.
+/// It writes the lowest version that holds a document ([`Document::version`]).
 pub const VERSION: u32 = 3;
 /// The oldest version this library reads (and writes for documents without levels).
 pub const MIN_VERSION: u32 = 1;
@@ -330,8 +331,9 @@ pub struct Document {
     pub map: RawMap,
     /// The mechanical attributes of a body (3-G-maps only).
     pub mechanics: Option<RawMechanics>,
-    /// The levels of a leveled map (version 2): one record per dart slot (dead slots are not
-    /// stored and come back as defaults), the max level and the vertex positions.
+    /// The levels of a leveled map (version 2; 3 with origins): one record per dart slot (dead
+    /// slots are not stored and come back as defaults), the max level, the vertex positions and
+    /// the origins of a cut's copies.
     pub levels: Option<LevelParts>,
 }
 
@@ -773,7 +775,7 @@ pub fn load_leveled<const N: usize>(path: &Path) -> Result<LeveledMap<N>, StoreE
     read_document(path)?.into_leveled()
 }
 
-/// Saves a leveled map (version 2) in `format`, atomically. O(capacity · n + entries).
+/// Saves a leveled map (version 2, or 3 when a cut made copies) in `format`, atomically. O(capacity · n + entries).
 ///
 /// # Errors
 /// As [`save_document`].

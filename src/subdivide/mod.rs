@@ -547,18 +547,28 @@ pub enum LevelError {
         /// Its origin.
         origin: u32,
     },
-    /// A top cell (a volume in 3D, a face in 2D) is not a cell of the level its μ names
-    /// (module `own_level`): it has no dart of that level (`escape` = `None`), or its orbit at
-    /// that level reaches `escape`, a dart of another cell (the cell is part of a coarser one
-    /// there).
-    #[error("the top cell of {dart} is no cell of its level {level} ({})", .escape.map_or("it has no dart of that level".to_string(), |y| format!("at that level it reaches {y} of another cell")))]
+    /// A k-cell is not a cell of the level its μ names (module `own_level`): it has no dart of
+    /// that level (`escape` = `None`), or its orbit ⟨α0, …, α(k−1)⟩ at that level reaches
+    /// `escape`, a dart of another k-cell (the cell is part of a coarser one there).
+    #[error("the {dim}-cell of {dart} is no cell of its level {level} ({})", .escape.map_or("it has no dart of that level".to_string(), |y| format!("at that level it reaches {y} of another cell")))]
     NotAtOwnLevel {
+        /// The dimension k of the cell (1 edge, 2 face, 3 volume).
+        dim: usize,
         /// A dart of the cell.
         dart: DartId,
-        /// Its resolution level (μt, μf in 2D).
+        /// Its resolution level (μa, μf or μt).
         level: u8,
-        /// A dart of another cell its orbit at that level reaches, if any.
+        /// A dart of another k-cell its orbit at that level reaches, if any.
         escape: Option<DartId>,
+    },
+    /// A top cell (a volume in 3D, a face in 2D) with resolution level L > 0 was already a cell
+    /// at level L − 1: no operation of level L made it (module `own_level`, minimality).
+    #[error("the top cell of {dart} has the level {level} but was already a cell at level {}", .level - 1)]
+    AboveOwnLevel {
+        /// A dart of the cell.
+        dart: DartId,
+        /// Its resolution level.
+        level: u8,
     },
     /// An n-cell (a volume in 3D) has two vertices with one origin: a cut never splits a vertex
     /// inside a cell.
@@ -1165,8 +1175,9 @@ impl<const N: usize> LeveledMap<N> {
     /// iff L ≥ 1, e = α1(d) ≠ d has level L, neither d nor e has an α1 history entry, and
     /// x = α0^L(d), y = α0^L(e) have the history entries (L, α0, y) and (L, α0, x) (its vertex
     /// was inserted on one edge at level L and no face split has made it a corner since;
-    /// [`LevelError::FlatFlag`]); every top cell a cell of the level its μ names
-    /// ([`LevelError::NotAtOwnLevel`], module `own_level`); then the laws of the vertices' past
+    /// [`LevelError::FlatFlag`]); every cell a cell of the level its μ names, and a top cell
+    /// of no lower level ([`LevelError::NotAtOwnLevel`], [`LevelError::AboveOwnLevel`], module
+    /// `own_level`); then the laws of the vertices' past
     /// (module `origins`): origins
     /// are roots lying at their copies' points, no top cell meets one origin twice
     /// ([`LevelError::OriginNotRoot`], [`LevelError::OriginElsewhere`],

@@ -9,6 +9,9 @@ use topomech::mechanics::{check_conservation, Body, Integrator, Material, Simula
 use topomech::ops::same_raw;
 use topomech::store::{self, Document, Format};
 use topomech::subdivide::{LeveledMap, TetMasses};
+
+mod subdivide_common;
+use subdivide_common::canon_log;
 use topomech::{CellId, DartId, GMap};
 
 const FORMATS: [Format; 2] = [Format::Text, Format::Binary];
@@ -417,19 +420,7 @@ fn loaded_2d_leveled_map_follows_the_original() {
         assert!(same_raw(a.map(), b.map()));
         assert_eq!(a.to_parts(), b.to_parts());
         // The loaded log is rebuilt from the history (finding 336): by origins, the same entries.
-        let canon = |x: &LeveledMap<2>| {
-            let mut log: Vec<[u32; 3]> = x
-                .split_log()
-                .iter()
-                .map(|e| {
-                    let [v, p, q] = e.map(|u| x.vertex_origin(u));
-                    [v, p.min(q), p.max(q)]
-                })
-                .collect();
-            log.sort_unstable();
-            log
-        };
-        assert!(!b.split_log().is_empty() && canon(&a) == canon(&b), "{format:?}: the split logs agree");
+        assert!(!b.split_log().is_empty() && canon_log(&a) == canon_log(&b), "{format:?}: the split logs agree");
     }
 }
 
@@ -523,19 +514,7 @@ fn a_cut_leveled_map_keeps_its_origins_and_lumping_through_a_round_trip() {
         assert_eq!(masses.vertex_masses(&back).unwrap(), before, "{format:?}: lumped masses changed by save/load");
         assert_eq!(back.to_parts(), m.to_parts(), "{format:?}");
         // The rebuilt log says what the original says, by origins.
-        let canon = |x: &LeveledMap<3>| {
-            let mut log: Vec<[u32; 3]> = x
-                .split_log()
-                .iter()
-                .map(|e| {
-                    let [v, a, b] = e.map(|u| x.vertex_origin(u));
-                    [v, a.min(b), a.max(b)]
-                })
-                .collect();
-            log.sort_unstable();
-            log
-        };
-        assert_eq!(canon(&back), canon(&m), "{format:?}");
+        assert_eq!(canon_log(&back), canon_log(&m), "{format:?}");
         // Later refinement of both: equal masses per point.
         let mut a = m.clone();
         let (mut ma, mut mb) = (masses.clone(), masses.clone());

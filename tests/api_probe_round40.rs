@@ -9,6 +9,9 @@ use topomech::generate::{grid_triangles, kuhn_cube};
 use topomech::ops::same_raw;
 use topomech::store::{self, Document, Format};
 use topomech::subdivide::{LeveledMap, TetMasses};
+
+mod subdivide_common;
+use subdivide_common::canon_log;
 use topomech::{DartId, GMap};
 
 const FORMATS: [Format; 2] = [Format::Text, Format::Binary];
@@ -34,20 +37,6 @@ fn grid_leveled(k: usize) -> LeveledMap<2> {
     let (points, tris) = grid_triangles(k);
     let (map, _) = GMap::<2>::from_triangles(points.len(), &tris).unwrap();
     LeveledMap::new(map, points)
-}
-
-/// The split log read through origins, ends increasing, sorted.
-fn canon_log<const N: usize>(x: &LeveledMap<N>) -> Vec<[u32; 3]> {
-    let mut log: Vec<[u32; 3]> = x
-        .split_log()
-        .iter()
-        .map(|e| {
-            let [v, a, b] = e.map(|u| x.vertex_origin(u));
-            [v, a.min(b), a.max(b)]
-        })
-        .collect();
-    log.sort_unstable();
-    log
 }
 
 fn bits(v: &[f64]) -> Vec<u64> {

@@ -82,3 +82,19 @@ pub fn dart_rows<const N: usize>(map: &GMap<N>) -> String {
     }
     out
 }
+
+/// The split log read through [origins](LeveledMap::vertex_origin), ends increasing, sorted: what
+/// two maps with the same split history agree on, however their logs were written (a loaded
+/// map's log is rebuilt from its link history, finding 336). O(log length · log).
+pub fn canon_log<const N: usize>(x: &LeveledMap<N>) -> Vec<[u32; 3]> {
+    let mut log: Vec<[u32; 3]> = x
+        .split_log()
+        .iter()
+        .map(|e| {
+            let [v, a, b] = e.map(|u| x.vertex_origin(u));
+            [v, a.min(b), a.max(b)]
+        })
+        .collect();
+    log.sort_unstable();
+    log
+}

@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use proptest::prelude::*;
-use topomech::subdivide::fuzz::{decode, run_bytes, Mesh, Op};
+use topomech::subdivide::fuzz::{decode, is_cut_mode, run_bytes, Mesh, Op};
 
 #[test]
 fn every_subdivide_corpus_input_keeps_the_laws() {
@@ -13,20 +13,27 @@ fn every_subdivide_corpus_input_keeps_the_laws() {
     let mut entries: Vec<_> = std::fs::read_dir(&dir).expect("corpus directory").map(|e| e.unwrap().path()).collect();
     entries.sort();
     assert!(
-        entries.len() >= 48,
-        "the committed corpus holds at least this many inputs (finding 326), found {}",
+        entries.len() >= 64,
+        "the committed corpus holds at least this many inputs (finding 326; 16 in cut mode), found {}",
         entries.len()
     );
-    let (mut applied, mut refused, mut top) = (0, 0, 0);
+    let (mut applied, mut refused, mut top, mut cuts, mut reloads) = (0, 0, 0, 0, 0);
     let mut meshes = [0; 3];
+    let mut cut_meshes = [0; 3];
     for path in entries {
         let bytes = std::fs::read(&path).unwrap();
-        meshes[decode(&bytes).0 as usize] += 1;
+        let mesh = decode(&bytes).0 as usize;
+        meshes[mesh] += 1;
+        if is_cut_mode(&bytes) {
+            cut_meshes[mesh] += 1;
+        }
         match run_bytes(&bytes) {
             Ok(r) => {
                 applied += r.applied;
                 refused += r.refused;
                 top = top.max(r.max_level);
+                cuts += r.cuts;
+                reloads += r.reloads;
             }
             Err(message) => panic!("{}: {message}", path.display()),
         }
@@ -35,6 +42,9 @@ fn every_subdivide_corpus_input_keeps_the_laws() {
     assert!(applied >= 100 && refused >= 10, "applied {applied}, refused {refused}");
     assert!(top >= 2, "the corpus never goes beyond level {top}");
     assert!(meshes.iter().all(|&n| n > 0), "meshes covered: {meshes:?}");
+    // Cut mode: cuts and reloads on every mesh, so that the later ops run on reloaded copies.
+    assert!(cut_meshes.iter().all(|&n| n > 0), "meshes covered in cut mode: {cut_meshes:?}");
+    assert!(cuts >= 20 && reloads >= 20, "cuts {cuts}, reloads {reloads}");
 }
 
 #[test]
@@ -64,6 +74,39 @@ proptest! {
     #![proptest_config(ProptestConfig { cases: 32, ..ProptestConfig::default() })]
     #[test]
     fn random_subdivision_sequences_keep_every_law(bytes in prop::collection::vec(any::<u8>(), 0..31)) {
+        if let Err(message) = run_bytes(&bytes) {
+            prop_assert!(false, "{}", message);
+        }
+    }
+}
+
+/// Cut mode (bit 7 of byte 0): the cube, a cut one level up, a binary reload, a 1→8 one level
+/// up (applied to the copy too), a text reload, a cut at the maximum level.
+#[test]
+fn cut_mode_cuts_reloads_and_refines_the_copy_alike() {
+    let bytes = [0x81, 0x84, 0, 3, 0x85, 0, 0, 0x82, 0, 9, 0x05, 0, 0, 0x04, 0, 11];
+    let (_, ops) = decode(&bytes);
+    assert_eq!(ops[0], Op::Cut { pick: 3, up: true });
+    assert_eq!((ops[1], ops[3]), (Op::Reload { binary: true }, Op::Reload { binary: false }));
+    let r = run_bytes(&bytes).unwrap();
+    assert_eq!((r.cuts, r.reloads), (2, 2), "{r:?}");
+    assert_eq!((r.applied, r.refused, r.max_level), (3, 0, 2), "{r:?}");
+    // The grid: a cut is a reload in 2D.
+    let r = run_bytes(&[0x80, 0x81, 0, 0, 0x04, 0, 0, 0x81, 0, 1]).unwrap();
+    assert_eq!((r.cuts, r.reloads, r.applied), (0, 1, 2), "{r:?}");
+    // The single tet has no sewn face: the cut is refused, the map unchanged.
+    let r = run_bytes(&[0x82, 0x84, 0, 0]).unwrap();
+    assert_eq!((r.cuts, r.refused, r.max_level), (0, 1, 0), "{r:?}");
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+    #[test]
+    fn random_cut_and_subdivide_sequences_keep_every_law(
+        mesh in 0u8..3,
+        ops in prop::collection::vec(any::<u8>(), 0..40),
+    ) {
+        let bytes: Vec<u8> = std::iter::once(0x80 | mesh).chain(ops).collect();
         if let Err(message) = run_bytes(&bytes) {
             prop_assert!(false, "{}", message);
         }

@@ -5,7 +5,7 @@
 use proptest::prelude::*;
 use topomech::generate::kuhn_cube;
 use topomech::mechanics::{Integrator, Material, SpringSystem, StepConfig, Stepper, Vec3};
-use topomech::subdivide::fuzz::{decode, Op, MAX_DARTS, MAX_FUZZ_LEVEL};
+use topomech::subdivide::fuzz::{Op, MAX_DARTS, MAX_FUZZ_LEVEL};
 use topomech::subdivide::{CouplingError, EdgeKey, LeveledMap, LeveledMechanics, SpringLawError, SubdivideError};
 use topomech::{DartId, GMap};
 
@@ -41,7 +41,18 @@ fn apply(mech: &mut LeveledMechanics, m: &mut LeveledMap<3>, op: Op) -> Result<(
             let levels = level_of(m, true);
             mech.refine_around(m, c, f64::from(radius) / 255.0, levels).map(drop)
         }
+        Op::Cut { .. } | Op::Reload { .. } => unreachable!("decoded without cut mode"),
     }
+}
+
+/// The decoder's mesh and ops of `bytes` outside cut mode (bit 7 of byte 0 cleared): the
+/// coupling cannot follow a cut.
+fn decode(bytes: &[u8]) -> (topomech::subdivide::fuzz::Mesh, Vec<Op>) {
+    let mut bytes = bytes.to_vec();
+    if let Some(b) = bytes.first_mut() {
+        *b &= 0x7f;
+    }
+    topomech::subdivide::fuzz::decode(&bytes)
 }
 
 /// Every vertex inserted since `from` (split log index) has the mean position and velocity of its

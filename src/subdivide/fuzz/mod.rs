@@ -3,8 +3,9 @@
 //! replay of the committed corpus `fuzz/corpus/subdivide/` on stable (one decoder, three engines).
 //!
 //! # Decoding
-//! Byte 0 picks the mesh: a 2×2 triangle grid (2-G-map), the Kuhn cube k = 1 (6 tets) or one
-//! tetrahedron (3-G-maps). Then every 3 bytes make one [`Op`]: byte a picks the kind (a % 4: edge
+//! Byte 0 picks the mesh (its low 7 bits % 3): a 2×2 triangle grid (2-G-map), the Kuhn cube k = 1 (6 tets)
+//! or one tetrahedron (3-G-maps), and the mode (its bit 7, [`is_cut_mode`]). Then every 3 bytes
+//! make one [`Op`]: byte a picks the kind (a % 4: edge
 //! split, triangle 1→4, tet 1→8, refinement around a ball; in 2D a tet 1→8 becomes a triangle
 //! split and a ball becomes the bulk uniform refinement one level up, `refine_uniform`, or, where
 //! that is refused as `NotUniform` (the map checked unchanged), a triangle split), bit 7 of a
@@ -15,17 +16,30 @@
 //! maximum level can pass it (4 in the committed corpus; finding 328). The map stops growing at
 //! [`MAX_DARTS`] darts: the ops after that are not applied.
 //!
+//! **Cut mode** (bit 7 of byte 0 set): a % 8 = 4 is a cut ([`Op::Cut`]:
+//! [`LeveledMap::unsew_face`] of the face of the (b·256 + c)-th α3-sewn dart, at the maximum
+//! level or one above) and a % 8 = 5 a save and reload ([`Op::Reload`], bit 7 of a: the binary
+//! store form, else the text form); the other kinds are as above. In 2D (no face cut in a
+//! 2-map) a cut is a reload too. The 3D ops go to the map alone, with its tet masses
+//! ([`TetMasses`]: `subdivide_tet_with_mass`, `refine_around`), since the spring coupling
+//! cannot follow a cut. Its laws are in [`cuts`]. Inputs whose byte 0 is below 128 (the whole
+//! corpus before cut mode) decode as they always did.
+//!
 //! # Laws checked after every op (a failure is a bug in topomech)
 //! - accepted op: [`LeveledMap::check_all`] (finest map valid, μt ≤ μf ≤ μa, every level a valid
 //!   G-map); level k isomorphic to the finest map; the Euler characteristic of every level equals
 //!   that of the input; a refinement around a ball keeps Σ tet mass and leaves every tet meeting
 //!   the ball at the top level;
 //! - refused op: only the documented refusals (`AlreadyAtLevel`, `NotATriangle`,
-//!   `NotATetrahedron`, `FaceRefinedTooFar`, `OpenEdge`, `NotUniform`), each true of the map it
-//!   refused (the cell already at the level has that level, and so on: finding 325), and the map
-//!   is unchanged (same darts, isomorphic, same maximum level).
+//!   `NotATetrahedron`, `FaceRefinedTooFar`, `OpenEdge`, `NotUniform`, and `FaceNotSewn` in cut
+//!   mode), each true of the map it refused (the cell already at the level has that level, and
+//!   so on: finding 325), and the map is unchanged (same darts, isomorphic, same maximum level).
 //! - 3D: every op goes through a [`LeveledMechanics`] (springs and masses follow the map); after an
 //!   accepted op its laws hold ([`LeveledMechanics::check`]), after a refused one it is unchanged.
+//! - cut mode: the laws of [`cuts`] (a cut leaves the levels below it unchanged; a reloaded
+//!   copy behaves as the original under every later op, stored bytes equal after each).
+
+pub mod cuts;
 
 use super::TetMasses;
 use super::{tet_distance, CouplingError, LeveledMap, LeveledMechanics, SubdivideError};
@@ -99,6 +113,19 @@ pub enum Op {
         /// Radius selector: byte / 255.
         radius: u8,
     },
+    /// Cut mode: `unsew_face` of the face of the pick-th α3-sewn dart (any live dart when none
+    /// is sewn), at the maximum level or one above (3D; a reload in 2D).
+    Cut {
+        /// Selector among the α3-sewn darts.
+        pick: u16,
+        /// Level one above the current maximum.
+        up: bool,
+    },
+    /// Cut mode: save the map, load it back, and from then on apply every op to the copy too.
+    Reload {
+        /// The binary store form (else the text form).
+        binary: bool,
+    },
 }
 
 /// What [`run_bytes`] did.
@@ -122,6 +149,10 @@ pub struct Report {
     pub max_level: u8,
     /// Darts at the end.
     pub darts: usize,
+    /// Cuts accepted (cut mode; also counted in `applied`).
+    pub cuts: usize,
+    /// Saves and reloads (cut mode; counted in neither `applied` nor `refused`).
+    pub reloads: usize,
 }
 
 /// Decodes bytes into a mesh and operations (see the [module docs](self)). Never fails.
@@ -136,17 +167,39 @@ pub struct Report {
 /// assert_eq!(decode(&[]), (Mesh::Grid, vec![]));
 /// ```
 pub fn decode(bytes: &[u8]) -> (Mesh, Vec<Op>) {
-    let mesh = match bytes.first().map_or(0, |b| b % 3) {
+    let mesh = match bytes.first().map_or(0, |b| (b & 0x7f) % 3) {
         0 => Mesh::Grid,
         1 => Mesh::Cube,
         _ => Mesh::Tet,
     };
-    let ops = bytes.get(1..).unwrap_or(&[]).chunks_exact(3).map(|c| decode_op(c[0], c[1], c[2])).collect();
+    let cut_mode = is_cut_mode(bytes);
+    let op = |c: &[u8]| decode_op(c[0], c[1], c[2], cut_mode);
+    let ops = bytes.get(1..).unwrap_or(&[]).chunks_exact(3).map(op).collect();
     (mesh, ops)
 }
 
-fn decode_op(a: u8, b: u8, c: u8) -> Op {
+/// Whether `bytes` decode in cut mode (bit 7 of byte 0; module docs). O(1).
+///
+/// # Examples
+///
+/// ```
+/// use topomech::subdivide::fuzz::{decode, is_cut_mode, Op};
+/// assert!(!is_cut_mode(&[1, 4, 0, 0]) && is_cut_mode(&[0x81, 4, 0, 0]));
+/// assert!(matches!(decode(&[1, 4, 0, 0]).1[..], [Op::SplitEdge { .. }])); // as before cut mode
+/// assert_eq!(decode(&[0x81, 4, 0, 7]).1, vec![Op::Cut { pick: 7, up: false }]);
+/// assert_eq!(decode(&[0x81, 0x85, 0, 0]).1, vec![Op::Reload { binary: true }]);
+/// ```
+pub fn is_cut_mode(bytes: &[u8]) -> bool {
+    bytes.first().is_some_and(|b| b & 0x80 != 0)
+}
+
+fn decode_op(a: u8, b: u8, c: u8, cut_mode: bool) -> Op {
     let (pick, up) = (u16::from_be_bytes([b, c]), a & 0x80 != 0);
+    match (a % 8, cut_mode) {
+        (4, true) => return Op::Cut { pick, up },
+        (5, true) => return Op::Reload { binary: up },
+        _ => {}
+    }
     match a % 4 {
         0 => Op::SplitEdge { pick, up },
         1 => Op::Triangle { pick, up },
@@ -171,24 +224,35 @@ fn decode_op(a: u8, b: u8, c: u8) -> Op {
 /// ```
 pub fn run_bytes(bytes: &[u8]) -> Result<Report, String> {
     let (mesh, ops) = decode(bytes);
+    if is_cut_mode(bytes) {
+        return cuts::run(mesh, &ops);
+    }
     match mesh {
-        Mesh::Grid => {
-            let (points, tris) = grid_triangles(2);
-            let (map, _) = GMap::<2>::from_triangles(points.len(), &tris).map_err(|e| e.to_string())?;
-            run(LeveledMap::new(map, points), &ops, apply_2d)
-        }
+        Mesh::Grid => run(leveled_grid()?, &ops, apply_2d),
         Mesh::Cube | Mesh::Tet => {
-            let (points, tets) = if mesh == Mesh::Cube {
-                kuhn_cube(1)
-            } else {
-                (vec![[0.0, 0.0, 0.0], [1.0, 0.1, 0.0], [0.2, 1.0, 0.1], [0.1, 0.3, 1.0]], vec![[0, 1, 2, 3]])
-            };
-            let (map, _) = GMap::<3>::from_tets(points.len(), &tets).map_err(|e| e.to_string())?;
-            let m = LeveledMap::new(map, points);
+            let m = leveled_3d(mesh)?;
             let mut mech = LeveledMechanics::new(&m, Material::default()).map_err(|e| e.to_string())?;
             run(m, &ops, |m, op| apply_3d(m, &mut mech, op))
         }
     }
+}
+
+/// The 2×2 triangle grid as a level-0 leveled map.
+fn leveled_grid() -> Result<LeveledMap<2>, String> {
+    let (points, tris) = grid_triangles(2);
+    let (map, _) = GMap::<2>::from_triangles(points.len(), &tris).map_err(|e| e.to_string())?;
+    Ok(LeveledMap::new(map, points))
+}
+
+/// The cube or the single tet of `mesh` (not [`Mesh::Grid`]) as a level-0 leveled map.
+fn leveled_3d(mesh: Mesh) -> Result<LeveledMap<3>, String> {
+    let (points, tets) = if mesh == Mesh::Cube {
+        kuhn_cube(1)
+    } else {
+        (vec![[0.0, 0.0, 0.0], [1.0, 0.1, 0.0], [0.2, 1.0, 0.1], [0.1, 0.3, 1.0]], vec![[0, 1, 2, 3]])
+    };
+    let (map, _) = GMap::<3>::from_tets(points.len(), &tets).map_err(|e| e.to_string())?;
+    Ok(LeveledMap::new(map, points))
 }
 
 /// What applying one op gives: `Err` for a broken law, `Ok(Err)` for a refusal.
@@ -254,6 +318,7 @@ fn apply_2d(m: &mut LeveledMap<2>, op: Op) -> Applied {
                 r => r.map(drop),
             }
         }
+        Op::Cut { .. } | Op::Reload { .. } => return Err(format!("{op:?} outside cut mode")),
     })
 }
 
@@ -265,6 +330,7 @@ fn apply_3d(m: &mut LeveledMap<3>, mech: &mut LeveledMechanics, op: Op) -> Appli
         Op::Triangle { pick, up } => mech.subdivide_triangle(m, pick_dart(m, pick), level_of(m, up)).map(drop),
         Op::Tet { pick, up } => mech.subdivide_tet(m, pick_dart(m, pick), level_of(m, up)).map(drop),
         Op::Around { center, radius } => return around(m, mech, center, radius),
+        Op::Cut { .. } | Op::Reload { .. } => return Err(format!("{op:?} outside cut mode")),
     };
     match result {
         Ok(()) => mech.check(m).map(Ok).map_err(|e| format!("spring laws: {e}")),
@@ -279,8 +345,7 @@ fn apply_3d(m: &mut LeveledMap<3>, mech: &mut LeveledMechanics, op: Op) -> Appli
 /// refusal, but only on a map that fails [`LeveledMap::check_faces_refinable`]; a map that
 /// passes it is refused no tet for its faces and passes it afterwards (finding 272).
 fn around(m: &mut LeveledMap<3>, mech: &mut LeveledMechanics, center: [u8; 2], radius: u8) -> Applied {
-    let c = [f64::from(center[0]) / 255.0, f64::from(center[1]) / 255.0, 0.5];
-    let r = f64::from(radius) / 255.0;
+    let (c, r) = ball(center, radius);
     let levels = level_of(m, true);
     let (before, mech_before) = (m.clone(), mech.clone());
     let expected = masses_total(m)?;
@@ -296,12 +361,26 @@ fn around(m: &mut LeveledMap<3>, mech: &mut LeveledMechanics, center: [u8; 2], r
             e => Err(format!("spring coupling: {e}")),
         };
     }
-    if refinable {
-        m.check_faces_refinable().map_err(|e| format!("refinable before, not after: {e}"))?;
-    }
     let total = mech.masses.total(m);
     if (total - expected).abs() > 1e-12 * expected.max(1.0) {
         return Err(format!("Σ tet mass {total} after, {expected} before"));
+    }
+    ball_laws(m, (c, r), levels, refinable)?;
+    mech.check(m).map(Ok).map_err(|e| format!("spring laws: {e}"))
+}
+
+/// The ball of an [`Op::Around`]: centre (b/255, c/255, 1/2), radius byte/255.
+fn ball(center: [u8; 2], radius: u8) -> ([f64; 3], f64) {
+    let c = [f64::from(center[0]) / 255.0, f64::from(center[1]) / 255.0, 0.5];
+    (c, f64::from(radius) / 255.0)
+}
+
+/// The laws after an accepted refinement around the ball (c, r) up to `levels`: a map whose
+/// faces were refinable before still is, and every tet meeting the ball reached `levels`.
+/// O(darts).
+fn ball_laws(m: &LeveledMap<3>, (c, r): ([f64; 3], f64), levels: u8, refinable: bool) -> Result<(), String> {
+    if refinable {
+        m.check_faces_refinable().map_err(|e| format!("refinable before, not after: {e}"))?;
     }
     for d in m.map().one_dart_per_cell(3) {
         let corners = m.tet_vertices(d).map_err(|e| e.to_string())?.map(|v| m.points()[v as usize]);
@@ -312,7 +391,7 @@ fn around(m: &mut LeveledMap<3>, mech: &mut LeveledMechanics, center: [u8; 2], r
             return Err(format!("the tet of {d} meets the ball but stayed at level {}", m.mu(d).tet));
         }
     }
-    mech.check(m).map(Ok).map_err(|e| format!("spring laws: {e}"))
+    Ok(())
 }
 
 /// Σ ρ·V over the tets of `m` (ρ of the default material: every tet keeps m_t = ρ·V_t).
@@ -393,6 +472,7 @@ pub fn check_refused<const N: usize>(
             | SubdivideError::FaceRefinedTooFar { .. }
             | SubdivideError::OpenEdge(_)
             | SubdivideError::NotUniform { .. }
+            | SubdivideError::FaceNotSewn(_)
     );
     if !documented {
         return Err("not a documented refusal for a live dart at a valid level".into());
@@ -449,6 +529,12 @@ fn refusal_holds<const N: usize>(before: &LeveledMap<N>, e: &SubdivideError) -> 
             live(d)?;
             if !(0..N).any(|j| before.map().is_free(j, d)) {
                 return Err(format!("{e}: {d} is not free for any αj, j < {N}"));
+            }
+        }
+        SubdivideError::FaceNotSewn(d) => {
+            live(d)?;
+            if N < 3 || !before.map().is_free(3, d) {
+                return Err(format!("{e}: {d} is not α3-free"));
             }
         }
         SubdivideError::FaceRefinedTooFar { dart } | SubdivideError::NotUniform { dart, .. } => live(dart)?,

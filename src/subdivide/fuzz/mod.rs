@@ -3,9 +3,9 @@
 //! replay of the committed corpus `fuzz/corpus/subdivide/` on stable (one decoder, three engines).
 //!
 //! # Decoding
-//! Byte 0 picks the mesh (its low 7 bits % 3): a 2×2 triangle grid (2-G-map), the Kuhn cube k = 1 (6 tets)
-//! or one tetrahedron (3-G-maps), and the mode (its bit 7, [`is_cut_mode`]). Then every 3 bytes
-//! make one [`Op`]: byte a picks the kind (a % 4: edge
+//! Byte 0 picks the mesh (its low 7 bits modulo 3): a 2×2 triangle grid (2-G-map), the Kuhn
+//! cube k = 1 (6 tets) or one tetrahedron (3-G-maps), and the mode (its bit 7,
+//! [`is_cut_mode`]). Then every 3 bytes make one [`Op`]: byte a picks the kind (a % 4: edge
 //! split, triangle 1→4, tet 1→8, refinement around a ball; in 2D a tet 1→8 becomes a triangle
 //! split and a ball becomes the bulk uniform refinement one level up, `refine_uniform`, or, where
 //! that is refused as `NotUniform` (the map checked unchanged), a triangle split), bit 7 of a
@@ -58,7 +58,7 @@ pub const MAX_DARTS: usize = 5_000;
 ///
 /// ```
 /// use topomech::subdivide::fuzz::{decode, Mesh};
-/// // The first byte modulo 3 picks the mesh.
+/// // The first byte (its low 7 bits) modulo 3 picks the mesh.
 /// assert_eq!(decode(&[0]).0, Mesh::Grid);
 /// assert_eq!(decode(&[4]).0, Mesh::Cube);
 /// assert_eq!(decode(&[2]).0, Mesh::Tet);

@@ -11,7 +11,7 @@ use topomech::store::{self, Document, Format};
 use topomech::subdivide::{LeveledMap, TetMasses};
 
 mod subdivide_common;
-use subdivide_common::canon_log;
+use subdivide_common::{canon_log, cube};
 use topomech::{CellId, DartId, GMap};
 
 const FORMATS: [Format; 2] = [Format::Text, Format::Binary];
@@ -39,12 +39,6 @@ fn body_bits(body: &Body) -> Vec<u8> {
 fn cube_body(k: usize) -> Body {
     let (points, tets) = kuhn_cube(k);
     Body::from_tets(&points, &tets, Material::default()).unwrap().0
-}
-
-fn cube_leveled(k: usize) -> LeveledMap<3> {
-    let (points, tets) = kuhn_cube(k);
-    let (map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
-    LeveledMap::new(map, points)
 }
 
 fn inner_faces(body: &Body) -> Vec<DartId> {
@@ -208,7 +202,7 @@ fn loaded_fresh_body_tears_like_the_original() {
 /// A refined leveled map and its loaded copy refine further to the same map and records.
 #[test]
 fn loaded_leveled_map_refines_like_the_original() {
-    let mut m = cube_leveled(1);
+    let mut m = cube(1);
     let mut masses = TetMasses::from_density(&m, 2.0).unwrap();
     m.refine_around([0.2, 0.2, 0.2], 0.3, 1, &mut masses).unwrap();
     for format in FORMATS {
@@ -235,7 +229,7 @@ fn loaded_leveled_map_refines_like_the_original() {
 /// of mass" (Σ_v m_v x_v = Σ_t m_t · centroid_t, finding 218) no longer holds on the loaded map.
 #[test]
 fn loaded_refined_map_lumps_the_same_vertex_masses() {
-    let mut m = cube_leveled(1);
+    let mut m = cube(1);
     let masses = TetMasses::from_density(&m, 6.0).unwrap();
     let d = m.map().darts().next().unwrap();
     m.split_edge(d, 1).unwrap();
@@ -281,7 +275,7 @@ fn loaded_refined_map_lumps_the_same_vertex_masses() {
 /// original refuses, with the same error.
 #[test]
 fn a_loaded_leveled_map_has_the_default_dart_limit_and_takes_it_again() {
-    let mut m = cube_leveled(1);
+    let mut m = cube(1);
     m.set_max_darts(1000);
     let masses = TetMasses::from_density(&m, 1.0).unwrap();
     for format in FORMATS {
@@ -306,7 +300,7 @@ fn a_loaded_leveled_map_has_the_default_dart_limit_and_takes_it_again() {
 #[test]
 fn loader_refuses_mu_records_that_contradict_the_levels() {
     use topomech::subdivide::{LevelError, LevelPartsError};
-    let mut m = cube_leveled(1);
+    let mut m = cube(1);
     let d = m.map().darts().next().unwrap();
     m.subdivide_tet(d, 1).unwrap();
     assert!(m.finest_tets().is_ok() && TetMasses::from_density(&m, 1.0).is_ok() && m.conforming_tets().is_ok());
@@ -337,7 +331,7 @@ fn loader_refuses_mu_records_that_contradict_the_levels() {
 #[test]
 fn loader_refuses_dart_levels_that_no_operation_made() {
     use topomech::subdivide::{LevelError, LevelPartsError};
-    let m = cube_leveled(1);
+    let m = cube(1);
     let mut doc = Document::from_leveled(&m);
     let l = doc.levels.as_mut().unwrap();
     l.max_level = 1;
@@ -429,7 +423,7 @@ fn loaded_2d_leveled_map_follows_the_original() {
 #[test]
 fn loaded_level0_map_couples_like_the_original() {
     use topomech::subdivide::LeveledMechanics;
-    let m = cube_leveled(1);
+    let m = cube(1);
     for format in FORMATS {
         let (mut a, mut b) = (m.clone(), lev_rt(&m, format));
         let mut ca = LeveledMechanics::new(&a, Material::default()).unwrap();
@@ -455,7 +449,7 @@ fn loaded_level0_map_couples_like_the_original() {
 /// its loaded copy take the same later refinements, masses and cuts.
 #[test]
 fn loaded_cut_leveled_map_refines_and_cuts_like_the_original() {
-    let mut m = cube_leveled(1);
+    let mut m = cube(1);
     let glued = m.map().darts().find(|&d| !m.map().is_free(3, d)).unwrap();
     m.unsew_face(glued, 1).unwrap();
     for format in FORMATS {

@@ -5,13 +5,12 @@
 //! tampered file the laws accept and a later operation trips over.
 
 use proptest::prelude::*;
-use topomech::generate::{grid_triangles, kuhn_cube};
 use topomech::ops::same_raw;
 use topomech::store::{self, Document, Format};
 use topomech::subdivide::{LeveledMap, TetMasses};
 
 mod subdivide_common;
-use subdivide_common::canon_log;
+use subdivide_common::{canon_log, cube, grid};
 use topomech::{DartId, GMap};
 
 const FORMATS: [Format; 2] = [Format::Text, Format::Binary];
@@ -25,18 +24,6 @@ fn lev_rt<const N: usize>(m: &LeveledMap<N>, format: Format) -> LeveledMap<N> {
         Ok(x) => x,
         Err(e) => panic!("a legitimate map was refused on load ({format:?}): {e}"),
     }
-}
-
-fn cube_leveled(k: usize) -> LeveledMap<3> {
-    let (points, tets) = kuhn_cube(k);
-    let (map, _) = GMap::<3>::from_tets(points.len(), &tets).unwrap();
-    LeveledMap::new(map, points)
-}
-
-fn grid_leveled(k: usize) -> LeveledMap<2> {
-    let (points, tris) = grid_triangles(k);
-    let (map, _) = GMap::<2>::from_triangles(points.len(), &tris).unwrap();
-    LeveledMap::new(map, points)
 }
 
 fn bits(v: &[f64]) -> Vec<u64> {
@@ -249,7 +236,7 @@ proptest! {
     /// reloaded after every op agrees with the original in everything.
     #[test]
     fn random_cube_sequences_with_cuts_round_trip(ops in prop::collection::vec(op3(), 1..14)) {
-        run3(cube_leveled(1), &ops);
+        run3(cube(1), &ops);
     }
 
     /// The same on two tets glued along one face (cuts split vertices).
@@ -286,7 +273,7 @@ fn counted_campaign_cube_sequences_with_cuts() {
     for seed in 0..n {
         let mut rng = Rng(seed);
         let ops: Vec<Op3> = (0..12).map(|_| rng.op3()).collect();
-        let start = if seed % 3 == 2 { cube_leveled(2) } else { cube_leveled(1) };
+        let start = if seed % 3 == 2 { cube(2) } else { cube(1) };
         let (a, r) = run3(start, &ops);
         applied += a;
         refused += r;
@@ -357,7 +344,7 @@ proptest! {
     /// holds after every op and a copy reloaded after every op agrees in everything.
     #[test]
     fn random_grid_sequences_round_trip(k in 2usize..4, ops in prop::collection::vec((any::<u8>(), any::<bool>(), any::<u16>()), 1..16)) {
-        run2(grid_leveled(k), &ops);
+        run2(grid(k), &ops);
     }
 }
 
@@ -455,7 +442,7 @@ type Tamper = Box<dyn Fn(&mut topomech::subdivide::LevelParts)>;
 #[test]
 fn tampered_cut_cube_is_refused_or_keeps_the_laws_later() {
     std::panic::set_hook(Box::new(|_| {}));
-    let mut base = cube_leveled(1);
+    let mut base = cube(1);
     let d = base.map().darts().next().unwrap();
     base.subdivide_tet(d, 1).unwrap();
     let e = base.map().darts().nth(300).unwrap();
@@ -607,7 +594,7 @@ fn cut_all(m: &mut LeveledMap<3>, level: u8) -> usize {
 #[test]
 fn shattered_cube_refines_and_round_trips_like_the_original() {
     for plan in 0..4 {
-        let mut m = cube_leveled(2);
+        let mut m = cube(2);
         let mut masses = TetMasses::from_density(&m, 1.0).unwrap();
         match plan {
             0 => {
@@ -719,7 +706,7 @@ fn a_lowered_edge_mu_is_refused_by_the_loader() {
     // names the tampered records.
     assert!(own_level_all_dims_violations(&m).is_empty());
     // 2D: μa of a split grid edge lowered the same way.
-    let mut g = grid_leveled(2);
+    let mut g = grid(2);
     let d = g.map().darts().next().unwrap();
     g.split_edge(d, 1).unwrap();
     assert!(own_level_all_dims_violations(&g).is_empty());
@@ -736,7 +723,7 @@ fn a_lowered_edge_mu_is_refused_by_the_loader() {
 /// kuhn_cube(1) with one tet split 1→8 at level 1, and its level records with every μ raised to
 /// at least 1.
 fn raised_mu() -> (LeveledMap<3>, topomech::subdivide::LevelParts) {
-    let mut m = cube_leveled(1);
+    let mut m = cube(1);
     let d = m.map().darts().next().unwrap();
     m.subdivide_tet(d, 1).unwrap();
     let mut parts = m.to_parts();

@@ -1041,6 +1041,30 @@ impl<const N: usize> LeveledMap<N> {
             .map_or_else(|| self.map.alpha_dyn(j, d), |c| DartId(c.old))
     }
 
+    /// The orbit ⟨α0^i, …, α(k−1)^i⟩ of `d` in G_i (the k-cell of d at level i for k = n, the
+    /// face for k = 2 …), breadth-first from `d`. `d` must be a live dart of B_i and k ≤ n + 1.
+    /// O(orbit · history length); the visited set is the thread's epoch stamps (no hashing).
+    pub(super) fn orbit_at(&self, i: u8, k: usize, d: DartId) -> Vec<DartId> {
+        crate::gmap::with_stamps(|stamps| {
+            let tag = stamps.fresh(self.map.capacity(), 1);
+            let mut out = vec![d];
+            stamps.mark(d.0, tag);
+            let mut next = 0;
+            while next < out.len() {
+                let x = out[next];
+                next += 1;
+                for j in 0..k {
+                    let y = self.alpha_at(i, j, x);
+                    if !stamps.has(y.0, tag) {
+                        stamps.mark(y.0, tag);
+                        out.push(y);
+                    }
+                }
+            }
+            out
+        })
+    }
+
     /// Extracts G_i = (B_i, α0^i, α1^i, …, αn^i) as a G-map of its own, with fresh dense dart and
     /// cell ids. O(capacity + |B_i| · n).
     ///

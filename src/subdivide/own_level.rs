@@ -60,23 +60,11 @@ impl<const N: usize> LeveledMap<N> {
     }
 
     /// A dart of another k-cell than `d`'s met by the orbit ⟨α0, …, α(k−1)⟩ of `d` at level
-    /// `level`, if any. O(orbit · history length).
+    /// `level` ([`Self::orbit_at`]), if any: the first in breadth-first order. O(orbit · history
+    /// length).
     fn escape(&self, k: usize, level: u8, d: DartId) -> Option<DartId> {
         let id = self.map.cell_id(k, d);
-        let mut seen = std::collections::BTreeSet::from([d]);
-        let mut stack = vec![d];
-        while let Some(x) = stack.pop() {
-            if self.map.cell_id(k, x) != id {
-                return Some(x);
-            }
-            for j in 0..k {
-                let y = self.alpha_at(level, j, x);
-                if seen.insert(y) {
-                    stack.push(y);
-                }
-            }
-        }
-        None
+        self.orbit_at(level, k, d).into_iter().find(|&x| self.map.cell_id(k, x) != id)
     }
 }
 

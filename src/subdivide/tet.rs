@@ -269,7 +269,7 @@ impl LeveledMap<3> {
         }
         let start = volume.iter().copied().find(|x| self.dart_level[x.index()] <= lt);
         let start = start.ok_or(SubdivideError::NotATetrahedron { dart: d, corners: 0 })?;
-        let coarse = self.orbit_at(lt, start);
+        let coarse = self.orbit_at(lt, 3, start);
         let mut corners: Vec<u32> = Vec::new();
         for &x in &coarse {
             let mut y = x;
@@ -292,29 +292,6 @@ impl LeveledMap<3> {
             Ok(c) => Ok(c),
             Err(_) => Err(SubdivideError::NotATetrahedron { dart: d, corners: corners.len() }),
         }
-    }
-
-    /// The ⟨α0, α1, α2⟩ orbit of `d` in G_lt, breadth-first. O(orbit); the visited set is the
-    /// thread's epoch stamps (no hashing).
-    fn orbit_at(&self, lt: u8, d: DartId) -> Vec<DartId> {
-        with_stamps(|stamps| {
-            let tag = stamps.fresh(self.map.capacity(), 1);
-            let mut out = vec![d];
-            stamps.mark(d.0, tag);
-            let mut k = 0;
-            while k < out.len() {
-                let x = out[k];
-                k += 1;
-                for j in 0..3 {
-                    let y = self.alpha_at(lt, j, x);
-                    if !stamps.has(y.0, tag) {
-                        stamps.mark(y.0, tag);
-                        out.push(y);
-                    }
-                }
-            }
-            out
-        })
     }
 
     /// Checks that every face of the volume of `d` is a triangle that is either unsplit (three

@@ -384,8 +384,8 @@ fn uniform_and_coupled_refinements_then_cuts() {
     let t = tear_vertex(&mut body, v, [0.0, 0.0, 1.0], None).unwrap();
     laws.after(&body, &t.touched, "coupled: tear");
 
-    // Cutting inside the coupled leveled map: the only in-map cut, `unsew_face`, is done on the
-    // map alone; the coupling then refuses everything (documented: no coupled cut exists).
+    // Cutting inside the coupled leveled map on the map alone (not through the coupled cut,
+    // `LeveledMechanics::unsew_face`): the coupling then refuses everything.
     let d = m.map().darts().find(|&d| !m.map().is_free(3, d)).unwrap();
     let level = m.max_level();
     m.unsew_face(d, level).unwrap();

@@ -5,48 +5,19 @@
 use proptest::prelude::*;
 use topomech::generate::kuhn_cube;
 use topomech::mechanics::{Integrator, Material, SpringSystem, StepConfig, Stepper, Vec3};
-use topomech::subdivide::fuzz::{Op, MAX_DARTS, MAX_FUZZ_LEVEL};
+use topomech::subdivide::fuzz::{Op, MAX_DARTS};
 use topomech::subdivide::{CouplingError, EdgeKey, LeveledMap, LeveledMechanics, SpringLawError, SubdivideError};
 use topomech::{DartId, GMap};
 
 mod subdivide_common;
-use subdivide_common::{jitter, tet_mesh};
-
-const TET: [[f64; 3]; 4] = [[0.0, 0.0, 0.0], [1.0, 0.1, 0.0], [0.2, 1.0, 0.1], [0.1, 0.3, 1.0]];
-
-fn material() -> Material {
-    Material { density: 2.0, young: 500.0, damping: 0.01, viscosity: 0.5 }
-}
-
-fn level_of(m: &LeveledMap<3>, up: bool) -> u8 {
-    let top = m.max_level();
-    if up && top < MAX_FUZZ_LEVEL {
-        top + 1
-    } else {
-        top
-    }
-}
-
-fn pick(m: &LeveledMap<3>, pick: u16) -> DartId {
-    m.map().darts().nth(pick as usize % m.map().dart_count()).unwrap()
-}
+use subdivide_common::{apply_coupled, jitter, material, moving_coupling, tet_mesh, TET};
 
 fn apply(mech: &mut LeveledMechanics, m: &mut LeveledMap<3>, op: Op) -> Result<(), CouplingError> {
-    match op {
-        Op::SplitEdge { pick: p, up } => mech.split_edge(m, pick(m, p), level_of(m, up)).map(drop),
-        Op::Triangle { pick: p, up } => mech.subdivide_triangle(m, pick(m, p), level_of(m, up)).map(drop),
-        Op::Tet { pick: p, up } => mech.subdivide_tet(m, pick(m, p), level_of(m, up)).map(drop),
-        Op::Around { center, radius } => {
-            let c = [f64::from(center[0]) / 255.0, f64::from(center[1]) / 255.0, 0.5];
-            let levels = level_of(m, true);
-            mech.refine_around(m, c, f64::from(radius) / 255.0, levels).map(drop)
-        }
-        Op::Cut { .. } | Op::Reload { .. } => unreachable!("decoded without cut mode"),
-    }
+    apply_coupled(mech, m, op).expect("decoded without cut mode: no reload")
 }
 
-/// The decoder's mesh and ops of `bytes` outside cut mode (bit 7 of byte 0 cleared): the
-/// coupling cannot follow a cut.
+/// The decoder's mesh and ops of `bytes` outside cut mode (bit 7 of byte 0 cleared): the cut
+/// mode with the coupling is `tests/subdivide_springs_cut.rs`.
 fn decode(bytes: &[u8]) -> (topomech::subdivide::fuzz::Mesh, Vec<Op>) {
     let mut bytes = bytes.to_vec();
     if let Some(b) = bytes.first_mut() {
@@ -80,13 +51,7 @@ fn run(bytes: &[u8]) -> Result<usize, String> {
             tet_mesh(p, &t)
         }
     };
-    let mut mech = LeveledMechanics::new(&m, material()).map_err(|e| e.to_string())?;
-    for (v, x) in mech.velocity.iter_mut().enumerate() {
-        *x = jitter(v as u64);
-    }
-    for (v, x) in mech.position.iter_mut().enumerate() {
-        *x = [0, 1, 2].map(|k| x[k] + 0.1 * jitter(100 + v as u64)[k]);
-    }
+    let mut mech = moving_coupling(&m)?;
     let mut splits = 0;
     for (k, &op) in ops.iter().enumerate() {
         if m.map().dart_count() >= MAX_DARTS {

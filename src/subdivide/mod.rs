@@ -42,6 +42,7 @@ mod parts;
 mod region;
 mod springs;
 mod springs_check;
+mod springs_cut;
 mod tet;
 mod tri;
 mod uniform;

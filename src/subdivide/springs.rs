@@ -56,6 +56,13 @@
 //!   from a and b changes it by −w (x_a − x_b)(x_a − x_b)ᵀ / 4), so a spinning body changes its
 //!   L = Σ m x × u, and the correction changes L by −(Σ_{v ∈ A} m_v x_v) × E / M_A.
 //!
+//! - **Cut** ([`LeveledMechanics::unsew_face`], round 42): a vertex the cut splits gives its
+//!   copy its position and velocity; an edge it splits shares its spring between its two parts
+//!   in parallel (k = k₁ + k₂, c = c₁ + c₂, L kept), in proportion to law 2's terms of the tets
+//!   around each part (so an edge that is no half gives each part what its own tets give it);
+//!   a part of a half stands beside the other part in the side of its split edge
+//!   ([`SplitNode`]). Masses and Σ m u are unchanged (the volumes are).
+//!
 //! Consequences: a chain in tension, its midpoints at equilibrium (equal links), stores exactly its
 //! root's energy, so edge splits alone keep the static response; the inner springs of a 1→8 add
 //! stiffness (the refined zone is stiffer by the children's contributions). A midpoint has no
@@ -190,6 +197,30 @@ impl Spring {
     }
 }
 
+/// An edge cell that was split at its midpoint, as the coupling keeps it: the midpoint's vertex
+/// id and, for each side (`sides[0]` at the split edge's end `a`, `sides[1]` at `b`), the edges
+/// that stand for that half now: the half itself, or the parallel parts a cut made of it
+/// ([`LeveledMechanics::unsew_face`]), each of which may have been split in turn. Gluing the cut
+/// back (identifying every vertex with its origin), a side is its members in parallel and the
+/// edge is its two sides in series (law 4 of [`LeveledMechanics::check`]).
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct SplitNode {
+    /// The midpoint's vertex id when the edge was split.
+    pub(super) mid: u32,
+    /// The members of each side.
+    pub(super) sides: [Vec<Member>; 2],
+}
+
+/// A member of a [`SplitNode`] side: an edge key and whether its end `a` is the one toward the
+/// split edge's end of that side (the outer end; the other lies at the midpoint or a copy of it).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Member {
+    /// The member's key as it is now.
+    pub(super) key: EdgeKey,
+    /// Whether `key.a` is its outer end.
+    pub(super) outer_at_a: bool,
+}
+
 /// Errors of the coupled operations.
 ///
 /// # Examples
@@ -253,8 +284,8 @@ pub enum CouplingError {
     /// The map changed by an operation the coupling did not follow: called on the map alone, and
     /// neither inserting a vertex ([`CouplingError::OutOfSync`]) nor adding a vertex id
     /// ([`CouplingError::StateCount`]) — a [`LeveledMap::unsew_face`] that splits an edge but no
-    /// vertex, or a subdivision whose edges were all split before. Its new edge cells have no
-    /// spring. Refused before the map changes.
+    /// vertex (the coupled cut is [`LeveledMechanics::unsew_face`]), or a subdivision whose edges
+    /// were all split before. Its new edge cells have no spring. Refused before the map changes.
     #[error("the map is at version {version} but the coupling followed it up to version {followed}: an operation was called on the map alone")]
     Unfollowed {
         /// The map's [`LeveledMap::version`] after the last operation the coupling followed.
@@ -321,8 +352,8 @@ pub enum CouplingError {
     System(crate::mechanics::SystemError),
 }
 
-/// A level-0 tet: its corner vertex ids (increasing) and the keys of its six edges in [`PAIRS`]
-/// order (`None` for a corner pair that is no edge of its volume).
+/// A tet of the map: its corner vertex ids (increasing) and the keys of its six edges in
+/// [`PAIRS`] order (`None` for a corner pair that is no edge of its volume).
 #[derive(Clone, Debug, PartialEq)]
 pub(super) struct Tet0 {
     pub(super) corners: [u32; 4],
@@ -371,12 +402,12 @@ pub struct LeveledMechanics {
     pub(super) springs: BTreeMap<EdgeKey, Spring>,
     /// Springs that were split and were not halves themselves: their value before the split.
     pub(super) roots: BTreeMap<EdgeKey, Spring>,
-    /// Every edge ever split → its midpoint and its halves (the one at its end `a`, at `b`).
-    pub(super) split_at: BTreeMap<EdgeKey, (u32, [EdgeKey; 2])>,
-    /// Halves produced by splits.
+    /// Every edge ever split → its midpoint and what replaced its two halves ([`SplitNode`]).
+    pub(super) split_at: BTreeMap<EdgeKey, SplitNode>,
+    /// The split edge each member of a [`SplitNode`] side belongs to (its key as it is now).
+    pub(super) member_of: BTreeMap<EdgeKey, EdgeKey>,
+    /// Halves produced by splits, and the parts a cut made of them.
     pub(super) halves: BTreeSet<EdgeKey>,
-    /// The level-0 tets (their springs come from law 2 over them).
-    pub(super) tets0: Vec<Tet0>,
     /// Entries of the map's split log already followed.
     pub(super) applied: usize,
     /// The [`LeveledMap::version`] of the map after the last operation followed.
@@ -486,8 +517,8 @@ impl LeveledMechanics {
             springs: BTreeMap::new(),
             roots: BTreeMap::new(),
             split_at: BTreeMap::new(),
+            member_of: BTreeMap::new(),
             halves: BTreeSet::new(),
-            tets0: Vec::new(),
             applied: m.edge_split_log().len(),
             followed: m.version(),
             followed_stamp: m.stamp(),
@@ -496,7 +527,6 @@ impl LeveledMechanics {
         for (volume, t) in &tets0 {
             mech.add_tet(m, t, *volume)?;
         }
-        mech.tets0 = tets0.into_iter().map(|(_, t)| t).collect();
         Ok(mech)
     }
 
@@ -667,17 +697,22 @@ impl LeveledMechanics {
     /// ```
     pub fn chain(&self, e: EdgeKey) -> Vec<EdgeKey> {
         let mut out = Vec::new();
-        self.chain_from(e, e.a, &mut out);
+        self.chain_from(e, true, &mut out);
         out
     }
 
-    /// Appends the chain of `e` walked from its end vertex `from`.
-    fn chain_from(&self, e: EdgeKey, from: u32, out: &mut Vec<EdgeKey>) {
+    /// Appends the chain of `e` walked from its end `a` (`from_a`) or `b`: the side at that end
+    /// first, each member from its end on the walk's way in.
+    fn chain_from(&self, e: EdgeKey, from_a: bool, out: &mut Vec<EdgeKey>) {
         match self.split_at.get(&e) {
-            Some(&(mid, [at_a, at_b])) => {
-                let (first, second) = if from == e.a { (at_a, at_b) } else { (at_b, at_a) };
-                self.chain_from(first, from, out);
-                self.chain_from(second, mid, out);
+            Some(node) => {
+                let sides = if from_a { [&node.sides[0], &node.sides[1]] } else { [&node.sides[1], &node.sides[0]] };
+                for (k, side) in sides.into_iter().enumerate() {
+                    // The first side is entered at its outer end, the second at the midpoint.
+                    for member in side {
+                        self.chain_from(member.key, member.outer_at_a == (k == 0), out);
+                    }
+                }
             }
             None => out.push(e),
         }
@@ -788,7 +823,7 @@ impl LeveledMechanics {
 
     /// Errors unless every vertex insertion of the map was followed and the coupling holds one
     /// state per vertex id of the map. O(1).
-    fn in_sync(&self, m: &LeveledMap<3>) -> Result<(), CouplingError> {
+    pub(super) fn in_sync(&self, m: &LeveledMap<3>) -> Result<(), CouplingError> {
         // The material is a public field: checked again here, before any operation, as
         // `new` checks it (a NaN Young's modulus or damping would pass the headroom bounds and
         // fail half way through the split: finding 205). O(1).
@@ -1162,7 +1197,7 @@ impl LeveledMechanics {
 
     /// With the `expensive-checks` feature, [`Self::check`] after a public operation (a bug of this
     /// module panics, as the map's own checks do). O(1) without the feature.
-    fn expensive_check(&self, m: &LeveledMap<3>) {
+    pub(super) fn expensive_check(&self, m: &LeveledMap<3>) {
         #[cfg(feature = "expensive-checks")]
         if let Err(e) = self.check(m) {
             panic!("topomech bug: the spring coupling broke a law: {e}");
@@ -1180,11 +1215,13 @@ impl LeveledMechanics {
             self.roots.insert(e, s);
         }
         let (at_a, at_b) = (EdgeKey::new(split.halves[0], a, v), EdgeKey::new(split.halves[1], v, b));
-        let ordered = if a == e.a { [at_a, at_b] } else { [at_b, at_a] };
-        self.split_at.insert(e, (v, ordered));
+        let [(h0, o0), (h1, o1)] = if a == e.a { [(at_a, a), (at_b, b)] } else { [(at_b, b), (at_a, a)] };
+        let member = |key: EdgeKey, outer: u32| vec![Member { key, outer_at_a: key.a == outer }];
+        self.split_at.insert(e, SplitNode { mid: v, sides: [member(h0, o0), member(h1, o1)] });
         for h in [at_a, at_b] {
             self.springs.insert(h, s.half());
             self.halves.insert(h);
+            self.member_of.insert(h, e);
         }
         let n = m.map().cell_id_bound(0).max(v as usize + 1);
         self.position.resize(n, [0.0; 3]);

@@ -1,6 +1,6 @@
 //! The laws of the subdivided spring network ([`LeveledMechanics::check`]), recomputed from the map
-//! and the rest positions; only the roots (the springs as they were when first split) and the level-0
-//! tets are trusted.
+//! and the rest positions; only the roots (the springs as they were when first split) are
+//! trusted.
 //!
 //! Springs are stated per *edge cell* ([`super::EdgeKey`]: cell id and end vertices), so two edges
 //! joining the same two vertices (a cut edge whose ends stayed joined) are two springs, each under
@@ -17,10 +17,13 @@
 //!    level, so the law allows 4 (d + 1) ε (|P_a|∞ + |P_b|∞) more, d the deeper end's split
 //!    depth (round 25, F1: a mesh 5 000 edge lengths from the origin failed its first split);
 //! 4. series: along every root (an edge cell split when it was not a half), the chain of finest
-//!    springs has Σ 1/k_i = 1/k_root, Σ 1/c_i = 1/c_root and Σ L_i = L_root;
-//! 5. every spring that is not a half of a split: k = Σ_{t ∋ e} E V_t / L_e² over the level-0 tets
-//!    and the finest tets of level μt ≥ 1 whose volume holds the edge cell e between two of its
-//!    corners, and c = β k (each term measured in wide floats when the tet's corners are outside
+//!    springs has Σ 1/k_i = 1/k_root, Σ 1/c_i = 1/c_root and Σ L_i = L_root; when a cut made
+//!    parallel parts of a half (round 42, [`LeveledMechanics::unsew_face`]), the chain is glued
+//!    back: each side of a split is its members in parallel (compliance 1 / Σ 1/compliance),
+//!    the two sides in series, and the network has the root's compliance, damping and length;
+//! 5. every spring that is not a half of a split (nor a part of one): k = Σ_{t ∋ e} E V_t / L_e²
+//!    over the volumes of the finest map (any level) whose volume holds the edge cell e between
+//!    two of its corners, and c = β k (each term measured in wide floats when the tet's corners are outside
 //!    the ordinary range, so a tet of edge 1e-110 or a needle has its finite terms);
 //! 6. Σ_t m_t equals its value when the coupling was built; every vertex mass gathered from the
 //!    volumes around the vertex (its share of each, as [`LeveledMechanics::vertex_masses`] lumps
@@ -229,17 +232,58 @@ fn split_depths(m: &LeveledMap<3>) -> Vec<u32> {
     depth
 }
 
-/// The series sum of a chain and the root's value: (Σ 1/x_i, 1/root) for a positive root, else
-/// (Σ x_i, 0) (a zero spring splits into zero halves).
-fn series(values: impl Iterator<Item = f64>, root: f64) -> (f64, f64) {
-    if root > 0.0 {
-        (values.map(|x| 1.0 / x).sum(), 1.0 / root)
-    } else {
-        (values.sum(), 0.0)
+/// What the springs that stand for a split edge now add up to, glued back (law 4): one value x
+/// (stiffness or damping) and the rest length, members of a side in parallel, sides in series.
+#[derive(Clone, Copy, Debug)]
+struct Network {
+    /// Compliance: Σ over the sides in series, 1 / Σ (1 / compliance) over a side's parallel
+    /// members, 1/x for a spring (∞ for x = 0).
+    compliance: f64,
+    /// Σ of x over every spring of the network (0 exactly when every spring holds 0).
+    sum: f64,
+    /// Rest length: Σ over the sides in series, the first member's for a side in parallel (each
+    /// member's own length is law 3's).
+    rest: f64,
+}
+
+impl Network {
+    /// (what the network gives, what the root gives) for the root's value x: (compliance, 1/x)
+    /// for x > 0, else (Σ of the values, 0): a zero spring splits into zero halves and parts.
+    fn law(self, root: f64) -> (f64, f64) {
+        if root > 0.0 {
+            (self.compliance, 1.0 / root)
+        } else {
+            (self.sum, 0.0)
+        }
     }
 }
 
 impl LeveledMechanics {
+    /// The [`Network`] of value `x` that stands for the edge `e` now: its spring if it was never
+    /// split, else the sides of its [`super::springs::SplitNode`]. `None` when a spring is
+    /// missing. O(springs of the network · log E).
+    fn network(&self, e: EdgeKey, x: fn(&super::springs::Spring) -> f64) -> Option<Network> {
+        let Some(node) = self.split_at.get(&e) else {
+            let s = self.springs.get(&e)?;
+            return Some(Network { compliance: 1.0 / x(s), sum: x(s), rest: s.rest });
+        };
+        let mut out = Network { compliance: 0.0, sum: 0.0, rest: 0.0 };
+        for side in &node.sides {
+            let members: Option<Vec<Network>> = side.iter().map(|m| self.network(m.key, x)).collect();
+            let members = members?;
+            let first = *members.first()?;
+            // One member passes through as it is (1/(1/c) may differ from c in the last bit).
+            let compliance = match members.len() {
+                1 => first.compliance,
+                _ => 1.0 / members.iter().map(|n| 1.0 / n.compliance).sum::<f64>(),
+            };
+            out.compliance += compliance;
+            out.sum += members.iter().map(|n| n.sum).sum::<f64>();
+            out.rest += first.rest;
+        }
+        Some(out)
+    }
+
     /// Checks every law of the module docs of `springs_check` against `m` (the map this coupling
     /// follows). O(darts log darts + E log E).
     ///
@@ -342,13 +386,10 @@ impl LeveledMechanics {
     pub fn check_series(&self) -> Result<(), SpringLawError> {
         for (&e, root) in &self.roots {
             let (a, b, edge) = (e.a, e.b, e.id);
-            let chain: Option<Vec<_>> = self.chain(e).into_iter().map(|h| self.springs.get(&h)).collect();
-            let chain = chain.ok_or(SpringLawError::MissingSpring { a, b, edge })?;
-            let laws = [
-                series(chain.iter().map(|s| s.stiffness), root.stiffness),
-                series(chain.iter().map(|s| s.damping), root.damping),
-                (chain.iter().map(|s| s.rest).sum(), root.rest),
-            ];
+            let missing = SpringLawError::MissingSpring { a, b, edge };
+            let k = self.network(e, |s| s.stiffness).ok_or(missing.clone())?;
+            let c = self.network(e, |s| s.damping).ok_or(missing)?;
+            let laws = [k.law(root.stiffness), c.law(root.damping), (k.rest, root.rest)];
             for (compliance, expected) in laws {
                 if !close(compliance, expected) {
                     return Err(SpringLawError::Series { a, b, edge, compliance, expected });
@@ -369,13 +410,10 @@ impl LeveledMechanics {
                 }
             }
         };
-        self.tets0.iter().for_each(&mut add);
         for d in m.map().one_dart_per_cell(3) {
-            if m.mu(d).tet >= 1 {
-                // Checked by the map's own laws; a volume that is not a tet contributes nothing.
-                if let Ok(t) = tet_edges(m, d) {
-                    add(&t);
-                }
+            // Checked by the map's own laws; a volume that is not a tet contributes nothing.
+            if let Ok(t) = tet_edges(m, d) {
+                add(&t);
             }
         }
         for (&e, s) in self.springs.iter().filter(|(e, _)| !self.halves.contains(e)) {

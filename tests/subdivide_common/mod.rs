@@ -3,8 +3,47 @@
 #![allow(dead_code)]
 
 use topomech::generate::{grid_triangles, kuhn_cube};
-use topomech::subdivide::LeveledMap;
-use topomech::GMap;
+use topomech::mechanics::Material;
+use topomech::subdivide::fuzz::{Op, MAX_FUZZ_LEVEL};
+use topomech::subdivide::{CouplingError, LeveledMap, LeveledMechanics};
+use topomech::{DartId, GMap};
+
+/// The tet of the spring-coupling suites' one-tet mesh.
+pub const TET: [[f64; 3]; 4] = [[0.0, 0.0, 0.0], [1.0, 0.1, 0.0], [0.2, 1.0, 0.1], [0.1, 0.3, 1.0]];
+
+/// The material of the spring-coupling suites (β > 0, so damping follows every rule too).
+pub fn material() -> Material {
+    Material { density: 2.0, young: 500.0, damping: 0.01, viscosity: 0.5 }
+}
+
+/// The level of a decoded op: the map's maximum, or one above it (`up`) below the fuzz cap.
+pub fn level_of(m: &LeveledMap<3>, up: bool) -> u8 {
+    let top = m.max_level();
+    if up && top < MAX_FUZZ_LEVEL {
+        top + 1
+    } else {
+        top
+    }
+}
+
+/// The coupling of the level-0 map `m` with [`material`], set moving: jittered velocities, and
+/// positions moved off the rest positions by a tenth of a jitter (so that interpolation and the
+/// momentum correction are seen at work).
+pub fn moving_coupling(m: &LeveledMap<3>) -> Result<LeveledMechanics, String> {
+    let mut mech = LeveledMechanics::new(m, material()).map_err(|e| e.to_string())?;
+    for (v, x) in mech.velocity.iter_mut().enumerate() {
+        *x = jitter(v as u64);
+    }
+    for (v, x) in mech.position.iter_mut().enumerate() {
+        *x = [0, 1, 2].map(|k| x[k] + 0.1 * jitter(100 + v as u64)[k]);
+    }
+    Ok(mech)
+}
+
+/// The pick-th live dart (modulo their number).
+pub fn pick(m: &LeveledMap<3>, pick: u16) -> DartId {
+    m.map().darts().nth(pick as usize % m.map().dart_count()).unwrap()
+}
 
 /// The leveled map (all at level 0) of a tet mesh with one position per point. O(tets).
 pub fn tet_mesh(points: Vec<[f64; 3]>, tets: &[[u32; 4]]) -> LeveledMap<3> {
@@ -97,4 +136,30 @@ pub fn canon_log<const N: usize>(x: &LeveledMap<N>) -> Vec<[u32; 3]> {
         .collect();
     log.sort_unstable();
     log
+}
+
+/// The pick-th α3-sewn dart (any dart when none is sewn: the map refuses it).
+pub fn sewn(m: &LeveledMap<3>, pick: u16) -> DartId {
+    let sewn: Vec<DartId> = m.map().darts().filter(|&d| !m.map().is_free(3, d)).collect();
+    match sewn.len() {
+        0 => m.map().darts().next().unwrap(),
+        n => sewn[pick as usize % n],
+    }
+}
+
+/// Applies one decoded op through the spring coupling (a cut by `LeveledMechanics::unsew_face`);
+/// `None` for a reload (no file holds a coupling).
+pub fn apply_coupled(mech: &mut LeveledMechanics, m: &mut LeveledMap<3>, op: Op) -> Option<Result<(), CouplingError>> {
+    Some(match op {
+        Op::SplitEdge { pick: p, up } => mech.split_edge(m, pick(m, p), level_of(m, up)).map(drop),
+        Op::Triangle { pick: p, up } => mech.subdivide_triangle(m, pick(m, p), level_of(m, up)).map(drop),
+        Op::Tet { pick: p, up } => mech.subdivide_tet(m, pick(m, p), level_of(m, up)).map(drop),
+        Op::Around { center, radius } => {
+            let c = [f64::from(center[0]) / 255.0, f64::from(center[1]) / 255.0, 0.5];
+            let levels = level_of(m, true);
+            mech.refine_around(m, c, f64::from(radius) / 255.0, levels).map(drop)
+        }
+        Op::Cut { pick: p, up } => mech.unsew_face(m, sewn(m, p), level_of(m, up)).map(drop),
+        Op::Reload { .. } => return None,
+    })
 }

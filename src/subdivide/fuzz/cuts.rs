@@ -1,7 +1,8 @@
 //! Cut mode of the subdivision decoder ([parent module](super), bit 7 of byte 0): face cuts
 //! ([`LeveledMap::unsew_face`]) and store round trips among the subdivisions, 2D and 3D. The
-//! 3D ops go to the map alone with its [`TetMasses`], since the spring coupling cannot follow a
-//! cut (docs/SUBDIVISION.md, "Not done yet").
+//! 3D ops go to the map alone with its [`TetMasses`]: a reloaded copy could have no spring
+//! coupling, which no file holds (the coupled cut is driven by the same decoder in
+//! `tests/subdivide_springs_cut.rs`).
 //!
 //! # Laws, beyond those of every accepted or refused op (parent module)
 //! - **Euler characteristic per level**: a subdivision keeps χ of every level, and a new level

@@ -21,8 +21,9 @@
 //! level or one above) and a % 8 = 5 a save and reload ([`Op::Reload`], bit 7 of a: the binary
 //! store form, else the text form); the other kinds are as above. In 2D (no face cut in a
 //! 2-map) a cut is a reload too. The 3D ops go to the map alone, with its tet masses
-//! ([`TetMasses`]: `subdivide_tet_with_mass`, `refine_around`), since the spring coupling
-//! cannot follow a cut. Its laws are in [`cuts`]. Inputs whose byte 0 is below 128 (the whole
+//! ([`TetMasses`]: `subdivide_tet_with_mass`, `refine_around`): a reloaded copy could have no
+//! spring coupling (no file holds one). The coupled cut ([`crate::subdivide::LeveledMechanics::unsew_face`])
+//! runs on the same decoded ops in `tests/subdivide_springs_cut.rs`. Its laws are in [`cuts`]. Inputs whose byte 0 is below 128 (the whole
 //! corpus before cut mode) decode as they always did.
 //!
 //! # Laws checked after every op (a failure is a bug in topomech)

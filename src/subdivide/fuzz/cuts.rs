@@ -1,8 +1,8 @@
 //! Cut mode of the subdivision decoder ([parent module](super), bit 7 of byte 0): face cuts
-//! ([`LeveledMap::unsew_face`]) and store round trips among the subdivisions, 2D and 3D. The
-//! 3D ops go to the map alone with its [`TetMasses`]: a reloaded copy could have no spring
-//! coupling, which no file holds (the coupled cut is driven by the same decoder in
-//! `tests/subdivide_springs_cut.rs`).
+//! ([`LeveledMap::unsew_face`]) and store round trips among the subdivisions, 2D and 3D. In 3D
+//! the original runs every op through its spring coupling ([`LeveledMechanics`], cuts by
+//! [`LeveledMechanics::unsew_face`]; its laws after every accepted op); a reloaded copy has none
+//! (no file holds one) and runs the same ops on the map alone with its [`TetMasses`].
 //!
 //! # Laws, beyond those of every accepted or refused op (parent module)
 //! - **Euler characteristic per level**: a subdivision keeps χ of every level, and a new level
@@ -25,13 +25,15 @@ use super::{Mesh, Op, Report, MAX_DARTS};
 use crate::gmap::DartId;
 use crate::mechanics::Material;
 use crate::store::{self, Document, Format};
-use crate::subdivide::{LeveledMap, SubdivideError, TetMasses};
+use crate::subdivide::{LeveledMap, LeveledMechanics, SubdivideError, TetMasses};
 
-/// The state the ops apply to: the map and, in 3D, its tet masses.
+/// The state the ops apply to: the map and, in 3D, its spring coupling (the original) or its
+/// tet masses alone (a reloaded copy).
 #[derive(Clone)]
 struct State<const N: usize> {
     m: LeveledMap<N>,
     masses: Option<TetMasses>,
+    mech: Option<LeveledMechanics>,
 }
 
 /// What differs between 2D and 3D in cut mode.
@@ -49,11 +51,11 @@ trait Step {
 /// Runs `ops` in cut mode on `mesh` (module docs). O(ops · (op + k · darts · n²)).
 pub(super) fn run(mesh: Mesh, ops: &[Op]) -> Result<Report, String> {
     match mesh {
-        Mesh::Grid => run_on(State { m: leveled_grid()?, masses: None }, ops),
+        Mesh::Grid => run_on(State { m: leveled_grid()?, masses: None, mech: None }, ops),
         Mesh::Cube | Mesh::Tet => {
             let m = leveled_3d(mesh)?;
-            let masses = TetMasses::from_density(&m, Material::default().density).map_err(|e| e.to_string())?;
-            run_on(State { m, masses: Some(masses) }, ops)
+            let mech = LeveledMechanics::new(&m, Material::default()).map_err(|e| e.to_string())?;
+            run_on(State { m, masses: None, mech: Some(mech) }, ops)
         }
     }
 }
@@ -174,7 +176,7 @@ fn reload<const N: usize>(state: &State<N>, binary: bool) -> Result<State<N>, St
         return Err(format!("the map loaded from the {format:?} form saves other bytes"));
     }
     m.check_all().map_err(|e| format!("the loaded map breaks a law: {e}"))?;
-    Ok(State { m, masses: state.masses.clone() })
+    Ok(State { m, masses: state.tet_masses().cloned(), mech: None })
 }
 
 /// The reloaded copy `twin` after the same op as `state`: the same outcome, the same stored
@@ -209,7 +211,7 @@ where
 }
 
 /// The pick-th α3-sewn dart (any live dart when none is sewn: the cut is then refused). O(darts).
-fn pick_sewn(m: &LeveledMap<3>, pick: u16) -> DartId {
+pub(super) fn pick_sewn(m: &LeveledMap<3>, pick: u16) -> DartId {
     let map = m.map();
     let sewn = || map.darts().filter(|&d| !map.is_free(3, d));
     match sewn().count() {
@@ -236,9 +238,19 @@ impl Step for State<2> {
     }
 }
 
+impl<const N: usize> State<N> {
+    /// The tet masses: the coupling's, or the state's own.
+    fn tet_masses(&self) -> Option<&TetMasses> {
+        self.mech.as_ref().map(|mech| &mech.masses).or(self.masses.as_ref())
+    }
+}
+
 impl Step for State<3> {
     fn apply(&mut self, op: Op) -> Applied {
-        let State { m, masses } = self;
+        let State { m, masses, mech } = self;
+        if let Some(mech) = mech {
+            return super::apply_3d(m, mech, op);
+        }
         let masses = masses.as_mut().ok_or("a 3D state without masses")?;
         Ok(match op {
             Op::SplitEdge { pick, up } => m.split_edge(pick_dart(m, pick), level_of(m, up)).map(drop),
@@ -251,7 +263,7 @@ impl Step for State<3> {
     }
 
     fn mass_laws(&self, total: f64) -> Result<(), String> {
-        let masses = self.masses.as_ref().ok_or("a 3D state without masses")?;
+        let masses = self.tet_masses().ok_or("a 3D state without masses")?;
         masses.check(&self.m).map_err(|e| format!("tet masses: {e}"))?;
         let now = masses.total(&self.m);
         if (now - total).abs() > 1e-12 * total.max(1.0) {
@@ -261,11 +273,14 @@ impl Step for State<3> {
     }
 
     fn vertex_masses(&self) -> Option<Vec<f64>> {
-        self.masses.as_ref().and_then(|w| w.vertex_masses(&self.m).ok())
+        match &self.mech {
+            Some(mech) => mech.vertex_masses(&self.m).ok(),
+            None => self.masses.as_ref().and_then(|w| w.vertex_masses(&self.m).ok()),
+        }
     }
 
     fn total_mass(&self) -> f64 {
-        self.masses.as_ref().map_or(0.0, |w| w.total(&self.m))
+        self.tet_masses().map_or(0.0, |w| w.total(&self.m))
     }
 }
 
@@ -297,7 +312,7 @@ mod tests {
     fn cube() -> State<3> {
         let m = leveled_3d(Mesh::Cube).expect("builds");
         let masses = TetMasses::from_density(&m, 1.0).expect("masses");
-        State { m, masses: Some(masses) }
+        State { m, masses: Some(masses), mech: None }
     }
 
     fn glued(m: &LeveledMap<3>) -> DartId {

@@ -20,10 +20,11 @@
 //! [`LeveledMap::unsew_face`] of the face of the (b·256 + c)-th α3-sewn dart, at the maximum
 //! level or one above) and a % 8 = 5 a save and reload ([`Op::Reload`], bit 7 of a: the binary
 //! store form, else the text form); the other kinds are as above. In 2D (no face cut in a
-//! 2-map) a cut is a reload too. The 3D ops go to the map alone, with its tet masses
-//! ([`TetMasses`]: `subdivide_tet_with_mass`, `refine_around`): a reloaded copy could have no
-//! spring coupling (no file holds one). The coupled cut ([`crate::subdivide::LeveledMechanics::unsew_face`])
-//! runs on the same decoded ops in `tests/subdivide_springs_cut.rs`. Its laws are in [`cuts`]. Inputs whose byte 0 is below 128 (the whole
+//! 2-map) a cut is a reload too. The 3D ops go through the spring coupling, cuts included
+//! ([`LeveledMechanics::unsew_face`], round 42), until the first reload; a reloaded copy has no
+//! coupling (no file holds one), so its ops go to the map alone with its tet masses
+//! ([`TetMasses`]: `subdivide_tet_with_mass`, `refine_around`) and must give the same maps,
+//! outcomes and lumped vertex masses as the coupled original. Its laws are in [`cuts`]. Inputs whose byte 0 is below 128 (the whole
 //! corpus before cut mode) decode as they always did.
 //!
 //! # Laws checked after every op (a failure is a bug in topomech)
@@ -323,7 +324,8 @@ fn apply_2d(m: &mut LeveledMap<2>, op: Op) -> Applied {
     })
 }
 
-/// An op through the coupling; its laws after an accepted op, unchanged after a refused one.
+/// An op through the coupling (a cut too, [`LeveledMechanics::unsew_face`]); its laws after an
+/// accepted op, unchanged after a refused one.
 fn apply_3d(m: &mut LeveledMap<3>, mech: &mut LeveledMechanics, op: Op) -> Applied {
     let before = mech.clone();
     let result = match op {
@@ -331,7 +333,8 @@ fn apply_3d(m: &mut LeveledMap<3>, mech: &mut LeveledMechanics, op: Op) -> Appli
         Op::Triangle { pick, up } => mech.subdivide_triangle(m, pick_dart(m, pick), level_of(m, up)).map(drop),
         Op::Tet { pick, up } => mech.subdivide_tet(m, pick_dart(m, pick), level_of(m, up)).map(drop),
         Op::Around { center, radius } => return around(m, mech, center, radius),
-        Op::Cut { .. } | Op::Reload { .. } => return Err(format!("{op:?} outside cut mode")),
+        Op::Cut { pick, up } => mech.unsew_face(m, cuts::pick_sewn(m, pick), level_of(m, up)).map(drop),
+        Op::Reload { .. } => return Err("a reload is not an op of the map".into()),
     };
     match result {
         Ok(()) => mech.check(m).map(Ok).map_err(|e| format!("spring laws: {e}")),

@@ -675,7 +675,9 @@ impl LeveledMechanics {
     }
 
     /// The finest springs along the edge cell `e` of some level, in order from its end `e.a` to
-    /// `e.b`: `e` itself if it was never split, else the chains of its two halves. O(chain · log E).
+    /// `e.b`: `e` itself if it was never split, else the chains of its two halves; where a cut
+    /// made parallel parts of a half ([`Self::unsew_face`]), their chains come one after the
+    /// other, each walked in the same direction. O(chain · log E).
     ///
     /// # Examples
     ///
